@@ -1,0 +1,1 @@
+"""The GVE protocol conformance suite."""
