@@ -1,1 +1,1 @@
-"""Time and ways in: clocks, the serial line, pyserial URLs, pty and TCP servers."""
+"""Time and ways in: clocks, the serial line with its units, the gve:// URL, servers."""

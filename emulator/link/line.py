@@ -1,0 +1,181 @@
+"""The serial line: units sharing it, the host's side of it, and its clock.
+
+Bytes take ``round(1e10 / baud)`` ns each (8N1: ten bits). In virtual time the clock
+moves when the host writes (by the bytes' transmission time), when it reads with a
+timeout (up to the moment the bytes are there, or the timeout), and on explicit waits;
+nothing sleeps. Units answer through ``emit``; answers are serialized at the baud rate
+from the instant the unit emits them. Every byte can be logged as a transcript.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterable
+from pathlib import Path
+from typing import IO
+
+from emulator.link.clock import RealClock, VirtualClock
+from emulator.protocol.unit import Unit
+from gve_fixtures.transcript import TranscriptWriter
+
+SECOND = 1_000_000_000
+
+
+def byte_time(baud: int) -> int:
+    return round(10 * SECOND / baud)
+
+
+class Line:
+    def __init__(self, units: Iterable[Unit], baud: int, *,
+                 clock: VirtualClock | RealClock | None = None,
+                 log: str | Path | IO[str] | None = None) -> None:
+        self.units = list(units)
+        self.baud = baud
+        self.byte_ns = byte_time(baud)
+        self.clock = clock or VirtualClock()
+        self._rx: deque[tuple[int, bytes]] = deque()     # (instant complete, byte) to host
+        self._unit_free = 0          # when the unit->host direction is free again
+        self._host_free = 0          # when the host->unit direction is free again
+        self.log: TranscriptWriter | None = None
+        if log is not None:
+            meta = {"title": "emulator wire log",
+                    "profiles": " ".join(u.profile.name for u in self.units),
+                    "baud": str(baud)}
+            self.log = (TranscriptWriter.open(log, meta) if isinstance(log, str | Path)
+                        else TranscriptWriter(log, meta))
+        for unit in self.units:
+            unit.emit = self._emit
+
+    # -- time ----------------------------------------------------------------------------
+    @property
+    def now(self) -> int:
+        return self.clock.now()
+
+    def _settle(self, t: int) -> None:
+        for unit in self.units:
+            unit.advance(t)
+
+    def next_deadline(self) -> int | None:
+        due = [d for d in (u.next_deadline() for u in self.units) if d is not None]
+        return min(due) if due else None
+
+    def advance(self, seconds: float) -> None:
+        """Let ``seconds`` pass (virtual time), handling every unit event on the way."""
+        self.advance_to(self.now + round(seconds * SECOND))
+
+    def advance_to(self, t: int) -> None:
+        while True:
+            d = self.next_deadline()
+            if d is None or d > t:
+                break
+            self.clock.advance_to(d)
+            self._settle(d)
+        self.clock.advance_to(t)
+        self._settle(t)
+
+    def run_until_idle(self, max_seconds: float = 3600.0) -> bool:
+        """Advance until no unit has anything scheduled; False if ``max_seconds`` ran out."""
+        limit = self.now + round(max_seconds * SECOND)
+        while True:
+            d = self.next_deadline()
+            if d is None:
+                return True
+            if d > limit:
+                self.advance_to(limit)
+                return False
+            self.advance_to(d)
+
+    # -- host -> units ----------------------------------------------------------------------
+    def write(self, data: bytes) -> int:
+        start = max(self.now, self._host_free)
+        first = start + self.byte_ns
+        if self.log is not None:
+            self.log.host(data, first)
+        for unit in self.units:
+            unit.receive(data, first, self.byte_ns)
+        self._host_free = start + len(data) * self.byte_ns
+        if self.clock.virtual:
+            self.advance_to(self._host_free)
+        return len(data)
+
+    # -- units -> host -------------------------------------------------------------------------
+    def _emit(self, data: bytes, t: int) -> None:
+        start = max(t, self._unit_free)
+        b = self.byte_ns
+        self._rx.extend((start + (i + 1) * b, data[i:i + 1]) for i in range(len(data)))
+        self._unit_free = start + len(data) * b
+        if self.log is not None:
+            self.log.unit(data, start + b)
+
+    @property
+    def in_waiting(self) -> int:
+        now = self.now
+        if not self.clock.virtual:
+            self._settle(now)
+        return sum(1 for ready, _ in self._rx if ready <= now)
+
+    def _take(self, size: int, terminator: bytes | None) -> bytes:
+        out = bytearray()
+        now = self.now
+        rx = self._rx
+        while rx and rx[0][0] <= now and len(out) < size:
+            out += rx.popleft()[1]
+            if terminator and out.endswith(terminator):
+                break
+        return bytes(out)
+
+    def read(self, size: int = 1, timeout: float | None = 0.0,
+             terminator: bytes | None = None) -> bytes:
+        """Up to ``size`` bytes (stopping after ``terminator``), waiting at most
+        ``timeout`` seconds of (virtual) time for them."""
+        if not self.clock.virtual:
+            self._settle(self.now)
+            return self._take(size, terminator)
+        deadline = None if timeout is None else self.now + round(timeout * SECOND)
+        out = bytearray()
+        while True:
+            out += self._take(size - len(out), terminator)
+            if len(out) >= size or (terminator and out.endswith(terminator)):
+                return bytes(out)
+            nxt = [x for x in (self._rx[0][0] if self._rx else None, self.next_deadline())
+                   if x is not None]
+            t = min(nxt) if nxt else None
+            if t is None or (deadline is not None and t > deadline):
+                if deadline is not None:
+                    self.advance_to(deadline)
+                    out += self._take(size - len(out), terminator)
+                return bytes(out)
+            self.advance_to(t)
+
+    def read_until(self, terminator: bytes = b"\r", size: int = 4096,
+                   timeout: float | None = 0.0) -> bytes:
+        return self.read(size, timeout, terminator)
+
+    # -- the rig -------------------------------------------------------------------------------
+    def unit(self, address: int | None = None) -> Unit:
+        if address is None:
+            return self.units[0]
+        for u in self.units:
+            if address in u.addresses:
+                return u
+        raise KeyError(f"no unit at address {address}")
+
+    def set_input(self, port: int, value: int, address: int | None = None) -> None:
+        self.unit(address).set_input(port, value, self.now)
+
+    def set_switch(self, axis: str, position: int | None, address: int | None = None) -> None:
+        self.unit(address).set_switch(axis, position)
+
+    def power_on(self, address: int | None = None) -> None:
+        units = self.units if address is None else [self.unit(address)]
+        for u in units:
+            u.power_on(self.now)
+
+    def state(self, address: int | None = None) -> dict:
+        return self.unit(address).snapshot(self.now)
+
+    def outputs(self, address: int | None = None) -> int:
+        return self.unit(address).state.outputs
+
+    def spindle(self, address: int | None = None) -> int:
+        return self.unit(address).state.spindle

@@ -1,0 +1,70 @@
+"""`gve://` URLs: which units a line carries, and how (docs/architecture.md, Ways in).
+
+``gve://?model=GVE84-100&address=0`` or ``gve://?unit=GVE54@1&unit=GVE84-100@0``, with
+``baud``, ``watchdog_ms``, ``eeprom``, ``mutant``, ``stepper``, ``log``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from urllib.parse import parse_qs, urlsplit
+
+from emulator.protocol.unit import Unit
+from gve_fixtures.profile import load_profile
+
+DEFAULT_MODEL = "GVE84-100"
+
+
+@dataclass
+class LineSpec:
+    units: list[tuple[str, int | None]] = field(default_factory=list)
+    baud: int | None = None
+    watchdog_ms: int | None = None
+    eeprom: str | None = None
+    mutant: str | None = None
+    stepper: str | None = None
+    log: str | None = None
+
+    def build_units(self) -> list[Unit]:
+        units = []
+        for model, address in self.units or [(DEFAULT_MODEL, None)]:
+            units.append(Unit(load_profile(model), address, eeprom_path=self.eeprom,
+                              mutant=self.mutant, watchdog_ms=self.watchdog_ms,
+                              stepper=self.stepper))
+        return units
+
+    def line_baud(self, units: list[Unit]) -> int:
+        return self.baud or units[0].profile.default_baud
+
+
+def parse_unit(text: str) -> tuple[str, int | None]:
+    """``MODEL@ADDRESS`` (or just ``MODEL``)."""
+    model, _, address = text.partition("@")
+    return model, (int(address) if address else None)
+
+
+def parse_url(url: str) -> LineSpec:
+    parts = urlsplit(url)
+    if parts.scheme != "gve":
+        raise ValueError(f"not a gve:// URL: {url!r}")
+    q = parse_qs(parts.query)
+    unknown = set(q) - {"model", "address", "unit", "baud", "watchdog_ms", "eeprom",
+                        "mutant", "stepper", "log"}
+    if unknown:
+        raise ValueError(f"unknown gve:// parameter(s): {', '.join(sorted(unknown))}")
+
+    def one(key: str) -> str | None:
+        return q[key][-1] if key in q else None
+
+    spec = LineSpec(units=[parse_unit(u) for u in q.get("unit", [])])
+    if not spec.units:
+        model = one("model") or parts.netloc or DEFAULT_MODEL
+        address = one("address")
+        spec.units = [(model, int(address) if address is not None else None)]
+    for key in ("baud", "watchdog_ms"):
+        value = one(key)
+        if value is not None:
+            setattr(spec, key, int(value))
+    for key in ("eeprom", "mutant", "stepper", "log"):
+        setattr(spec, key, one(key))
+    return spec
