@@ -28,11 +28,12 @@ def byte_time(baud: int) -> int:
 class Line:
     def __init__(self, units: Iterable[Unit], baud: int, *,
                  clock: VirtualClock | RealClock | None = None,
-                 log: str | Path | IO[str] | None = None) -> None:
+                 log: str | Path | IO[str] | None = None, paced: bool = True) -> None:
         self.units = list(units)
         self.baud = baud
-        self.byte_ns = byte_time(baud)
         self.clock = clock or VirtualClock()
+        # unpaced (a real-time pty without --baud): bytes take no time either way
+        self.byte_ns = byte_time(baud) if paced or self.clock.virtual else 0
         self._rx: deque[tuple[int, bytes]] = deque()     # (instant complete, byte) to host
         self._unit_free = 0          # when the unit->host direction is free again
         self._host_free = 0          # when the host->unit direction is free again
@@ -146,6 +147,11 @@ class Line:
                     out += self._take(size - len(out), terminator)
                 return bytes(out)
             self.advance_to(t)
+
+    def take_ready(self) -> bytes:
+        """Real time: every byte due by now (the server writes them to its port)."""
+        self._settle(self.now)
+        return self._take(1 << 30, None)
 
     def read_until(self, terminator: bytes = b"\r", size: int = 4096,
                    timeout: float | None = 0.0) -> bytes:
