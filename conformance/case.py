@@ -1,0 +1,156 @@
+"""Cases: the @case decorator, the registry, and the context a case runs in
+(docs/suite.md). A case records checks; the runner grades them."""
+
+from __future__ import annotations
+
+import fnmatch
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from conformance.link.link import Link
+from conformance.link.safety import SafetyStop
+from gve_fixtures.profile import Profile
+
+__all__ = ["REGISTRY", "Case", "CaseContext", "Check", "CouldNotTest", "Missing",
+           "SafetyStop", "TargetInfo", "case", "select"]
+
+
+class CouldNotTest(Exception):
+    """A precondition failed: the case cannot judge this target."""
+
+
+class Missing(Exception):
+    """The profile lacks what the case checks."""
+
+
+@dataclass(frozen=True)
+class Case:
+    id: str
+    func: Callable[[CaseContext], None]
+    rule: str
+    tag: str
+    source: str
+    requires: tuple[str, ...] = ()
+    absent: tuple[str, ...] = ()
+    applies: Callable[[Profile], bool] | None = None
+    rig: bool = False
+    destructive: bool = False
+    timing: bool = False
+
+    @property
+    def section(self) -> str:
+        m = re.match(r"\d+(?:\.\d+)*", self.id)
+        return m.group(0) if m else self.id.split(".")[0]
+
+    def missing_for(self, profile: Profile) -> str | None:
+        """Why the case does not apply to ``profile`` (None when it does)."""
+        lacking = [c for c in self.requires if c not in profile.commands]
+        if lacking:
+            return f"the profile lacks {', '.join(lacking)}"
+        present = [c for c in self.absent if c in profile.commands]
+        if present:
+            return f"checks the refusal of {', '.join(present)}, which the profile has"
+        if self.applies is not None and not self.applies(profile):
+            return "does not apply to this profile"
+        return None
+
+
+REGISTRY: dict[str, Case] = {}
+
+
+def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...] = (),
+         absent: tuple[str, ...] = (), applies: Callable[[Profile], bool] | None = None,
+         rig: bool = False, destructive: bool = False, timing: bool = False):
+    """Register a case (see docs/suite.md)."""
+    if tag not in ("M", "M-ex", "D", "D-info"):
+        raise ValueError(f"{id}: tag must be M, M-ex, D or D-info")
+
+    def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
+        if id in REGISTRY:
+            raise ValueError(f"case {id} is registered twice")
+        REGISTRY[id] = Case(id, func, rule, tag, source, tuple(requires), tuple(absent),
+                            applies, rig, destructive, timing)
+        return func
+    return register
+
+
+def select(include: list[str] | None = None, exclude: list[str] | None = None) -> list[Case]:
+    import conformance.cases  # noqa: F401  (registers the catalogue)
+    cases = sorted(REGISTRY.values(), key=lambda c: _order(c.id))
+    if include:
+        cases = [c for c in cases if any(fnmatch.fnmatch(c.id, g) for g in include)]
+    if exclude:
+        cases = [c for c in cases if not any(fnmatch.fnmatch(c.id, g) for g in exclude)]
+    return cases
+
+
+def _order(id: str) -> tuple:
+    return (*tuple(int(p) if p.isdigit() else 1000000 for p in id.split(".")[:3]), id)
+
+
+@dataclass(frozen=True)
+class TargetInfo:
+    kind: str                  # emu, serial, tcp
+    spec: str                  # as given on the command line
+    virtual_time: bool
+    has_rig: bool
+    allow_destructive: bool
+    max_travel: int
+
+
+@dataclass
+class Check:
+    ok: bool
+    what: str
+    observed: str = ""
+    expected: str = ""
+    tag: str = ""
+    rule: str = ""
+
+
+@dataclass
+class CaseContext:
+    case: Case
+    profile: Profile
+    target: TargetInfo
+    settings: Any
+    _open_link: Callable[..., Link]
+    checks: list[Check] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    artifacts: dict[str, str] = field(default_factory=dict)
+    links: list[Link] = field(default_factory=list)
+    _link: Link | None = None
+
+    @property
+    def link(self) -> Link:
+        if self._link is None:
+            self._link = self.fresh_link()
+        return self._link
+
+    def fresh_link(self, address: int | None = None) -> Link:
+        """A new link in the known state (on the emulator: a new unit, at ``address``
+        when given)."""
+        link = self._open_link(address)
+        self.links.append(link)
+        self._link = link
+        return link
+
+    def expect(self, ok: bool, what: str, *, observed: Any = None, expected: Any = None,
+               tag: str | None = None, rule: str | None = None) -> bool:
+        self.checks.append(Check(bool(ok), what,
+                                 "" if observed is None else str(observed),
+                                 "" if expected is None else str(expected),
+                                 tag or self.case.tag, rule or self.case.rule))
+        return bool(ok)
+
+    def require(self, ok: bool, why: str) -> None:
+        if not ok:
+            raise CouldNotTest(why)
+
+    def note(self, text: str) -> None:
+        self.notes.append(text)
+
+    def artifact(self, name: str, text: str) -> None:
+        self.artifacts[name] = text

@@ -1,0 +1,15 @@
+"""The case catalogue: importing this package registers every case."""
+
+from conformance.cases import (  # noqa: F401
+    checksum,
+    errors,
+    frame,
+    golden,
+    index,
+    keep,
+    motion,
+    packet,
+    status,
+    units,
+)
+from conformance.machines import register as _machines  # noqa: F401  (machine cases)

@@ -1,0 +1,54 @@
+"""Small helpers the directed cases share."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext
+from conformance.link.framing import Response
+
+
+def show(r: Response | None) -> str:
+    return "nothing" if r is None else r.text
+
+
+def answers(ctx: CaseContext, r: Response | None, text: str, what: str, *,
+            tag: str | None = None) -> bool:
+    """Expect the answer's exact bytes (``text`` without the final CR)."""
+    return ctx.expect(r is not None and r.raw == text.encode() + b"\r", what,
+                      observed=show(r), expected=text, tag=tag)
+
+
+def code(ctx: CaseContext, r: Response | None, value: int, what: str, *,
+         tag: str | None = None, inta: bool | None = None) -> bool:
+    ok = r is not None and r.code == value and (inta is None or r.inta == inta)
+    shown = f"{value + (8 if inta else 0):X}" if inta is not None else str(value)
+    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag)
+
+
+def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
+    """The parameters of an L/C vector for the profile's axes."""
+    return f"{x},{y},{z}"
+
+
+def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | None:
+    """A setup step: if it does not answer as expected the case cannot judge."""
+    r = ctx.link.send(body, **kw)
+    ctx.require(r is not None and r.raw.split(b",")[0].rstrip(b"\r") == expect.encode(),
+                f"setup {body} answered {show(r)}, expected {expect}")
+    return r
+
+
+def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 1500) -> None:
+    """Setup: CONT vectors queued and running, then HALT (INTA = 1, RUN = 1)."""
+    setup(ctx, "V1000")
+    for _ in range(vectors):
+        setup(ctx, "C" + vector(ctx, steps))
+    ctx.link.wait(0.5)
+    r = ctx.link.send("H")
+    ctx.require(r is not None and r.code == 0 and r.inta, f"H answered {show(r)}")
+
+
+def position(ctx: CaseContext) -> list[int] | None:
+    r = ctx.link.send("PF")
+    if r is None or r.code != 0 or len(r.values) < 3:
+        return None
+    return [int(v) for v in r.values]

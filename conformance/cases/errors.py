@@ -1,0 +1,76 @@
+"""Section 5: every error code provoked from a state where it arises."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, halted_with_queue, setup, vector
+
+
+@case("5.errors.ok", tag="M-ex", source="M84 12.6 (G4a)", rule="An accepted command answers 0")
+def ok(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("L" + vector(ctx, 100)), "0", "L100,0,0 on an idle unit")
+
+
+@case("5.errors.queue-full", tag="M", source="M84 12.5.2, 12.6 code 1",
+      rule="C with no room in the CONT buffer answers 1; the buffer holds the profile's size")
+def queue_full(ctx: CaseContext) -> None:
+    n = ctx.profile.buffer
+    setup(ctx, "V10")
+    for i in range(n):
+        r = ctx.link.send("C" + vector(ctx, 5000))
+        if not code(ctx, r, 0, f"vector {i + 1} of {n} is accepted"):
+            return
+    code(ctx, ctx.link.send("C" + vector(ctx, 5000)), 1, f"vector {n + 1} answers 1")
+
+
+@case("5.errors.unknown", tag="M", source="M84 12.6 code 3",
+      rule="An unknown command answers 3")
+def unknown(ctx: CaseContext) -> None:
+    for body in ("Z", "E", "XQ"):
+        code(ctx, ctx.link.send(body), 3, f"{body} → 3")
+
+
+@case("5.errors.out-of-range", tag="M-ex", source="M84 12.6 (G4e)",
+      rule="A parameter out of range answers 5 (!0SW8,F1 → 5)")
+def out_of_range(ctx: CaseContext) -> None:
+    for body in ("SW8,F1", "T25", "A0", "SR7"):
+        code(ctx, ctx.link.send(body), 5, f"{body} → 5")
+
+
+@case("5.errors.go-without-inta", tag="M", source="M84 12.6 code 6",
+      rule="G while INTA = 0 answers 6 and does nothing")
+def go_idle(ctx: CaseContext) -> None:
+    code(ctx, ctx.link.send("G"), 6, "G on an idle unit → 6")
+
+
+@case("5.errors.busy", tag="M", source="M84 12.5.6, 12.5.8: 'nelze použít za chodu'",
+      rule="D, K, R, N while a vector runs answer 7")
+def busy(ctx: CaseContext) -> None:
+    setup(ctx, "V1000")
+    setup(ctx, "C" + vector(ctx, 3000))
+    ctx.link.wait(0.3)
+    for body in ("D", "K", "R", "N"):
+        code(ctx, ctx.link.send(body), 7, f"{body} while moving → 7")
+    ctx.link.send("H")
+
+
+@case("5.errors.n-while-run", tag="M", source="M84 12.5.6: 'pri RUN=1'",
+      rule="N is refused (7) while interrupted vectors still hold RUN = 1")
+def n_run(ctx: CaseContext) -> None:
+    halted_with_queue(ctx)
+    code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True)
+
+
+@case("5.errors.refused-not-executed", tag="M", source="spec 4; M84 12.6",
+      rule="A command answered with an error is not executed")
+def refused_not_executed(ctx: CaseContext) -> None:
+    ctx.link.send("V1000,5")
+    ctx.link.send("SW0,1FF")
+    r = ctx.link.send("SR0")
+    answers(ctx, r, "0,00", "SW0,1FF (out of range) did not write ST0", tag="M")
+    setup(ctx, "L" + vector(ctx, 10))
+    code(ctx, ctx.link.send("L" + vector(ctx, 20)), 1, "L while busy → 1")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    r = ctx.link.send("PF")
+    ctx.expect(r is not None and r.values[:1] == ["10"], "only the accepted L moved",
+               observed=r, expected="0,10,0,0", tag="always")

@@ -1,0 +1,115 @@
+"""Sections 2-4: the link, the command frame, the response frame."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, show
+
+
+@case("2.link.other-address-ignored", tag="M", source="M114 1, 9.5; spec 2-3",
+      rule="Only the addressed unit answers; a frame for another address is ignored whole")
+def other_address(ctx: CaseContext) -> None:
+    link = ctx.link
+    other = (link.address + 1) % 8
+    if other == 7:
+        other = (other + 1) % 8
+    link.send("V2000", address=other, answer=False)
+    got = link.wait(0.3)
+    ctx.expect(got == b"", "no answer to another address", observed=got, expected=b"",
+               tag="always")
+    r = link.send("@")
+    answers(ctx, r, "0,0", "the ignored frame did not count in the index", tag="D")
+
+
+@case("3.frame.noise-before-bang", tag="D", source="spec 3 [D]",
+      rule="Bytes before '!' are ignored")
+def noise(ctx: CaseContext) -> None:
+    ctx.link.send_raw(b"\x00xyz 12\n")
+    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "a frame after noise")
+
+
+@case("3.frame.bang-restarts", tag="D", source="spec 3 [D]",
+      rule="A '!' inside an unfinished frame starts a new frame; the old one gets no answer")
+def restart(ctx: CaseContext) -> None:
+    ctx.link.send_raw(b"!%dV12" % ctx.link.address)
+    r = ctx.link.send("@")
+    answers(ctx, r, "0,0", "only the complete frame is answered; the dropped one not counted")
+    ctx.expect(ctx.link.wait(0.3) == b"", "no second answer", tag="always")
+
+
+@case("3.frame.lf-after-cr", tag="D", source="spec 3 [D]",
+      rule="A LF after CR is ignored")
+def lf(ctx: CaseContext) -> None:
+    ctx.link.send_raw(b"!%dV1000\r\n" % ctx.link.address)
+    r = ctx.link.read_response(1.0)
+    answers(ctx, r, "0", "the frame is answered once")
+    answers(ctx, ctx.link.send("@"), "0,1", "the LF made no frame")
+
+
+@case("3.frame.lower-case-unknown", tag="D", source="spec 3 [D]",
+      rule="Command letters are upper case: a lower-case command is unknown (3)")
+def lower(ctx: CaseContext) -> None:
+    code(ctx, ctx.link.send("v1000"), 3, "v1000 is an unknown command")
+    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "still answering")
+
+
+@case("3.frame.syntax-errors", tag="D", source="spec 3 [D]; M84 12.6 code 4",
+      rule="A '+', a space, an empty field or a non-digit in a number is a syntax error (4)")
+def syntax(ctx: CaseContext) -> None:
+    for body in ("V+100", "V 100", "V", "V1x", "T5,5", "L1,,2"):
+        code(ctx, ctx.link.send(body), 4, f"{body} → 4")
+
+
+@case("3.frame.too-long", tag="D", source="spec 3 [D]",
+      rule="A frame longer than 96 bytes is a syntax error (4) once its CR arrives")
+def too_long(ctx: CaseContext) -> None:
+    code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), 4, "a 106-byte frame → 4")
+
+
+@case("3.frame.watchdog", tag="M", source="M84 12.6 code 2; spec 3 [timing D]",
+      rule="A frame left unfinished longer than the watchdog time is dropped and answered 2",
+      timing=True)
+def watchdog(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.inject("host", "delay", at=4, seconds=0.5)
+    r = link.send("V1000", timeout=1.0)
+    code(ctx, r, 2, "the unfinished frame is answered 2")
+    rest = link.wait(0.3)
+    ctx.expect(b"0\r" not in rest, "the rest of the frame is not executed",
+               observed=rest, expected="no further answer except an error", tag="always")
+    answers(ctx, link.send("@"), "0,0", "a frame dropped by the watchdog does not count",
+            tag="D")
+
+
+@case("3.frame.lone-bang-silent", tag="D", source="spec 3 [D]",
+      rule="If only '!' arrived before the watchdog time, nothing is answered", timing=True)
+def lone_bang(ctx: CaseContext) -> None:
+    ctx.link.send_raw(b"!")
+    got = ctx.link.wait(0.5)
+    ctx.expect(got == b"", "no answer to a lone '!'", observed=got, expected=b"")
+
+
+@case("4.response.inta-bit", tag="M", source="M84 12.6",
+      rule="While ST6.INTA = 1 every response carries bit 3 (8..F)")
+def inta_bit(ctx: CaseContext) -> None:
+    from conformance.cases._kit import halted_with_queue
+    halted_with_queue(ctx)
+    for body, value in (("V1000", 0), ("T99", 5), ("Z", 3), ("SR6", 0), ("PF", 0)):
+        r = ctx.link.send(body)
+        code(ctx, r, value, f"{body} while interrupted", inta=True)
+
+
+@case("4.response.hex-values", tag="M", source="M-ex 12.6; M84 12.5.11",
+      rule="Status words and ports are two upper-case hex digits")
+def hex_values(ctx: CaseContext) -> None:
+    ctx.link.send("SW2,ab")
+    answers(ctx, ctx.link.send("SR2"), "0,AB", "SR2 in upper case after SW2,ab")
+
+
+@case("4.response.refused-has-no-values", tag="D", source="spec 4 [D]",
+      rule="A failing command's response carries no values")
+def refused(ctx: CaseContext) -> None:
+    for body in ("SR9", "ERXY", "PF1"):
+        r = ctx.link.send(body)
+        ctx.expect(r is not None and r.code and not r.values, f"{body} → code only",
+                   observed=show(r), expected="an error code alone")

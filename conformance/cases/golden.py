@@ -1,0 +1,99 @@
+"""Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
+case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from conformance.case import CaseContext, case
+from gve_fixtures import golden_transcripts
+from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
+
+RIG_ACTIONS = {"input", "expect", "power-on"}
+TAGS = {"M", "M-ex", "D", "D-info"}
+
+
+def _tag(kind: str | None, default: str) -> str:
+    return kind if kind in TAGS else default
+
+
+def play(ctx: CaseContext, t: Transcript) -> None:
+    link = ctx.link
+    default = _tag(t.tag.kind if t.tag else None, "M-ex")
+    for rec in t.records:
+        setup = "setup" in rec.comment
+        tag = _tag(rec.tag.kind if rec.tag else None, default)
+        what = f"{rec.line()}"
+        if rec.direction == HOST:
+            link.send_raw(rec.data)
+        elif rec.direction in (UNIT, UNIT_MATCH):
+            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False)
+            got = r.raw if r else b""
+            ok = (got == rec.data if rec.direction == UNIT
+                  else bool(rec.pattern().fullmatch(got)))
+            if setup:
+                ctx.require(ok, f"setup answered {got!r} at {what}")
+            else:
+                ctx.expect(ok, what, observed=got, expected=rec.data, tag=tag)
+        elif rec.direction == ACTION:
+            _action(ctx, rec.action, what, tag)
+
+
+def _action(ctx: CaseContext, words: list[str], what: str, tag: str) -> None:
+    link, verb, args = ctx.link, words[0], words[1:]
+    if verb == "wait":
+        link.wait(float(args[0]))
+    elif verb == "silence":
+        got = link.wait(float(args[0]))
+        ctx.expect(got == b"", what, observed=got, expected=b"", tag="always")
+    elif verb == "poll":
+        frame, pattern = unescape(args[1]), re.compile(unescape(args[2]), re.DOTALL)
+        limit = link.now + float(args[0]) * 1e9
+        while True:
+            link.send_raw(frame)
+            r = link.read_response(30.0, summed=False)
+            if r is not None and pattern.fullmatch(r.raw):
+                break
+            ctx.require(link.now < limit, f"{what}: never matched")
+            link.wait(0.05)
+    elif verb == "fill":
+        frame = unescape(args[1])
+        for _ in range(int(args[0])):
+            link.send_raw(frame)
+            r = link.read_response(5.0, summed=False)
+            if r is None or r.raw != b"0\r":
+                break
+    elif verb == "input":
+        link.rig.set_input(int(args[0]), int(args[1], 16))
+    elif verb == "expect":
+        got = ("%02X" % link.rig.outputs()) if args[0] == "outputs" else str(link.rig.spindle())
+        ctx.expect(got == args[1], what, observed=got, expected=args[1], tag=tag)
+    elif verb == "power-on":
+        link.rig.power_on()
+        link.wait(2.5)
+    else:
+        raise ValueError(f"unknown transcript action {verb!r}")
+
+
+def _register(path: Path) -> None:
+    t = load(path)
+    families = t.meta.get("profiles", "").split()
+    needs_rig = any(r.direction == ACTION and r.action[0] in RIG_ACTIONS for r in t.records)
+    address = int(t.meta.get("address", "-1"))
+    tag = _tag(t.tag.kind if t.tag else None, "M-ex")
+
+    def applies(profile) -> bool:
+        return not families or profile.family in families or profile.name in families
+
+    @case(f"11.golden.{path.stem}", rule=t.meta.get("title", path.stem),
+          tag="M-ex" if tag == "M-ex" else tag, source=t.meta.get("source", ""),
+          applies=applies, rig=needs_rig, destructive=bool(t.meta.get("destructive")))
+    def replay(ctx: CaseContext) -> None:
+        if address >= 0 and address != ctx.link.address:
+            ctx.fresh_link(address)
+        play(ctx, t)
+
+
+for _path in golden_transcripts():
+    _register(_path)

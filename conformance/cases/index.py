@@ -1,0 +1,83 @@
+"""Section 8: index @ and repeat >."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, position, setup, vector
+
+SRC = "M84 12.5.12; spec 8 [D what counts]"
+
+
+@case("8.index.counts-every-frame", tag="M", source=SRC,
+      rule="Every complete frame advances the index by one, refused ones too")
+def counts(ctx: CaseContext) -> None:
+    link = ctx.link
+    answers(ctx, link.send("@"), "0,0", "the index starts at 0", tag="D")
+    link.send("V1000")
+    link.send("T99")          # refused: 5
+    link.send("Z")            # refused: 3
+    answers(ctx, link.send("@"), "0,3", "three frames, two refused, counted")
+
+
+@case("8.index.queries-not-counted", tag="D", source=SRC,
+      rule="@ and > themselves do not advance the index")
+def queries(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.send("V1000")
+    link.send("@")
+    link.send(">", lines=2)
+    answers(ctx, link.send("@"), "0,1", "only V1000 counted")
+
+
+@case("8.index.modulo-256", tag="M", source=SRC, rule="The index counts modulo 256")
+def modulo(ctx: CaseContext) -> None:
+    for _ in range(258):
+        ctx.link.send("F")
+    answers(ctx, ctx.link.send("@"), "0,2", "258 frames → index 2")
+
+
+@case("8.repeat.last-frame-and-answer", tag="D", source=SRC,
+      rule="> answers the last frame as received, then the response it got")
+def repeat(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.send("T99")
+    r = link.send(">", lines=2)
+    expected = f"!{link.address}T99\r5"
+    answers(ctx, r, expected, "> repeats the refused frame and its answer")
+
+
+@case("8.repeat.no-history", tag="D", source=SRC,
+      rule="With no history since reset, > answers a single line 0")
+def no_history(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send(">"), "0", "> right after reset")
+
+
+@case("8.repeat.not-reexecuted", tag="M", source="M84 12.5.12",
+      rule="> re-executes nothing")
+def not_again(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "L" + vector(ctx, 7))
+    link.send(">", lines=2)
+    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.expect(position(ctx) == [7, 0, 0], "the vector ran once", observed=position(ctx),
+               expected=[7, 0, 0], tag="always")
+    answers(ctx, link.send("@"), "0,3", "> added no frame to the index", tag="D")
+
+
+@case("8.recovery.lost-response", tag="M", source="M84 12.5.12: recovery with @ and >",
+      rule="A lost response is recovered with @ and > without executing the vector twice")
+def lost_response(ctx: CaseContext) -> None:
+    link = ctx.link
+    before = link.send("@")
+    link.inject("unit", "drop")
+    lost = link.send("L" + vector(ctx, 9))
+    ctx.require(lost is None, "the injected loss did not happen")
+    after = link.send("@")
+    ctx.expect(before is not None and after is not None and
+               int(after.values[0]) == int(before.values[0]) + 1,
+               "the index shows the command arrived", observed=after, expected="index + 1")
+    r = link.send(">", lines=2)
+    answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer")
+    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
+               expected=[9, 0, 0], tag="always")

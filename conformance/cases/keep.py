@@ -1,0 +1,63 @@
+"""Section 10.5: KEEP / RESTORE."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, halted_with_queue, position, setup, show, vector
+
+SRC = "M84 12.5.8; M114 13.6.9; M54"
+
+
+@case("10.5.keep.saves-st6", tag="M", source=SRC,
+      rule="K saves the queue and ST4..ST6 and clears them; R brings them back")
+def saves(ctx: CaseContext) -> None:
+    halted_with_queue(ctx)
+    answers(ctx, ctx.link.send("K"), "0", "K clears INTA")
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared after K")
+    answers(ctx, ctx.link.send("R"), "8", "R restores INTA", tag="D")
+    r = ctx.link.send("SR6")
+    ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 as saved",
+               observed=show(r), expected="8,D0")
+
+
+@case("10.5.keep.partial-vector", tag="M", source=SRC,
+      rule="K keeps the rest of the interrupted vector: after R and G no step is lost")
+def partial(ctx: CaseContext) -> None:
+    halted_with_queue(ctx, 2, 1500)
+    setup(ctx, "K")
+    setup(ctx, "L" + vector(ctx, 0, 0, -100))
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    setup(ctx, "L" + vector(ctx, 0, 0, 100))
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.link.send("R")
+    ctx.link.send("G")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
+    ctx.expect(position(ctx) == [3000, 0, 0], "the job finished exactly",
+               observed=position(ctx), expected=[3000, 0, 0])
+
+
+@case("10.5.keep.single-l", tag="D", source="M84 12.5.8 [M]; C → 4 [D]",
+      applies=lambda p: p.keep == "single-L",
+      rule="After K the GVE84/GVE114 queue takes only L (a C answers 4)")
+def single_l(ctx: CaseContext) -> None:
+    halted_with_queue(ctx)
+    setup(ctx, "K")
+    code(ctx, ctx.link.send("C" + vector(ctx, 10)), 4, "C after K → 4")
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 0, "L after K → 0", tag="M")
+
+
+@case("10.5.keep.refused-while-moving", tag="M", source=SRC,
+      rule="K and R are not possible while moving (7)")
+def moving(ctx: CaseContext) -> None:
+    setup(ctx, "C" + vector(ctx, 2000))
+    ctx.link.wait(0.2)
+    code(ctx, ctx.link.send("K"), 7, "K while moving")
+    code(ctx, ctx.link.send("R"), 7, "R while moving")
+    ctx.link.send("H")
+
+
+@case("10.5.restore.empty", tag="D", source="spec 10.5 [D]",
+      rule="R with nothing saved restores an empty save and answers 0")
+def restore_empty(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("R"), "0", "R at reset")
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved")

@@ -1,0 +1,92 @@
+"""Section 7: packets *S / *E."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, position, setup, vector
+
+RULE = "spec 7 [D]; M84 12.3.3"
+
+
+def _packet(ctx: CaseContext, members: list[str], count: int):
+    link = ctx.link
+    link.send("*S", answer=False)
+    for m in members:
+        link.send(m, answer=False)
+    return link.send(f"*E{count}")
+
+
+@case("7.packet.commits-all", tag="M", source="M84 12.3.3", requires=("*S",),
+      rule="*E<n> commits every member in order and answers code,k")
+def commits(ctx: CaseContext) -> None:
+    r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
+    answers(ctx, r, "0,3", "a good packet → 0,3")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.expect(position(ctx) == [10, 20, 0], "both vectors ran", observed=position(ctx),
+               expected=[10, 20, 0])
+
+
+@case("7.packet.count-mismatch", tag="D", source=RULE, requires=("*S",),
+      rule="k ≠ n: nothing is committed and *E answers 2,k")
+def count(ctx: CaseContext) -> None:
+    r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
+    answers(ctx, r, "2,2", "2 members, *E3 → 2,2")
+    ctx.link.wait(1.0)
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", tag="always")
+
+
+@case("7.packet.invalid-member", tag="D", source=RULE, requires=("*S",),
+      rule="A member other than C or B fails the packet with 4; nothing is committed")
+def invalid(ctx: CaseContext) -> None:
+    r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
+    answers(ctx, r, "4,3", "V inside a packet → 4,3")
+    ctx.link.wait(1.0)
+    ctx.expect(position(ctx) == [0, 0, 0], "no member was committed", observed=position(ctx),
+               expected=[0, 0, 0], tag="always")
+
+
+@case("7.packet.out-of-range-member", tag="D", source=RULE, requires=("*S",),
+      rule="A member out of range fails the packet with its code (5)")
+def out_of_range(ctx: CaseContext) -> None:
+    r = _packet(ctx, ["B1", "C" + vector(ctx, 10)], 2)
+    answers(ctx, r, "5,2", "B1 (below range) → 5,2")
+
+
+@case("7.packet.no-room", tag="D", source=RULE, requires=("*S",),
+      rule="A packet that does not fit the queue answers 1 and commits nothing")
+def no_room(ctx: CaseContext) -> None:
+    setup(ctx, "V10")
+    n = ctx.profile.buffer
+    for _ in range(n - 1):
+        setup(ctx, "C" + vector(ctx, 5000))
+    r = _packet(ctx, ["C" + vector(ctx, 5000), "C" + vector(ctx, 5000)], 2)
+    answers(ctx, r, "1,2", "2 vectors into 1 free place → 1,2")
+    r = ctx.link.send("F")
+    ctx.expect(r is not None and r.values == ["40"], "the queue is not full (nothing added)",
+               observed=r, expected="0,40")
+
+
+@case("7.packet.end-without-start", tag="D", source=RULE, requires=("*S",),
+      rule="*E with no open packet answers 4,0")
+def end_alone(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("*E1"), "4,0", "*E1 alone → 4,0")
+
+
+@case("7.packet.halt-inside", tag="D", source=RULE, requires=("*S",),
+      rule="H, @, > inside an open packet are answered at once and discard the packet")
+def breakers(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.send("*S", answer=False)
+    link.send("C" + vector(ctx, 10), answer=False)
+    r = link.send("@")
+    answers(ctx, r, "0,2", "@ inside a packet is answered (index 2)")
+    answers(ctx, link.send("*E1"), "4,0", "the packet was discarded")
+
+
+@case("7.packet.with-checksums", tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
+      rule="Packets work in checksum mode, each member with its own checksum")
+def summed(ctx: CaseContext) -> None:
+    setup(ctx, "%+", checksum=False)
+    r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 2)
+    ctx.expect(r is not None and r.code == 0 and r.values == ["2"] and r.checksum_ok,
+               "a summed packet → 0,2 with its checksum", observed=r, expected="0,2,XX")

@@ -1,0 +1,67 @@
+"""Section 10.3: status words, F, inputs and interrupts."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, position, setup, show, vector
+
+
+@case("10.3.status.all-bits-stored", tag="D", source="spec 10.3 [D]; M84 12.5.8 SW1,3F",
+      rule="Every status word stores all 8 bits as written")
+def all_bits(ctx: CaseContext) -> None:
+    for n, value in ((0, "A2"), (1, "3F"), (2, "2B"), (3, "FF"), (5, "80")):
+        setup(ctx, f"SW{n},{value}")
+        answers(ctx, ctx.link.send(f"SR{n}"), f"0,{value}", f"SR{n} after SW{n},{value}")
+
+
+@case("10.3.status.run-bit", tag="M", source="M84 12.5.11",
+      rule="ST6 bit 6 (RUN) is set while a vector is processed and clear when idle")
+def run_bit(ctx: CaseContext) -> None:
+    setup(ctx, "L" + vector(ctx, 500))
+    r = ctx.link.send("SR6")
+    ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
+               observed=show(r), expected="0,40")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    answers(ctx, ctx.link.send("SR6"), "0,00", "idle again")
+
+
+@case("10.3.status.inputs-read-ff", tag="D", source="spec 10.3 [D]",
+      rule="Input ports read FF with nothing connected")
+def inputs(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected")
+
+
+@case("10.3.interrupt.stops-motion", tag="M", source="M84 12.5.11", rig=True,
+      rule="An enabled active input stops the motion, sets its cause bit and INTA")
+def interrupt(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "SW0,01")
+    setup(ctx, "C" + vector(ctx, 3000))
+    link.wait(0.3)
+    link.rig.set_input(1, 0xFE)          # IN0 grounded: active at polarity 0
+    link.wait(1.0)
+    here = position(ctx)
+    link.wait(0.5)
+    ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here)
+    r = link.send("SR4")
+    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"], "ST4 bit 0, INTA",
+               observed=show(r), expected="8,01")
+
+
+@case("10.3.interrupt.polarity", tag="M", source="M84 12.5.11", rig=True,
+      rule="An input is active when its level equals its polarity bit")
+def polarity(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "SW2,01")                 # IN0 active at log. 1: unconnected = active
+    setup(ctx, "SW0,01")
+    r = link.send("SR4")
+    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"],
+               "an unconnected input with polarity 1 interrupts at once", observed=show(r),
+               expected="8,01")
+
+
+@case("10.3.flags.f-command", tag="M", source="M84 12.5.11",
+      rule="F answers ST6 with bit 5 = queue full")
+def f_idle(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("F"), "0,00", "F when idle")
+    code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", tag="D")

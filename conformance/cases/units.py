@@ -1,0 +1,130 @@
+"""Sections 1, 9, 10 (formats of every command per profile), 10.6 EEPROM, 10.7 GVE54
+motor mode, 12 GVE114 spindle."""
+
+from __future__ import annotations
+
+import re
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, position, setup, show, vector
+
+# command -> (a valid frame on an idle unit after reset, a regex of its answer) [spec 10]
+FORMATS = {
+    "?": ("?", r"0,.+"), "Q": ("Q", r"0,\d{8}"), "T": ("T10", "0"), "$": ("$100", "0"),
+    "A": ("A100", "0"), "V": ("V1000", "0"), "B": ("B1000", "0"),
+    "VL": ("VL1000,1000,1000", "0"), "VK": ("VK", "0"), "VN": ("VN", "0"), "XA": ("XA", "0"),
+    "XU": ("XU", "0"), "XD": ("XD", "0"), "XM": ("XM100", "0"), "P": ("P", r"0,-?\d+,-?\d+"),
+    "PF": ("PF", r"0(,-?\d+){3}"), "N": ("N", "0"), "NX": ("NX0", "0"), "NY": ("NY0", "0"),
+    "NZ": ("NZ0", "0"), "NA": ("NA0", "0"), "ER": ("ER05", r"0,[0-9A-F]{2}"),
+    "EFR": ("EFR30", r"0,\S+"), "EUR": ("EUR4C", r"0,\d+"), "O0": ("O0,FF", "0"),
+    "I0": ("I0", r"0,[0-9A-F]{2}"), "I1": ("I1", r"0,[0-9A-F]{2}"),
+    "I2": ("I2", r"0,[0-9A-F]{2}"), "SR": ("SR0", r"0,[0-9A-F]{2}"), "SW": ("SW0,00", "0"),
+    "F": ("F", r"0,[0-9A-F]{2}"), "@": ("@", r"0,\d+"), "H": ("H", "8"),
+}
+# commands of spec 10 a profile may lack (the refusal is 3)
+OPTIONAL = ["VL", "VK", "VN", "XM", "NX", "NY", "NZ", "NA", "W", "EFR", "EFW", "EUR", "EUW",
+            "M", "Y", "I0", "I2", "%", "*S", "*E"]
+REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100",
+                  "NX": "NX0", "NY": "NY0", "NZ": "NZ0", "NA": "NA0", "W": "WX,100,100,100,100",
+                  "EFR": "EFR30", "EFW": "EFW30,1", "EUR": "EUR30", "EUW": "EUW30,1",
+                  "M": "M4", "Y": "Y-", "I0": "I0", "I2": "I2", "%": "%+", "*S": "*S",
+                  "*E": "*E1"}
+
+
+@case("10.commands.formats", tag="M", source="M84 12.5; M114 13.6; M54; spec 10",
+      rule="Every command of the profile answers in the format of spec 10")
+def formats(ctx: CaseContext) -> None:
+    for name, (body, pattern) in FORMATS.items():
+        if name not in ctx.profile.commands:
+            continue
+        link = ctx.fresh_link()
+        r = link.send(body)
+        ok = r is not None and re.fullmatch(pattern, r.raw.decode("latin-1").rstrip("\r"))
+        ctx.expect(bool(ok), f"{body}", observed=show(r), expected=pattern)
+
+
+@case("10.commands.absent-refused", tag="M", source="spec 1, 5: code 3",
+      rule="A command the profile lacks answers 3")
+def absent(ctx: CaseContext) -> None:
+    lacking = [c for c in OPTIONAL if c not in ctx.profile.commands]
+    if not lacking:
+        ctx.expect(True, "the profile has every optional command")
+    for name in lacking:
+        code(ctx, ctx.link.send(REFUSAL_FRAMES[name]), 3, f"{name} → 3")
+
+
+@case("1.profile.version", tag="D", source="spec 1 [D]",
+      rule="? answers 0,<the profile's firmware string>")
+def version(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string")
+
+
+@case("9.reset.state", tag="M", source="M84 12.4; M114 13.5; M54",
+      rule="After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off")
+def reset_state(ctx: CaseContext) -> None:
+    for n in range(7):
+        answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00")
+    ctx.expect(position(ctx) == [0, 0, 0], "position 0", observed=position(ctx))
+    answers(ctx, ctx.link.send("@"), "0,8", "the index counted the SR and PF frames", tag="D")
+
+
+@case("9.reset.after-j", tag="D", source="M84 12.4; spec 9, 10 J [D]", destructive=True,
+      rule="J answers a plain 0 and restores the reset state after about 2 s", timing=True)
+def after_j(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "SW2,2B")
+    setup(ctx, "L" + vector(ctx, 16))
+    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    answers(ctx, link.send("J"), "0", "J → 0")
+    link.wait(2.5)
+    answers(ctx, link.send("SR2"), "0,00", "ST2 reset", tag="M")
+    answers(ctx, link.send("@"), "0,1", "the index restarted at 0")
+    ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", tag="M")
+
+
+@case("10.6.eeprom.round-trip", tag="M", source="M84 11; M114 11-12", destructive=True,
+      rule="EW writes a byte that ER reads back (kept, then restored by the suite)")
+def eeprom(ctx: CaseContext) -> None:
+    link = ctx.link
+    r = link.send("ER40")
+    ctx.require(r is not None and r.code == 0, "ER40 answered")
+    old = int(r.values[0], 16)
+    new = old ^ 0x5A
+    answers(ctx, link.send("EW40,%02X" % new), "0", "EW40 → 0")
+    answers(ctx, link.send("ER40"), "0,%02X" % new, "ER40 reads the new byte")
+
+
+@case("10.6.eeprom.words", tag="D", source="spec 10 EFR/EUR [D]", destructive=True,
+      requires=("EFW", "EUW"), rule="EFW/EFR store float32 and EUW/EUR uint32 little-endian")
+def words(ctx: CaseContext) -> None:
+    link = ctx.link
+    answers(ctx, link.send("EFW30,0.25"), "0", "EFW30,0.25")
+    answers(ctx, link.send("EFR30"), "0,0.25", "EFR30 → 0.25")
+    answers(ctx, link.send("ER33"), "0,3E", "the float's top byte at 33 (little-endian)")
+    answers(ctx, link.send("EUW40,305419896"), "0", "EUW40")
+    answers(ctx, link.send("ER40"), "0,78", "the uint's low byte first")
+    code(ctx, link.send("EFRFD"), 5, "a word past FF → 5")
+
+
+@case("10.7.microstep.positions-in-sixteenths", tag="M-ex", source="M54 (G5)",
+      requires=("M",), rule="GVE54 positions are in 1/16 steps: M4, L100,100,100 → 400")
+def microstep(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "M4")
+    setup(ctx, "L100,100,100")
+    link.poll("L0,0,0", lambda r: r.code == 0, 60)
+    answers(ctx, link.send("PF"), "0,400,400,400", "PF after M4 and L100,100,100")
+    code(ctx, link.send("MQ"), 4, "an unknown mode → 4", tag="D")
+
+
+@case("12.spindle.address-7", tag="M-ex", source="M114 13.7 (G8)", rig=True,
+      applies=lambda p: p.spindle is not None,
+      rule="!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate")
+def spindle(ctx: CaseContext) -> None:
+    link = ctx.link
+    answers(ctx, link.send("V300", address=7), "0", "!7V300")
+    ctx.expect(link.rig.spindle() == 300, "spindle 300", observed=link.rig.spindle())
+    ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs())
+    answers(ctx, link.send("V0", address=7), "0", "!7V0")
+    ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs())
+    code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors", tag="D")

@@ -1,0 +1,1 @@
+"""Stateful Hypothesis machines, each run as a case with its own abstract model."""

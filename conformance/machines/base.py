@@ -1,0 +1,48 @@
+"""What every machine shares: a fresh link per example and the model's index check."""
+
+from __future__ import annotations
+
+from hypothesis.stateful import RuleBasedStateMachine, invariant
+
+from conformance.link.framing import Response
+from conformance.model.unit import ModelUnit
+
+
+class UnitMachine(RuleBasedStateMachine):
+    ctx = None      # set by run_machine
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.link = self.ctx.fresh_link()
+        p = self.ctx.profile
+        self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0] * len(p.axes))
+
+    def send(self, body: str, **kw) -> Response | None:
+        r = self.link.send(body, **kw)
+        if kw.get("answer", True) is not False:
+            self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1])
+        return r
+
+    def idle(self) -> None:
+        r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120)
+        self.model.frame_arrived("L")
+        assert r is not None, "the unit never became idle"
+        # the polls counted too: resynchronize with what the unit says the index is
+        self.model.index = self.index()
+
+    def index(self) -> int:
+        r = self.link.send("@")
+        assert r is not None and r.code == 0 and r.values, f"@ answered {r}"
+        return int(r.values[0])
+
+    def position(self) -> list[int]:
+        r = self.link.send("PF")
+        self.model.frame_arrived("P")
+        assert r is not None and r.code == 0, f"PF answered {r}"
+        return [int(v) for v in r.values]
+
+    @invariant()
+    def index_is_the_models(self) -> None:
+        if self.model.packet is None:
+            got = self.index()
+            assert got == self.model.index, f"index {got}, model {self.model.index}"

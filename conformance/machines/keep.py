@@ -1,0 +1,88 @@
+"""KEEP/RESTORE interleaved with motion, HALT, L moves, speed changes and GO: no step
+lost or gained (spec 10.4, 10.5)."""
+
+from __future__ import annotations
+
+from hypothesis import strategies as st
+from hypothesis.stateful import initialize, precondition, rule
+
+from conformance.case import CaseContext, case
+from conformance.machines.base import UnitMachine
+from conformance.machines.runner import run_machine
+
+
+class KeepMachine(UnitMachine):
+    @initialize()
+    def speed(self) -> None:
+        self.halted = False
+        self.kept = False
+        r = self.link.send("V2000")
+        assert r is not None and r.code == 0
+
+    @precondition(lambda self: not self.kept)
+    @rule(steps=st.integers(200, 1500), count=st.integers(1, 3))
+    def job(self, steps: int, count: int) -> None:
+        for _ in range(count):
+            r = self.link.send(f"C{steps},0,0")
+            assert r is not None, "C got no answer"
+            if r.code == 0:
+                self.model.book((steps, 0, 0))
+
+    @rule(seconds=st.sampled_from([0.05, 0.2, 0.6]))
+    def run(self, seconds: float) -> None:
+        self.link.wait(seconds)
+
+    @precondition(lambda self: not self.kept)
+    @rule()
+    def halt(self) -> None:
+        r = self.link.send("H")
+        assert r is not None and r.code == 0 and r.inta, f"H answered {r}"
+        self.halted = True
+
+    @precondition(lambda self: self.halted and not self.kept)
+    @rule(lift=st.integers(1, 300))
+    def keep_and_detour(self, lift: int) -> None:
+        r = self.link.send("K")
+        assert r is not None and r.code == 0 and not r.inta, f"K answered {r}"
+        self.kept, self.halted = True, False
+        for z in (-lift, lift):
+            self.idle()
+            r = self.link.send(f"L0,0,{z}")
+            assert r is not None and r.code == 0, f"L0,0,{z} after K answered {r}"
+        self.idle()
+
+    @precondition(lambda self: self.kept)
+    @rule(speed=st.sampled_from([500, 1000, 3000]))
+    def restore(self, speed: int) -> None:
+        r = self.link.send("R")
+        assert r is not None and r.code == 0 and r.inta, f"R answered {r} (INTA as saved)"
+        self.kept, self.halted = False, True
+        self.link.send(f"V{speed}")
+        self.link.send("XA")
+
+    @precondition(lambda self: self.halted)
+    @rule()
+    def go(self) -> None:
+        r = self.link.send("G")
+        assert r is not None and r.code == 0, f"G answered {r}"
+        self.halted = False
+
+    def teardown(self) -> None:
+        if self.kept:
+            self.link.send("R")
+            self.halted = True
+        if self.halted:
+            self.link.send("G")
+        self.idle()
+        got = self.position()
+        assert got == self.model.committed, f"position {got}, expected {self.model.committed}"
+
+    def index_is_the_models(self) -> None:      # this machine books positions instead
+        pass
+
+
+@case("10.5.machine.keep-restore", tag="M", source="M84 12.5.8; M114 13.6.9",
+      applies=lambda p: p.keep == "single-L" or p.keep == "full",
+      rule="KEEP/RESTORE around detours with HALT, GO and XA loses and gains no step")
+def keep_machine(ctx: CaseContext) -> None:
+    run_machine(ctx, KeepMachine)

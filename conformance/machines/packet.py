@@ -1,0 +1,75 @@
+"""Packets *S/*E: member counts right and wrong, invalid members, breakers (spec 7)."""
+
+from __future__ import annotations
+
+from hypothesis import strategies as st
+from hypothesis.stateful import initialize, precondition, rule
+
+from conformance.case import CaseContext, case
+from conformance.machines.base import UnitMachine
+from conformance.machines.runner import run_machine
+
+# member frame -> (kind, code it fails the packet with, steps it commits)
+MEMBERS = {"C1,0,0": ("C", 0, (1, 0, 0)), "C0,2,0": ("C", 0, (0, 2, 0)),
+           "B500": ("B", 0, None), "B1": ("B", 5, None), "V100": ("V", 4, None),
+           "C1,2": ("C", 4, None)}
+
+
+class PacketMachine(UnitMachine):
+    @initialize(summed=st.booleans())
+    def mode(self, summed: bool) -> None:
+        if summed:
+            r = self.send("%+", checksum=False)
+            assert r is not None and r.code == 0
+            self.model.checksums = True
+
+    @rule()
+    def start(self) -> None:
+        self.send("*S", answer=False)
+        self.model.open_packet()
+
+    @precondition(lambda self: self.model.packet is not None and len(self.model.packet) < 8)
+    @rule(body=st.sampled_from(sorted(MEMBERS)))
+    def member(self, body: str) -> None:
+        self.link.send(body, answer=False)
+        kind, code, _ = MEMBERS[body]
+        self.model.frame_arrived(kind)
+        self.model.member(kind, code)
+        self.pending = [*getattr(self, "pending", []), body]
+
+    @rule(delta=st.sampled_from([0, 0, 0, 1, -1]))
+    def end(self, delta: int) -> None:
+        members = list(getattr(self, "pending", [])) if self.model.packet is not None else []
+        k = len(self.model.packet) if self.model.packet is not None else 0
+        n = max(0, k + delta)
+        expected = self.model.end_packet(n, self.model.buffer)
+        r = self.send(f"*E{n}")
+        self.pending = []
+        assert r is not None, "*E got no answer"
+        assert (r.code, r.values) == (expected[0], [str(expected[1])]), (
+            f"*E{n}: {r.text}, expected {expected[0]},{expected[1]}")
+        if expected[0] == 0:
+            for body in members:
+                steps = MEMBERS[body][2]
+                if steps:
+                    self.model.book(steps)
+
+    @precondition(lambda self: self.model.packet is not None)
+    @rule()
+    def breaker(self) -> None:
+        r = self.link.send("@")
+        assert r is not None and r.code == 0, f"@ inside a packet answered {r}"
+        self.model.packet = None
+        self.pending = []
+
+    def teardown(self) -> None:
+        if self.model.packet is None:
+            self.idle()
+            got = self.position()
+            assert got == self.model.committed, f"position {got}, committed {self.model.committed}"
+
+
+@case("7.machine.packets", tag="D", source="M84 12.3.3; spec 7 [D]", requires=("*S",),
+      rule="Packets commit all or nothing, answer code,k, with and without checksums")
+def packet_machine(ctx: CaseContext) -> None:
+    run_machine(ctx, PacketMachine)

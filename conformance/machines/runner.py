@@ -1,0 +1,25 @@
+"""Running a RuleBasedStateMachine as a case: the machine gets the case context, every
+example starts from a fresh link, a failing example's wire log is saved as a transcript."""
+
+from __future__ import annotations
+
+from hypothesis.stateful import RuleBasedStateMachine, run_state_machine_as_test
+
+from conformance.case import CaseContext
+
+
+def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
+    """Run ``machine`` with ctx.settings; a failure becomes a failed check of the case."""
+    machine.ctx = ctx  # type: ignore[attr-defined]
+    try:
+        run_state_machine_as_test(machine, settings=ctx.settings)
+    except AssertionError as err:
+        link = ctx.links[-1] if ctx.links else None
+        ctx.expect(False, f"{machine.__name__}: {err}".splitlines()[0][:300],
+                   observed=str(err)[-500:], expected="every invariant holds")
+        if link is not None:
+            ctx.artifact("failing-example.gvt", "# gve-transcript 1\n# title: failing "
+                         f"example of {machine.__name__}\n" + "\n".join(
+                             link.transcript_lines()) + "\n")
+    else:
+        ctx.expect(True, f"{machine.__name__}: every example kept the invariants")

@@ -1,0 +1,64 @@
+"""An abstract GVE unit: the protocol state a host can observe (spec 4-8, 10.1, 10.5).
+
+It does not simulate motion; it books what the unit must have accepted, so that the
+machines can check the index, the checksum mode, packets and position bookkeeping.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+UNCOUNTED = ("@", ">")       # spec 8
+PACKET_MEMBERS = ("C", "B")  # spec 7
+
+
+@dataclass
+class ModelUnit:
+    axes: int = 3
+    buffer: int = 64
+    checksums: bool = False
+    index: int = 0
+    inta: bool = False
+    packet: list[tuple[str, int]] | None = None     # (member kind, its code)
+    committed: list[int] = field(default_factory=lambda: [0, 0, 0])
+
+    # -- section 8 ------------------------------------------------------------------------
+    def frame_arrived(self, name: str, checksum_ok: bool = True) -> None:
+        """A complete frame for the unit arrived (spec 8: counted unless @/> or a bad sum)."""
+        if checksum_ok and name not in UNCOUNTED:
+            self.index = (self.index + 1) % 256
+
+    # -- section 6 ------------------------------------------------------------------------
+    def checksum_answer(self, sum_state: str) -> int:
+        """The code for a frame whose checksum is "good", "bad", "missing" or "lower"."""
+        if not self.checksums:
+            return 0 if sum_state == "missing" else 4
+        return 0 if sum_state in ("good", "lower") else 4
+
+    # -- section 7 ------------------------------------------------------------------------
+    def open_packet(self) -> None:
+        self.packet = []
+
+    def member(self, kind: str, code: int) -> None:
+        assert self.packet is not None
+        self.packet.append((kind, code))
+
+    def end_packet(self, n: int, room: int) -> tuple[int, int]:
+        """(code, k) of *E<n> (spec 7), and commit when 0."""
+        if self.packet is None:
+            return 4, 0
+        members, self.packet = self.packet, None
+        k = len(members)
+        if k != n:
+            return 2, k
+        for _, c in members:
+            if c:
+                return c, k
+        vectors = sum(1 for kind, _ in members if kind == "C")
+        if vectors > room:
+            return 1, k
+        return 0, k
+
+    def book(self, steps: tuple[int, ...]) -> None:
+        for i, s in enumerate(steps):
+            self.committed[i] += s

@@ -1,0 +1,46 @@
+"""JUnit XML in the common schema: testsuites > testsuite (one per target) > testcase."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from conformance.runner import CaseResult, RunResult
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+
+
+def _message(r: CaseResult) -> str:
+    failed = r.failed_checks
+    if failed:
+        c = failed[0]
+        return f"[{c['tag']}] {c['what']} (observed {c['observed']!r}, expected {c['expected']!r})"
+    return "; ".join(r.notes)[:500] or r.verdict
+
+
+def render_junit(run: RunResult) -> str:
+    root = ET.Element("testsuites", name="gve-conformance", tests=str(len(run.results)),
+                      time=f"{run.seconds:.3f}")
+    for target in run.targets:
+        results = [r for r in run.results if r.target == target]
+        suite = ET.SubElement(
+            root, "testsuite", name=target, tests=str(len(results)),
+            failures=str(sum(r.verdict == FAIL for r in results)),
+            errors=str(sum(r.verdict == ERROR for r in results)),
+            skipped=str(sum(r.verdict in (MISSING, COULD_NOT_TEST) for r in results)),
+            time=f"{sum(r.seconds for r in results):.3f}")
+        for r in results:
+            tc = ET.SubElement(suite, "testcase", name=f"{r.id}[{r.profile}]",
+                               classname=f"gve.{r.profile}.section{r.section}",
+                               time=f"{r.seconds:.3f}")
+            log = "\n".join(r.wire_log)
+            if r.verdict == FAIL:
+                ET.SubElement(tc, "failure", message=_message(r), type=r.verdict).text = log
+            elif r.verdict == ERROR:
+                ET.SubElement(tc, "error", message=_message(r), type=r.verdict).text = (
+                    "\n".join(r.notes) + "\n" + log)
+            elif r.verdict in (MISSING, COULD_NOT_TEST):
+                ET.SubElement(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
+            props = ET.SubElement(tc, "properties")
+            for key in ("verdict", "tag", "rule", "source", "section"):
+                ET.SubElement(props, "property", name=key, value=str(getattr(r, key)))
+            ET.SubElement(tc, "system-out").text = log
+    return ET.tostring(root, encoding="unicode", xml_declaration=True)

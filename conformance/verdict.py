@@ -1,0 +1,37 @@
+"""Verdicts and their grading from the spec's tags (docs/suite.md, spec preamble)."""
+
+from __future__ import annotations
+
+PASS = "PASS"
+NON_STRICT = "NON-STRICT"
+FAIL = "FAIL"
+INFO = "INFO"
+MISSING = "MISSING"
+COULD_NOT_TEST = "COULD-NOT-TEST"
+ERROR = "ERROR"
+
+#: worst first: the verdict of a case is the worst of its checks
+ORDER = (ERROR, FAIL, NON_STRICT, INFO, COULD_NOT_TEST, MISSING, PASS)
+TAGS = ("M", "M-ex", "D", "D-info", "always")
+
+
+def grade(tag: str, implements_decisions: bool) -> str:
+    """The verdict of one failed check carrying ``tag``."""
+    if tag in ("M", "M-ex", "always"):
+        return FAIL
+    if tag == "D":
+        return FAIL if implements_decisions else NON_STRICT
+    if tag == "D-info":
+        return INFO
+    raise ValueError(f"unknown tag {tag!r}")
+
+
+def worst(verdicts: list[str]) -> str:
+    if not verdicts:
+        return PASS
+    return min(verdicts, key=ORDER.index)
+
+
+def failing(verdict: str) -> bool:
+    """Whether the run's exit status must be non-zero."""
+    return verdict in (FAIL, ERROR)
