@@ -15,7 +15,7 @@ def ok(ctx: CaseContext) -> None:
       rule="C with no room in the CONT buffer answers 1; the buffer holds the profile's size")
 def queue_full(ctx: CaseContext) -> None:
     n = ctx.profile.buffer
-    setup(ctx, "V10")
+    setup(ctx, f"V{ctx.profile.ranges['V'].lo}")
     for i in range(n):
         r = ctx.link.send("C" + vector(ctx, 5000))
         if not code(ctx, r, 0, f"vector {i + 1} of {n} is accepted"):

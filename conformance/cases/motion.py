@@ -30,7 +30,7 @@ def idiom(ctx: CaseContext) -> None:
 @case("10.1.queue.executing-counts", tag="M", source="M84 12.5.2: '1 je vykonáván'",
       rule="The CONT buffer's size includes the executing vector; F shows bit 5 when full")
 def queue_full_flag(ctx: CaseContext) -> None:
-    setup(ctx, "V10")
+    setup(ctx, f"V{ctx.profile.ranges['V'].lo}")
     for _ in range(ctx.profile.buffer):
         setup(ctx, "C" + vector(ctx, 5000))
     r = ctx.link.send("F")

@@ -55,7 +55,7 @@ def out_of_range(ctx: CaseContext) -> None:
 @case("7.packet.no-room", tag="D", source=RULE, requires=("*S",),
       rule="A packet that does not fit the queue answers 1 and commits nothing")
 def no_room(ctx: CaseContext) -> None:
-    setup(ctx, "V10")
+    setup(ctx, f"V{ctx.profile.ranges['V'].lo}")
     n = ctx.profile.buffer
     for _ in range(n - 1):
         setup(ctx, "C" + vector(ctx, 5000))

@@ -64,7 +64,8 @@ def version(ctx: CaseContext) -> None:
 def reset_state(ctx: CaseContext) -> None:
     for n in range(7):
         answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00")
-    ctx.expect(position(ctx) == [0, 0, 0], "position 0", observed=position(ctx))
+    here = position(ctx)
+    ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0])
     answers(ctx, ctx.link.send("@"), "0,8", "the index counted the SR and PF frames", tag="D")
 
 

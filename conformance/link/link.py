@@ -69,6 +69,13 @@ class Link:
             self._record(UNIT, data)
         return data
 
+    def _pause(self, seconds: float) -> None:
+        """Hold back the next bytes (an injected delay); what arrives stays unread."""
+        if self.virtual:
+            self.port.line.advance(seconds)
+        else:
+            time.sleep(seconds)      # the fault itself is a pause on the wire
+
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
         """Plan a fault for the next frame ("host") or response ("unit")."""
@@ -95,7 +102,7 @@ class Link:
             self.note(f"fault host {fault.kind} {fault.params}")
         for piece, pause in pieces:
             if pause:
-                self.wait(pause)
+                self._pause(pause)
             if piece:
                 self._record(HOST, piece)
                 self.port.write(piece)
@@ -118,7 +125,9 @@ class Link:
         name = body[:1]
         wait = timeout if timeout is not None else SLOW.get(name, MARGIN + self.byte_seconds(
             len(data) + 64))
-        r = self.read_response(wait, lines, summed=self.checksums or summed is not False)
+        # the answer is summed iff the mode is on after the command (spec 6, 10 J)
+        after = {"%+": True, "%-": False, "J": False}.get(body, self.checksums)
+        r = self.read_response(wait, lines, summed=after)
         if r is None:
             return None
         r.sent_at = sent_at

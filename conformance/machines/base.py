@@ -15,12 +15,12 @@ class UnitMachine(RuleBasedStateMachine):
         super().__init__()
         self.link = self.ctx.fresh_link()
         p = self.ctx.profile
-        self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0] * len(p.axes))
+        # PF reports X, Y, Z on every profile (spec 10: GVE114 PF also 3 values)
+        self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0])
 
     def send(self, body: str, **kw) -> Response | None:
         r = self.link.send(body, **kw)
-        if kw.get("answer", True) is not False:
-            self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1])
+        self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1])
         return r
 
     def idle(self) -> None:
