@@ -1,0 +1,43 @@
+"""The command line and the three reports."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+from conformance.__main__ import main
+
+
+def test_a_run_writes_three_reports(tmp_path, capsys):
+    status = main(["--target", "emu:GVE84-100", "--cases", "5.*", "--cases", "11.golden.g1*",
+                   "--report-dir", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "frames exchanged" in out
+    (folder,) = tmp_path.iterdir()
+    suites = ET.parse(folder / "junit.xml").getroot()
+    cases = suites.findall("./testsuite/testcase")
+    assert cases and all(c.get("name") and c.get("classname") for c in cases)
+    results = json.loads((folder / "results.json").read_text())
+    assert results["counts"].get("PASS") == len(cases)
+    html = (folder / "report.html").read_text()
+    assert "<link" not in html and "<script src" not in html      # self-contained
+    assert "5.errors.go-without-inta" in html and "!0G" in html      # the wire log
+
+
+def test_a_mutant_fails_the_run(tmp_path, capsys):
+    status = main(["--target", "emu:GVE84-100", "--cases", "5.errors.go-without-inta",
+                   "--mutant", "go-without-inta", "--no-reports"])
+    assert status == 1
+    assert "FAIL" in capsys.readouterr().out
+
+
+def test_bad_targets_are_explained(capsys):
+    assert main(["--target", "carrier-pigeon:x"]) == 2
+    assert main(["--target", "serial:/dev/null"]) == 2      # needs --profile
+    assert "--profile" in capsys.readouterr().err
+
+
+def test_list(capsys):
+    assert main(["--list"]) == 0
+    assert "11.golden.g6-keep-restore" in capsys.readouterr().out
