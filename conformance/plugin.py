@@ -1,1 +1,78 @@
-"""The pytest plugin of the conformance suite (registered through the pytest11 entry point)."""
+"""The pytest plugin (entry point ``gve_conformance``): run the suite's cases as pytest
+items with ``pytest --gve-target emu:GVE84-100`` (any target of the command line).
+
+Inert unless ``--gve-target`` is given, so it never changes other pytest runs.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+
+import pytest
+
+from conformance.runner import CaseResult, run_case
+from conformance.targets import DEFAULT_MAX_TRAVEL, parse_target
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    g = parser.getgroup("gve-conformance", "GVE protocol conformance suite")
+    g.addoption("--gve-target", action="append", default=[],
+                help="run the suite's cases against this target (emu:PROFILE, serial:..., tcp:...)")
+    g.addoption("--gve-profile", default=None, help="the profile a serial/tcp target behaves as")
+    g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
+    g.addoption("--gve-settings", default="ci", help="Hypothesis settings profile")
+    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
+    g.addoption("--gve-allow-destructive", action="store_true")
+
+
+class CaseFailed(Exception):
+    def __init__(self, result: CaseResult) -> None:
+        super().__init__(result.verdict)
+        self.result = result
+
+
+class GveItem(pytest.Item):
+    def __init__(self, *, case, target, settings_name: str, **kw) -> None:
+        super().__init__(**kw)
+        self.case, self.target, self.settings_name = case, target, settings_name
+
+    def runtest(self) -> None:
+        result = run_case(self.case, self.target, self.settings_name)
+        if result.verdict in (MISSING, COULD_NOT_TEST):
+            pytest.skip(f"{result.verdict}: {'; '.join(result.notes)[:200]}")
+        if result.verdict in (FAIL, ERROR):
+            raise CaseFailed(result)
+        for c in result.checks:
+            assert c["ok"] or result.verdict not in (FAIL, ERROR)
+
+    def repr_failure(self, excinfo, style=None) -> str:
+        if isinstance(excinfo.value, CaseFailed):
+            r = excinfo.value.result
+            lines = [f"{r.verdict} {r.id} [{r.profile}]: {r.rule} ({r.source})"]
+            lines += [f"  [{c['tag']}] {c['what']}: observed {c['observed']!r}, "
+                      f"expected {c['expected']!r}" for c in r.failed_checks]
+            return "\n".join(lines + r.notes + ["wire log:", *r.wire_log])
+        return super().repr_failure(excinfo, style)
+
+    def reportinfo(self):
+        return "gve-conformance", None, f"{self.case.id} [{self.target.profile.name}]"
+
+
+def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
+                                  items: list[pytest.Item]) -> None:
+    specs = config.getoption("--gve-target")
+    if not specs:
+        return
+    from conformance.case import select
+    globs = config.getoption("--gve-cases") or None
+    for spec in specs:
+        target = parse_target(spec, profile=config.getoption("--gve-profile"),
+                              allow_destructive=config.getoption("--gve-allow-destructive"),
+                              max_travel=config.getoption("--gve-max-travel"))
+        for case in select(globs):
+            if globs and not any(fnmatch.fnmatch(case.id, g) for g in globs):
+                continue
+            items.append(GveItem.from_parent(
+                session, name=f"{case.id}[{target.profile.name}]", case=case, target=target,
+                settings_name=config.getoption("--gve-settings")))
