@@ -100,30 +100,70 @@ class Line:
         return len(data)
 
     # -- units -> host -------------------------------------------------------------------------
+    # _rx holds answers as [instant its first byte is complete, bytes, bytes taken];
+    # byte i of a chunk is complete byte_ns after byte i-1.
     def _emit(self, data: bytes, t: int) -> None:
         start = max(t, self._unit_free)
         b = self.byte_ns
-        self._rx.extend((start + (i + 1) * b, data[i:i + 1]) for i in range(len(data)))
+        self._rx.append([start + b, data, 0])
         self._unit_free = start + len(data) * b
         if self.log is not None:
             self.log.unit(data, start + b)
+
+    def _ready_count(self, now: int) -> int:
+        b, n = self.byte_ns, 0
+        for first, data, taken in self._rx:
+            if first > now:
+                break
+            ready = len(data) if not b else min(len(data), (now - first) // b + 1)
+            n += ready - taken
+            if ready < len(data):
+                break
+        return n
 
     @property
     def in_waiting(self) -> int:
         now = self.now
         if not self.clock.virtual:
             self._settle(now)
-        return sum(1 for ready, _ in self._rx if ready <= now)
+        return self._ready_count(now)
 
     def _take(self, size: int, terminator: bytes | None) -> bytes:
         out = bytearray()
-        now = self.now
-        rx = self._rx
-        while rx and rx[0][0] <= now and len(out) < size:
-            out += rx.popleft()[1]
-            if terminator and out.endswith(terminator):
+        now, b, rx = self.now, self.byte_ns, self._rx
+        while rx and len(out) < size:
+            chunk = rx[0]
+            first, data, taken = chunk
+            if first > now:
+                break
+            ready = len(data) if not b else min(len(data), (now - first) // b + 1)
+            end = min(ready, taken + size - len(out))
+            if terminator:
+                k = data.find(terminator, taken, end)
+                if k >= 0:
+                    end = k + len(terminator)
+            out += data[taken:end]
+            chunk[2] = end
+            if end == len(data):
+                rx.popleft()
+            if end < ready or (terminator and out.endswith(terminator)) or ready < len(data):
                 break
         return bytes(out)
+
+    def _complete_at(self, size: int, terminator: bytes | None) -> int | None:
+        """The instant the request (``size`` bytes or the terminator) is complete, if the
+        bytes are already on their way."""
+        b, need = self.byte_ns, size
+        for first, data, taken in self._rx:
+            avail = len(data) - taken
+            if terminator:
+                k = data.find(terminator, taken)
+                if k >= 0 and k - taken < need:
+                    return first + k * b
+            if avail >= need:
+                return first + (taken + need - 1) * b
+            need -= avail
+        return None
 
     def read(self, size: int = 1, timeout: float | None = 0.0,
              terminator: bytes | None = None) -> bytes:
@@ -138,8 +178,8 @@ class Line:
             out += self._take(size - len(out), terminator)
             if len(out) >= size or (terminator and out.endswith(terminator)):
                 return bytes(out)
-            nxt = [x for x in (self._rx[0][0] if self._rx else None, self.next_deadline())
-                   if x is not None]
+            ready = self._complete_at(size - len(out), terminator)
+            nxt = [x for x in (ready, self.next_deadline()) if x is not None]
             t = min(nxt) if nxt else None
             if t is None or (deadline is not None and t > deadline):
                 if deadline is not None:
@@ -151,7 +191,7 @@ class Line:
     def take_ready(self) -> bytes:
         """Real time: every byte due by now (the server writes them to its port)."""
         self._settle(self.now)
-        return self._take(1 << 30, None)
+        return self._take(1 << 30, None) if self._rx else b""
 
     def read_until(self, terminator: bytes = b"\r", size: int = 4096,
                    timeout: float | None = 0.0) -> bytes:

@@ -60,7 +60,10 @@ class Server:
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, self.stop)
         if self.control is not None:
-            self.sel.register(self.control, selectors.EVENT_READ, "control")
+            try:
+                self.sel.register(self.control, selectors.EVENT_READ, "control")
+            except (PermissionError, OSError, ValueError):
+                self.control = None          # e.g. /dev/null: no console, serve anyway
         while self.running:
             for key, _ in self.sel.select(self._timeout()):
                 if key.data == "control":

@@ -466,12 +466,13 @@ COMMANDS: dict[str, Handler] = {
 }
 # Answered by the unit itself (they act on framing, history, packets or the restart).
 SPECIAL = (">", "J", "%", "*S", "*E")
-NAMES = sorted([*COMMANDS, *SPECIAL], key=len, reverse=True)
+NAMES = frozenset([*COMMANDS, *SPECIAL])
 
 
 def split(body: str) -> tuple[str | None, str]:
-    """The command name at the start of ``body`` and its parameter text."""
-    for name in NAMES:
-        if body.startswith(name):
-            return name, body[len(name):]
+    """The command name at the start of ``body`` (the longest that matches) and its
+    parameter text."""
+    for n in (3, 2, 1):
+        if body[:n] in NAMES and len(body) >= n:
+            return body[:n], body[n:]
     return None, body

@@ -160,14 +160,20 @@ class Unit:
 
     # -- time -------------------------------------------------------------------------------
     def next_deadline(self) -> int | None:
-        candidates = [self.framer.deadline(), self.motion.next_event()]
-        candidates += [d.instant for _, d in self._pending]
-        if self._deaf_until > self.now:
-            candidates.append(self._deaf_until)
-        due = [c for c in candidates if c is not None and c > self.now]
-        return min(due) if due else None
+        now, best = self.now, None
+        for c in (self.framer.deadline(), self.motion.next_event(), self._deaf_until):
+            if c is not None and c > now and (best is None or c < best):
+                best = c
+        for _, d in self._pending:
+            if d.instant > now and (best is None or d.instant < best):
+                best = d.instant
+        return best
 
     def advance(self, t: int) -> None:
+        if not self._pending and self.framer.buf is None:
+            if t > self.now:
+                self.now = t
+            return
         while True:
             expiry = self.framer.deadline()
             answer = min((d.instant for _, d in self._pending), default=None)

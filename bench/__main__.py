@@ -1,0 +1,8 @@
+"""Run every benchmark: `python -m bench`."""
+
+from bench import bench_emulator, bench_stepper
+
+if __name__ == "__main__":
+    bench_emulator.main()
+    print()
+    bench_stepper.main()
