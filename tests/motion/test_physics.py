@@ -1,4 +1,4 @@
-"""Physics of the stepper core (spec 10.2, 10.4, 10.5), checked on the Python twin.
+"""Physics of the stepper cores (spec 10.2, 10.4, 10.5), checked on every core built.
 
 The expectations come from the spec's rules (vectors end on their targets, no rate above
 the cap, HALT + GO loses no step, KEEP/RESTORE keeps a partial vector), not from the
@@ -12,17 +12,20 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import SECOND, Vector, create
+from emulator.motion import SECOND, Vector, c_available, create
 from emulator.motion.arith import acc_count, acc_time
 
 MAX_RATE = 100_000
 AXES = 3
 
+CORES = ["python"] + (["c"] if c_available() else [])
+pytestmark = pytest.mark.parametrize("core", CORES)
+
 SETTINGS = settings(max_examples=40, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow])
 
 
-def make(stepper: str = "python"):
+def make(stepper: str):
     return create(AXES, MAX_RATE, stepper=stepper)
 
 
@@ -56,7 +59,7 @@ def total(vectors) -> tuple[int, ...]:
 
 @given(st.integers(0, 10**6), st.integers(0, 10**8), st.integers(0, 2**35))
 @settings(max_examples=300, deadline=None, derandomize=True)
-def test_acc_time_is_the_first_instant_of_the_step(v, a, m):
+def test_acc_time_is_the_first_instant_of_the_step(core, v, a, m):
     if v == 0 and a == 0:
         return
     tau = acc_time(v, a, m)
@@ -68,8 +71,8 @@ def test_acc_time_is_the_first_instant_of_the_step(v, a, m):
 
 @given(st.lists(vector_st, min_size=1, max_size=6))
 @SETTINGS
-def test_vectors_end_on_their_targets_and_pulses_add_up(vectors):
-    m = make()
+def test_vectors_end_on_their_targets_and_pulses_add_up(core, vectors):
+    m = make(core)
     t = 0
     for v in vectors:
         m.push(v, t)
@@ -86,8 +89,8 @@ def test_vectors_end_on_their_targets_and_pulses_add_up(vectors):
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
-def test_position_equals_the_pulses_before_it(vectors, data):
-    m = make()
+def test_position_equals_the_pulses_before_it(core, vectors, data):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     end = m.drain_instant() or m.now
@@ -104,8 +107,8 @@ def test_position_equals_the_pulses_before_it(vectors, data):
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
-def test_pulse_windows_slice_exactly(vectors, data):
-    m = make()
+def test_pulse_windows_slice_exactly(core, vectors, data):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     end = m.drain_instant() or m.now
@@ -118,8 +121,8 @@ def test_pulse_windows_slice_exactly(vectors, data):
 
 @given(st.lists(vector_st, min_size=1, max_size=4))
 @SETTINGS
-def test_no_axis_steps_faster_than_the_variant_allows(vectors):
-    m = make()
+def test_no_axis_steps_faster_than_the_variant_allows(core, vectors):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     end = run_out(m)
@@ -130,39 +133,39 @@ def test_no_axis_steps_faster_than_the_variant_allows(vectors):
             assert np.diff(axis_times).min() >= SECOND // MAX_RATE
 
 
-def test_cruise_runs_at_the_commanded_rate():
-    m = make()
+def test_cruise_runs_at_the_commanded_rate(core):
+    m = make(core)
     m.push(vector((10_000, 0, 0), continuous=False, v=2000, a=1_000_000), 0)
     times, _ = m.pulses(0, m.drain_instant() + 1)
     middle = np.diff(times[4000:6000])
     assert middle.min() >= SECOND // 2000 and middle.max() <= SECOND // 2000 + 1
 
 
-def test_path_speed_divides_the_rate_by_the_length():
-    m = make()
+def test_path_speed_divides_the_rate_by_the_length(core):
+    m = make(core)
     m.push(vector((3000, 4000, 0), continuous=False, v=1000, a=10_000_000, vk=True), 0)
     end = m.drain_instant()
     # |d| = 5000 at 1000/s: 5 s of motion; the dominant Y runs at 800/s
     assert 5 * SECOND <= end - 5_000_000 <= 5 * SECOND + SECOND // 50
 
 
-def test_axis_limit_caps_the_dominant_rate():
-    m = make()
+def test_axis_limit_caps_the_dominant_rate(core):
+    m = make(core)
     m.push(vector((1000, 1000, 0), continuous=False, v=5000, a=10_000_000,
                   limits=(500, MAX_RATE, MAX_RATE)), 0)
     end = m.drain_instant()
     assert end >= 2 * SECOND  # X capped at 500/s over 1000 steps
 
 
-def test_zero_vector_completes_at_once():
-    m = make()
+def test_zero_vector_completes_at_once(core):
+    m = make(core)
     m.push(vector((0, 0, 0), continuous=False), 123)
     assert not m.flags(123).busy
     assert m.drain_instant() is None
 
 
-def test_dwell_before_a_start_from_rest():
-    m = make()
+def test_dwell_before_a_start_from_rest(core):
+    m = make(core)
     m.push(vector((10, 0, 0), continuous=False, dwell_ms=20), 0)
     end = run_out(m)
     m.push(vector((10, 0, 0), continuous=False, dwell_ms=20), end)
@@ -170,9 +173,9 @@ def test_dwell_before_a_start_from_rest():
     assert times[0] - end >= 20_000_000
 
 
-def test_junction_is_faster_than_stopping():
+def test_junction_is_faster_than_stopping(core):
     def duration(gap: int) -> int:
-        m = make()
+        m = make(core)
         m.push(vector((2000, 0, 0), v=1000, b=1000), 0)
         m.push(vector((2000, 0, 0), v=1000, b=1000), gap)
         return m.drain_instant()
@@ -183,8 +186,8 @@ def test_junction_is_faster_than_stopping():
 
 @given(st.lists(vector_st, min_size=1, max_size=5), st.data())
 @SETTINGS
-def test_halt_and_resume_end_where_not_halting_ends(vectors, data):
-    m = make()
+def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     end = m.drain_instant() or m.now
@@ -202,8 +205,8 @@ def test_halt_and_resume_end_where_not_halting_ends(vectors, data):
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
-def test_keep_restore_around_a_detour_loses_no_step(vectors, data):
-    m = make()
+def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     end = m.drain_instant() or m.now
@@ -223,8 +226,8 @@ def test_keep_restore_around_a_detour_loses_no_step(vectors, data):
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
-def test_overrides_change_speed_not_targets(vectors, data):
-    m = make()
+def test_overrides_change_speed_not_targets(core, vectors, data):
+    m = make(core)
     for i, v in enumerate(vectors):
         m.push(v, i)
     t = 0
@@ -243,17 +246,17 @@ def test_overrides_change_speed_not_targets(vectors, data):
     assert m.position(m.now) == total(vectors)
 
 
-def test_multiplier_doubles_the_speed():
+def test_multiplier_doubles_the_speed(core):
     def duration(percent: int) -> int:
-        m = make()
+        m = make(core)
         m.set_multiplier(percent, 0)
         m.push(vector((20_000, 0, 0), continuous=False, v=1000, a=10_000_000), 0)
         return m.drain_instant()
     assert abs(duration(100) - 2 * duration(200)) < SECOND // 10
 
 
-def test_delete_keeps_the_position():
-    m = make()
+def test_delete_keeps_the_position(core):
+    m = make(core)
     m.push(vector((5000, 0, 0)), 0)
     rest = m.halt(SECOND)
     here = m.position(rest)
@@ -262,14 +265,14 @@ def test_delete_keeps_the_position():
     assert not m.flags(rest).halted
 
 
-def test_set_position_moves_the_counter_only():
-    m = make()
+def test_set_position_moves_the_counter_only(core):
+    m = make(core)
     m.set_position(1, 100, 0)
     assert m.position(0) == (0, 100, 0)
 
 
-def test_instant_of_position_finds_the_crossing():
-    m = make()
+def test_instant_of_position_finds_the_crossing(core):
+    m = make(core)
     m.push(vector((0, 3000, 0), continuous=False), 0)
     t = m.instant_of_position(1, 1234)
     assert t is not None
@@ -279,9 +282,8 @@ def test_instant_of_position_finds_the_crossing():
 
 # -- the closed form ----------------------------------------------------------------------
 
-@pytest.mark.parametrize("stepper", ["python"])
-def test_a_full_queue_of_huge_vectors_costs_nothing_per_step(stepper):
-    m = create(4, 500_000, stepper=stepper)
+def test_a_full_queue_of_huge_vectors_costs_nothing_per_step(core):
+    m = create(4, 500_000, stepper=core)
     big = 2**31 - 1
     v = Vector((big, -big, big // 3, 7), True, 500_000, 10_000_000, 500_000, 512, 5_000_000,
                False, (500_000,) * 4)

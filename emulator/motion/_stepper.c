@@ -1,0 +1,693 @@
+/* The C stepper core: a faithful port of python_twin.py / segment.py / arith.py.
+ *
+ * Every quantity is an integer; products are computed in 128 bits so the results equal
+ * the Python twin's (unbounded integers) bit for bit. docs/motion-model.md is the spec.
+ * The only floating point is the first guess of an integer square root, which is then
+ * corrected exactly.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "_stepper.h"
+
+typedef __int128 i128;
+typedef unsigned __int128 u128;
+typedef int64_t i64;
+
+#define SECOND 1000000000LL
+#define NEVER ((i64)((uint64_t)1 << 61))
+#define HISTORY 65536
+#define FWD 0
+#define REV 1
+
+/* ---- arithmetic (arith.py) ------------------------------------------------------ */
+
+static i64 sat(i128 t) { return t < NEVER ? (i64)t : NEVER; }
+static i128 max128(i128 a, i128 b) { return a > b ? a : b; }
+static i128 min128(i128 a, i128 b) { return a < b ? a : b; }
+static i64 max64(i64 a, i64 b) { return a > b ? a : b; }
+static i64 min64(i64 a, i64 b) { return a < b ? a : b; }
+static i128 abs128(i128 a) { return a < 0 ? -a : a; }
+
+/* floor division (b > 0), as Python's // */
+static i128 fdiv(i128 a, i128 b) {
+    i128 q = a / b;
+    if ((a % b != 0) && (a < 0)) q -= 1;
+    return q;
+}
+
+u128 st_isqrt(u128 n) {
+    if (n < 2) return n;
+    u128 x = (u128)sqrtl((long double)n);
+    const u128 limit = ((u128)1 << 64) - 1;   /* x*x must not overflow */
+    if (x > limit) x = limit;
+    while (x * x > n) x--;
+    while (x < limit && (x + 1) * (x + 1) <= n) x++;
+    return x;
+}
+
+static i128 isqrt(i128 n) { return n <= 0 ? 0 : (i128)st_isqrt((u128)n); }
+
+static i128 acc_count(i64 v, i64 a, i128 tau) {
+    i128 num = (i128)2 * SECOND * v * tau + (i128)a * tau * tau;
+    return fdiv(num, (i128)2 * SECOND * SECOND);
+}
+
+i64 st_acc_time(i64 v, i64 a, i64 m) {
+    if (m <= 0) return 0;
+    i128 target = (i128)2 * SECOND * SECOND * m;
+    i128 b = (i128)2 * SECOND * v;
+    i128 tau;
+    if (a == 0) {
+        tau = -fdiv(-target, b);
+    } else {
+        u128 disc = (u128)(b * b) + (u128)4 * (u128)a * (u128)target;
+        tau = fdiv((i128)st_isqrt(disc) - b, (i128)2 * a);
+        while (tau > 0 && b * (tau - 1) + (i128)a * (tau - 1) * (tau - 1) >= target) tau--;
+        while (b * tau + (i128)a * tau * tau < target) tau++;
+    }
+    return sat(tau);
+}
+
+i64 st_acc_count(i64 v, i64 a, i64 tau) { return (i64)acc_count(v, a, tau); }
+
+static i64 axis_count(i64 k, i64 d, i64 n) {
+    if (d == 0 || n == 0) return 0;
+    i128 c = fdiv((i128)2 * k * abs128(d) + n, (i128)2 * n);
+    return (i64)(d > 0 ? c : -c);
+}
+
+static i64 first_step_reaching(i64 c, i64 d, i64 n) {
+    i128 ad = abs128(d);
+    i128 k = -fdiv(-((i128)2 * n * c - n), 2 * ad);
+    return (i64)max128(0, k);
+}
+
+/* ---- segments (segment.py) -------------------------------------------------------- */
+
+static seg_t forward(i64 t0, i64 v, i64 a, i64 length, i64 k0) {
+    seg_t s = {FWD, t0, v, a, length, 0, length, k0, 0, t0, 0};
+    s.end = sat((i128)t0 + st_acc_time(v, a, length));
+    return s;
+}
+
+static seg_t reverse(i64 t0, i64 v, i64 a, i64 total, i64 m0, i64 length, i64 k0) {
+    seg_t s = {REV, t0, v, a, total, m0, length, k0, 0, 0, 0};
+    s.tdec = st_acc_time(v, a, total);
+    s.start = sat((i128)t0 + s.tdec - st_acc_time(v, a, total - m0));
+    s.end = sat((i128)t0 + s.tdec - st_acc_time(v, a, total - m0 - length));
+    return s;
+}
+
+static i64 seg_count(const seg_t *s, i64 t) {
+    if (t < s->start) return 0;
+    if (t >= s->end) return s->length;
+    if (s->kind == FWD) return (i64)min128(s->length, acc_count(s->v, s->a, (i128)t - s->t0));
+    i128 x = (i128)s->tdec - ((i128)t - s->t0);
+    i128 curve = s->total - (acc_count(s->v, s->a, x - 1) + 1);
+    return (i64)min128(max128(curve - s->m0, 0), s->length);
+}
+
+static i64 seg_step_instant(const seg_t *s, i64 j) {
+    if (s->kind == FWD) return sat((i128)s->t0 + st_acc_time(s->v, s->a, j));
+    return sat((i128)s->t0 + s->tdec - st_acc_time(s->v, s->a, s->total - s->m0 - j));
+}
+
+static i64 seg_rate(const seg_t *s, i64 t) {
+    i128 tau = (i128)min64(max64(t, s->start), s->end) - s->t0;
+    if (s->kind == FWD) return (i64)(s->v + fdiv((i128)s->a * tau, SECOND));
+    return (i64)(s->v + fdiv((i128)s->a * max128((i128)s->tdec - tau, 0), SECOND));
+}
+
+typedef struct { int kind; i128 v, acc, length; } piece_spec;
+
+static int plan(i64 t, i64 k0, i64 r, i64 vin, i64 vc, i64 vx, i64 a, seg_t *out) {
+    if (r <= 0) return 0;
+    i128 two_a = (i128)2 * a, R = r, VIN = vin, VC = vc, VX = vx;
+    i128 down = fdiv(VC * VC - VX * VX, two_a);
+    piece_spec p[3];
+    int np = 0;
+    if (vin <= vc) {
+        i128 up = fdiv(VC * VC - VIN * VIN, two_a);
+        if (up + down <= R) {
+            p[0] = (piece_spec){FWD, VIN, a, up};
+            p[1] = (piece_spec){FWD, VC, 0, R - up - down};
+            p[2] = (piece_spec){REV, VX, a, down};
+            np = 3;
+        } else if (VIN * VIN + two_a * R <= VX * VX) {
+            p[0] = (piece_spec){FWD, VIN, a, R};
+            np = 1;
+        } else if (VX * VX + two_a * R <= VIN * VIN) {
+            p[0] = (piece_spec){REV, isqrt(VIN * VIN - two_a * R), a, R};
+            np = 1;
+        } else {
+            i128 peak2 = fdiv(two_a * R + VIN * VIN + VX * VX, 2);
+            up = min128(max128(fdiv(peak2 - VIN * VIN, two_a), 0), R);
+            p[0] = (piece_spec){FWD, VIN, a, up};
+            p[1] = (piece_spec){REV, VX, a, R - up};
+            np = 2;
+        }
+    } else {
+        i128 over = fdiv(VIN * VIN - VC * VC, two_a);
+        if (over + down <= R) {
+            p[0] = (piece_spec){REV, VC, a, over};
+            p[1] = (piece_spec){FWD, VC, 0, R - over - down};
+            p[2] = (piece_spec){REV, VX, a, down};
+            np = 3;
+        } else {
+            p[0] = (piece_spec){REV, max128(VX, isqrt(max128(0, VIN * VIN - two_a * R))), a, R};
+            np = 1;
+        }
+    }
+    int n = 0;
+    for (int i = 0; i < np; i++) {
+        if (p[i].length <= 0) continue;
+        seg_t s = p[i].kind == FWD
+            ? forward(t, (i64)p[i].v, (i64)p[i].acc, (i64)p[i].length, k0)
+            : reverse(t, (i64)p[i].v, (i64)p[i].acc, (i64)p[i].length, 0, (i64)p[i].length, k0);
+        out[n++] = s;
+        t = s.end;
+        k0 += (i64)p[i].length;
+    }
+    return n;
+}
+
+/* ---- the core (python_twin.py) ---------------------------------------------------- */
+
+typedef struct {
+    st_vector vec;
+    i64 n, done;
+    int has_plan, nseg;       /* has_plan = 0: Python's plan None */
+    seg_t plan[3];
+    i64 end, exit_rate, decision;
+    int final;
+} entry_t;
+
+typedef struct {
+    i64 base[ST_AXES], steps[ST_AXES];
+    i64 n, k_from, k_to;
+    int nseg;
+    seg_t plan[3];
+} piece_t;
+
+struct stepper {
+    int axes;
+    i64 max_rate, now, rest, stop_end, xm;
+    int halted;
+    i64 base[ST_AXES];
+    entry_t *q;
+    size_t qhead, qlen, qcap;
+    piece_t *hist;            /* ring buffer of executed pieces */
+    size_t hhead, hlen, hcap;
+    int keep_history;
+};
+
+static entry_t *head(stepper *m) { return &m->q[m->qhead]; }
+static entry_t *qat(stepper *m, size_t i) { return &m->q[m->qhead + i]; }
+
+stepper *st_new(int axes, int64_t max_rate) {
+    stepper *m = calloc(1, sizeof *m);
+    if (!m) return NULL;
+    m->axes = axes;
+    m->max_rate = max_rate;
+    m->xm = 100;
+    m->keep_history = 1;
+    return m;
+}
+
+void st_free(stepper *m) {
+    if (!m) return;
+    free(m->q);
+    free(m->hist);
+    free(m);
+}
+
+static stepper *ghost(const stepper *m) {
+    stepper *g = malloc(sizeof *g);
+    if (!g) return NULL;
+    *g = *m;
+    g->q = NULL;
+    g->qhead = 0;
+    g->qcap = m->qlen ? m->qlen : 1;
+    g->q = malloc(g->qcap * sizeof(entry_t));
+    if (!g->q) { free(g); return NULL; }
+    if (m->qlen) memcpy(g->q, m->q + m->qhead, m->qlen * sizeof(entry_t));
+    g->hist = NULL;
+    g->hhead = g->hlen = g->hcap = 0;
+    g->keep_history = 1;
+    return g;
+}
+
+static i64 vec_len(const st_vector *v, int axes) {
+    i64 n = 0;
+    for (int i = 0; i < axes; i++) n = max64(n, (i64)abs128(v->steps[i]));
+    return n;
+}
+
+static i64 entry_steps(const entry_t *e, i64 t) {
+    if (!e->has_plan) return e->done;
+    i64 k = e->done;
+    for (int i = 0; i < e->nseg; i++) k += seg_count(&e->plan[i], t);
+    return k;
+}
+
+static i64 entry_rate(const entry_t *e, i64 t) {
+    if (!e->has_plan || e->nseg == 0 || t < e->plan[0].start) return 0;
+    for (int i = 0; i < e->nseg; i++)
+        if (t < e->plan[i].end) return seg_rate(&e->plan[i], t);
+    return e->exit_rate;
+}
+
+static int history_push(stepper *m, const piece_t *p) {
+    if (m->hlen == HISTORY) {                  /* full: drop the oldest */
+        m->hist[m->hhead] = *p;
+        m->hhead = (m->hhead + 1) % HISTORY;
+        return 0;
+    }
+    if (m->hlen == m->hcap) {                 /* grow (the ring is not wrapped yet) */
+        size_t cap = m->hcap ? m->hcap * 2 : 64;
+        if (cap > HISTORY) cap = HISTORY;
+        piece_t *h = realloc(m->hist, cap * sizeof(piece_t));
+        if (!h) return -1;
+        m->hist = h;
+        m->hcap = cap;
+    }
+    m->hist[(m->hhead + m->hlen) % m->hcap] = *p;
+    m->hlen++;
+    return 0;
+}
+
+static void make_piece(piece_t *p, const i64 *base, const entry_t *e, i64 k_from, i64 k_to,
+                       int axes) {
+    memset(p, 0, sizeof *p);
+    for (int i = 0; i < axes; i++) { p->base[i] = base[i]; p->steps[i] = e->vec.steps[i]; }
+    p->n = e->n;
+    p->k_from = k_from;
+    p->k_to = k_to;
+    p->nseg = e->nseg;
+    memcpy(p->plan, e->plan, sizeof p->plan);
+}
+
+static void record(stepper *m, const entry_t *e, i64 k_to) {
+    if (!m->keep_history) return;
+    if (e->has_plan && e->nseg > 0 && k_to > e->done) {
+        piece_t p;
+        make_piece(&p, m->base, e, e->done, k_to, m->axes);
+        history_push(m, &p);
+    }
+}
+
+static i64 cruise(const stepper *m, const entry_t *e) {
+    const st_vector *vec = &e->vec;
+    i128 n = e->n;
+    i128 v = fdiv((i128)vec->velocity * m->xm, 100);
+    if (vec->path_speed) {
+        i128 s = 0;
+        for (int i = 0; i < m->axes && i < 3; i++) s += (i128)vec->steps[i] * vec->steps[i];
+        if (s) v = isqrt(fdiv((v * n) * (v * n), s));
+    }
+    if (n < vec->short_) v = min128(v, vec->brake);
+    v = min128(v, m->max_rate);
+    for (int i = 0; i < m->axes; i++)
+        if (vec->steps[i]) v = min128(v, fdiv((i128)vec->axis_limits[i] * n, abs128(vec->steps[i])));
+    return (i64)max128(v, 1);
+}
+
+static i64 junction(const stepper *m, const entry_t *e, const entry_t *nxt, i64 vc) {
+    if (!nxt || !(e->vec.continuous && nxt->vec.continuous) || nxt->n == 0) return 0;
+    i128 v = min128(min128(e->vec.brake, vc), cruise(m, nxt));
+    v = min128(v, isqrt((i128)2 * nxt->vec.accel * nxt->n));
+    return (i64)max128(0, v);
+}
+
+static void plan_entry(stepper *m, entry_t *e, i64 t, i64 vin, int join) {
+    i64 vc = cruise(m, e);
+    const entry_t *nxt = (m->qlen > 1 && e == head(m)) ? qat(m, 1) : NULL;
+    i64 vx = join ? junction(m, e, nxt, vc) : 0;
+    e->nseg = plan(t, e->done, e->n - e->done, vin, vc, vx, e->vec.accel, e->plan);
+    e->has_plan = 1;
+    e->end = e->nseg ? e->plan[e->nseg - 1].end : t;
+    e->exit_rate = vx;
+    e->final = 1;
+    e->decision = -1;
+    if (vx == 0 && e->vec.continuous) {
+        const seg_t *last = e->nseg ? &e->plan[e->nseg - 1] : NULL;
+        e->decision = (last && last->kind == REV) ? last->start : t;
+    }
+}
+
+static void start_head(stepper *m, i64 t, i64 vin) {
+    entry_t *e = head(m);
+    if (e->has_plan) return;
+    i64 start = (vin > 0 || e->done == e->n) ? t : max64(t, sat((i128)m->rest + e->vec.dwell));
+    plan_entry(m, e, start, vin, 1);
+}
+
+static void replan(stepper *m, i64 t, int join) {
+    if (!m->qlen || m->halted) return;
+    entry_t *e = head(m);
+    if (!e->has_plan || e->nseg == 0 || !e->final) return;
+    join = join && (e->exit_rate > 0 || e->decision > t);
+    if (t < e->plan[0].start) {
+        i64 start = e->plan[0].start;
+        plan_entry(m, e, start, 0, join);
+        return;
+    }
+    i64 k = entry_steps(e, t);
+    i64 v = entry_rate(e, t);
+    record(m, e, k);
+    e->done = k;
+    plan_entry(m, e, t, v, join);
+}
+
+static void pop_head(stepper *m) {
+    m->qhead++;
+    m->qlen--;
+    if (!m->qlen) m->qhead = 0;
+}
+
+void st_advance(stepper *m, int64_t t) {
+    if (t < m->now) t = m->now;
+    while (m->qlen) {
+        entry_t *e = head(m);
+        if (!e->has_plan) {
+            if (m->halted) break;
+            start_head(m, m->now, 0);
+        }
+        if (e->end > t) break;
+        record(m, e, entry_steps(e, e->end));
+        if (!e->final) {
+            e->done = entry_steps(e, e->end);
+            e->has_plan = 0;
+            e->nseg = 0;
+            m->rest = e->end;
+            if (m->halted) break;
+            start_head(m, e->end, 0);
+            continue;
+        }
+        i64 end = e->end, exit_rate = e->exit_rate, n = e->n;
+        for (int i = 0; i < m->axes; i++) m->base[i] += e->vec.steps[i];
+        pop_head(m);
+        if (exit_rate == 0 && n) m->rest = end;
+        if (m->qlen && (!m->halted || head(m)->has_plan)) start_head(m, end, exit_rate);
+    }
+    m->now = t;
+}
+
+int64_t st_now(stepper *m) { return m->now; }
+
+int st_next_event(stepper *m, int64_t *out) {
+    if (m->qlen) {
+        entry_t *e = head(m);
+        if (e->has_plan && e->end > m->now) { *out = e->end; return 1; }
+    }
+    if (m->halted && m->stop_end > m->now) { *out = m->stop_end; return 1; }
+    return 0;
+}
+
+int st_drain_instant(stepper *m, int64_t *out) {
+    if (m->halted || !m->qlen) return 0;
+    stepper *g = ghost(m);
+    if (!g) return -1;
+    g->keep_history = 0;
+    st_advance(g, NEVER);
+    int ok = g->qlen == 0;
+    if (ok) *out = g->rest;
+    st_free(g);
+    return ok;
+}
+
+static void position_now(stepper *m, i64 *out) {
+    for (int i = 0; i < m->axes; i++) out[i] = m->base[i];
+    if (!m->qlen) return;
+    entry_t *e = head(m);
+    i64 k = entry_steps(e, m->now);
+    for (int i = 0; i < m->axes; i++) out[i] += axis_count(k, e->vec.steps[i], e->n);
+}
+
+void st_position(stepper *m, int64_t t, int64_t *out) {
+    st_advance(m, t);
+    position_now(m, out);
+}
+
+void st_flags(stepper *m, int64_t t, int *busy, int *moving, int *stopping, int *halted) {
+    st_advance(m, t);
+    *stopping = m->halted && m->stop_end > m->now;
+    *busy = m->qlen > 0;
+    *moving = (*busy && !m->halted) || *stopping;
+    *halted = m->halted;
+}
+
+int64_t st_queued(stepper *m, int64_t t) {
+    st_advance(m, t);
+    return (i64)m->qlen;
+}
+
+/* the executed pieces, then the planned future up to t1 (played on a ghost) */
+typedef struct { piece_t *p; size_t n; } timeline_t;
+
+static int timeline(stepper *m, i64 t1, timeline_t *tl) {
+    stepper *g = ghost(m);
+    if (!g) return -1;
+    st_advance(g, t1);
+    size_t total = m->hlen + g->hlen + 1;
+    tl->p = malloc(total * sizeof(piece_t));
+    if (!tl->p) { st_free(g); return -1; }
+    size_t n = 0;
+    for (size_t i = 0; i < m->hlen; i++) tl->p[n++] = m->hist[(m->hhead + i) % m->hcap];
+    for (size_t i = 0; i < g->hlen; i++) tl->p[n++] = g->hist[(g->hhead + i) % g->hcap];
+    if (g->qlen && head(g)->has_plan && head(g)->nseg > 0) {
+        entry_t *e = head(g);
+        make_piece(&tl->p[n++], g->base, e, e->done, entry_steps(e, NEVER), g->axes);
+    }
+    tl->n = n;
+    st_free(g);
+    return 0;
+}
+
+static i64 piece_instant(const piece_t *p, i64 k) {
+    for (int i = 0; i < p->nseg; i++) {
+        const seg_t *s = &p->plan[i];
+        if (s->k0 < k && k <= s->k0 + s->length) return seg_step_instant(s, k - s->k0);
+    }
+    return -1;
+}
+
+static i64 plan_steps(const piece_t *p, i64 t) {
+    if (!p->nseg) return 0;
+    i64 k = p->plan[0].k0;
+    for (int i = 0; i < p->nseg; i++) k += seg_count(&p->plan[i], t);
+    return k;
+}
+
+int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
+    i64 here[ST_AXES];
+    position_now(m, here);
+    if (here[axis] == value) { *out = m->now; return 1; }
+    timeline_t tl;
+    if (timeline(m, NEVER, &tl)) return -1;
+    int found = 0;
+    for (size_t i = 0; i < tl.n && !found; i++) {
+        const piece_t *p = &tl.p[i];
+        i64 d = p->steps[axis];
+        i128 c = (i128)value - p->base[axis];
+        if (d == 0 || c == 0 || ((c > 0) != (d > 0)) || abs128(c) > abs128(d)) continue;
+        i64 k = max64(first_step_reaching((i64)abs128(c), d, p->n), p->k_from + 1);
+        if (k <= p->k_to && p->base[axis] + axis_count(k, d, p->n) == value) {
+            i64 t = piece_instant(p, k);
+            if (t >= m->now) { *out = t; found = 1; }
+        }
+    }
+    free(tl.p);
+    return found;
+}
+
+int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
+                  int64_t cap) {
+    timeline_t tl;
+    if (timeline(m, t1, &tl)) return -1;
+    i64 count = 0;
+    for (size_t i = 0; i < tl.n; i++) {
+        const piece_t *p = &tl.p[i];
+        i64 first = max64(p->k_from, plan_steps(p, t0 - 1)) + 1;
+        i64 last = min64(p->k_to, plan_steps(p, t1 - 1));
+        for (i64 k = first; k <= last; k++) {
+            if (count < cap) {
+                uint8_t mask = 0;
+                for (int a = 0; a < m->axes; a++) {
+                    i64 d = p->steps[a];
+                    if (axis_count(k, d, p->n) != axis_count(k - 1, d, p->n))
+                        mask |= (uint8_t)((1 << a) | ((d < 0) << (4 + a)));
+                }
+                times[count] = piece_instant(p, k);
+                masks[count] = mask;
+            }
+            count++;
+        }
+    }
+    free(tl.p);
+    return count;
+}
+
+static int append(stepper *m, const st_vector *v, i64 done) {
+    if (m->qhead + m->qlen == m->qcap) {
+        if (m->qhead) {
+            memmove(m->q, m->q + m->qhead, m->qlen * sizeof(entry_t));
+            m->qhead = 0;
+        } else {
+            size_t cap = m->qcap ? m->qcap * 2 : 16;
+            entry_t *q = realloc(m->q, cap * sizeof(entry_t));
+            if (!q) return -1;
+            m->q = q;
+            m->qcap = cap;
+        }
+    }
+    entry_t *e = &m->q[m->qhead + m->qlen];
+    memset(e, 0, sizeof *e);
+    e->vec = *v;
+    e->n = vec_len(v, m->axes);
+    e->done = done;
+    e->decision = -1;
+    e->final = 1;
+    m->qlen++;
+    return 0;
+}
+
+int st_push(stepper *m, const st_vector *v, int64_t t) {
+    st_advance(m, t);
+    if (append(m, v, 0)) return -1;
+    if (m->qlen == 1) {
+        if (!m->halted) {
+            start_head(m, t, 0);
+            st_advance(m, t);
+        }
+    } else if (m->qlen == 2 && head(m)->decision > t && v->continuous) {
+        replan(m, t, 1);
+    }
+    return 0;
+}
+
+int64_t st_halt(stepper *m, int64_t t) {
+    st_advance(m, t);
+    if (m->halted) return max64(m->stop_end, t);
+    m->halted = 1;
+    m->stop_end = t;
+    if (!m->qlen || !head(m)->has_plan) return t;
+    entry_t *h = head(m);
+    if (t < h->plan[0].start) {
+        h->has_plan = 0;
+        h->nseg = 0;
+        return t;
+    }
+    i64 k = entry_steps(h, t);
+    i64 v = entry_rate(h, t);
+    i64 a = h->vec.accel;
+    i64 distance = (i64)fdiv((i128)v * v, (i128)2 * a);
+    record(m, h, k);
+    h->done = k;
+    i64 covered = 0, start = t;
+    for (size_t i = 0; i < m->qlen; i++) {
+        entry_t *e = qat(m, i);
+        if (covered == distance) break;
+        i64 length = min64(distance - covered, e->n - e->done);
+        seg_t piece = reverse(t, 0, a, distance, covered, length, e->done);
+        e->has_plan = 1;
+        e->nseg = length ? 1 : 0;
+        if (length) e->plan[0] = piece;
+        e->end = length ? piece.end : start;
+        e->exit_rate = 0;
+        e->decision = -1;
+        covered += length;
+        e->final = e->done + length == e->n;
+        start = e->end;
+    }
+    if (covered == 0) {
+        h->has_plan = 0;
+        h->nseg = 0;
+        m->rest = t;
+        return t;
+    }
+    m->stop_end = start;
+    return start;
+}
+
+void st_resume(stepper *m, int64_t t) {
+    st_advance(m, t);
+    if (!m->halted) return;
+    m->halted = 0;
+    if (m->qlen && !head(m)->has_plan) start_head(m, t, 0);
+}
+
+void st_clear(stepper *m, int64_t t) {
+    st_advance(m, t);
+    position_now(m, m->base);
+    m->qlen = 0;
+    m->qhead = 0;
+    m->halted = 0;
+}
+
+int64_t st_entries(stepper *m) { return (i64)m->qlen; }
+
+void st_entry(stepper *m, int64_t i, st_vector *v, int64_t *done) {
+    entry_t *e = qat(m, (size_t)i);
+    *v = e->vec;
+    *done = e->done;
+}
+
+int st_halted(stepper *m) { return m->halted; }
+
+void st_restore_begin(stepper *m, int64_t t, int64_t *here) {
+    st_advance(m, t);
+    position_now(m, here);
+    m->qlen = 0;
+    m->qhead = 0;
+}
+
+int st_restore_add(stepper *m, const st_vector *v, int64_t done) { return append(m, v, done); }
+
+void st_restore_end(stepper *m, const int64_t *here, int halted, int64_t t) {
+    m->halted = halted;
+    if (m->qlen) {
+        entry_t *h = head(m);
+        for (int i = 0; i < m->axes; i++)
+            m->base[i] = here[i] - axis_count(h->done, h->vec.steps[i], h->n);
+        if (!halted) start_head(m, t, 0);
+    } else {
+        for (int i = 0; i < m->axes; i++) m->base[i] = here[i];
+    }
+}
+
+void st_set_position(stepper *m, int axis, int64_t value, int64_t t) {
+    i64 here[ST_AXES];
+    st_advance(m, t);
+    position_now(m, here);
+    m->base[axis] += value - here[axis];
+}
+
+void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel) {
+    st_advance(m, t);
+    for (size_t i = 0; i < m->qlen; i++) {
+        entry_t *e = qat(m, i);
+        e->vec.velocity = velocity;
+        if (has_accel) e->vec.accel = accel;
+    }
+    replan(m, t, 1);
+}
+
+void st_scale_velocity(stepper *m, int64_t num, int64_t den, int64_t t, int accel) {
+    st_advance(m, t);
+    for (size_t i = 0; i < m->qlen; i++) {
+        entry_t *e = qat(m, i);
+        e->vec.velocity = (i64)max128(1, fdiv((i128)e->vec.velocity * num, den));
+        if (accel) e->vec.accel = (i64)max128(1, fdiv((i128)e->vec.accel * num, den));
+    }
+    replan(m, t, 1);
+}
+
+void st_set_multiplier(stepper *m, int64_t percent, int64_t t) {
+    st_advance(m, t);
+    m->xm = percent;
+    replan(m, t, 1);
+}

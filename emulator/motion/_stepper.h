@@ -1,0 +1,51 @@
+/* The C stepper core's API (a port of python_twin.py; see docs/motion-model.md). */
+#ifndef GVE_STEPPER_H
+#define GVE_STEPPER_H
+#include <stdint.h>
+
+#define ST_AXES 4
+
+typedef struct {
+    int64_t steps[ST_AXES];
+    int continuous;
+    int64_t velocity, accel, brake, short_, dwell;
+    int path_speed;
+    int64_t axis_limits[ST_AXES];
+} st_vector;
+
+typedef struct {
+    int kind;
+    int64_t t0, v, a, total, m0, length, k0, tdec, start, end;
+} seg_t;
+
+typedef struct stepper stepper;
+
+stepper *st_new(int axes, int64_t max_rate);
+void st_free(stepper *m);
+int64_t st_acc_time(int64_t v, int64_t a, int64_t m);
+int64_t st_acc_count(int64_t v, int64_t a, int64_t tau);
+void st_advance(stepper *m, int64_t t);
+int64_t st_now(stepper *m);
+int st_next_event(stepper *m, int64_t *out);
+int st_drain_instant(stepper *m, int64_t *out);
+void st_position(stepper *m, int64_t t, int64_t *out);
+void st_flags(stepper *m, int64_t t, int *busy, int *moving, int *stopping, int *halted);
+int64_t st_queued(stepper *m, int64_t t);
+int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out);
+int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
+                  int64_t cap);
+int st_push(stepper *m, const st_vector *v, int64_t t);
+int64_t st_halt(stepper *m, int64_t t);
+void st_resume(stepper *m, int64_t t);
+void st_clear(stepper *m, int64_t t);
+int64_t st_entries(stepper *m);
+void st_entry(stepper *m, int64_t i, st_vector *v, int64_t *done);
+int st_halted(stepper *m);
+void st_restore_begin(stepper *m, int64_t t, int64_t *here);
+int st_restore_add(stepper *m, const st_vector *v, int64_t done);
+void st_restore_end(stepper *m, const int64_t *here, int halted, int64_t t);
+void st_set_position(stepper *m, int axis, int64_t value, int64_t t);
+void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel);
+void st_scale_velocity(stepper *m, int64_t num, int64_t den, int64_t t, int accel);
+void st_set_multiplier(stepper *m, int64_t percent, int64_t t);
+#endif

@@ -1,0 +1,112 @@
+"""The C core and the Python twin are bit-identical (issue 3): the same random sequences of
+pushes, waits, halts, resumes, overrides, KEEP/RESTORE, DELETE and N give the same
+positions, flags, queue lengths, events, drain instants and pulse trains."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from emulator.motion import Vector, c_available, create
+from emulator.motion.arith import acc_count, acc_time
+
+pytestmark = pytest.mark.skipif(not c_available(), reason="the C stepper core is not built "
+                                "(the emulator falls back to the Python twin)")
+
+SETTINGS = settings(max_examples=60, deadline=None, derandomize=True,
+                    suppress_health_check=list(HealthCheck))
+
+
+@given(st.integers(0, 8_000_000), st.integers(0, 160_000_000), st.integers(0, 2**35),
+       st.integers(0, 2**40))
+@settings(max_examples=500, deadline=None, derandomize=True)
+def test_primitives_are_identical(v, a, m, tau):
+    from emulator.motion._stepper_c import lib
+    if v == 0 and a == 0:
+        return
+    assert lib.st_acc_time(v, a, m) == acc_time(v, a, m)
+    if acc_count(v, a, tau) < 2**62:
+        assert lib.st_acc_count(v, a, tau) == acc_count(v, a, tau)
+
+
+def vectors(axes: int, max_rate: int):
+    return st.builds(
+        lambda steps, c, v, a, b, short, t, vk, vl: Vector(
+            tuple(steps), c, v, a * 1000, b, short, t * 1_000_000, vk, tuple(vl)),
+        st.lists(st.one_of(st.integers(-3000, 3000), st.integers(-2**31 + 1, 2**31 - 1)),
+                 min_size=axes, max_size=axes),
+        st.booleans(), st.integers(10, max_rate), st.integers(1, 10000),
+        st.integers(10, max_rate), st.integers(1, 5000), st.integers(1, 24), st.booleans(),
+        st.lists(st.integers(10, max_rate), min_size=axes, max_size=axes))
+
+
+def ops(axes: int, max_rate: int):
+    return st.lists(st.one_of(
+        st.tuples(st.just("push"), vectors(axes, max_rate)),
+        st.tuples(st.just("wait"), st.integers(0, 3_000_000_000)),
+        st.tuples(st.just("halt"), st.none()),
+        st.tuples(st.just("resume"), st.none()),
+        st.tuples(st.just("xa"), st.integers(10, max_rate)),
+        st.tuples(st.just("xu"), st.none()),
+        st.tuples(st.just("xd"), st.none()),
+        st.tuples(st.just("xm"), st.integers(1, 1000)),
+        st.tuples(st.just("keep"), st.none()),
+        st.tuples(st.just("restore"), st.none()),
+        st.tuples(st.just("clear"), st.none()),
+        st.tuples(st.just("set"), st.integers(-1000, 1000)),
+    ), max_size=25)
+
+
+def observe(m, t: int):
+    return (m.position(t), m.flags(t), m.queued(t), m.next_event(), m.drain_instant())
+
+
+@pytest.mark.parametrize(("axes", "max_rate"), [(3, 100_000), (4, 500_000)])
+@given(data=st.data())
+@SETTINGS
+def test_twins_agree_step_by_step(axes, max_rate, data):
+    py, c = create(axes, max_rate, stepper="python"), create(axes, max_rate, stepper="c")
+    t = 0
+    saves = {}
+    for op, arg in data.draw(ops(axes, max_rate)):
+        t += data.draw(st.integers(0, 50_000_000))
+        for name, m in (("py", py), ("c", c)):
+            if op == "push":
+                m.push(arg, t)
+            elif op == "wait":
+                m.advance(t + arg)
+            elif op == "halt":
+                m.halt(t)
+            elif op == "resume":
+                m.resume(t)
+            elif op == "xa":
+                m.set_velocity(arg, t)
+            elif op == "xu":
+                m.scale_velocity(17, 16, t)
+            elif op == "xd":
+                m.scale_velocity(15, 16, t, accel=True)
+            elif op == "xm":
+                m.set_multiplier(arg, t)
+            elif op == "keep":
+                saves[name] = m.keep(max(t, m.now))
+            elif op == "restore" and name in saves:
+                m.restore(saves[name], max(t, m.now))
+            elif op == "clear":
+                m.clear(t)
+            elif op == "set":
+                m.set_position(0, arg, t)
+        if op == "keep":
+            assert saves["py"] == saves["c"]
+        t = max(t, py.now)
+        assert observe(py, t) == observe(c, t)
+        assert py.instant_of_position(0, 5) == c.instant_of_position(0, 5)
+    end = (py.drain_instant() or t) + 1
+    window = min(end, t + 2_000_000_000)
+    p_times, p_masks = py.pulses(0, window)
+    c_times, c_masks = c.pulses(0, window)
+    assert np.array_equal(p_times, c_times) and np.array_equal(p_masks, c_masks)
+    cut = data.draw(st.integers(0, window))
+    first, second = c.pulses(0, cut), c.pulses(cut, window)
+    assert np.array_equal(np.concatenate([first[0], second[0]]), c_times)
