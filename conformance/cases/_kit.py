@@ -47,6 +47,48 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 1500) -> 
     ctx.require(r is not None and r.code == 0 and r.inta, f"H answered {show(r)}")
 
 
+def fresh_reset(ctx: CaseContext) -> None:
+    """Cases about the state right after a reset: the emulator gives a fresh unit; a real
+    unit is restarted with J, which needs --allow-destructive."""
+    if ctx.target.kind == "emu":
+        return
+    ctx.require(ctx.target.allow_destructive, "needs a reset (J): run with --allow-destructive")
+    r = ctx.link.send("J")
+    ctx.require(r is not None and r.code == 0, f"J answered {show(r)}")
+    ctx.link.wait(2.5)
+
+
+def index(ctx: CaseContext) -> int | None:
+    r = ctx.link.send("@")
+    if r is None or r.code != 0 or not r.values or not r.values[0].isdigit():
+        return None
+    return int(r.values[0])
+
+
+def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
+                tag: str | None = None) -> bool:
+    """Expect the index to have advanced by ``frames`` since ``before`` (spec 8)."""
+    after = index(ctx)
+    expected = None if before is None else (before + frames) % 256
+    return ctx.expect(after is not None and after == expected, what, observed=after,
+                      expected=expected, tag=tag)
+
+
+def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:
+    """Setup: stop the unit (H, so INTA = 1 and vectors wait in the queue [D 10.1]) and
+    queue ``count`` (default: the buffer's size) one-step vectors going back and forth,
+    so that a real unit's axes stay within the envelope. Returns whether every vector
+    was accepted; records a check per refusal."""
+    r = ctx.link.send("H")
+    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+    for i in range(ctx.profile.buffer if count is None else count):
+        r = ctx.link.send("C" + vector(ctx, 1 if i % 2 == 0 else -1))
+        if not ctx.expect(r is not None and r.code == 0, f"vector {i + 1} is accepted",
+                          observed=show(r), expected="code 0"):
+            return False
+    return True
+
+
 def position(ctx: CaseContext) -> list[int] | None:
     r = ctx.link.send("PF")
     if r is None or r.code != 0 or len(r.values) < 3:

@@ -3,7 +3,15 @@
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, position, setup, vector
+from conformance.cases._kit import (
+    answers,
+    fresh_reset,
+    index,
+    index_moved,
+    position,
+    setup,
+    vector,
+)
 
 SRC = "M84 12.5.12; spec 8 [D what counts]"
 
@@ -12,28 +20,30 @@ SRC = "M84 12.5.12; spec 8 [D what counts]"
       rule="Every complete frame advances the index by one, refused ones too")
 def counts(ctx: CaseContext) -> None:
     link = ctx.link
-    answers(ctx, link.send("@"), "0,0", "the index starts at 0", tag="D")
+    before = index(ctx)
     link.send("V1000")
     link.send("T99")          # refused: 5
     link.send("Z")            # refused: 3
-    answers(ctx, link.send("@"), "0,3", "three frames, two refused, counted")
+    index_moved(ctx, before, 3, "three frames, two refused, counted")
 
 
 @case("8.index.queries-not-counted", tag="D", source=SRC,
       rule="@ and > themselves do not advance the index")
 def queries(ctx: CaseContext) -> None:
     link = ctx.link
+    before = index(ctx)
     link.send("V1000")
     link.send("@")
     link.send(">", lines=2)
-    answers(ctx, link.send("@"), "0,1", "only V1000 counted")
+    index_moved(ctx, before, 1, "only V1000 counted")
 
 
 @case("8.index.modulo-256", tag="M", source=SRC, rule="The index counts modulo 256")
 def modulo(ctx: CaseContext) -> None:
+    before = index(ctx)
     for _ in range(258):
         ctx.link.send("F")
-    answers(ctx, ctx.link.send("@"), "0,2", "258 frames → index 2")
+    index_moved(ctx, before, 258, "258 frames later the index moved by 2 (mod 256)")
 
 
 @case("8.repeat.last-frame-and-answer", tag="D", source=SRC,
@@ -49,6 +59,7 @@ def repeat(ctx: CaseContext) -> None:
 @case("8.repeat.no-history", tag="D", source=SRC,
       rule="With no history since reset, > answers a single line 0")
 def no_history(ctx: CaseContext) -> None:
+    fresh_reset(ctx)
     answers(ctx, ctx.link.send(">"), "0", "> right after reset")
 
 
@@ -56,6 +67,8 @@ def no_history(ctx: CaseContext) -> None:
       rule="> re-executes nothing")
 def not_again(ctx: CaseContext) -> None:
     link = ctx.link
+    start = position(ctx)
+    ctx.require(start is not None, "PF answered")
     setup(ctx, "L" + vector(ctx, 7))
     before = link.send("@")
     link.send(">", lines=2)
@@ -64,8 +77,8 @@ def not_again(ctx: CaseContext) -> None:
                "> added no frame to the index", observed=after, expected=before, tag="D")
     link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
     here = position(ctx)
-    ctx.expect(here == [7, 0, 0], "the vector ran once", observed=here, expected=[7, 0, 0],
-               tag="always")
+    want = [start[0] + 7, start[1], start[2]]
+    ctx.expect(here == want, "the vector ran once", observed=here, expected=want, tag="always")
 
 
 @case("8.recovery.lost-response", tag="M", source="M84 12.5.12: recovery with @ and >",

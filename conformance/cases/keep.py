@@ -3,7 +3,16 @@
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, halted_with_queue, position, setup, show, vector
+from conformance.cases._kit import (
+    answers,
+    code,
+    fresh_reset,
+    halted_with_queue,
+    position,
+    setup,
+    show,
+    vector,
+)
 
 SRC = "M84 12.5.8; M114 13.6.9; M54"
 
@@ -59,5 +68,6 @@ def moving(ctx: CaseContext) -> None:
 @case("10.5.restore.empty", tag="D", source="spec 10.5 [D]",
       rule="R with nothing saved restores an empty save and answers 0")
 def restore_empty(ctx: CaseContext) -> None:
+    fresh_reset(ctx)
     answers(ctx, ctx.link.send("R"), "0", "R at reset")
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved")

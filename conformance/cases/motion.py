@@ -3,7 +3,16 @@
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, halted_with_queue, position, setup, show, vector
+from conformance.cases._kit import (
+    answers,
+    code,
+    fill_queue,
+    halted_with_queue,
+    position,
+    setup,
+    show,
+    vector,
+)
 
 
 @case("10.1.line.refused-while-busy", tag="M", source="M84 12.5.2",
@@ -30,13 +39,11 @@ def idiom(ctx: CaseContext) -> None:
 @case("10.1.queue.executing-counts", tag="M", source="M84 12.5.2: '1 je vykonáván'",
       rule="The CONT buffer's size includes the executing vector; F shows bit 5 when full")
 def queue_full_flag(ctx: CaseContext) -> None:
-    setup(ctx, f"V{ctx.profile.ranges['V'].lo}")
-    for _ in range(ctx.profile.buffer):
-        setup(ctx, "C" + vector(ctx, 5000))
-    r = ctx.link.send("F")
-    ctx.expect(r is not None and r.values[:1] == ["60"], "F = RUN + full",
-               observed=show(r), expected="0,60")
-    ctx.link.send("H")
+    if fill_queue(ctx):
+        r = ctx.link.send("F")
+        ctx.expect(r is not None and r.values[:1] == ["F0"], "F = INTA + RUN + INTCOM + full",
+                   observed=show(r), expected="8,F0")
+    ctx.link.send("D")
 
 
 @case("10.2.motion.targets-reached", tag="M", source="M84 12.5.2: vectors are relative",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, position, setup, vector
+from conformance.cases._kit import answers, fill_queue, index, index_moved, position, setup, vector
 
 RULE = "spec 7 [D]; M84 12.3.3"
 
@@ -55,15 +55,16 @@ def out_of_range(ctx: CaseContext) -> None:
 @case("7.packet.no-room", tag="D", source=RULE, requires=("*S",),
       rule="A packet that does not fit the queue answers 1 and commits nothing")
 def no_room(ctx: CaseContext) -> None:
-    setup(ctx, f"V{ctx.profile.ranges['V'].lo}")
-    n = ctx.profile.buffer
-    for _ in range(n - 1):
-        setup(ctx, "C" + vector(ctx, 5000))
-    r = _packet(ctx, ["C" + vector(ctx, 5000), "C" + vector(ctx, 5000)], 2)
-    answers(ctx, r, "1,2", "2 vectors into 1 free place → 1,2")
+    if not fill_queue(ctx, ctx.profile.buffer - 1):
+        return
+    r = _packet(ctx, ["C" + vector(ctx, 1), "C" + vector(ctx, -1)], 2)
+    ctx.expect(r is not None and (r.code, r.values) == (1, ["2"]),
+               "2 vectors into 1 free place → 1,2 (9,2 while INTA)", observed=r,
+               expected="9,2")
     r = ctx.link.send("F")
-    ctx.expect(r is not None and r.values == ["40"], "the queue is not full (nothing added)",
-               observed=r, expected="0,40")
+    ctx.expect(r is not None and r.values == ["D0"], "the queue is not full (nothing added)",
+               observed=r, expected="8,D0")
+    ctx.link.send("D")
 
 
 @case("7.packet.end-without-start", tag="D", source=RULE, requires=("*S",),
@@ -76,10 +77,10 @@ def end_alone(ctx: CaseContext) -> None:
       rule="H, @, > inside an open packet are answered at once and discard the packet")
 def breakers(ctx: CaseContext) -> None:
     link = ctx.link
+    before = index(ctx)
     link.send("*S", answer=False)
     link.send("C" + vector(ctx, 10), answer=False)
-    r = link.send("@")
-    answers(ctx, r, "0,2", "@ inside a packet is answered (index 2)")
+    index_moved(ctx, before, 2, "@ inside a packet is answered (*S and the member counted)")
     answers(ctx, link.send("*E1"), "4,0", "the packet was discarded")
 
 

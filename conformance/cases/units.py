@@ -6,7 +6,17 @@ from __future__ import annotations
 import re
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, position, setup, show, vector
+from conformance.cases._kit import (
+    answers,
+    code,
+    fresh_reset,
+    index,
+    index_moved,
+    position,
+    setup,
+    show,
+    vector,
+)
 
 # command -> (a valid frame on an idle unit after reset, a regex of its answer) [spec 10]
 FORMATS = {
@@ -62,11 +72,13 @@ def version(ctx: CaseContext) -> None:
 @case("9.reset.state", tag="M", source="M84 12.4; M114 13.5; M54",
       rule="After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off")
 def reset_state(ctx: CaseContext) -> None:
+    fresh_reset(ctx)
+    before = index(ctx)
     for n in range(7):
         answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00")
     here = position(ctx)
     ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0])
-    answers(ctx, ctx.link.send("@"), "0,8", "the index counted the SR and PF frames", tag="D")
+    index_moved(ctx, before, 8, "the index counted the SR and PF frames", tag="D")
 
 
 @case("9.reset.after-j", tag="D", source="M84 12.4; spec 9, 10 J [D]", destructive=True,

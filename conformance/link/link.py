@@ -116,6 +116,7 @@ class Link:
             self._backup(a)
         summed = self.checksums if checksum == "auto" else checksum
         address = self.address if address is None else address
+        self.drain_unsolicited()
         data = frame(body, address, summed)
         self.frames += 1
         sent_at = self.now
@@ -167,6 +168,17 @@ class Link:
                            lines=lines)
         r.received_at = self.now
         return r
+
+    def drain_unsolicited(self) -> bytes:
+        """Bytes that arrived although nothing was asked (late or extra answers): they
+        are logged, so that they cannot pass for the answer to the next frame."""
+        waiting = self.port.in_waiting
+        if not waiting:
+            return b""
+        data = self.port.read(waiting)
+        if data:
+            self._record(UNIT, data, "unsolicited")
+        return data
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05) -> Response | None:

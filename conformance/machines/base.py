@@ -17,6 +17,9 @@ class UnitMachine(RuleBasedStateMachine):
         p = self.ctx.profile
         # PF reports X, Y, Z on every profile (spec 10: GVE114 PF also 3 values)
         self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0])
+        # a real unit is not fresh: start the bookkeeping from where it is
+        self.model.committed = self.position()
+        self.model.index = self.index()
 
     def send(self, body: str, **kw) -> Response | None:
         r = self.link.send(body, **kw)
