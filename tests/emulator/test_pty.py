@@ -131,3 +131,15 @@ def test_tcp_server():
         port.close()
     finally:
         assert emu.stop() == 0
+
+
+def test_log_is_written_line_by_line(tmp_path):
+    log = tmp_path / "wire.gvt"
+    emu = Emulator("--model", "GVE84-100", "--pty", "--log", str(log))
+    port = serial.Serial(emu.first, 115200, timeout=5)
+    port.write(b"!0?\r")
+    assert port.read_until(b"\r").startswith(b"0,IP84")
+    emu.proc.kill()                                    # no clean shutdown: nothing flushed late
+    emu.proc.wait(10)
+    records = [(r.direction, r.data) for r in load(log).records]
+    assert records == [(">", b"!0?\r"), ("<", b"0,IP84 v3 27.1.2010\r")]

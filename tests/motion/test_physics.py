@@ -292,3 +292,23 @@ def test_a_full_queue_of_huge_vectors_costs_nothing_per_step(core):
     end = m.drain_instant()
     assert m.position(end) == (2048 * big, -2048 * big, 2048 * (big // 3), 2048 * 7)
     assert m.position(end // 2)[0] > 0
+
+
+@given(st.integers(100, 20_000), st.integers(10, MAX_RATE), st.integers(1, 200))
+@SETTINGS
+def test_accelerations_stay_within_a(core, length, rate, kilo):
+    """Within one vector the rate between consecutive steps changes by at most A·Δt,
+    allowing for instants rounded to whole nanoseconds (docs/motion-model.md)."""
+    a = kilo * 1000
+    m = make(core)
+    m.push(vector((length, 0, 0), continuous=False, v=rate, a=a), 0)
+    times, _ = m.pulses(0, m.drain_instant() + 1)
+    gaps = np.diff(times).astype(float)[1:-1]          # skip the first and last steps
+    if len(gaps) < 2:
+        return
+    rates = 1e9 / gaps
+    change = np.abs(np.diff(rates))
+    # a phase boundary may add one more step of A·Δt (up/down are floored)
+    allowed = a * (gaps[:-1] + gaps[1:]) / 1e9 + 2e9 / np.minimum(gaps[:-1],
+                                                                          gaps[1:]) ** 2 + 1
+    assert np.all(change <= allowed), float(np.max(change - allowed))
