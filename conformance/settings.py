@@ -9,7 +9,7 @@ _COMMON = {"suppress_health_check": list(HealthCheck), "deadline": None,
 
 PROFILES = {
     "ci": settings(max_examples=8, stateful_step_count=12, derandomize=True, **_COMMON),
-    "dev": settings(max_examples=30, stateful_step_count=25, **_COMMON),
+    "dev": settings(max_examples=40, stateful_step_count=25, **_COMMON),
     "thorough": settings(max_examples=300, stateful_step_count=50, **_COMMON),
     "hardware": settings(max_examples=3, stateful_step_count=10, derandomize=True, **_COMMON),
 }

@@ -26,7 +26,8 @@ class PacketMachine(UnitMachine):
     @rule()
     def start(self) -> None:
         self.send("*S", answer=False)
-        self.model.open_packet()
+        self.model.open_packet()              # a second *S restarts the packet (spec 7)
+        self.pending = []
 
     @precondition(lambda self: self.model.packet is not None and len(self.model.packet) < 8)
     @rule(body=st.sampled_from(sorted(MEMBERS)))

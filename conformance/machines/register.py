@@ -1,3 +1,3 @@
 """Importing this registers every machine's case."""
 
-from conformance.machines import checksum, index, keep, packet  # noqa: F401
+from conformance.machines import checksum, errors, index, keep, packet, queue  # noqa: F401

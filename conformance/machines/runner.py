@@ -13,7 +13,10 @@ def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
     machine.ctx = ctx  # type: ignore[attr-defined]
     try:
         run_state_machine_as_test(machine, settings=ctx.settings)
-    except AssertionError as err:
+    except (AssertionError, ExceptionGroup) as err:
+        if isinstance(err, ExceptionGroup) and not all(
+                isinstance(e, AssertionError) for e in _leaves(err)):
+            raise
         link = ctx.links[-1] if ctx.links else None
         ctx.expect(False, f"{machine.__name__}: {err}".splitlines()[0][:300],
                    observed=str(err)[-500:], expected="every invariant holds")
@@ -23,3 +26,10 @@ def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
                              link.transcript_lines()) + "\n")
     else:
         ctx.expect(True, f"{machine.__name__}: every example kept the invariants")
+
+
+def _leaves(group: BaseExceptionGroup) -> list[BaseException]:
+    out: list[BaseException] = []
+    for e in group.exceptions:
+        out.extend(_leaves(e) if isinstance(e, BaseExceptionGroup) else [e])
+    return out

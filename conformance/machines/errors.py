@@ -1,0 +1,76 @@
+"""Error codes 0-7 and the INTA bit, each provoked from the states where it arises:
+idle, moving, and interrupted with the rest queued (spec 4, 5)."""
+
+from __future__ import annotations
+
+from hypothesis import strategies as st
+from hypothesis.stateful import rule
+
+from conformance.case import CaseContext, case
+from conformance.machines.base import UnitMachine
+from conformance.machines.runner import run_machine
+
+RUN, INTA = 0x40, 0x80
+
+
+def expected_code(body: str, moving: bool, run: bool, inta: bool) -> int:
+    """The code of spec 5 for ``body`` in a state (moving; RUN; INTA)."""
+    table = {"V1000": 0, "T99": 5, "Z": 3, "V+1": 4, "SW8,F1": 5, "F": 0, "SR6": 0,
+             "C1,0,0": 0, "A0": 5, "T5,5": 4}
+    if body == "N":
+        return 7 if run else 0
+    if body in ("D", "K"):
+        return 7 if moving else 0
+    if body == "G":
+        return 0 if inta else 6
+    if body == "L0,0,0":
+        return 1 if run else 0
+    return table[body]
+
+
+class ErrorMachine(UnitMachine):
+    def observe(self) -> tuple[bool, bool, bool]:
+        r = self.link.send("SR6")
+        self.model.frame_arrived("S")
+        assert r is not None and r.code == 0 and r.values, f"SR6 answered {r}"
+        st6 = int(r.values[0], 16)
+        assert r.inta == bool(st6 & INTA), f"the INTA bit of {r.text} disagrees with ST6"
+        inta, run = bool(st6 & INTA), bool(st6 & RUN)
+        return (run and not inta) or bool(st6 & 0x01), run, inta
+
+    @rule(steps=st.integers(500, 3000))
+    def motion(self, steps: int) -> None:
+        r = self.link.send(f"C{steps},0,0")
+        self.model.frame_arrived("C")
+        assert r is not None and r.code in (0, 1), f"C answered {r}"
+
+    @rule()
+    def halt(self) -> None:
+        r = self.link.send("H")
+        self.model.frame_arrived("H")
+        assert r is not None and r.code == 0 and r.inta, f"H answered {r}"
+
+    @rule(seconds=st.sampled_from([0.01, 0.3, 1.5]))
+    def wait(self, seconds: float) -> None:
+        self.link.wait(seconds)
+
+    @rule(body=st.sampled_from(["V1000", "T99", "Z", "V+1", "SW8,F1", "F", "SR6", "C1,0,0",
+                                "A0", "T5,5", "N", "D", "G", "L0,0,0"]))
+    def probe(self, body: str) -> None:
+        moving, run, inta = self.observe()
+        if body == "C1,0,0" and not inta:
+            return                      # would start motion the model cannot time
+        r = self.link.send(body)
+        self.model.frame_arrived(body[:1])
+        want = expected_code(body, moving, run, inta)
+        assert r is not None, f"{body} got no answer"
+        assert r.code == want, f"{body} (moving={moving}, RUN={run}, INTA={inta}): " \
+                               f"code {r.code}, expected {want}"
+        after = {"G": False, "D": False}.get(body, inta) if r.code == 0 else inta
+        assert r.inta == after, f"{body}: INTA bit {r.inta}, expected {after}"
+
+
+@case("5.machine.error-codes", tag="M", source="M84 12.6; spec 4, 5",
+      rule="Each error code arises exactly in its states, with the INTA bit of ST6")
+def error_machine(ctx: CaseContext) -> None:
+    run_machine(ctx, ErrorMachine)
