@@ -51,8 +51,10 @@ def main() -> None:
     results = {core: measure(core) for core in cores}
     for key in results["python"]:
         line = f"{key:40}" + "".join(f"{core}: {results[core][key]:>14,.3f}  " for core in cores)
-        if len(cores) == 2 and results["python"][key]:
-            line += f"c/python: {results['c'][key] / results['python'][key]:.1f}x"
+        if len(cores) == 2 and results["python"][key] and results["c"][key]:
+            py, c = results["python"][key], results["c"][key]
+            speedup = py / c if key.startswith("seconds") else c / py   # rates vs durations
+            line += f"C is {speedup:.1f}x the Python twin"
         print(line)
     if len(cores) == 1:
         print("(the C core is not built: only the Python twin was measured)")

@@ -1,6 +1,9 @@
 """Done-when of the suite: a run against `python -m emulator --pty` through `serial:`
 gives the same verdicts as the in-process run, apart from the cases that need the
-emulator's test rig (which a serial port does not have)."""
+emulator's test rig (which a serial port does not have).
+
+The directed and golden cases run here in real time; the Hypothesis machines, whose
+real-time runs take minutes, are compared with the `hardware` settings by the slow test."""
 
 from __future__ import annotations
 
@@ -17,22 +20,31 @@ from conformance.verdict import COULD_NOT_TEST
 pytestmark = pytest.mark.pty
 
 
-def test_serial_run_matches_the_in_process_run():
+def _compare(globs: list[str] | None, exclude: list[str] | None, settings_name: str) -> dict:
     proc = subprocess.Popen([sys.executable, "-m", "emulator", "--model", "GVE84-100", "--pty"],
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                             stderr=subprocess.DEVNULL, text=True)
     try:
         path = proc.stdout.readline().strip()
-        cases = select()
+        cases = select(globs, exclude)
         serial_target = parse_target(f"serial:{path}?baud=115200", profile="GVE84-100",
                                      allow_destructive=True, max_travel=100_000)
-        over_pty = {r.id: r.verdict for r in run([serial_target], cases).results}
-        in_process = {r.id: r.verdict for r in run([parse_target("emu:GVE84-100")],
-                                                   cases).results}
+        over_pty = {r.id: r.verdict for r in run([serial_target], cases,
+                                                  settings_name=settings_name).results}
+        in_process = {r.id: r.verdict for r in run([parse_target("emu:GVE84-100")], cases,
+                                                   settings_name=settings_name).results}
     finally:
         proc.terminate()
         proc.wait(10)
     rig = {c.id for c in cases if c.rig}
-    differ = {i: (in_process[i], over_pty[i]) for i in in_process
-              if in_process[i] != over_pty[i] and not (i in rig and over_pty[i] == COULD_NOT_TEST)}
-    assert differ == {}
+    return {i: (in_process[i], over_pty[i]) for i in in_process
+            if in_process[i] != over_pty[i] and not (i in rig and over_pty[i] == COULD_NOT_TEST)}
+
+
+def test_serial_run_matches_the_in_process_run():
+    assert _compare(None, ["*machine*"], "ci") == {}
+
+
+@pytest.mark.slow
+def test_machines_over_serial_match_with_hardware_settings():
+    assert _compare(["*machine*"], None, "hardware") == {}
