@@ -42,6 +42,14 @@ vector_st = st.builds(
     st.integers(10, MAX_RATE), st.integers(1, 5000))
 
 
+def loaded(core: str, vectors):
+    """A core with ``vectors`` pushed 1 ns apart from instant 0."""
+    m = make(core)
+    for i, v in enumerate(vectors):
+        m.push(v, i)
+    return m
+
+
 def run_out(m) -> int:
     end = m.drain_instant()
     if end is None:                       # nothing held (zero-length vectors only)
@@ -90,9 +98,7 @@ def test_vectors_end_on_their_targets_and_pulses_add_up(core, vectors):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_position_equals_the_pulses_before_it(core, vectors, data):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     end = m.drain_instant() or m.now
     times, masks = m.pulses(0, end + 1)
     instant = data.draw(st.integers(0, end))
@@ -108,9 +114,7 @@ def test_position_equals_the_pulses_before_it(core, vectors, data):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_pulse_windows_slice_exactly(core, vectors, data):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     end = m.drain_instant() or m.now
     cut = data.draw(st.integers(0, end))
     whole = m.pulses(0, end + 1)
@@ -122,9 +126,7 @@ def test_pulse_windows_slice_exactly(core, vectors, data):
 @given(st.lists(vector_st, min_size=1, max_size=4))
 @SETTINGS
 def test_no_axis_steps_faster_than_the_variant_allows(core, vectors):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     end = run_out(m)
     times, masks = m.pulses(0, end + 1)
     for i in range(AXES):
@@ -187,9 +189,7 @@ def test_junction_is_faster_than_stopping(core):
 @given(st.lists(vector_st, min_size=1, max_size=5), st.data())
 @SETTINGS
 def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     end = m.drain_instant() or m.now
     at = data.draw(st.integers(0, end))
     rest = m.halt(at)
@@ -206,9 +206,7 @@ def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     end = m.drain_instant() or m.now
     rest = m.halt(data.draw(st.integers(0, end)))
     saved = m.keep(rest)
@@ -227,9 +225,7 @@ def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_overrides_change_speed_not_targets(core, vectors, data):
-    m = make(core)
-    for i, v in enumerate(vectors):
-        m.push(v, i)
+    m = loaded(core, vectors)
     t = 0
     for _ in range(data.draw(st.integers(1, 4))):
         t += data.draw(st.integers(0, SECOND))
