@@ -87,7 +87,7 @@ def _register(path: Path) -> None:
         return not families or profile.family in families or profile.name in families
 
     @case(f"11.golden.{path.stem}", rule=t.meta.get("title", path.stem),
-          tag="M-ex" if tag == "M-ex" else tag, source=t.meta.get("source", ""),
+          tag=tag, source=t.meta.get("source", ""),
           applies=applies, rig=needs_rig, destructive=bool(t.meta.get("destructive")))
     def replay(ctx: CaseContext) -> None:
         if address >= 0 and address != ctx.link.address:

@@ -74,7 +74,7 @@ class Link:
         if self.virtual:
             self.port.line.advance(seconds)
         else:
-            time.sleep(seconds)      # the fault itself is a pause on the wire
+            time.sleep(seconds)      # real serial/TCP time: the fault is a pause on the wire
 
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:

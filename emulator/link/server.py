@@ -29,7 +29,6 @@ class Server:
         self.control = control
         self.sel = selectors.DefaultSelector()
         self.running = True
-        self._out: callable | None = None  # type: ignore[valid-type]
 
     def stop(self, *_: object) -> None:
         self.running = False

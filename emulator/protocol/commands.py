@@ -300,7 +300,7 @@ def cmd_restore(u: Unit, p: str, t: int) -> list[str]:
     _not_moving(u, t)
     s = u.state
     if s.saved is None:
-        motion_save, st4, st5, st6 = _emptied(None), 0, 0, 0
+        motion_save, st4, st5, st6 = EMPTY_SAVE, 0, 0, 0
     else:
         motion_save, st4, st5, st6 = s.saved
     if u.mutant.active("restore-drops-partial"):
@@ -311,8 +311,8 @@ def cmd_restore(u: Unit, p: str, t: int) -> list[str]:
     return []
 
 
-def _emptied(save: object) -> object:
-    return ((), False)
+# a KEEP save with nothing in it (the save structure both stepper cores use)
+EMPTY_SAVE: object = ((), False)
 
 
 def _drop_partial(save: object) -> object:

@@ -253,9 +253,8 @@ class Unit:
         if self.mutant.active("lower-case-command"):
             text = text.upper()
         name, params = split(text)
-        if name in ("@", ">") and not self.mutant.active("index-counts-queries"):
-            pass
-        else:
+        # every intact frame counts except @ and > themselves (spec 8)
+        if name not in ("@", ">") or self.mutant.active("index-counts-queries"):
             s.index = (s.index + 1) & 0xFF
         if len(raw) > MAX_FRAME:
             self._answer(raw, SYNTAX, [], t)
