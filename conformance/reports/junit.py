@@ -1,4 +1,7 @@
-"""JUnit XML in the common schema: testsuites > testsuite (one per target) > testcase."""
+"""JUnit XML in the common (Ant/Jenkins junit-10) schema: testsuites > testsuite (one per
+target, with its properties) > testcase (skipped | error | failure, then system-out).
+A testcase carries no properties there, so its verdict, tag, rule and source head its
+system-out, above the wire log."""
 
 from __future__ import annotations
 
@@ -27,10 +30,16 @@ def render_junit(run: RunResult) -> str:
             errors=str(sum(r.verdict == ERROR for r in results)),
             skipped=str(sum(r.verdict in (MISSING, COULD_NOT_TEST) for r in results)),
             time=f"{sum(r.seconds for r in results):.3f}")
+        props = ET.SubElement(suite, "properties")
+        for key, value in (("target", target), ("settings", run.settings),
+                           ("profiles", " ".join(sorted({r.profile for r in results})))):
+            ET.SubElement(props, "property", name=key, value=value)
         for r in results:
             tc = ET.SubElement(suite, "testcase", name=f"{r.id}[{r.profile}]",
                                classname=f"gve.{r.profile}.section{r.section}",
                                time=f"{r.seconds:.3f}")
+            head = (f"verdict {r.verdict}; tag {r.tag}; section {r.section}; "
+                    f"source {r.source}\nrule: {r.rule}\n")
             log = "\n".join(r.wire_log)
             if r.verdict == FAIL:
                 ET.SubElement(tc, "failure", message=_message(r), type=r.verdict).text = log
@@ -39,8 +48,5 @@ def render_junit(run: RunResult) -> str:
                     "\n".join(r.notes) + "\n" + log)
             elif r.verdict in (MISSING, COULD_NOT_TEST):
                 ET.SubElement(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
-            props = ET.SubElement(tc, "properties")
-            for key in ("verdict", "tag", "rule", "source", "section"):
-                ET.SubElement(props, "property", name=key, value=str(getattr(r, key)))
-            ET.SubElement(tc, "system-out").text = log
+            ET.SubElement(tc, "system-out").text = head + log
     return ET.tostring(root, encoding="unicode", xml_declaration=True)
