@@ -8,6 +8,7 @@ a refused command changes nothing (spec 4).
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -361,6 +362,8 @@ def cmd_float_write(u: Unit, p: str, t: int) -> list[str]:
         data = struct.pack("<f", value)
     except OverflowError as err:
         raise CommandError(RANGE, "not a float32") from err
+    if not math.isfinite(struct.unpack("<f", data)[0]):
+        raise CommandError(RANGE, "not a finite float32")
     _eeprom_write(u, address, data, t)
     return []
 

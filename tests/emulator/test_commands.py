@@ -259,6 +259,7 @@ def test_eeprom_words(profile):
     assert ask(port, "ER4C") == b"0,78\r"
     assert ask(port, "EUR4C") == b"0,305419896\r"
     assert ask(port, "EFRFD") == b"5\r"
+    assert ask(port, "EFW30,1e999") == b"5\r"          # not a finite float32 [D]
 
 
 def test_eeprom_image_survives_a_restart_and_is_replaced_whole(tmp_path):
