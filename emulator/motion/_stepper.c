@@ -71,7 +71,21 @@ i64 st_acc_time(i64 v, i64 a, i64 m) {
     return sat(tau);
 }
 
-i64 st_acc_count(i64 v, i64 a, i64 tau) { return (i64)acc_count(v, a, tau); }
+/* The exported count (tests, tools): exact for any tau >= 0, saturating at NEVER where
+ * the count leaves int64 (the core itself only counts within a segment's duration). */
+i64 st_acc_count(i64 v, i64 a, i64 tau) {
+    if (tau <= 0) return tau == 0 ? 0 : (i64)acc_count(v, a, tau);
+    const u128 top = ~(u128)0;
+    u128 lin = (u128)2 * SECOND * (u128)v * (u128)tau;     /* < 2^117 */
+    u128 at = (u128)a * (u128)tau;                         /* < 2^92 */
+    if (at != 0 && at > (top - lin) / (u128)tau) return NEVER;
+    u128 q = (lin + at * (u128)tau) / ((u128)2 * SECOND * SECOND);
+    return q < (u128)NEVER ? (i64)q : NEVER;
+}
+
+uint64_t st_isqrt_u128(uint64_t hi, uint64_t lo) {
+    return (uint64_t)st_isqrt(((u128)hi << 64) | lo);
+}
 
 static i64 axis_count(i64 k, i64 d, i64 n) {
     if (d == 0 || n == 0) return 0;

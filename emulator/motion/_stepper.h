@@ -24,6 +24,8 @@ stepper *st_new(int axes, int64_t max_rate);
 void st_free(stepper *m);
 int64_t st_acc_time(int64_t v, int64_t a, int64_t m);
 int64_t st_acc_count(int64_t v, int64_t a, int64_t tau);
+/* floor(sqrt(hi·2^64 + lo)), exact */
+uint64_t st_isqrt_u128(uint64_t hi, uint64_t lo);
 void st_advance(stepper *m, int64_t t);
 int64_t st_now(stepper *m);
 int st_next_event(stepper *m, int64_t *out);

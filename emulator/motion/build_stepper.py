@@ -27,7 +27,7 @@ ffibuilder.set_source(
     include_dirs=[str(HERE)],
     # exact integer arithmetic; the one float (a square root's first guess) must not be
     # contracted or fast-mathed
-    extra_compile_args=["-O2", "-std=gnu11", "-ffp-contract=off", "-fno-fast-math"],
+    extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off", "-fno-fast-math"],
     libraries=["m"],
 )
 
