@@ -1,7 +1,8 @@
 """cffi (API mode) builder of the C stepper core: ``emulator.motion._stepper_c``.
 
-Built by setup.py at install time (``cffi_modules``); also runnable by hand:
-``python emulator/motion/build_stepper.py`` builds it in place.
+Built by setup.py at install time (``cffi_modules``): ``pip install -e .`` rebuilds it in
+place after a change to _stepper.c. Running this file from the project root also builds it
+in place, provided the setuptools at hand can read pyproject.toml (77 or later).
 """
 
 from __future__ import annotations
