@@ -55,7 +55,7 @@ def ops(axes: int, max_rate: int):
         st.tuples(st.just("keep"), st.none()),
         st.tuples(st.just("restore"), st.none()),
         st.tuples(st.just("clear"), st.none()),
-        st.tuples(st.just("set"), st.integers(-1000, 1000)),
+        st.tuples(st.just("set"), st.tuples(st.integers(0, axes - 1), st.integers(-1000, 1000))),
     ), max_size=25)
 
 
@@ -63,7 +63,8 @@ def observe(m, t: int):
     return (m.position(t), m.flags(t), m.queued(t), m.next_event(), m.drain_instant())
 
 
-@pytest.mark.parametrize(("axes", "max_rate"), [(3, 100_000), (4, 500_000)])
+@pytest.mark.parametrize(("axes", "max_rate"),
+                         [(1, 20_000), (2, 250_000), (3, 100_000), (4, 500_000)])
 @given(data=st.data())
 @SETTINGS
 def test_twins_agree_step_by_step(axes, max_rate, data):
@@ -96,11 +97,14 @@ def test_twins_agree_step_by_step(axes, max_rate, data):
             elif op == "clear":
                 m.clear(t)
             elif op == "set":
-                m.set_position(0, arg, t)
+                m.set_position(*arg, t)
         if op == "keep":
             assert saves["py"] == saves["c"]
         t = max(t, py.now)
         assert observe(py, t) == observe(c, t)
+        later = t + data.draw(st.integers(0, 5_000_000_000))
+        assert py.position(later) == c.position(later)
+        assert py.flags(later) == c.flags(later)
         assert py.instant_of_position(0, 5) == c.instant_of_position(0, 5)
     end = (py.drain_instant() or t) + 1
     window = min(end, t + 2_000_000_000)
@@ -110,3 +114,4 @@ def test_twins_agree_step_by_step(axes, max_rate, data):
     cut = data.draw(st.integers(0, window))
     first, second = c.pulses(0, cut), c.pulses(cut, window)
     assert np.array_equal(np.concatenate([first[0], second[0]]), c_times)
+    assert np.array_equal(np.concatenate([first[1], second[1]]), c_masks)
