@@ -71,3 +71,14 @@ def restore_empty(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     answers(ctx, ctx.link.send("R"), "0", "R at reset")
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved")
+
+
+@case("10.5.keep.one-level", tag="M", source="M54 [M]; M84 12.5.8, M114 13.6.9 [INFO]",
+      rule="The save has one level: a second K without R overwrites it")
+def one_level(ctx: CaseContext) -> None:
+    halted_with_queue(ctx)
+    setup(ctx, "K")      # saves the halted queue, INTA = 1
+    setup(ctx, "K")      # saves the now empty queue over it
+    tag = "M" if ctx.profile.keep != "single-L" else "D-info"
+    answers(ctx, ctx.link.send("R"), "0", "R brings back the second (empty) save", tag=tag)
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 as the second K saved it", tag=tag)
