@@ -1,0 +1,75 @@
+"""The runner on toy cases: each way a case can end gets the verdict of docs/suite.md."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from conformance.case import Case, CouldNotTest, Missing
+from conformance.runner import run_case
+from conformance.targets import parse_target
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, PASS
+
+
+def _toy(body, tag="M", **kw) -> Case:
+    return Case("99.toy.case", body, rule="toy rule", tag=tag, source="test", **kw)
+
+
+def _status_word(ctx):
+    # spec: an in-range status word read answers code 0 with one value
+    r = ctx.link.send("SR0")
+    ctx.expect(r.code == 0 and len(r.values) == 1, "SR0 answers one value", observed=r)
+
+
+def _fails(ctx):
+    ctx.expect(False, "a check that fails")
+
+
+def _raises(exc):
+    def body(ctx):
+        ctx.link.send("SR0")
+        raise exc
+    return body
+
+
+@pytest.fixture
+def target():
+    return parse_target("emu:GVE84-100")
+
+
+@pytest.mark.parametrize(("body", "tag", "verdict"), [
+    (_status_word, "M", PASS),
+    (_fails, "M", FAIL),
+    (_fails, "M-ex", FAIL),
+    (_fails, "D", FAIL),              # the emulator's profile implements the [D] rules
+    (_fails, "D-info", INFO),
+    (_raises(CouldNotTest("no rig")), "M", COULD_NOT_TEST),
+    (_raises(Missing("no such command")), "M", MISSING),
+    (_raises(RuntimeError("suite bug")), "M", ERROR),
+    (lambda ctx: None, "M", ERROR),   # a case that recorded no check cannot fail: a defect
+])
+def test_each_ending_has_its_verdict(target, body, tag, verdict):
+    assert run_case(_toy(body, tag), target).verdict == verdict
+
+
+def test_d_is_non_strict_on_a_unit_that_does_not_implement_the_decisions(target):
+    target.profile = dataclasses.replace(target.profile, implements_decisions=False)
+    assert run_case(_toy(_fails, "D"), target).verdict == NON_STRICT
+
+
+def test_profile_filters_come_before_running(target):
+    ran = []
+    lacking = _toy(lambda ctx: ran.append(1), requires=("NOSUCH",))
+    assert run_case(lacking, target).verdict == MISSING and not ran
+
+
+def test_the_wire_log_and_frames_are_kept(target):
+    r = run_case(_toy(_status_word), target)
+    assert r.frames >= 1 and any("SR0" in line for line in r.wire_log)
+
+
+def test_destructive_cases_wait_for_permission_on_real_units():
+    real = parse_target("tcp:localhost:1", profile="GVE84-100")
+    r = run_case(_toy(_fails, destructive=True), real)
+    assert r.verdict == COULD_NOT_TEST and r.frames == 0
