@@ -134,3 +134,56 @@ def test_bytes_during_restart_after_j_are_lost():
     h.settle()
     # spec 8/9: after the restart the index starts again; one answer, code 0
     assert len(h.answers) == 1 and h.answers[0][1].startswith(b"0,")
+
+
+def _codes(h: Harness) -> list[bytes]:
+    return [d for _, d, _ in h.answers]
+
+
+def test_gve114_addresses_0_and_7_share_index_and_checksum_mode():
+    unit = Unit("GVE114-500", 0)
+    h = Harness([unit])
+    for frame in (b"!0?\r", b"!7?\r", b"!7@\r"):
+        h.send(frame)
+        h.settle()
+    # spec 8 + 12: two counted frames, one on each address, one index
+    assert _codes(h)[-1] == b"0,2\r"
+    h.answers.clear()
+    h.send(b"!7%+\r")                          # checksums on via address 7
+    h.settle()
+    h.answers.clear()
+    h.send(b"!0?\r")                           # no checksum: address 0 refuses it too
+    h.settle()
+    assert len(h.answers) == 1 and h.answers[0][1][:1] != b"0", h.answers
+
+
+def test_address_7_refuses_motion_commands():
+    h = Harness([Unit("GVE114-500", 0)])
+    h.send(b"!7L1,0,0,0\r")
+    h.settle()
+    assert _codes(h) == [b"3\r"]               # spec 12: anything else there → 3
+
+
+def test_frames_during_a_pending_halt_are_dropped():
+    unit = Unit("GVE84-100", 0)
+    h = Harness([unit])
+    h.send(b"!0V1000\r!0L20000,0,0\r")
+    h.now += 50_000_000                        # let the vector run for 50 ms
+    unit.advance(h.now)
+    h.answers.clear()
+    h.send(b"!0H\r")
+    h.send(b"!0?\r")                           # arrives while H waits for the stop
+    h.settle()
+    # spec 2/10.4 + project decision: only H's answer, 8 (INTA set by HALT), no '?' answer
+    assert _codes(h) == [b"8\r"]
+    assert not unit.motion.flags(h.now).moving
+
+
+def test_reference_run_without_a_switch_is_5():
+    unit = Unit("GVE84-100", 0)
+    h = Harness([unit])
+    h.send(b"!0WX,-200,1000,200,500\r")
+    h.settle()
+    # spec 10 W: the switch is never found → 5, answered after the move
+    assert len(h.answers) == 1 and h.answers[0][1] == b"5\r"
+    assert h.answers[0][2] >= 200_000_000        # 200 steps at no more than 1000/s
