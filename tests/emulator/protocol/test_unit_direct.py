@@ -151,10 +151,12 @@ def test_gve114_addresses_0_and_7_share_index_and_checksum_mode():
     h.answers.clear()
     h.send(b"!7%+\r")                          # checksums on via address 7
     h.settle()
+    assert _codes(h) == [b"0,5C\r"]            # spec 6: already with its checksum
     h.answers.clear()
     h.send(b"!0?\r")                           # no checksum: address 0 refuses it too
     h.settle()
-    assert len(h.answers) == 1 and h.answers[0][1][:1] != b"0", h.answers
+    # spec 6: error 4 with a checksum; "4," sums to 0x34 + 0x2C = 0x60
+    assert _codes(h) == [b"4,60\r"]
 
 
 def test_address_7_refuses_motion_commands():
@@ -170,6 +172,7 @@ def test_frames_during_a_pending_halt_are_dropped():
     h.send(b"!0V1000\r!0L20000,0,0\r")
     h.now += 50_000_000                        # let the vector run for 50 ms
     unit.advance(h.now)
+    assert unit.motion.flags(h.now).moving
     h.answers.clear()
     h.send(b"!0H\r")
     h.send(b"!0?\r")                           # arrives while H waits for the stop
