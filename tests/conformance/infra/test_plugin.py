@@ -16,3 +16,9 @@ def test_inert_without_a_target(pytester):
     pytester.makepyfile("def test_nothing():\n    assert True\n")
     result = pytester.runpytest("-q")
     result.assert_outcomes(passed=1)
+
+
+def test_pyargs_conformance_runs_the_cases_on_the_default_target(pytester):
+    result = pytester.runpytest("--pyargs", "conformance", "--gve-cases", "5.errors.*", "-q")
+    result.assert_outcomes(passed=8)
+    result.stdout.fnmatch_lines(["*passed*"])

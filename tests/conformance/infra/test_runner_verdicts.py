@@ -73,3 +73,13 @@ def test_destructive_cases_wait_for_permission_on_real_units():
     real = parse_target("tcp:localhost:1", profile="GVE84-100")
     r = run_case(_toy(_fails, destructive=True), real)
     assert r.verdict == COULD_NOT_TEST and r.frames == 0
+
+
+def test_one_id_for_two_different_cases_is_refused():
+    from conformance.case import REGISTRY, case
+    try:
+        case("99.toy.twice", rule="r", tag="M", source="test")(_fails)
+        with pytest.raises(ValueError, match="registered twice"):
+            case("99.toy.twice", rule="r", tag="M", source="test")(_status_word)
+    finally:
+        REGISTRY.pop("99.toy.twice", None)
