@@ -31,11 +31,11 @@ def _address(words: list[str]) -> tuple[list[str], int | None]:
 
 def handle(line: Line, text: str) -> str | None:
     """Run one control line; returns the text to print (or None)."""
-    words, address = _address(text.split())
-    if not words:
-        return None
-    cmd, args = words[0].lower(), words[1:]
     try:
+        words, address = _address(text.split())
+        if not words:
+            return None
+        cmd, args = words[0].lower(), words[1:]
         if cmd in ("quit", "exit"):
             raise Quit
         if cmd == "help":
