@@ -49,11 +49,14 @@ def main(argv: list[str] | None = None) -> int:
         for c in cases:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
         return 0
-    specs = args.target or [f"emu:{name}" for name in available_profiles()]
+    every = [f"emu:{name}" for name in available_profiles()]
+    # no --target, or emu:all: the embedded emulator on every profile
+    specs = [s for t in args.target or ["emu:all"]
+             for s in (every if t.split("?")[0] == "emu:all" else [t])]
     try:
         targets = [parse_target(s, profile=args.profile, allow_destructive=args.allow_destructive,
                                 max_travel=args.max_travel, mutant=args.mutant) for s in specs]
-    except ValueError as err:
+    except (ValueError, LookupError) as err:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
     run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]

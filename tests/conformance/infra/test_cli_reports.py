@@ -48,3 +48,15 @@ def test_bad_targets_are_explained(capsys):
 def test_list(capsys):
     assert main(["--list"]) == 0
     assert "11.golden.g6-keep-restore" in capsys.readouterr().out
+
+
+def test_emu_all_means_every_profile(capsys):
+    assert main(["--target", "emu:all", "--cases", "5.errors.go-without-inta",
+                 "--no-reports"]) == 0
+    out = capsys.readouterr().out
+    assert "8 case runs on 8 target(s)" in out and "[GVE54]" in out and "[GVE114-500]" in out
+
+
+def test_an_unknown_profile_is_explained(capsys):
+    assert main(["--target", "emu:GVE99", "--no-reports"]) == 2
+    assert "GVE99" in capsys.readouterr().err
