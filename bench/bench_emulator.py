@@ -1,6 +1,6 @@
 """Commands per second in process (virtual time) and round trips per second over the pty.
 
-    python -m bench.bench_emulator [--seconds 3] [--profile]
+    python -m bench.bench_emulator [--seconds 3] [--no-profile]
 
 Prints its figures; the machine is shared and noisy, so compare ratios from one run.
 """
@@ -57,7 +57,8 @@ def over_pty(seconds: float) -> tuple[int, float]:
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seconds", type=float, default=3.0)
-    ap.add_argument("--profile", action="store_true", help="print where the time goes")
+    ap.add_argument("--no-profile", dest="profile", action="store_false",
+                    help="skip the cProfile run of the in-process loop (top items by own time)")
     args = ap.parse_args(argv)
     n, dt = in_process(args.seconds)
     print(f"in process (virtual time): {n / dt:,.0f} commands/s  (goal 50,000)")
