@@ -5,9 +5,12 @@ the clock by the bytes' transmission time, reads wait (virtually) up to the time
 
 from __future__ import annotations
 
+import time
+
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
-from emulator.link.line import Line
+from emulator.link.clock import RealClock
+from emulator.link.line import SECOND, Line
 from emulator.link.url import parse_url
 
 
@@ -30,7 +33,8 @@ class Serial(SerialBase):
             raise SerialException(f"gve://: {err}") from err
         baud = spec.line_baud(units)
         self._baudrate = baud
-        self.line = Line(units, baud, log=spec.log)
+        self.line = Line(units, baud, log=spec.log,
+                         clock=RealClock() if spec.realtime else None)
         self.is_open = True
 
     def close(self) -> None:
@@ -52,12 +56,31 @@ class Serial(SerialBase):
     def read(self, size: int = 1) -> bytes:
         if not self.is_open or self.line is None:
             raise PortNotOpenError()
-        return self.line.read(size, self._timeout)
+        return self._read(size, None)
 
     def read_until(self, expected: bytes = b"\n", size: int | None = None) -> bytes:
         if not self.is_open or self.line is None:
             raise PortNotOpenError()
-        return self.line.read(size or 1 << 30, self._timeout, expected)
+        return self._read(size or 1 << 30, expected)
+
+    def _read(self, size: int, terminator: bytes | None) -> bytes:
+        line = self.line
+        if line.clock.virtual:
+            return line.read(size, self._timeout, terminator)
+        # real time: take what is due, then sleep until the next byte or unit event
+        deadline = None if self._timeout is None else line.now + round(self._timeout * SECOND)
+        out = bytearray()
+        while True:
+            out += line.read(size - len(out), 0.0, terminator)
+            if len(out) >= size or (terminator and out.endswith(terminator)):
+                return bytes(out)
+            now = line.now
+            nxt = [x for x in (line._rx[0][0] if line._rx else None, line.next_deadline(),
+                               deadline) if x is not None]
+            if deadline is not None and now >= deadline:
+                return bytes(out)
+            wait = (min(nxt) - now) / SECOND if nxt else 0.05
+            time.sleep(min(max(wait, 0.0), 0.05))
 
     def write(self, data: bytes) -> int:
         if not self.is_open or self.line is None:

@@ -1,7 +1,8 @@
 """`gve://` URLs: which units a line carries, and how (docs/architecture.md, Ways in).
 
 ``gve://?model=GVE84-100&address=0`` or ``gve://?unit=GVE54@1&unit=GVE84-100@0``, with
-``baud``, ``watchdog_ms``, ``eeprom``, ``mutant``, ``stepper``, ``log``.
+``baud``, ``watchdog_ms``, ``eeprom``, ``mutant``, ``stepper``, ``log``, and
+``realtime=1`` (the line runs on the wall clock instead of virtual time).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ class LineSpec:
     mutant: str | None = None
     stepper: str | None = None
     log: str | None = None
+    realtime: bool = False
 
     def build_units(self) -> list[Unit]:
         units = []
@@ -49,7 +51,7 @@ def parse_url(url: str) -> LineSpec:
         raise ValueError(f"not a gve:// URL: {url!r}")
     q = parse_qs(parts.query)
     unknown = set(q) - {"model", "address", "unit", "baud", "watchdog_ms", "eeprom",
-                        "mutant", "stepper", "log"}
+                        "mutant", "stepper", "log", "realtime"}
     if unknown:
         raise ValueError(f"unknown gve:// parameter(s): {', '.join(sorted(unknown))}")
 
@@ -67,4 +69,5 @@ def parse_url(url: str) -> LineSpec:
             setattr(spec, key, int(value))
     for key in ("eeprom", "mutant", "stepper", "log"):
         setattr(spec, key, one(key))
+    spec.realtime = one("realtime") in ("1", "true", "yes")
     return spec

@@ -3,6 +3,8 @@ virtual time (answers from the spec's identification table, timeouts in virtual 
 
 from __future__ import annotations
 
+import time
+
 import pytest
 import serial
 
@@ -70,3 +72,14 @@ def test_log_parameter_writes_a_transcript(tmp_path) -> None:
     records = load(path).records
     assert [(r.direction, r.data) for r in records] == [
         (HOST, b"!0?\r"), (UNIT, b"0,IP84 v3 27.1.2010\r")]
+
+
+def test_realtime_port_answers_on_the_wall_clock() -> None:
+    port = serial.serial_for_url("gve://?model=GVE84-100&realtime=1", timeout=2.0)
+    assert not port.line.clock.virtual
+    start = time.monotonic()
+    port.write(b"!0?\r")
+    assert port.read_until(b"\r") == b"0,IP84 v3 27.1.2010\r"
+    port.timeout = 0.05
+    assert port.read(1) == b""
+    assert 0.05 <= time.monotonic() - start < 2.0
