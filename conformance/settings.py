@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from hypothesis import HealthCheck, settings
+from hypothesis import HealthCheck, Phase, settings
 
 _COMMON = {"suppress_health_check": list(HealthCheck), "deadline": None,
            "database": None, "print_blob": False}
@@ -11,7 +11,9 @@ PROFILES = {
     "ci": settings(max_examples=8, stateful_step_count=12, derandomize=True, **_COMMON),
     "dev": settings(max_examples=40, stateful_step_count=25, **_COMMON),
     "thorough": settings(max_examples=300, stateful_step_count=50, **_COMMON),
-    "hardware": settings(max_examples=3, stateful_step_count=10, derandomize=True, **_COMMON),
+    # real time is dear: no shrinking (a failing example is reported as it ran)
+    "hardware": settings(max_examples=3, stateful_step_count=10, derandomize=True,
+                         phases=[Phase.explicit, Phase.generate], **_COMMON),
 }
 
 
