@@ -77,6 +77,8 @@ RESET_SEQUENCE = ("H", "D", "SW0,00", "SW1,00", "SW2,00", "SW3,00", "SW4,00", "S
 
 def known_state(link: Link, profile: Profile) -> None:
     """Put a real unit into the state a case expects (docs/suite.md)."""
+    # H first: it is answered even inside an open packet, and discards it (spec 7)
+    link.send("H", checksum=True)
     link.send("%-", checksum=True)          # harmless if checksums were off: an error
     link.checksums = False
     r = profile.reset

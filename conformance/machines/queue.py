@@ -57,6 +57,9 @@ class QueueMachine(UnitMachine):
 
     @rule(address=st.integers(0x40, 0x47), value=st.integers(0, 255))
     def eeprom_write(self, address: int, value: int) -> None:
+        guard = self.link.guard
+        if guard.enforce and address not in guard.eeprom_touched:
+            self.model.frame_arrived("E")    # on a real unit the link backs it up first (ER)
         r = self.send("EW%02X,%02X" % (address, value))
         assert r is not None and r.code == 0, f"EW answered {r}"
         self.eeprom[address] = value
