@@ -110,12 +110,17 @@ class Line:
         if self.log is not None:
             self.log.unit(data, start + b)
 
+    def _ready(self, first: int, data: bytes, now: int) -> int:
+        """How many bytes of a chunk whose first byte is complete at ``first`` are by now."""
+        b = self.byte_ns
+        return len(data) if not b else min(len(data), (now - first) // b + 1)
+
     def _ready_count(self, now: int) -> int:
-        b, n = self.byte_ns, 0
+        n = 0
         for first, data, taken in self._rx:
             if first > now:
                 break
-            ready = len(data) if not b else min(len(data), (now - first) // b + 1)
+            ready = self._ready(first, data, now)
             n += ready - taken
             if ready < len(data):
                 break
@@ -130,13 +135,13 @@ class Line:
 
     def _take(self, size: int, terminator: bytes | None) -> bytes:
         out = bytearray()
-        now, b, rx = self.now, self.byte_ns, self._rx
+        now, rx = self.now, self._rx
         while rx and len(out) < size:
             chunk = rx[0]
             first, data, taken = chunk
             if first > now:
                 break
-            ready = len(data) if not b else min(len(data), (now - first) // b + 1)
+            ready = self._ready(first, data, now)
             end = min(ready, taken + size - len(out))
             if terminator:
                 k = data.find(terminator, taken, end)

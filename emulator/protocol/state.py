@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from gve_fixtures.profile import Profile
 
@@ -45,7 +45,6 @@ class UnitState:
     mpg: str = ""
     spindle: int = 0
     reference_until: int = -1         # a W reference run in progress until then
-    extra: dict = field(default_factory=dict)
 
     @property
     def inta(self) -> bool:
