@@ -10,7 +10,7 @@ import sys
 import time
 import uuid
 
-from conformance.case import select
+from conformance.catalogue import select
 from conformance.reports import write_reports
 from conformance.runner import CaseResult, run
 from conformance.settings import PROFILES

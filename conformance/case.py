@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import fnmatch
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -14,7 +13,7 @@ from conformance.link.safety import SafetyStop
 from gve_fixtures.profile import Profile
 
 __all__ = ["REGISTRY", "Case", "CaseContext", "Check", "CouldNotTest", "Missing",
-           "SafetyStop", "TargetInfo", "case", "select"]
+           "SafetyStop", "TargetInfo", "case"]
 
 
 class CouldNotTest(Exception):
@@ -78,20 +77,6 @@ def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...]
                             applies, rig, destructive, timing)
         return func
     return register
-
-
-def select(include: list[str] | None = None, exclude: list[str] | None = None) -> list[Case]:
-    import conformance.cases  # noqa: F401  (registers the catalogue)
-    cases = sorted(REGISTRY.values(), key=lambda c: _order(c.id))
-    if include:
-        cases = [c for c in cases if any(fnmatch.fnmatch(c.id, g) for g in include)]
-    if exclude:
-        cases = [c for c in cases if not any(fnmatch.fnmatch(c.id, g) for g in exclude)]
-    return cases
-
-
-def _order(id: str) -> tuple:
-    return (*tuple(int(p) if p.isdigit() else 1000000 for p in id.split(".")[:3]), id)
 
 
 @dataclass(frozen=True)
