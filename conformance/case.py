@@ -11,6 +11,8 @@ from typing import Any
 from conformance.link.link import Link
 from conformance.link.safety import SafetyStop
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
+from gve_fixtures.rules import load_rules
 
 __all__ = ["REGISTRY", "Case", "CaseContext", "Check", "CouldNotTest", "Missing",
            "SafetyStop", "TargetInfo", "case"]
@@ -37,6 +39,7 @@ class Case:
     rig: bool = False
     destructive: bool = False
     timing: bool = False
+    rules: tuple[str, ...] = ()      # IDs of fixtures/rules.toml this case can fail
 
     @property
     def section(self) -> str:
@@ -61,10 +64,14 @@ REGISTRY: dict[str, Case] = {}
 
 def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...] = (),
          absent: tuple[str, ...] = (), applies: Callable[[Profile], bool] | None = None,
-         rig: bool = False, destructive: bool = False, timing: bool = False):
+         rig: bool = False, destructive: bool = False, timing: bool = False,
+         rules: tuple[str, ...] = ()):
     """Register a case (see docs/suite.md)."""
-    if tag not in ("M", "M-ex", "D", "D-info"):
-        raise ValueError(f"{id}: tag must be M, M-ex, D or D-info")
+    if tag not in TAGS:
+        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
+    unknown = [r for r in rules if r not in load_rules()]
+    if unknown:
+        raise ValueError(f"{id}: unknown rule(s) {unknown} (see fixtures/rules.toml)")
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)
@@ -74,7 +81,7 @@ def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...]
                 func.__module__, func.__qualname__):
             raise ValueError(f"case {id} is registered twice")
         REGISTRY[id] = Case(id, func, rule, tag, source, tuple(requires), tuple(absent),
-                            applies, rig, destructive, timing)
+                            applies, rig, destructive, timing, tuple(rules))
         return func
     return register
 
