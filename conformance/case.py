@@ -118,6 +118,7 @@ class CaseContext:
     artifacts: dict[str, str] = field(default_factory=dict)
     links: list[Link] = field(default_factory=list)
     _link: Link | None = None
+    seed: int | None = None      # the run's seed for the Hypothesis machines (None: settings)
 
     @property
     def link(self) -> Link:

@@ -1,6 +1,9 @@
-"""Hypothesis settings profiles for the machines (issue 4 item 5)."""
+"""Hypothesis settings profiles for the machines (issue 4 item 5) and the run's seed
+(issue 12 item 7)."""
 
 from __future__ import annotations
+
+import secrets
 
 from hypothesis import HealthCheck, Phase, settings
 
@@ -22,3 +25,14 @@ def get(name: str) -> settings:
         return PROFILES[name]
     except KeyError:
         raise ValueError(f"unknown settings profile {name!r}: {', '.join(PROFILES)}") from None
+
+
+def run_seed(name: str, seed: int | None = None) -> int | None:
+    """The seed a run records and gives the machines: ``seed`` when given (it overrides
+    derandomization), else None for derandomized settings (every run draws the same
+    examples) and a fresh random one for the others, so that any run can be replayed."""
+    if seed is not None:
+        return seed
+    if get(name).derandomize:
+        return None
+    return secrets.randbits(32)
