@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections import Counter
 from importlib import resources
 
-from conformance.reports import plots
+import conformance.reports.plots as plots
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import html_text as h
