@@ -16,7 +16,9 @@ def _packet(ctx: CaseContext, members: list[str], count: int):
     return link.send(f"*E{count}")
 
 
-@case("7.packet.commits-all", tag="M", source="M84 12.3.3", requires=("*S",),
+@case("7.packet.commits-all",
+      rules=("7.packet.exchange", "7.packet.members", "7.packet.all-or-nothing"),
+      tag="M", source="M84 12.3.3", requires=("*S",),
       rule="*E<n> commits every member in order and answers code,k")
 def commits(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
@@ -26,7 +28,9 @@ def commits(ctx: CaseContext) -> None:
                expected=[10, 20, 0])
 
 
-@case("7.packet.count-mismatch", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.count-mismatch",
+      rules=("7.packet.codes", "7.packet.all-or-nothing", "5.code.watchdog"),
+      tag="D", source=RULE, requires=("*S",),
       rule="k ≠ n: nothing is committed and *E answers 2,k")
 def count(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
@@ -35,7 +39,9 @@ def count(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", tag="always")
 
 
-@case("7.packet.invalid-member", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.invalid-member",
+      rules=("7.packet.other-member", "7.packet.codes", "7.packet.all-or-nothing"),
+      tag="D", source=RULE, requires=("*S",),
       rule="A member other than C or B fails the packet with 4; nothing is committed")
 def invalid(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
@@ -45,14 +51,18 @@ def invalid(ctx: CaseContext) -> None:
                expected=[0, 0, 0], tag="always")
 
 
-@case("7.packet.out-of-range-member", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.out-of-range-member",
+      rules=("7.packet.codes",),
+      tag="D", source=RULE, requires=("*S",),
       rule="A member out of range fails the packet with its code (5)")
 def out_of_range(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B1", "C" + vector(ctx, 10)], 2)
     answers(ctx, r, "5,2", "B1 (below range) → 5,2")
 
 
-@case("7.packet.no-room", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.no-room",
+      rules=("7.packet.codes", "5.code.queue-full", "7.packet.all-or-nothing"),
+      tag="D", source=RULE, requires=("*S",),
       rule="A packet that does not fit the queue answers 1 and commits nothing")
 def no_room(ctx: CaseContext) -> None:
     if not fill_queue(ctx, ctx.profile.buffer - 1):
@@ -67,13 +77,17 @@ def no_room(ctx: CaseContext) -> None:
     ctx.link.send("D")
 
 
-@case("7.packet.end-without-start", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.end-without-start",
+      rules=("7.packet.breakers",),
+      tag="D", source=RULE, requires=("*S",),
       rule="*E with no open packet answers 4,0")
 def end_alone(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("*E1"), "4,0", "*E1 alone → 4,0")
 
 
-@case("7.packet.halt-inside", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.halt-inside",
+      rules=("7.packet.breakers", "8.index.counts"),
+      tag="D", source=RULE, requires=("*S",),
       rule="H, @, > inside an open packet are answered at once and discard the packet")
 def breakers(ctx: CaseContext) -> None:
     link = ctx.link
@@ -84,7 +98,9 @@ def breakers(ctx: CaseContext) -> None:
     answers(ctx, link.send("*E1"), "4,0", "the packet was discarded")
 
 
-@case("7.packet.with-checksums", tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
+@case("7.packet.with-checksums",
+      rules=("7.packet.checksums",),
+      tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
       rule="Packets work in checksum mode, each member with its own checksum")
 def summed(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
