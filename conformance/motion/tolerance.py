@@ -95,6 +95,30 @@ def processing_window(sent_at: int, received_at: int, frame_bytes: int, answer_b
     return Window(sent_at, received_at)
 
 
+def answer_window(sent_at: int, received_at: int, frame_bytes: int, answer_bytes: int,
+                  baud: int, *, virtual: bool, paced: bool) -> Window:
+    """The window in which the unit sent its answer: the processing instant for most
+    frames; for ``H`` and ``W``, which answer when the motion has stopped, later."""
+    if virtual:
+        t = received_at - answer_bytes * byte_ns(baud)
+        return Window(t, t)
+    return processing_window(sent_at, received_at, frame_bytes, answer_bytes, baud,
+                             virtual=False, paced=paced)
+
+
+def late_window(sent_at: int, frame_bytes: int, baud: int, round_trip: int, *,
+                virtual: bool, paced: bool) -> Window:
+    """The processing window of a frame answered late (``H``): after its bytes arrived,
+    and no later than the longest round trip observed on the link for frames answered
+    at once."""
+    b = byte_ns(baud)
+    if virtual:
+        t = sent_at + frame_bytes * b
+        return Window(t, t)
+    lo = sent_at + (frame_bytes * b if paced else 0)
+    return Window(lo, max(lo, sent_at + round_trip))
+
+
 def tolerance(window: Window, *, virtual: bool) -> Tolerance:
     """The tolerance a position read in ``window`` is judged with."""
     return Tolerance(window.seconds, 0 if virtual else PLACEMENT_STEPS)
