@@ -7,6 +7,7 @@ from conformance.cases import (  # noqa: F401
     golden,
     index,
     keep,
+    measured,
     motion,
     packet,
     status,

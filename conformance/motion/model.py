@@ -35,10 +35,10 @@ class Vector:
     active: bool = False         # has a plan it is executing (or dwelling before)
     start: int = 0               # the instant its current plan starts
     exit: int = 0                # the rate it leaves with
+    n: int = field(init=False)   # its dominant length
 
-    @property
-    def n(self) -> int:
-        return dominant(self.d)
+    def __post_init__(self) -> None:
+        self.n = dominant(self.d)
 
     def count(self, t: int) -> int:
         return sum(s.count(t) for s in self.segments)

@@ -29,9 +29,11 @@ from conformance.motion.tolerance import (
 )
 
 #: dense model points per trace
-TRACE_POINTS = 120
+TRACE_POINTS = 60
 #: let the unit rest longer than any T (24 ms) before a scenario starts
 SETTLE = 0.03
+#: a scenario's moves take well under this
+UNTIL_SECONDS = 5.0
 
 
 @dataclass
@@ -109,6 +111,30 @@ class Probe:
 
     def wait(self, seconds: float) -> None:
         self.link.wait(seconds)
+
+    def until(self, target: list[int], max_seconds: float, every: float) -> None:
+        """Read PF every ``every`` s until the axes stand at ``target`` (counter units)."""
+        end = self.link.now + round(max_seconds * SECOND)
+        while self.link.now < end:
+            got = self.read()
+            if got is not None and got[:len(target)] == target:
+                return
+            self.link.wait(every)
+        raise CouldNotTest(f"the axes did not reach {target} within {max_seconds} s")
+
+    def script(self, steps: list, every: float = 0.05) -> bool:
+        """Run a scenario and judge it: a string is a frame to send, a number the seconds
+        to sample PF for (every ``every`` s), a list the position (in commanded steps) to
+        poll PF until (every 2 ms)."""
+        for step in steps:
+            if isinstance(step, str):
+                self.send(step)
+            elif isinstance(step, list):
+                self.until([o + x * self.scale for o, x in zip(self.origin, step, strict=False)],
+                           UNTIL_SECONDS, 0.002)
+            else:
+                self.sample(step, every)
+        return self.judge()
 
     # -- the frames' meaning (spec 10) --------------------------------------------------
     def _book(self, body: str, w: Window, answered: Window) -> None:
