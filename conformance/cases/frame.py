@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, show
+from conformance.link.framing import frame
+from conformance.motion.tolerance import byte_ns
 
 
 @case("2.link.other-address-ignored",
@@ -138,3 +140,22 @@ def refused(ctx: CaseContext) -> None:
         r = ctx.link.send(body)
         ctx.expect(r is not None and r.code and not r.values, f"{body} → code only",
                    observed=show(r), expected="an error code alone")
+
+
+#: how long a real unit may take to process a frame before it answers (spec 2: "as soon
+#: as possible"): well under the watchdog; in virtual time the emulator takes none
+PROCESSING_SECONDS = 0.1
+
+
+@case("2.link.answers-at-once", rules=("2.link.answer-promptly",))
+def at_once(ctx: CaseContext) -> None:
+    link = ctx.link
+    for body in ("V1000", "PF", "SR6", "?", "Z"):
+        r = link.send(body)
+        wire = (len(frame(body, link.address, link.checksums)) + (len(r.raw) if r else 0)) \
+            * byte_ns(link.baud)
+        limit = wire + (0 if link.virtual else round(PROCESSING_SECONDS * 1e9))
+        took = None if r is None else r.received_at - r.sent_at
+        ctx.expect(took is not None and took <= limit, f"{body} is answered at once",
+                   observed=f"{took} ns", expected=f"at most {limit} ns (the bytes' time"
+                   f"{'' if link.virtual else ' and 0.1 s'})")

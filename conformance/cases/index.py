@@ -12,6 +12,7 @@ from conformance.cases._kit import (
     setup,
     vector,
 )
+from conformance.link.framing import byte_sum
 
 SRC = "M84 12.5.12; spec 8 [D what counts]"
 
@@ -112,3 +113,17 @@ def lost_response(ctx: CaseContext) -> None:
     link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
     ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
                expected=[9, 0, 0], tag="always")
+
+
+@case("8.repeat.queries-forgotten", requires=("%",), rules=("8.repeat.remembered",))
+def queries_forgotten(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "%+", checksum=False)
+    setup(ctx, "V1000")
+    link.send("@", checksum="00")                  # a bad checksum: answered 4, not kept
+    link.send(">", checksum="00", lines=1)
+    r = link.send(">", lines=2)
+    ctx.expect(r is not None and r.lines[:1] == [f"!{link.address}V1000,%02X".encode()
+                                                 % byte_sum(f"!{link.address}V1000,".encode())],
+               "> still shows V1000: @ and > are never remembered, even refused",
+               observed=r, expected=f"!{link.address}V1000,XX then 0,5C")

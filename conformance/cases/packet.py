@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, fill_queue, index, index_moved, position, setup, vector
+from conformance.link.framing import byte_sum
 
 RULE = "spec 7 [D]; M84 12.3.3"
 
@@ -107,3 +108,24 @@ def summed(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 2)
     ctx.expect(r is not None and r.code == 0 and r.values == ["2"] and r.checksum_ok,
                "a summed packet → 0,2 with its checksum", observed=r, expected="0,2,XX")
+
+
+@case("7.packet.bad-checksum-member.corrupted-end", requires=("*S",),
+      rules=("7.packet.bad-checksum-member", "8.index.uncounted"))
+def corrupted_end(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "%+", checksum=False)
+    before = index(ctx)
+    link.send("*S", answer=False)
+    link.send("C" + vector(ctx, 1), answer=False)
+    r = link.send("*E1", checksum="00", timeout=0.5)
+    ctx.expect(r is None, "a corrupted *E is a failing member: no answer", observed=r,
+               expected="nothing", rule="7.packet.bad-checksum-member")
+    answers(ctx, link.send("*E1"), "2,2,%02X" % byte_sum(b"2,2,"),
+            "the packet stayed open with two members",
+            rule="7.packet.bad-checksum-member")
+    index_moved(ctx, before, 3, "*S, the member and *E counted; the corrupted frame not",
+                rule="8.index.uncounted")
+    ctx.link.wait(0.5)
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing was committed", observed=position(ctx),
+               expected=[0, 0, 0], rule="7.packet.bad-checksum-member")
