@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import fnmatch
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -12,9 +11,11 @@ from typing import Any
 from conformance.link.link import Link
 from conformance.link.safety import SafetyStop
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
+from gve_fixtures.rules import load_rules
 
 __all__ = ["REGISTRY", "Case", "CaseContext", "Check", "CouldNotTest", "Missing",
-           "SafetyStop", "TargetInfo", "case", "select"]
+           "SafetyStop", "TargetInfo", "case"]
 
 
 class CouldNotTest(Exception):
@@ -38,6 +39,7 @@ class Case:
     rig: bool = False
     destructive: bool = False
     timing: bool = False
+    rules: tuple[str, ...] = ()      # IDs of fixtures/rules.toml this case can fail
 
     @property
     def section(self) -> str:
@@ -62,10 +64,14 @@ REGISTRY: dict[str, Case] = {}
 
 def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...] = (),
          absent: tuple[str, ...] = (), applies: Callable[[Profile], bool] | None = None,
-         rig: bool = False, destructive: bool = False, timing: bool = False):
+         rig: bool = False, destructive: bool = False, timing: bool = False,
+         rules: tuple[str, ...] = ()):
     """Register a case (see docs/suite.md)."""
-    if tag not in ("M", "M-ex", "D", "D-info"):
-        raise ValueError(f"{id}: tag must be M, M-ex, D or D-info")
+    if tag not in TAGS:
+        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
+    unknown = [r for r in rules if r not in load_rules()]
+    if unknown:
+        raise ValueError(f"{id}: unknown rule(s) {unknown} (see fixtures/rules.toml)")
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)
@@ -75,23 +81,9 @@ def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...]
                 func.__module__, func.__qualname__):
             raise ValueError(f"case {id} is registered twice")
         REGISTRY[id] = Case(id, func, rule, tag, source, tuple(requires), tuple(absent),
-                            applies, rig, destructive, timing)
+                            applies, rig, destructive, timing, tuple(rules))
         return func
     return register
-
-
-def select(include: list[str] | None = None, exclude: list[str] | None = None) -> list[Case]:
-    import conformance.cases  # noqa: F401  (registers the catalogue)
-    cases = sorted(REGISTRY.values(), key=lambda c: _order(c.id))
-    if include:
-        cases = [c for c in cases if any(fnmatch.fnmatch(c.id, g) for g in include)]
-    if exclude:
-        cases = [c for c in cases if not any(fnmatch.fnmatch(c.id, g) for g in exclude)]
-    return cases
-
-
-def _order(id: str) -> tuple:
-    return (*tuple(int(p) if p.isdigit() else 1000000 for p in id.split(".")[:3]), id)
 
 
 @dataclass(frozen=True)

@@ -63,7 +63,7 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
         specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
     if not specs:
         return
-    from conformance.case import select
+    from conformance.catalogue import select
     globs = config.getoption("--gve-cases") or None
     for spec in specs:
         target = parse_target(spec, profile=config.getoption("--gve-profile"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.case import select
+from conformance.catalogue import select
 from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.verdict import ERROR, FAIL

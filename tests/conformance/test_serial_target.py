@@ -12,7 +12,7 @@ import sys
 
 import pytest
 
-from conformance.case import select
+from conformance.catalogue import select
 from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.verdict import COULD_NOT_TEST

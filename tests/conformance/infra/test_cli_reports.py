@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as ET
 
-from conformance.__main__ import main
+from conformance.cli import main
 
 
 def test_a_run_writes_three_reports(tmp_path, capsys):

@@ -1,23 +1,16 @@
-"""Targets: where the suite's links go (issue 4 item 1).
-
-``emu:PROFILE`` (the embedded emulator in virtual time, a fresh unit per link;
-``emu:GVE84-100?mutant=NAME`` plants a mutant), ``serial:/dev/ttyUSB0?baud=115200&address=0``
-and ``tcp:HOST:PORT`` (a unit or a clone's simulator in real time, one shared port put
-into a known state before each case). This is the only module of the suite that imports
-the emulator, and only to open its ``gve://`` URL.
-"""
+"""A target: the profile expected of it, how to open links to it, and the known state
+a real unit is put into before each case (docs/suite.md)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from urllib.parse import parse_qs, urlsplit
 
 import serial
 
 from conformance.case import TargetInfo
 from conformance.link.link import Link
 from conformance.link.safety import Guard
-from gve_fixtures.profile import Profile, available_profiles, load_profile
+from gve_fixtures.profile import Profile
 
 DEFAULT_MAX_TRAVEL = 2000
 
@@ -88,35 +81,3 @@ def known_state(link: Link, profile: Profile) -> None:
     link.send("D")
     link.guard.position = [0, 0, 0, 0]
     link.log.clear()
-
-
-def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bool = False,
-                 max_travel: int = DEFAULT_MAX_TRAVEL, mutant: str | None = None) -> Target:
-    kind, _, rest = spec.partition(":")
-    if kind == "emu":
-        parts = urlsplit("x://h/" + rest)
-        name = parts.path.lstrip("/") or "GVE84-100"
-        q = parse_qs(parts.query)
-        mutant = q.get("mutant", [mutant])[-1]
-        p = load_profile(profile or name)
-        info = TargetInfo("emu", spec, True, True, True, max_travel)
-        return Target(info, p, p.address, p.default_baud, spec, mutant)
-    if kind in ("serial", "tcp"):
-        if kind == "serial":
-            parts = urlsplit("x://h" + (rest if rest.startswith("/") else "/" + rest))
-            q = parse_qs(parts.query)
-            url = parts.path
-        else:
-            host, _, q_text = rest.partition("?")
-            q = parse_qs(q_text)
-            url = f"socket://{host}"
-        if profile is None:
-            raise ValueError(f"{spec}: say which profile the unit should behave as "
-                             f"(--profile, one of {', '.join(available_profiles())})")
-        p = load_profile(profile)
-        baud = int(q.get("baud", [p.default_baud])[-1])
-        address = int(q.get("address", [p.address])[-1])
-        info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
-        return Target(info, p, address, baud, url)
-    raise ValueError(f"unknown target {spec!r}: use emu:PROFILE, serial:PATH?baud=&address=, "
-                     "or tcp:HOST:PORT")
