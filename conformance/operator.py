@@ -17,6 +17,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TextIO
 
+from tqdm import tqdm
+
 from conformance.case import CouldNotTest
 from conformance.link.link import Link
 
@@ -35,14 +37,16 @@ class Console:
         self.interactive = self.stdin.isatty() if interactive is None else interactive
 
     def say(self, text: str) -> None:
-        print(text, file=self.stdout, flush=True)
+        with tqdm.external_write_mode(file=self.stdout):    # above a progress bar
+            print(text, file=self.stdout, flush=True)
 
     def _answer(self, prompt: str) -> str | None:
         if not self.interactive:
             return None
-        self.stdout.write(prompt)
-        self.stdout.flush()
-        line = self.stdin.readline()
+        with tqdm.external_write_mode(file=self.stdout):
+            self.stdout.write(prompt)
+            self.stdout.flush()
+            line = self.stdin.readline()
         return None if not line else line.strip()         # end of input: no answer
 
     def confirm(self, question: str) -> bool:

@@ -10,9 +10,13 @@ import sys
 import time
 import uuid
 
+from serial import SerialException
+
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
+from conformance.cli.unit import confirmed, record_identities, resolve
 from conformance.metadata import RunMeta, now_iso
+from conformance.operator import Console
 from conformance.reports import write_junit, write_reports
 from conformance.runner import run
 from conformance.settings import PROFILES, run_seed
@@ -26,7 +30,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT; repeatable")
-    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target; 'auto': "
+                    "ask the unit (? and Q) and choose")
+    ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
+                    "say it: the variant (e.g. 100 for a GVE84-100)")
+    ap.add_argument("--yes", action="store_true",
+                    help="real units: move without asking first (unattended benches)")
+    ap.add_argument("--operator", action=argparse.BooleanOptionalAction, default=None,
+                    help="real units: ask a technician for hand steps (ground an input...); "
+                         "default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
@@ -64,7 +76,6 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
     for target in targets:
         t = meta.target(target.info.spec)
         t.kind, t.profile = target.info.kind, target.profile.name
-        t.profile_chosen = "emulated" if target.info.kind == "emu" else "--profile"
         t.envelope = None if target.info.kind == "emu" else target.info.max_travel
     return meta
 
@@ -91,22 +102,42 @@ def main(argv: list[str] | None = None) -> int:
     # no --target, or emu:all: the embedded emulator on every profile
     specs = [s for t in args.target or ["emu:all"]
              for s in (every if t.split("?")[0] == "emu:all" else [t])]
+    console = Console()
     try:
-        targets = [parse_target(s, profile=args.profile, allow_destructive=args.allow_destructive,
-                                max_travel=args.max_travel, mutant=args.mutant) for s in specs]
-    except (ValueError, LookupError) as err:
+        chosen = [resolve(s, args.profile, args.variant, console) for s in specs]
+        targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
+                                max_travel=args.max_travel, mutant=args.mutant)
+                   for s, p, _ in chosen]
+    except (ValueError, LookupError, OSError, SerialException) as err:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
     run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
     seed = run_seed(args.settings, args.seed)
     meta = _meta(args, argv, targets, seed)
+    for (_, _, how), target in zip(chosen, targets, strict=True):
+        meta.target(target.info.spec).profile_chosen = how
+    real = any(t.info.kind != "emu" for t in targets)
+    meta.operator_steps = (real and console.interactive if args.operator is None
+                           else args.operator)
+    try:
+        record_identities(targets, meta)
+    except (OSError, SerialException) as err:
+        print(f"gve-conformance: {err}", file=sys.stderr)
+        return 2
+    if real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+        if not args.yes and not confirmed(targets, meta, console):
+            print("gve-conformance: motion not confirmed, nothing that moves was sent (answer "
+                  "y, or give --yes on an unattended bench)", file=sys.stderr)
+            return 2
     print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
           f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
           "examples; --seed N for others)", flush=True)
     progress = Progress(len(targets) * len(cases), quiet=args.quiet)
     try:
         result = run(targets, cases, settings_name=args.settings, run_id=run_id,
-                     on_result=progress.result, seed=seed)
+                     on_result=progress.result, seed=seed,
+                     console=console if meta.operator_steps else None)
     finally:
         progress.close()
     meta.finished = now_iso()

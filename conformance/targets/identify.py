@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import serial
 
 from conformance.link.framing import frame, parse_response
+from conformance.targets.base import Target
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: how long one question waits for its answer (no unit answers `?` slower)
@@ -87,10 +88,9 @@ def family_of(version: str) -> str | None:
 def candidates(version: str) -> list[Profile]:
     """The profiles a unit answering ``version`` to `?` may be."""
     exact = [p for p in profiles() if p.version == version]
-    if exact:
-        return exact
     family = family_of(version)
-    return [p for p in profiles() if p.family == family]
+    found = exact or [p for p in profiles() if p.family == family]
+    return sorted(found, key=lambda p: p.max_rate)
 
 
 def variant_of(name: str) -> str:
@@ -135,3 +135,14 @@ def probe(url: str, address: int = 0) -> str | None:
     family = family_of(identity.version) or "unknown family"
     return (f"{family}: ? {identity.version!r}, Q {identity.processor_id!r} "
             f"at {identity.baud} baud, address {address}")
+
+
+def of_target(target: Target) -> Identity | None:
+    """What the target answers to `?` and `Q`, for the report (nothing that moves)."""
+    if target.info.kind == "emu":
+        link = target.open_link()
+        version, processor_id = link.send("?"), link.send("Q")
+        if version is None or processor_id is None:
+            return None
+        return Identity(",".join(version.values), ",".join(processor_id.values), target.baud)
+    return ask(target.url, target.address, [target.baud])
