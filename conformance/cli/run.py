@@ -15,6 +15,7 @@ from serial import SerialException
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
 from conformance.cli.unit import confirmed, record_identities, resolve
+from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.reports import write_junit, write_reports
@@ -89,7 +90,6 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
         return 0
     if args.coverage:
-        from conformance.coverage import coverage, format_coverage
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
@@ -116,6 +116,10 @@ def main(argv: list[str] | None = None) -> int:
     meta = _meta(args, argv, targets, seed)
     for (_, _, how), target in zip(chosen, targets, strict=True):
         meta.target(target.info.spec).profile_chosen = how
+    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
+                                        for s in d["sections"]]}
+                     for d in (pc.as_dict() for pc in coverage(
+                         sorted({t.profile.name for t in targets}), cases=cases))]
     real = any(t.info.kind != "emu" for t in targets)
     meta.operator_steps = (real and console.interactive if args.operator is None
                            else args.operator)

@@ -91,6 +91,36 @@ def _matrix(run: RunResult, sections: list[str]) -> list[str]:
     return out
 
 
+def _coverage(run: RunResult) -> list[str]:
+    """Which rules of the spec the run's cases can fail, per section and profile."""
+    report = run.meta.coverage
+    if not report:
+        return []
+    cells: dict[str, dict[str, str]] = {}
+    uncovered: dict[str, list[str]] = {}
+    for pc in report:
+        for s in pc["sections"]:
+            total = s["covered"] + len(s["uncovered"])
+            cells.setdefault(s["section"], {})[pc["profile"]] = f"{s['covered']}/{total}"
+            for rule in s["uncovered"]:
+                uncovered.setdefault(rule, []).append(pc["profile"])
+    profiles = [pc["profile"] for pc in report]
+    out = ["<h2>Coverage: rules of the spec the cases can fail</h2><table><tr><th>section</th>",
+           *(f"<th>{h(p)}</th>" for p in profiles), "</tr>"]
+    for s in sorted(cells, key=section_key):
+        out.append(f"<tr><td>{h(section_title(s))}</td>"
+                   + "".join(f"<td class='n'>{h(cells[s].get(p, ''))}</td>" for p in profiles)
+                   + "</tr>")
+    out.append("<tr><th>all</th>" + "".join(f"<th class='n'>{pc['covered']}/{pc['total']}</th>"
+                                           for pc in report) + "</tr></table>")
+    if uncovered:
+        out.append("<details><summary>Rules no selected case can fail "
+                   f"({len(uncovered)})</summary><ul>"
+                   + "".join(f"<li>{h(rule)}: {h(', '.join(ps))}</li>"
+                             for rule, ps in sorted(uncovered.items())) + "</ul></details>")
+    return out
+
+
 def _filters(sections: list[str]) -> str:
     boxes = "".join(f"<label class='{h(v)}'><input type='checkbox' value='{h(v)}' checked> "
                     f"{h(v)}</label>" for v in ORDER)
@@ -157,7 +187,7 @@ def render_html(run: RunResult, full_logs: bool | None = None) -> str:
     out = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
            f"<title>{verdict} — gve-conformance {h(run.run_id)}</title>",
            f"<style>{_asset('report.css')}</style></head><body>",
-           *_header(run), *_matrix(run, sections),
+           *_header(run), *_matrix(run, sections), *_coverage(run),
            "<h2 id='cases'>Cases</h2>", _filters(sections)]
     for s in sections:
         out.append(f"<section class='cases' id='sec-{h(s)}'><h3>{h(section_title(s))}</h3>")
