@@ -175,6 +175,17 @@ class CaseContext:
     def artifact(self, name: str, text: str) -> None:
         self.artifacts[name] = text
 
+    def step_train(self, name: str) -> None:
+        """Record the pulses per axis the emulator's stepper core gave on the current link
+        so far, for the reports (through the test rig; nothing on a real unit)."""
+        rig = self.link.rig
+        if rig is None:
+            return
+        origin = rig.now - self.link.now            # the link's instant 0 on the rig's clock
+        pulses = [[(t - origin) / 1e9, mask] for t, mask in rig.pulses(origin)]
+        self.traces.append({"name": name, "pulses": pulses, "total": len(pulses),
+                            "axes": list(self.profile.axes)})
+
     def trace(self, name: str, *, samples: list[tuple[float, list[int]]],
               model: list[tuple[float, list[int]]], tolerance: dict[str, float],
               params: dict[str, Any]) -> None:
