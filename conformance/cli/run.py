@@ -68,7 +68,11 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return ap.parse_args(argv)
 
 
-def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
+class Refused(Exception):
+    """The run cannot start; the message says why (exit status 2)."""
+
+
+def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], cases: list,
           seed: int | None) -> RunMeta:
     meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
                    settings=args.settings, seed=seed, mutant=args.mutant,
@@ -78,7 +82,41 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
         t = meta.target(target.info.spec)
         t.kind, t.profile = target.info.kind, target.profile.name
         t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
+                                        for s in d["sections"]]}
+                     for d in (pc.as_dict() for pc in coverage(
+                         sorted({t.profile.name for t in targets}), cases=cases))]
     return meta
+
+
+def prepare(args: argparse.Namespace, argv: list[str], cases: list, console: Console
+            ) -> tuple[list[Target], RunMeta]:
+    """The targets and the run's metadata: profiles chosen (``--profile auto`` asks the
+    units), identities recorded, motion confirmed on real units. Refused when not."""
+    every = [f"emu:{name}" for name in available_profiles()]
+    # no --target, or emu:all: the embedded emulator on every profile
+    specs = [s for t in args.target or ["emu:all"]
+             for s in (every if t.split("?")[0] == "emu:all" else [t])]
+    try:
+        chosen = [resolve(s, args.profile, args.variant, console) for s in specs]
+        targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
+                                max_travel=args.max_travel, mutant=args.mutant)
+                   for s, p, _ in chosen]
+        meta = _meta(args, argv, targets, cases, run_seed(args.settings, args.seed))
+        record_identities(targets, meta)
+    except (ValueError, LookupError, OSError, SerialException) as err:
+        raise Refused(str(err)) from err
+    for (_, _, how), target in zip(chosen, targets, strict=True):
+        meta.target(target.info.spec).profile_chosen = how
+    real = any(t.info.kind != "emu" for t in targets)
+    meta.operator_steps = (real and console.interactive if args.operator is None
+                           else args.operator)
+    if real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+        if not args.yes and not confirmed(targets, meta, console):
+            raise Refused("motion not confirmed, nothing that moves was sent (answer y, or "
+                          "give --yes on an unattended bench)")
+    return targets, meta
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -98,42 +136,18 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         print(format_coverage(report, args.coverage))
         return 0
-    every = [f"emu:{name}" for name in available_profiles()]
-    # no --target, or emu:all: the embedded emulator on every profile
-    specs = [s for t in args.target or ["emu:all"]
-             for s in (every if t.split("?")[0] == "emu:all" else [t])]
     console = Console()
     try:
-        chosen = [resolve(s, args.profile, args.variant, console) for s in specs]
-        targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
-                                max_travel=args.max_travel, mutant=args.mutant)
-                   for s, p, _ in chosen]
-    except (ValueError, LookupError, OSError, SerialException) as err:
+        targets, meta = prepare(args, argv, cases, console)
+    except Refused as err:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("\ngve-conformance: interrupted before the run, nothing that moves was sent",
+              file=sys.stderr)
+        return 130
     run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-    seed = run_seed(args.settings, args.seed)
-    meta = _meta(args, argv, targets, seed)
-    for (_, _, how), target in zip(chosen, targets, strict=True):
-        meta.target(target.info.spec).profile_chosen = how
-    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
-                                        for s in d["sections"]]}
-                     for d in (pc.as_dict() for pc in coverage(
-                         sorted({t.profile.name for t in targets}), cases=cases))]
-    real = any(t.info.kind != "emu" for t in targets)
-    meta.operator_steps = (real and console.interactive if args.operator is None
-                           else args.operator)
-    try:
-        record_identities(targets, meta)
-    except (OSError, SerialException) as err:
-        print(f"gve-conformance: {err}", file=sys.stderr)
-        return 2
-    if real:
-        meta.confirmed = "--yes" if args.yes else "asked"
-        if not args.yes and not confirmed(targets, meta, console):
-            print("gve-conformance: motion not confirmed, nothing that moves was sent (answer "
-                  "y, or give --yes on an unattended bench)", file=sys.stderr)
-            return 2
+    seed = meta.seed
     print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
           f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
           "examples; --seed N for others)", flush=True)
