@@ -211,6 +211,8 @@ struct stepper {
     i64 max_rate, now, rest, stop_end, xm;
     int halted;
     i64 base[ST_AXES];
+    i64 offset[ST_AXES];      /* physical position minus counter */
+    i64 lo[ST_AXES], hi[ST_AXES];   /* the physical extremes visited so far */
     entry_t *q;
     size_t qhead, qlen, qcap;
     piece_t *hist;            /* ring buffer of executed pieces */
@@ -219,6 +221,15 @@ struct stepper {
 };
 
 static entry_t *head(stepper *m) { return &m->q[m->qhead]; }
+
+/* record a point the axes have been at (counter units) in the excursion */
+static void visit(stepper *m, const i64 *counters) {
+    for (int i = 0; i < m->axes; i++) {
+        i64 x = counters[i] + m->offset[i];
+        if (x < m->lo[i]) m->lo[i] = x;
+        else if (x > m->hi[i]) m->hi[i] = x;
+    }
+}
 static entry_t *qat(stepper *m, size_t i) { return &m->q[m->qhead + i]; }
 
 stepper *st_new(int axes, int64_t max_rate) {
@@ -382,6 +393,8 @@ static void pop_head(stepper *m) {
     if (!m->qlen) m->qhead = 0;
 }
 
+static void position_now(stepper *m, i64 *out);
+
 void st_advance(stepper *m, int64_t t) {
     if (t < m->now) t = m->now;
     while (m->qlen) {
@@ -397,12 +410,16 @@ void st_advance(stepper *m, int64_t t) {
             e->has_plan = 0;
             e->nseg = 0;
             m->rest = e->end;
+            i64 here[ST_AXES];
+            position_now(m, here);
+            visit(m, here);
             if (m->halted) break;
             start_head(m, e->end, 0);
             continue;
         }
         i64 end = e->end, exit_rate = e->exit_rate, n = e->n;
         for (int i = 0; i < m->axes; i++) m->base[i] += e->vec.steps[i];
+        visit(m, m->base);
         pop_head(m);
         if (exit_rate == 0 && n) m->rest = end;
         if (m->qlen && (!m->halted || head(m)->has_plan)) start_head(m, end, exit_rate);
@@ -584,7 +601,9 @@ int st_push(stepper *m, const st_vector *v, int64_t t) {
 }
 
 int64_t st_halt(stepper *m, int64_t t) {
-    st_advance(m, t);
+    i64 here[ST_AXES];
+    st_position(m, t, here);
+    visit(m, here);
     if (m->halted) return max64(m->stop_end, t);
     m->halted = 1;
     m->stop_end = t;
@@ -637,6 +656,7 @@ void st_resume(stepper *m, int64_t t) {
 void st_clear(stepper *m, int64_t t) {
     st_advance(m, t);
     position_now(m, m->base);
+    visit(m, m->base);
     m->qlen = 0;
     m->qhead = 0;
     m->halted = 0;
@@ -655,6 +675,7 @@ int st_halted(stepper *m) { return m->halted; }
 void st_restore_begin(stepper *m, int64_t t, int64_t *here) {
     st_advance(m, t);
     position_now(m, here);
+    visit(m, here);
     m->qlen = 0;
     m->qhead = 0;
 }
@@ -677,7 +698,31 @@ void st_set_position(stepper *m, int axis, int64_t value, int64_t t) {
     i64 here[ST_AXES];
     st_advance(m, t);
     position_now(m, here);
+    visit(m, here);
     m->base[axis] += value - here[axis];
+    m->offset[axis] -= value - here[axis];     /* the axis itself does not move */
+}
+
+void st_jump(stepper *m, int axis, int64_t delta, int64_t t) {
+    i64 here[ST_AXES];
+    st_advance(m, t);
+    position_now(m, here);
+    visit(m, here);
+    m->base[axis] += delta;
+    position_now(m, here);
+    visit(m, here);
+}
+
+void st_physical(stepper *m, int64_t t, int64_t *out) {
+    st_position(m, t, out);
+    for (int i = 0; i < m->axes; i++) out[i] += m->offset[i];
+}
+
+void st_excursion(stepper *m, int64_t t, int64_t *lo, int64_t *hi) {
+    i64 here[ST_AXES];
+    st_position(m, t, here);
+    visit(m, here);
+    for (int i = 0; i < m->axes; i++) { lo[i] = m->lo[i]; hi[i] = m->hi[i]; }
 }
 
 void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel) {

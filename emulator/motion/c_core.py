@@ -68,6 +68,15 @@ class CMotion:
         lib.st_position(self._m, t, self._out)
         return tuple(self._out[i] for i in range(self.axes))
 
+    def physical(self, t: int) -> tuple[int, ...]:
+        lib.st_physical(self._m, t, self._out)
+        return tuple(self._out[i] for i in range(self.axes))
+
+    def excursion(self, t: int) -> tuple[tuple[int, int], ...]:
+        lo, hi = ffi.new("int64_t[4]"), ffi.new("int64_t[4]")
+        lib.st_excursion(self._m, t, lo, hi)
+        return tuple((lo[i], hi[i]) for i in range(self.axes))
+
     def flags(self, t: int) -> MotionFlags:
         f = ffi.new("int[4]")
         lib.st_flags(self._m, t, f, f + 1, f + 2, f + 3)
@@ -133,6 +142,9 @@ class CMotion:
 
     def set_position(self, axis: int, value: int, t: int) -> None:
         lib.st_set_position(self._m, axis, value, t)
+
+    def jump(self, axis: int, delta: int, t: int) -> None:
+        lib.st_jump(self._m, axis, delta, t)
 
     def set_velocity(self, velocity: int, t: int, accel: int | None = None) -> None:
         lib.st_set_velocity(self._m, velocity, t, accel is not None, accel or 0)

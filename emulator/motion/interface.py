@@ -85,6 +85,14 @@ class Motion(Protocol):
     def position(self, t: int) -> tuple[int, ...]:
         """Counter value of every axis at ``t`` (advances to ``t`` first)."""
 
+    def physical(self, t: int) -> tuple[int, ...]:
+        """Where every axis physically is at ``t``, in counter units: the counter plus
+        what :meth:`set_position` took away; only motion and :meth:`jump` move it."""
+
+    def excursion(self, t: int) -> tuple[tuple[int, int], ...]:
+        """Per axis the lowest and highest physical position since the core was
+        created (up to ``t``)."""
+
     def flags(self, t: int) -> MotionFlags:
         """The state flags at ``t``."""
 
@@ -126,7 +134,13 @@ class Motion(Protocol):
         """RESTORE: put a save from :meth:`keep` back (replacing what is held)."""
 
     def set_position(self, axis: int, value: int, t: int) -> None:
-        """N / N<axis>: set a counter. Only while nothing is held."""
+        """N / N<axis>: set a counter (the axis does not move). Only while nothing is
+        held."""
+
+    def jump(self, axis: int, delta: int, t: int) -> None:
+        """The axis moved by ``delta`` outside the planner (the W reference run, which
+        the unit times itself): counter and physical position move, the excursion
+        covers the way. Only while nothing is held."""
 
     def set_velocity(self, velocity: int, t: int, accel: int | None = None) -> None:
         """XA: every held vector (the running one from ``t``) takes ``velocity``

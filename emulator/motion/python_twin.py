@@ -83,6 +83,9 @@ class PythonMotion:
         self._stop_end = 0               # the end of a HALT ramp
         self._xm = 100
         self._history: deque[Piece] = deque(maxlen=HISTORY)
+        self._offset = [0] * axes        # physical position minus counter, per axis
+        self._lo = [0] * axes            # the physical extremes visited so far
+        self._hi = [0] * axes
 
     # -- planning -----------------------------------------------------------------
     def _cruise(self, e: Entry) -> int:
@@ -152,6 +155,15 @@ class PythonMotion:
             self._history.append(Piece(tuple(self._base), e.vector.steps, e.n, e.done, k_to,
                                        tuple(e.plan)))
 
+    def _visit(self, counters) -> None:
+        """Record a point the axes have been at (counter units) in the excursion."""
+        for i, c in enumerate(counters):
+            x = c + self._offset[i]
+            if x < self._lo[i]:
+                self._lo[i] = x
+            elif x > self._hi[i]:
+                self._hi[i] = x
+
     # -- time -----------------------------------------------------------------------
     @property
     def now(self) -> int:
@@ -174,6 +186,7 @@ class PythonMotion:
                 e.done = e.steps(e.end)
                 e.plan = None
                 self._rest = e.end
+                self._visit(self._position_at(e))
                 if self._halted:
                     break
                 self._start_head(e.end, 0)
@@ -181,6 +194,7 @@ class PythonMotion:
             q.popleft()
             for i, d in enumerate(e.vector.steps):
                 self._base[i] += d
+            self._visit(self._base)
             if e.exit_rate == 0 and e.n:
                 self._rest = e.end
             if q and (not self._halted or q[0].plan is not None):
@@ -211,10 +225,20 @@ class PythonMotion:
     def _position_now(self) -> tuple[int, ...]:
         if not self._queue:
             return tuple(self._base)
-        e = self._queue[0]
+        return self._position_at(self._queue[0])
+
+    def _position_at(self, e: Entry) -> tuple[int, ...]:
+        """The counters with the head ``e`` at its steps done by now."""
         k = e.steps(self._now)
         steps = e.vector.steps
         return tuple(b + axis_count(k, d, e.n) for b, d in zip(self._base, steps, strict=True))
+
+    def physical(self, t: int) -> tuple[int, ...]:
+        return tuple(c + o for c, o in zip(self.position(t), self._offset, strict=True))
+
+    def excursion(self, t: int) -> tuple[tuple[int, int], ...]:
+        self._visit(self.position(t))
+        return tuple(zip(self._lo, self._hi, strict=True))
 
     def flags(self, t: int) -> MotionFlags:
         self.advance(t)
@@ -292,6 +316,7 @@ class PythonMotion:
 
     def halt(self, t: int) -> int:
         self.advance(t)
+        self._visit(self._position_now())
         if self._halted:
             return max(self._stop_end, t)
         self._halted = True
@@ -342,6 +367,7 @@ class PythonMotion:
     def clear(self, t: int) -> None:
         self.advance(t)
         self._base = list(self._position_now())
+        self._visit(self._base)
         self._queue.clear()
         self._halted = False
 
@@ -349,6 +375,7 @@ class PythonMotion:
         self.advance(t)
         saved = (tuple((e.vector, e.done) for e in self._queue), self._halted)
         self._base = list(self._position_now())
+        self._visit(self._base)
         self._queue.clear()
         self._halted = False
         return saved
@@ -356,6 +383,7 @@ class PythonMotion:
     def restore(self, saved: object, t: int) -> None:
         self.advance(t)
         here = self._position_now()
+        self._visit(here)
         entries, halted = saved  # type: ignore[misc]
         self._queue = deque(Entry(v, _length(v.steps), done) for v, done in entries)
         self._halted = halted
@@ -370,7 +398,16 @@ class PythonMotion:
 
     def set_position(self, axis: int, value: int, t: int) -> None:
         self.advance(t)
-        self._base[axis] += value - self._position_now()[axis]
+        here = self._position_now()
+        self._visit(here)
+        self._base[axis] += value - here[axis]
+        self._offset[axis] -= value - here[axis]      # the axis itself does not move
+
+    def jump(self, axis: int, delta: int, t: int) -> None:
+        self.advance(t)
+        self._visit(self._position_now())
+        self._base[axis] += delta
+        self._visit(self._position_now())
 
     def _modify(self, change, t: int) -> None:
         self.advance(t)

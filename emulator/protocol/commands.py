@@ -206,7 +206,9 @@ def _set_axis(axis: int) -> Handler:
 
 
 def cmd_reference(u: Unit, p: str, t: int) -> list[str] | Deferred:
-    """W<axis>[,]travel,speed,back,speed_back: find the switch, zero where it releases."""
+    """W<axis>[,]travel,speed,back,speed_back: run to the switch, back off until it
+    releases, and zero the counter there (spec 10 W [D]). The run is timed at constant
+    speeds; the axis moves (``jump``) when it ends."""
     if not p or p[0] not in u.profile.axes:
         raise CommandError(SYNTAX, "W needs an axis letter")
     axis = u.profile.axes.index(p[0])
@@ -220,31 +222,40 @@ def cmd_reference(u: Unit, p: str, t: int) -> list[str] | Deferred:
         if not vr.lo <= s <= vr.hi:
             raise CommandError(RANGE, "speed out of range")
     _vector_rules(u, t)
-    _not_moving(u, t)
-    if u.motion.queued(t):
-        raise CommandError(FULL, "vectors are queued")
-    here = u.motion.position(t)[axis]
+    _not_running(u, t)
     f = u.factor()
-    switch = u.switch_position(p[0], here)
+    here = u.motion.physical(t)[axis]
     direction = 1 if travel > 0 else -1
-    reach = travel * f
-    found = switch is not None and 0 <= (switch - here) * direction <= abs(reach)
-    if not found:
-        end = t + abs(travel) * SECOND // speed
-        u.state.reference_until = end
+    switch = u.reference_switch(p[0], here)
+    to_switch = None if switch is None else switch[0] - here
+    if to_switch is None or not 0 <= to_switch * direction <= abs(travel) * f:
+        # not found within the travel: the whole travel, then 5
+        return _reference_run(u, t, abs(travel) * SECOND // speed,
+                              [(axis, travel * f)], RANGE)
+    releases = switch[1]
+    time_to = abs(to_switch) // f * SECOND // speed
+    if releases and back >= 1:
+        # a virtual switch releases one step back; the counter is 0 there
+        return _reference_run(u, t, time_to + SECOND // speed_back,
+                              [(axis, to_switch), (axis, -direction * f)], 0, zero=axis)
+    # the switch is still active after n4 steps back: 5, the axis stays there
+    return _reference_run(u, t, time_to + back * SECOND // speed_back,
+                          [(axis, to_switch), (axis, -direction * back * f)], RANGE)
 
-        def missed(at: int) -> tuple[int, list[str]]:
-            u.motion.set_position(axis, here + reach, at)
-            return RANGE, []
-        return Deferred(end, missed)
-    distance = abs(switch - here) // f
-    end = t + distance * SECOND // speed + (1 + min(back, 1)) * SECOND // speed_back
+
+def _reference_run(u: Unit, t: int, duration: int, moves: list[tuple[int, int]],
+                   code: int, zero: int | None = None) -> Deferred:
+    end = t + duration
     u.state.reference_until = end
 
-    def homed(at: int) -> tuple[int, list[str]]:
-        u.motion.set_position(axis, 0, at)
-        return 0, []
-    return Deferred(end, homed)
+    def finish(at: int) -> tuple[int, list[str]]:
+        for axis, delta in moves:
+            if delta:
+                u.motion.jump(axis, delta, at)
+        if zero is not None:
+            u.motion.set_position(zero, 0, at)
+        return code, []
+    return Deferred(end, finish)
 
 
 # -- HALT, GO, DELETE, KEEP, RESTORE ---------------------------------------------------

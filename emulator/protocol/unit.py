@@ -71,9 +71,15 @@ class Unit:
     def _reset(self, t: int) -> None:
         p = self.profile
         self.state: UnitState = reset_state(p)
-        scale = p.position_scale if p.microstep is not None else 1
-        self.motion = create(len(p.axes), p.max_rate * scale, stepper=self.stepper)
-        self.motion.advance(t)
+        if not hasattr(self, "motion"):
+            scale = p.position_scale if p.microstep is not None else 1
+            self.motion = create(len(p.axes), p.max_rate * scale, stepper=self.stepper)
+        # the same axes after a restart: the queue is gone and the counters read 0, but
+        # nothing moves (the physical position and the excursion go on)
+        self.motion.clear(t)
+        for axis in range(len(p.axes)):
+            self.motion.set_position(axis, 0, t)
+        self.motion.set_multiplier(self.state.xm, t)
         self.framer.reset()
         self._pending: list[tuple[bytes, Deferred]] = []
 
@@ -113,16 +119,18 @@ class Unit:
             return tuple(int(x / f) for x in here)
         return here
 
-    def switch_position(self, axis: str, here: int) -> int | None:
-        """Where the axis's reference switch is: a virtual switch, or here if its input
-        is active now (spec 10 W [D])."""
+    def reference_switch(self, axis: str, here: int) -> tuple[int, bool] | None:
+        """The axis's reference switch for W (spec 10 W [D]): (physical position, whether
+        it releases when the axis backs off). A virtual switch placed by the rig releases
+        one step back; the axis's reference input, when it is active now, is a level the
+        rig holds: it is here and stays active however the axis moves."""
         if self.switches.get(axis) is not None:
-            return self.switches[axis]
+            return self.switches[axis], True
         bit = self.profile.reference_inputs.get(axis)
         if bit is not None:
             level = (self.state.inputs[1] >> bit) & 1
             if level == (self.state.status[2] >> bit) & 1:
-                return here
+                return here, False
         return None
 
     def push(self, steps: tuple[int, ...], continuous: bool, t: int) -> None:
@@ -420,6 +428,8 @@ class Unit:
             "addresses": sorted(self.addresses),
             "time_ns": t,
             "position": list(self.motion.position(t)),
+            "physical": list(self.motion.physical(t)),
+            "excursion": [list(e) for e in self.motion.excursion(t)],
             "status": ["%02X" % x for x in s.status[:6]] + ["%02X" % self.st6(t)],
             "queue": self.motion.queued(t),
             "index": s.index,

@@ -56,11 +56,13 @@ def ops(axes: int, max_rate: int):
         st.tuples(st.just("restore"), st.none()),
         st.tuples(st.just("clear"), st.none()),
         st.tuples(st.just("set"), st.tuples(st.integers(0, axes - 1), st.integers(-1000, 1000))),
+        st.tuples(st.just("jump"), st.tuples(st.integers(0, axes - 1), st.integers(-1000, 1000))),
     ), max_size=25)
 
 
 def observe(m, t: int):
-    return (m.position(t), m.flags(t), m.queued(t), m.next_event(), m.drain_instant())
+    return (m.position(t), m.physical(t), m.excursion(t), m.flags(t), m.queued(t),
+            m.next_event(), m.drain_instant())
 
 
 @pytest.mark.parametrize(("axes", "max_rate"),
@@ -98,6 +100,8 @@ def test_twins_agree_step_by_step(axes, max_rate, data):
                 m.clear(t)
             elif op == "set":
                 m.set_position(*arg, t)
+            elif op == "jump":
+                m.jump(*arg, t)
         if op == "keep":
             assert saves["py"] == saves["c"]
         t = max(t, py.now)
