@@ -80,11 +80,11 @@ class EmulatedUnit:
             self._path = self.proc.stdout.readline().strip()
         return self._path
 
-    def rig(self, command: str) -> None:
-        """A control-channel command (``in 1 FE``: IN0 grounded); waits for its answer."""
+    def rig(self, command: str) -> str:
+        """A control-channel command (``in 1 FE``: IN0 grounded); its answer."""
         self.proc.stdin.write(command + "\n")
         self.proc.stdin.flush()
-        self.proc.stdout.readline()
+        return self.proc.stdout.readline()
 
     def close(self) -> None:
         self.proc.terminate()
