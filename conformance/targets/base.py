@@ -68,6 +68,13 @@ RESET_SEQUENCE = ("H", "D", "SW0,00", "SW1,00", "SW2,00", "SW3,00", "SW4,00", "S
                   "XM100", "VN", "N")
 
 
+def known_axis_limits(profile: Profile) -> tuple[int, ...]:
+    """The VL a real unit is put back to: the reset VL (the variant's maximum) where VL's
+    range reaches it, else the top of the range (only J restores more, spec 9, 10)."""
+    top = profile.range("VL").hi
+    return tuple(min(v, top) for v in profile.reset.VL)
+
+
 def known_state(link: Link, profile: Profile) -> None:
     """Put a real unit into the state a case expects (docs/suite.md)."""
     # H first: it is answered even inside an open packet, and discards it (spec 7)
@@ -75,7 +82,13 @@ def known_state(link: Link, profile: Profile) -> None:
     link.send("%-", checksum=True)          # harmless if checksums were off: an error
     link.checksums = False
     r = profile.reset
-    for body in (*RESET_SEQUENCE, f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"):
+    # modal parameters a case may have changed, back to the reset state (spec 9)
+    modal = [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
+    if "VL" in profile.commands:
+        modal.append("VL" + ",".join(str(v) for v in known_axis_limits(profile)))
+    if profile.microstep is not None:
+        modal += [f"M{profile.microstep.reset_mode}", f"M{profile.microstep.reset_current}"]
+    for body in (*RESET_SEQUENCE, *modal):
         link.send(body)                      # a command the unit lacks just answers 3
     link.send("G")                           # clears INTA left by H (6 when none)
     link.send("D")
