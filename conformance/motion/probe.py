@@ -27,7 +27,7 @@ from conformance.motion.tolerance import (
     processing_window,
     tolerance,
 )
-from conformance.targets.base import known_axis_limits
+from conformance.targets.session import known_axis_limits
 
 #: dense model points per trace
 TRACE_POINTS = 60
