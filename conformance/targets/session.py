@@ -249,6 +249,10 @@ class Session:
         link.send("D")
         for body in self._reset_frames():
             link.send(body)
+        # a KEEP left by the last case leaves a queue that takes only L (spec 10.5): R
+        # empties the save; D then clears what R and a still active input set again
+        link.send("R")
+        link.send("D")
         self._go_back(link)
         link.send("N")
 
