@@ -130,11 +130,13 @@ class Probe:
 
     def script(self, steps: list, every: float = 0.05) -> bool:
         """Run a scenario and judge it: a string is a frame to send, a number the seconds
-        to sample PF for (every ``every`` s), a list the position (in commanded steps) to
-        poll PF until (every 2 ms)."""
+        to sample PF for (every ``every`` s; a pair: seconds and how often), a list the
+        position (in commanded steps) to poll PF until (every 2 ms)."""
         for step in steps:
             if isinstance(step, str):
                 self.send(step)
+            elif isinstance(step, tuple):
+                self.sample(*step)
             elif isinstance(step, list):
                 self.until([o + x * self.scale for o, x in zip(self.origin, step, strict=False)],
                            UNTIL_SECONDS, 0.002)

@@ -53,6 +53,8 @@ RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
 def known_axis_limits(profile: Profile) -> tuple[int, ...]:
     """The VL a unit is put back to: the reset VL (the variant's maximum) where VL's range
     reaches it, else the top of the range (only J restores more, spec 9, 10)."""
+    if "VL" not in profile.ranges:
+        return tuple(profile.reset.VL)
     top = profile.range("VL").hi
     return tuple(min(v, top) for v in profile.reset.VL)
 
