@@ -20,6 +20,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 from conformance.verdict import ERROR, FAIL
+from gve_fixtures.rules import load_rules
 
 #: profiles tried first, one per family; the others follow
 FIRST = ("GVE84-100", "GVE114-500", "GVE54")
@@ -49,10 +50,14 @@ def profiles_in_order(chosen: list[str] | None = None) -> list[str]:
     return [p for p in FIRST if p in every] + [p for p in every if p not in FIRST]
 
 
-def in_area(section: str, area: str) -> bool:
-    """Whether a case of spec section ``section`` checks the rule area ``area`` (a
-    section: 10 is the command table, 10.2 the motion model, each an area of its own)."""
-    return section == area
+def closeness(case, area: str) -> int:
+    """How closely a case checks the rule area ``area`` (a spec section: 10 is the command
+    table, 10.2 the motion model, each an area of its own): 0 filed there, 1 naming a rule
+    of it, 2 neither."""
+    if case.section == area:
+        return 0
+    rules = load_rules()
+    return 1 if any(rules[r].section == area for r in case.rules) else 2
 
 
 def hunt(mutant: str, profiles: list[str] | None = None,
@@ -64,8 +69,8 @@ def hunt(mutant: str, profiles: list[str] | None = None,
     area, description = emu.mutants()[mutant]
     result = Hunt(mutant, area, description)
     cases = select(include or None)
-    area_cases = [c for c in cases if in_area(c.section, area)]
-    ordered = area_cases + [c for c in cases if not in_area(c.section, area)]
+    ordered = sorted(cases, key=lambda c: closeness(c, area))      # stable: spec order
+    area_cases = [c for c in ordered if closeness(c, area) < 2]
     names = profiles_in_order(profiles)
     targets = {p: (parse_target(f"emu:{p}", mutant=mutant), parse_target(f"emu:{p}"))
                for p in names}
