@@ -26,7 +26,7 @@ def mpg_modes(ctx: CaseContext) -> None:
             rule="9.reset.mpg-inert")
 
 
-@case("5.moving.mpg-holds-run", requires=("Y",), destructive=True,
+@case("9.reset.mpg-enabled", requires=("Y",), destructive=True,
       rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg"))
 def mpg_moving(ctx: CaseContext) -> None:
     link = ctx.link

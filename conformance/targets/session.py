@@ -50,6 +50,15 @@ class Reachable(Protocol):
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
 
 
+def known_axis_limits(profile: Profile) -> tuple[int, ...]:
+    """The VL a unit is put back to: the reset VL (the variant's maximum) where VL's range
+    reaches it, else the top of the range (only J restores more, spec 9, 10)."""
+    if "VL" not in profile.ranges:
+        return tuple(profile.reset.VL)
+    top = profile.range("VL").hi
+    return tuple(min(v, top) for v in profile.reset.VL)
+
+
 class SessionError(Exception):
     """The session cannot begin on this target (one line for the user)."""
 
@@ -228,7 +237,7 @@ class Session:
         p, r = self.profile, self.profile.reset
         frames = [f"SW{n},00" for n in range(6)]
         table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
-                 "VL": "VL" + ",".join(str(v) for v in r.VL)}
+                 "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames += [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
         if p.microstep:
@@ -242,6 +251,10 @@ class Session:
         link.send("D")
         for body in self._reset_frames():
             link.send(body)
+        # a KEEP left by the last case leaves a queue that takes only L (spec 10.5): R
+        # empties the save; D then clears what R and a still active input set again
+        link.send("R")
+        link.send("D")
         self._go_back(link)
         link.send("N")
 
