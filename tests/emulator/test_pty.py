@@ -1,7 +1,7 @@
 """`python -m emulator --pty` as a separate process, driven with pyserial exactly as a
 third-party program would: the golden KEEP/RESTORE scenario and packet example, the
 watchdog, the control channel, the TCP server, and the transcripts of the emulator issue
-(those that wait more than 2 s are marked slow)."""
+(those that wait more than 1 s are marked slow)."""
 
 from __future__ import annotations
 
@@ -110,7 +110,7 @@ def _over_the_pty():
             if profile == "GVE84-100":
                 chosen[path.stem] = (path, profile)
     for name, (path, profile) in sorted(chosen.items()):
-        marks = [pytest.mark.slow] if _waits(path) > 2 else []
+        marks = [pytest.mark.slow] if _waits(path) > 1 else []
         yield pytest.param(path, profile, id=f"{name}-{profile}", marks=marks)
 
 

@@ -109,7 +109,7 @@ def test_control_lines_are_read_as_they_come() -> None:
 def test_eeprom_writes_leave_no_temporary_file_also_when_interrupted(tmp_path: Path) -> None:
     image = tmp_path / "unit.eeprom"
     rnd = random.Random(9)
-    for attempt in range(4):
+    for attempt in range(3):
         emu = Emulator("--model", "GVE84-100", "--pty", "--eeprom", str(image))
         port = serial.Serial(emu.first, 115200, timeout=5)
         frames = b"".join(b"!0EW%02X,%02X\r" % (i, attempt) for i in range(0x40, 0x80))
@@ -132,7 +132,7 @@ def test_two_units_answering_one_address_are_refused() -> None:
 def test_a_stream_of_lone_bangs_costs_linear_time() -> None:
     port = serial.serial_for_url("gve://?model=GVE84-100&baud=921600", timeout=0)
     deadline = time.monotonic() + 30              # quadratic would take hours
-    port.write(b"!" * (2 * MB))
+    port.write(b"!" * MB)
     port.write(b"\r!0@\r")
     assert time.monotonic() < deadline
     port.timeout = 1
