@@ -20,7 +20,7 @@ from functools import cache
 import numpy as np
 
 #: a line holds at most this many points (the report must stay small)
-MAX_POINTS = 60
+MAX_POINTS = 40
 #: the step train shows at most this many pulses
 MAX_PULSES = 120
 #: verdict colours, the same as the page's (report.css)
