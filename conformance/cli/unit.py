@@ -56,21 +56,34 @@ def record_identities(targets: list[Target], meta: RunMeta) -> None:
             t.version, t.processor_id = identity.version, identity.processor_id
 
 
+def _what_moves(target: Target, version: str, processor_id: str) -> list[str]:
+    axes = ", ".join(f"{a} ±{target.info.max_travel}" for a in target.profile.axes)
+    return [f"{target.info.spec}: {version or '(no answer to ?)'}, Q {processor_id}, "
+            f"judged as {target.profile.name}",
+            f"  envelope (full steps either side of where the run began): {axes}",
+            "  destructive tests (J, W, EEPROM writes; EEPROM backed up and restored): "
+            + ("ON" if target.info.allow_destructive else "off")]
+
+
 def ask_before_motion(target: Target, console: Console, meta: RunMeta
                       ) -> Callable[[], bool]:
     """The question the target's session asks before the run's first frame that can move
     an axis (its guard then refuses every motion frame unless the answer was yes)."""
     def ask() -> bool:
         found = target.session.identity
-        axes = ", ".join(f"{a} ±{target.info.max_travel}" for a in target.profile.axes)
-        yes = confirm_motion(console, [
-            f"{target.info.spec}: {found.get('version', '(no answer to ?)')}, "
-            f"Q {found.get('processor_id', '')}, judged as {target.profile.name}",
-            f"  envelope (full steps either side of where the run began): {axes}",
-            "  destructive tests (J, W, EEPROM writes; EEPROM backed up and restored): "
-            + ("ON" if target.info.allow_destructive else "off")])
+        yes = confirm_motion(console, _what_moves(target, found.get("version", ""),
+                                                  found.get("processor_id", "")))
         meta.confirmed = "asked: yes" if yes else "asked: refused, nothing moved"
         if not yes:
             console.say("  motion refused: cases that move will be COULD-NOT-TEST")
         return yes
     return ask
+
+
+def confirmed(targets: list[Target], meta: RunMeta, console: Console) -> bool:
+    """The same question once for several targets before any of them runs (a fleet,
+    whose members have no terminal); the identities are those known so far."""
+    real = [t for t in targets if t.info.kind != "emu"]
+    lines = [line for t in real for line in _what_moves(
+        t, meta.target(t.info.spec).version, meta.target(t.info.spec).processor_id)]
+    return not real or confirm_motion(console, lines)
