@@ -146,21 +146,20 @@ class Hands:
                                f"(IN{bit} should read {want})")
         self.console.say(f"  verified: I{port} = {level:02X}")
 
+    def _set(self, port: int, bit: int, what: str, grounded: bool) -> bool:
+        if self._link().rig is not None:
+            self._rig(port, bit, grounded)
+        else:
+            self._by_hand(port, bit, what, grounded)
+        return True
+
     def ground(self, port: int, bit: int, what: str) -> bool:
         """Make input IN<bit> of port I<port> active (grounded); True once verified."""
-        if self._link().rig is not None:
-            self._rig(port, bit, grounded=True)
-        else:
-            self._by_hand(port, bit, what, grounded=True)
-        return True
+        return self._set(port, bit, what, grounded=True)
 
     def release(self, port: int, bit: int, what: str) -> bool:
         """Disconnect input IN<bit> again (reads 1); True once verified."""
-        if self._link().rig is not None:
-            self._rig(port, bit, grounded=False)
-        else:
-            self._by_hand(port, bit, what, grounded=False)
-        return True
+        return self._set(port, bit, what, grounded=False)
 
     @contextmanager
     def grounded(self, port: int, bit: int, what: str) -> Iterator[None]:
