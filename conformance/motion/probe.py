@@ -223,8 +223,9 @@ class Probe:
         widest = tolerance(Window(0, spread), virtual=virtual)
         halts = [e for e in self.events if e.kind == "halt"]
         for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
-            lo = min([rest] + [v[1][n] for v in variants])
-            hi = max([rest] + [v[1][n] for v in variants])
+            # what each event's window can change, added up (as for positions)
+            lo = rest + sum(min(0, v[1][n] - rest) for v in variants)
+            hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
             a = e.answer
             tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual)
             ok_all &= self.ctx.expect(
