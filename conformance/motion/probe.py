@@ -6,9 +6,9 @@ check), and the whole is recorded as a trace for the reports.
 
 The probe interprets the frames it sends as the unit must (spec 10): modal parameters
 (``V A B $ T VK VN VL M``) are captured by the vectors accepted after them, ``XM XA XU
-XD`` act on the queue at once, ``H`` and ``G`` halt and resume. On the GVE54 vectors, ``V``
-and ``B`` are in commanded steps and scaled to the 1/16-step counters by the micro-step
-factor (docs/decisions.md).
+XD`` act on the queue at once, ``H`` and ``G`` halt and resume. On the GVE54 vectors, ``V``,
+``B``, ``A``, ``$`` and the maximum rate are in commanded steps and scaled to the
+1/16-step counters by the micro-step factor (docs/decisions.md).
 """
 
 from __future__ import annotations
@@ -98,13 +98,12 @@ class Probe:
         return r
 
     def read(self, label: str = "") -> list[int] | None:
+        """Read PF and keep the reading (None when the unit did not answer with positions;
+        bytes that are not decimals fail the case through the response's accessor)."""
         r = self.link.send("PF")
         if r is None or r.code != 0 or len(r.values) < 3:
             return None
-        try:
-            values = [int(v) for v in r.values]
-        except ValueError:
-            return None
+        values = r.decs()
         self.readings.append(Reading(self._timing("PF", r)[0], values, label))
         return values
 
@@ -114,9 +113,6 @@ class Probe:
         while self.link.now < end:
             self.link.wait(every)
             self.read(label)
-
-    def wait(self, seconds: float) -> None:
-        self.link.wait(seconds)
 
     def until(self, target: list[int], max_seconds: float, every: float) -> None:
         """Read PF every ``every`` s until the axes stand at ``target`` (counter units)."""
@@ -227,8 +223,9 @@ class Probe:
         widest = tolerance(Window(0, spread), virtual=virtual)
         halts = [e for e in self.events if e.kind == "halt"]
         for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
-            lo = min([rest] + [v[1][n] for v in variants])
-            hi = max([rest] + [v[1][n] for v in variants])
+            # what each event's window can change, added up (as for positions)
+            lo = rest + sum(min(0, v[1][n] - rest) for v in variants)
+            hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
             a = e.answer
             tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual)
             ok_all &= self.ctx.expect(
