@@ -30,7 +30,7 @@ from typing import Any, Protocol
 from conformance.case import CouldNotTest, TargetInfo
 from conformance.link.framing import HostFramer, Response
 from conformance.link.interrupts import Interrupted, Interrupts
-from conformance.link.link import Link
+from conformance.link.link import MARGIN, Link
 from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
@@ -171,8 +171,9 @@ class Session:
                 st6 = r.hex()
                 self.report.found["ST6"] = "%02X" % st6
                 if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
-                    self.failed = (f"{self.target.info.spec}: the unit is moving (ST6 = "
-                                   f"{st6:02X}): stop it before running the suite")
+                    self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
+                                   f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
+                                   "mode; stop it before running the suite")
                     raise SessionError(self.failed)
             counters = self._position(link)
             if counters:
@@ -212,34 +213,40 @@ class Session:
                                         "they are not written")
 
     # -- the known state --------------------------------------------------------------------------
-    def _halt(self, link: Link) -> Response | None:
+    def _halt(self, link: Link, timeout: float | None = None) -> Response | None:
         """`H` in the mode the unit is in: refused (4) or unanswered in the mode the link
         believes, it is sent in the other."""
-        r = link.send("H")
+        r = link.send("H", timeout=timeout)
         if r is None or r.code == 4:
-            other = link.send("H", checksum=not link.checksums)
+            other = link.send("H", checksum=not link.checksums, timeout=timeout)
             if other is not None and other.code == 0:
                 link.checksums = not link.checksums
                 return other
         return r
 
     def _reset_frames(self) -> list[str]:
-        """What cannot be read, set to the reset state (spec 9), and ST0..ST5 = 00."""
+        """What cannot be read, set to the reset state (spec 9)."""
         p, r = self.profile, self.profile.reset
-        frames = [f"SW{n},00" for n in range(6)]
         table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
                  "VL": "VL" + ",".join(str(v) for v in r.VL)}
-        frames += [body for name, body in table.items() if name in p.commands]
+        frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
         if p.microstep:
             frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
         return frames
 
-    def _known_state(self, link: Link) -> None:
+    def _stop(self, link: Link) -> None:
+        """`H`, checksums off, interrupts off (ST0..ST5 = 00), then `D`: the queue empty
+        and ST6 clear (an input still enabled would set INTA again at once)."""
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
+        for n in range(6):
+            link.send(f"SW{n},00")
         link.send("D")
+
+    def _known_state(self, link: Link) -> None:
+        self._stop(link)
         for body in self._reset_frames():
             link.send(body)
         self._go_back(link)
@@ -266,9 +273,10 @@ class Session:
         """Ctrl-C: `H`, then `D`, before anything else (real units)."""
         if self.real and self._link is not None:
             self.report.interrupted = True
+            wait = None if self.guard.responding else MARGIN
             with self.guard.emergency():
-                self._halt(self._link)
-                self._link.send("D")
+                self._halt(self._link, timeout=wait)
+                self._link.send("D", timeout=wait)
         self.interrupts.handle()
 
     def finish(self) -> SessionReport:
@@ -276,7 +284,7 @@ class Session:
         if self.finished:
             return self.report
         self.finished = True
-        if self.real and self.started:
+        if self.real and self.started and not self.failed:     # found moving: untouched
             if self.interrupts.pending:
                 self.emergency_stop()
             link = self._new_link()
@@ -300,18 +308,15 @@ class Session:
     def _restore(self, link: Link) -> None:
         if not self.guard.responding:
             self.report.not_responding = "the target stopped responding"
-            with self.guard.emergency():
-                self._halt(link)
+            with self.guard.emergency():              # once, without waiting long
+                self._halt(link, timeout=MARGIN)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._halt(link)
-        if link.checksums:
-            link.send("%-", checksum=True)
-        link.send("D")
+        self._stop(link)
         for body in self._reset_frames():
             link.send(body)
         self.report.reset.append("set to the reset state (they cannot be read): "
-                                 + ", ".join(self._reset_frames()[6:]))
+                                 + ", ".join(self._reset_frames()))
         if self.profile.microstep:
             self.report.reset.append("GVE54 micro-step mode and current set to "
                                      f"M{self.profile.microstep.reset_mode}, "
