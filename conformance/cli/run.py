@@ -135,13 +135,15 @@ def _targets(args: argparse.Namespace) -> list[Target]:
     every = [f"emu:{name}" for name in available_profiles()]
     if args.profile and not args.target:
         every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
-    # no --target, or emu:all: the embedded emulator on every profile
-    specs = [s for t in args.target or ["emu:all"]
+    # no --target, or emu:all: the embedded emulator on every profile (--profile is for
+    # the targets named)
+    specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
              for s in (every if t.split("?")[0] == "emu:all" else [t])]
     try:
-        return [parse_target(s, profile=None if s in every else args.profile,
+        return [parse_target(s, profile=args.profile if named else None,
                              allow_destructive=args.allow_destructive,
-                             max_travel=args.max_travel, mutant=args.mutant) for s in specs]
+                             max_travel=args.max_travel, mutant=args.mutant)
+                for s, named in specs]
     except (ValueError, LookupError) as err:
         raise UsageError(str(err).strip("'\"")) from None
 

@@ -23,4 +23,5 @@ def to_json(run: RunResult) -> dict:
     return {"run_id": run.run_id, "targets": run.targets, "settings": run.settings,
             "seconds": round(run.seconds, 3), "frames": run.frames,
             "interrupted": run.interrupted, "counts": run.counts(),
+            "problems": run.problems, "sessions": run.sessions,
             "results": [r.to_dict() for r in run.results]}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from html import escape
 
+from conformance.reports.clean import clean
 from conformance.runner import RunResult
 from conformance.verdict import ORDER
 
@@ -33,6 +34,7 @@ def render_html(run: RunResult) -> str:
            f"<p>Targets: {escape(', '.join(run.targets))}. Settings: {escape(run.settings)}. "
            f"{len(run.results)} cases in {run.seconds:.1f} s, {run.frames} frames"
            f"{' (interrupted)' if run.interrupted else ''}.</p>",
+           *[f"<p class='FAIL'><b>PROBLEM</b>: {escape(p)}</p>" for p in run.problems],
            "<p>" + " ".join(f"<span class='{_cls(v)}'>{escape(v)}: {counts[v]}</span>"
                             for v in ORDER if v in counts) + "</p>",
            "<h2>Summary: spec section × verdict</h2><table><tr><th>section</th>"]
@@ -65,4 +67,4 @@ def render_html(run: RunResult) -> str:
             out.append(f"<p>{escape(name)}</p><pre>{escape(text)}</pre>")
         out.append("</details>")
     out.append("</body></html>")
-    return "\n".join(out)
+    return clean("\n".join(out))        # no raw control byte of a unit in the page

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from conformance.reports.clean import clean
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
 
@@ -49,4 +50,7 @@ def render_junit(run: RunResult) -> str:
             elif r.verdict in (MISSING, COULD_NOT_TEST):
                 ET.SubElement(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
             ET.SubElement(tc, "system-out").text = head + log
+    for element in root.iter():         # any unit bytes: always well-formed XML
+        element.text = None if element.text is None else clean(element.text)
+        element.attrib = {k: clean(v) for k, v in element.attrib.items()}
     return ET.tostring(root, encoding="unicode", xml_declaration=True)

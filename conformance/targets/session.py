@@ -71,6 +71,7 @@ class SessionReport:
     problems: list[str] = field(default_factory=list)
     interrupted: bool = False
     not_responding: str = ""
+    violations: list[str] = field(default_factory=list)   # answers outside the cases
     wire_log: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
@@ -153,34 +154,45 @@ class Session:
         if not self.real:
             return
         link = self._new_link()
-        with self.guard.own_frames():
-            self._probe_checksums(link)
-            for name, body in (("version", "?"), ("processor_id", "Q")):
-                r = link.send(body)
-                if r is not None and r.code == 0:
-                    self.identity[name] = ",".join(r.values)
-            self.report.identity = self.identity
-            for n in range(6):
-                r = link.send(f"SR{n}")
-                if _hex_ok(r):
-                    self.status[n] = r.hex()
-            self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
-            self.report.found["checksums"] = "on" if self.checksums else "off"
-            r = link.send("SR6")
+        try:
+            with self.guard.own_frames():
+                self._read_as_found(link)
+        finally:
+            self._keep_log(link)
+
+    def _read_as_found(self, link: Link) -> None:
+        """Identity, checksum mode, status words, where the axes are, EEPROM."""
+        self._probe_checksums(link)
+        for name, body in (("version", "?"), ("processor_id", "Q")):
+            r = link.send(body)
+            if r is not None and r.code == 0:
+                self.identity[name] = ",".join(r.values)
+        self.report.identity = self.identity
+        for n in range(6):
+            r = link.send(f"SR{n}")
             if _hex_ok(r):
-                st6 = r.hex()
-                self.report.found["ST6"] = "%02X" % st6
-                if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
-                    self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
-                                   f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
-                                   "mode; stop it before running the suite")
-                    raise SessionError(self.failed)
-            counters = self._position(link)
-            if counters:
-                self.guard.envelope.origin(counters)
-            if self.target.info.allow_destructive and "ER" in self.profile.commands:
-                self._backup_eeprom(link)
+                self.status[n] = r.hex()
+        self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
+        self.report.found["checksums"] = "on" if self.checksums else "off"
+        r = link.send("SR6")
+        if _hex_ok(r):
+            st6 = r.hex()
+            self.report.found["ST6"] = "%02X" % st6
+            if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
+                self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
+                               f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
+                               "mode; stop it before running the suite")
+                raise SessionError(self.failed)
+        counters = self._position(link)
+        if counters:
+            self.guard.envelope.origin(counters)
+        if self.target.info.allow_destructive and "ER" in self.profile.commands:
+            self._backup_eeprom(link)
+
+    def _keep_log(self, link: Link) -> None:
+        """The session's own frames and what went wrong there, for the report."""
         self.report.wire_log += link.transcript_lines()
+        self.report.violations += link.violations
 
     def _probe_checksums(self, link: Link) -> None:
         """The checksum mode as found: `?` without a checksum is refused (4) in the mode."""
@@ -299,7 +311,7 @@ class Session:
             except (TargetNotResponding, SafetyStop, CouldNotTest) as err:
                 self.report.problems.append(f"restorations stopped: {err}")
                 self._unrestored()
-            self.report.wire_log += link.transcript_lines()
+            self._keep_log(link)
         self.report.interrupted = self.report.interrupted or self.interrupts.stopped
         if self.real:
             self.report.excursion = [list(e) for e in self.guard.excursion()]
@@ -365,6 +377,8 @@ class Session:
             r = link.send(f"SR{n}")
             if not (_hex_ok(r) and r.hex() == value):
                 wrong.append(f"ST{n} reads {r}, found {value:02X}")
+        wrong += [f"ST{n} could not be read before the run, left 00" for n in range(6)
+                  if n not in self.status]
         if wrong:
             self.report.problems.append("status words not restored: " + "; ".join(wrong))
         elif self.status:
