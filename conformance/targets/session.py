@@ -92,6 +92,7 @@ class Session:
         self.status: dict[int, int] = {}           # ST0..ST5 as found
         self.checksums: bool | None = None         # the checksum mode as found
         self.eeprom: dict[int, int] = {}           # EEPROM bytes as found
+        self.counters: dict[int, int] = {}         # position counters as found (PF)
         self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
                                     self.real, max_travel=info.max_travel if self.real else None)
         self.started = False
@@ -183,9 +184,8 @@ class Session:
                                f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
                                "mode; stop it before running the suite")
                 raise SessionError(self.failed)
-        counters = self._position(link)
-        if counters:
-            self.guard.envelope.origin(counters)
+        self.counters = self._position(link)
+        self.guard.envelope.origin(self.counters)
         if self.target.info.allow_destructive and "ER" in self.profile.commands:
             self._backup_eeprom(link)
 
@@ -340,6 +340,7 @@ class Session:
                 "axes back where the run began" if all(h == 0 for h in here) else
                 "axes: the way back is not known exactly for "
                 + ", ".join(a for a, h in zip(self.profile.axes, here, strict=True) if h is None))
+        self._restore_counters(link)
         self._restore_eeprom(link)
         self._restore_status(link)
         if self.checksums:
@@ -348,6 +349,30 @@ class Session:
                 self.report.problems.append(f"checksum mode not turned back on: %+ answered {r}")
             else:
                 self.report.restored.append("checksum mode back on")
+
+    def _restore_counters(self, link: Link) -> None:
+        """The position counters read as they would had the run never zeroed them: as
+        found plus how far each axis now is from where the run began (N<axis>)."""
+        names = self.profile.axes
+        self._position(link)
+        here = self.guard.envelope.position()
+        wanted = {i: c + int(here[i]) for i, c in self.counters.items() if here[i] is not None}
+        settable = {i: v for i, v in wanted.items() if f"N{names[i]}" in self.profile.commands}
+        if not settable:
+            if self.counters:
+                self.report.reset.append(
+                    "position counters not restored (the unit cannot set them): they read "
+                    + ",".join(str(c) for c in self.counters.values()) + " when found")
+            return
+        for i, value in settable.items():
+            link.send(f"N{names[i]}{value}")
+        read = self._position(link)
+        if all(read.get(i) == v for i, v in settable.items()):
+            self.report.restored.append("position counters as found: " + ", ".join(
+                f"{names[i]} {v}" for i, v in settable.items()))
+        else:
+            self.report.problems.append(f"position counters not restored: PF reads {read}, "
+                                        f"expected {settable}")
 
     def _restore_eeprom(self, link: Link) -> None:
         if not self.guard.eeprom_written:
