@@ -100,6 +100,10 @@ class Session:
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
 
+    def share(self, interrupts: Interrupts) -> None:
+        """Take Ctrl-C from the run's ``interrupts``."""
+        self.interrupts = self.guard.interrupts = interrupts
+
     # -- the guard's interface, for frames sent by other means ---------------------------------
     @property
     def before_motion(self) -> Callable[[], bool | None] | None:

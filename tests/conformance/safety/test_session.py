@@ -151,3 +151,13 @@ def test_ctrl_c_during_eeprom_work_halts_first_and_restores(tmp_path, when):
         assert image.read_bytes() == found
         assert result.problems == []
     assert os.path.exists(image)
+
+
+def test_the_operator_is_asked_once_before_the_first_motion_with_the_identity_known():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    asked = []
+    unit.session.before_motion = lambda: asked.append(
+        (unit.session.identity["version"], [f for f in unit.frames if moves(f)]))
+    run([unit], select(["1.profile.*", "5.errors.ok", "10.1.*"]))
+    assert asked == [("IP84 v3 27.1.2010", [])]       # before any frame that moves
+    assert [f for f in unit.frames if moves(f)]
