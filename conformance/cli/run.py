@@ -147,7 +147,7 @@ def _main(argv: list[str] | None) -> int:
     if meta.confirmed == "asked":
         for target in targets:
             if target.info.kind != "emu":
-                target.before_motion = ask_before_motion(target, console, meta)
+                target.session.before_motion = ask_before_motion(target, console, meta)
     _say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
     _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
          "seed: none (derandomized settings draw the same examples every run; --seed N for "
@@ -225,12 +225,13 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     every = [f"emu:{name}" for name in available_profiles()]
     if args.profile and args.profile != "auto" and not args.target:
         every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
-    # no --target, or emu:all: the embedded emulator on every profile
-    specs = [s for t in args.target or ["emu:all"]
+    # no --target, or emu:all: the embedded emulator on every profile (--profile is for
+    # the targets named)
+    specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
              for s in (every if t.split("?")[0] == "emu:all" else [t])]
     try:
-        chosen = [resolve(s, None if s in every else args.profile, args.variant, console)
-                  for s in specs]
+        chosen = [resolve(s, args.profile if named else None, args.variant, console)
+                  for s, named in specs]
         return [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
                              max_travel=args.max_travel, mutant=args.mutant)
                 for s, p, _ in chosen], [how for _, _, how in chosen]

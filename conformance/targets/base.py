@@ -4,7 +4,6 @@ opens its links and keeps what must hold for the whole run (docs/suite.md)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import serial
@@ -33,9 +32,6 @@ class Target:
 
     def __post_init__(self) -> None:
         self._session: Session | None = None
-        # asked by every session of this target before its first motion frame (the
-        # operator's confirmation); None: nothing to ask
-        self.before_motion: Callable[[], bool | None] | None = None
 
     @property
     def session(self) -> Session:
@@ -45,9 +41,12 @@ class Target:
         return self._session
 
     def begin(self, interrupts: Interrupts | None = None) -> Session:
-        """A new session for a run (Ctrl-C shared through ``interrupts``)."""
-        self._session = Session(self, interrupts)
-        self._session.before_motion = self.before_motion
+        """The session for a run, Ctrl-C shared through ``interrupts``: the one prepared
+        before the run (an operator's prompt set, the identity read), else a new one."""
+        if self._session is None or self._session.finished:
+            self._session = Session(self, interrupts)
+        elif interrupts is not None:
+            self._session.share(interrupts)
         return self._session
 
     def open_link(self, address: int | None = None) -> Link:

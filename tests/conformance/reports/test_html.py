@@ -94,7 +94,7 @@ def test_hostile_unit_bytes_are_harmless(no_plots):
     parse(page)
     assert "\x00" not in page and "\x1b" not in page and "\x7f" not in page
     assert "<script>alert" not in page and "</pre><script>" not in page
-    assert "&lt;/pre&gt;&lt;script&gt;alert(1)" in page and "\\x00\\x07\\x1b" in page
+    assert "&lt;/pre&gt;&lt;script&gt;alert(1)" in page and "\\x00\\x07\\x1B" in page
 
 
 def test_motion_traces_are_drawn_as_inline_svg():

@@ -35,7 +35,7 @@ def test_junit_is_well_formed_with_hostile_bytes(tmp_path):
     root = ET.fromstring(text)                              # raises if not well-formed
     failure = root.find(".//testcase[@name='6.toy.fails[GVE84-100]']/failure")
     assert "</pre><script>alert(1)</script>" in failure.text
-    assert "\\x00\\x07\\x1b" in failure.text and "\x00" not in text
+    assert "\\x00\\x07\\x1B" in failure.text and "\x00" not in text
 
 
 def test_json_has_the_same_metadata_and_the_overall_verdict(tmp_path, no_plots):
