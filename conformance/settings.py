@@ -1,6 +1,9 @@
-"""Hypothesis settings profiles for the machines (issue 4 item 5)."""
+"""Hypothesis settings profiles for the machines (issue 4 item 5) and the run's seed
+(issue 12 item 7)."""
 
 from __future__ import annotations
+
+import secrets
 
 from hypothesis import HealthCheck, Phase, settings
 
@@ -25,3 +28,15 @@ def get(name: str) -> settings:
         return PROFILES[name]
     except KeyError:
         raise ValueError(f"unknown settings profile {name!r}: {', '.join(PROFILES)}") from None
+
+
+def run_seed(names: list[str], seed: int | None = None) -> int | None:
+    """The seed a run records and gives the machines: ``seed`` when given (it overrides
+    derandomization), else None when every settings profile ``names`` is derandomized
+    (every run draws the same examples), else a fresh random one, so that any run can be
+    replayed."""
+    if seed is not None:
+        return seed
+    if all(get(name).derandomize for name in names):
+        return None
+    return secrets.randbits(32)
