@@ -13,7 +13,9 @@ import importlib
 import sys
 
 #: subcommand -> (module, one line for the help)
-SUBCOMMANDS: dict[str, tuple[str, str]] = {}
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
+}
 
 
 def main(argv: list[str] | None = None) -> int:
