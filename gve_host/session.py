@@ -189,6 +189,9 @@ class Session:
             parsed = wire.parse(answer, self.summed) if answer else None
             if parsed is not None and parsed.code == 0 and len(parsed.values) == 1:
                 return int(parsed.values[0])
+            if answer and self.summed and wire.parse(answer, False) is not None:
+                raise UnitLost("the unit answers without checksums: it has restarted "
+                               "(checksum mode is off after power-on, spec 6)")
             self.drain()
         return None
 

@@ -23,7 +23,7 @@ from conformance.host.oracle import HostResult
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
 from conformance.reports import write_reports
-from conformance.verdict import ORDER, PASS, failing
+from conformance.verdict import ORDER, PASS, failing, grade
 from gve_fixtures.profile import ProfileError
 
 
@@ -107,7 +107,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.quiet and r.verdict == PASS:
             return
         line = f"{r.verdict:15} {r.id} [{r.profile}]"
-        failed = [c for c in r.checks if not c["ok"]]
+        failed = sorted((c for c in r.checks if not c["ok"]),
+                        key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
         if failed:
             line += f"  -- {failed[0]['rule']}: {failed[0]['what']} ({failed[0]['observed']})"
         elif r.verdict != PASS and r.notes:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
-from conformance.host.recording import Exchange, Recording, Unsolicited
+from conformance.host.recording import Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
@@ -76,7 +76,7 @@ def frames(rec: Recording, line: Line, out: Judgement) -> None:
             out.add(p.rule, _at(ex.frame.start, line), ex.text, p.what)
     for frag in rec.fragments:
         out.judged.add("3.frame.grammar")
-        shown = frag.data.decode("latin-1")
+        shown = show(frag.data)
         if frag.kind == "cut":
             out.add("3.frame.grammar", _at(frag.start, line), shown,
                     "a frame that never ended with CR")
@@ -84,7 +84,7 @@ def frames(rec: Recording, line: Line, out: Judgement) -> None:
             out.add("3.frame.grammar", _at(frag.start, line), shown,
                     "bytes outside any frame (units ignore them, spec 3 [D])", "D")
         else:
-            out.add("3.frame.grammar", _at(frag.start, line), "\\n",
+            out.add("3.frame.grammar", _at(frag.start, line), shown,
                     "a LF after CR (units ignore it, spec 3 [D])", "D-info")
 
 
@@ -111,13 +111,14 @@ def gaps(rec: Recording, line: Line, out: Judgement) -> None:
     out.notes.append(f"slowest gap between the bytes of a frame: {slowest / MS:.1f} ms "
                      f"(watchdog {line.watchdog_ms} ms)")
     for ex in rec.exchanges:
-        for a, b in ex.frame.pauses:
-            if b - a < limit:
-                continue
-            if any(s < b and e > a for s, e in rec.stalls):
-                out.notes.append(f"a {(b - a) / MS:.0f} ms gap in {ex.text} not judged: "
-                                 "the relay was late itself")
-                continue
+        long = [(a, b) for a, b in ex.frame.pauses if b - a >= limit]
+        ours = [(a, b) for a, b in long if any(s < b and e > a for s, e in rec.stalls)]
+        if ours:
+            out.notes.append(f"{len(ours)} long gap(s) in {ex.text} not judged: the relay "
+                             "was late itself")
+        theirs = [p for p in long if p not in ours]
+        if theirs:
+            a, b = max(theirs, key=lambda p: p[1] - p[0])
             out.add("3.frame.watchdog", _at(a, line), ex.text,
                     f"{(b - a) / MS:.1f} ms between two bytes (watchdog "
                     f"{line.watchdog_ms} ms)")
@@ -163,16 +164,19 @@ def packets(rec: Recording, line: Line, out: Judgement) -> None:
                         f"{n} member(s) sent since `*S`")
             members[f.address] = None
         elif n is not None:
-            if f.command in ("C", "B"):
-                members[f.address] = n + 1
-                if f.checksum is None and summed(ex):
-                    out.add("7.packet.checksums", _at(ex.frame.start, line), ex.text,
-                            "a member without its checksum in checksum mode")
-            elif f.command in ("H", "@", ">", "J"):
+            if f.command in ("H", "@", ">", "J"):
                 members[f.address] = None          # breaks the packet (spec 7)
-            else:
+                continue
+            members[f.address] = n + 1             # a member, failing or not
+            if f.command not in ("C", "B"):
                 out.add("7.packet.members", _at(ex.frame.start, line), ex.text,
                         f"`{f.command}` inside a packet")
+            elif f.checksum is None and summed(ex):
+                out.judged.add("7.packet.checksums")
+                out.add("7.packet.checksums", _at(ex.frame.start, line), ex.text,
+                        "a member without its checksum in checksum mode")
+            elif summed(ex):
+                out.judged.add("7.packet.checksums")
 
 
 def summed(ex: Exchange) -> bool:
@@ -243,7 +247,10 @@ def _resends(ex: Exchange, nxt: Exchange) -> bool:
 
 
 def queue_full(rec: Recording, line: Line, out: Judgement) -> None:
-    """A vector or packet refused with 1 is sent again later (spec 5, 10.1)."""
+    """A vector or packet refused with 1 is sent again later (spec 5, 10.1). Not judged
+    when the host had to be stopped (it hung: that is its own finding)."""
+    if line.exit_code is None:
+        return
     for i, ex in enumerate(rec.exchanges):
         if ex.parsed.command not in (*VECTORS, "*E") or ex.delivered is None:
             continue
@@ -320,6 +327,13 @@ def judge(rec: Recording, line: Line) -> Judgement:
     out = Judgement()
     for check in CHECKS:
         check(rec, line, out)
+    seen: set[tuple[str, int, str | None]] = set()
+    unique = []
+    for f in out.findings:               # a frame's grammar and its refusal: said once
+        if (f.rule, f.t, f.tag) not in seen:
+            seen.add((f.rule, f.t, f.tag))
+            unique.append(f)
+    out.findings = unique
     return out
 
 

@@ -26,7 +26,7 @@ from conformance.host.faults import Fault
 from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
-from conformance.host.unitview import Step, UnitView
+from conformance.host.unitview import VECTORS, Step, UnitView
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
 from gve_fixtures.rules import load_rules
@@ -143,6 +143,9 @@ def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None) -> None:
         g.notes.append("no baseline: the host did not finish its job on the clean line")
         return
     got = executed(out.views)
+    if sc.name == "restart":
+        restart_checks(g, baseline, got)
+        return
     for address, expected in baseline.executed.items():
         steps = got.get(address, [])
         if finished:
@@ -158,6 +161,21 @@ def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None) -> None:
     if not finished and not hung and sc.name != "interrupt":
         g.check(False, "8.recovery.finishes", "the host recovers (spec 8) and finishes "
                 "its job", f"gave up: {_ending(out)}")
+
+
+def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Step]]) -> None:
+    """How the host took the restart (INFO): the motion before it, and none after it,
+    as the unit's position was lost (spec 9: the counters start at 0)."""
+    for address, expected in baseline.executed.items():
+        steps = got.get(address, [])
+        cut = next((i for i, s in enumerate(steps) if s.kind == "power-on"), len(steps))
+        before, after = steps[:cut], [s for s in steps[cut + 1:] if s.kind in VECTORS]
+        g.check(before == expected[: len(before)], "8.recovery.exactly-once",
+                "the motion before the restart is the beginning of the clean run's",
+                difference(expected[: len(before)], before) or f"{len(before)} steps")
+        g.check(not after, "8.recovery.exactly-once", "no motion after the unit restarted "
+                "(its position was lost)", f"{len(after)} vector(s) ran after the "
+                "restart, the first " + _short(after[0]) if after else "none")
 
 
 def _position(baseline: Baseline, out: Outcome, address: int) -> str | None:

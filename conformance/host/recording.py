@@ -34,7 +34,8 @@ class Exchange:
 
     @property
     def text(self) -> str:
-        return self.parsed.text
+        """The frame as the wire log writes it (CR left out, other bytes escaped)."""
+        return show(self.frame.raw)
 
     @property
     def code(self) -> int | None:
