@@ -28,8 +28,9 @@ from gve_host.wire import Answer
 #: after a recovery question, more lines may follow the first (a late answer comes
 #: before the answer to `@`, never after it): take the last one within this time
 SETTLE_S = 0.03
-#: how many times `@` is asked before the unit is given up for lost (covers a restart)
-ASK_RETRIES = 16
+#: how long `@` is asked before the unit is given up for lost: longer than a restart
+#: (about 2 s, spec 2)
+ASK_FOR_S = 3.0
 #: commands that are not counted in the index (spec 8)
 UNCOUNTED = ("@", ">")
 #: a command's letters and its first decimal parameter (for the number bugs)
@@ -182,7 +183,8 @@ class Session:
         return got[1]
 
     def ask_index(self) -> int | None:
-        for _ in range(ASK_RETRIES):
+        until = time.monotonic() + ASK_FOR_S
+        while time.monotonic() < until:
             self.send(self.frame("@"))
             lines = self._settled(1)
             answer = lines[-1] if lines else None

@@ -81,8 +81,8 @@ def plan_of(args: argparse.Namespace) -> Plan:
         raise Usage("--host-timeout and --jobs take positive numbers")
     if args.command and not any("{port}" in a for a in args.command):
         raise Usage("the host command must name the port as {port}")
-    unmatched = [p for p in args.scenarios if len(select([p])) == 1 and
-                 select([p])[0].name != "clean" and not fnmatch.fnmatchcase("clean", p)]
+    unmatched = [p for p in args.scenarios if not any(
+        fnmatch.fnmatchcase(s.name, p) or fnmatch.fnmatchcase(s.id, p) for s in SCENARIOS)]
     if unmatched:
         raise Usage(f"no scenario matches {' '.join(unmatched)} (see --list)")
     scenarios = select(args.scenarios)

@@ -1,0 +1,30 @@
+"""Job files: one command a line, `wait`, `position X,Y,Z`; errors name the line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import gve_host
+from gve_host.job import JobError, Step, load, parse
+
+
+def test_the_sample_job():
+    steps = load(Path(gve_host.__file__).parent / "jobs" / "square.job")
+    assert steps[0] == Step("command", "SW2,00")
+    assert steps[-1] == Step("position", position=(1000, 0, 0))
+    assert any(s.continuous for s in steps)
+
+
+def test_steps():
+    steps = parse("V1000  # speed\n\nC10,0,0\nB500\nwait\nposition 1, 2, 3\n")
+    assert [s.kind for s in steps] == ["command", "command", "command", "wait", "position"]
+    assert [s.continuous for s in steps] == [False, True, True, False, False]
+    assert steps[-1].position == (1, 2, 3)
+
+
+@pytest.mark.parametrize("text", ["v1000", "position 1,x", "wait now", "L1 0 0"])
+def test_bad_lines_are_named(text):
+    with pytest.raises(JobError, match="job:1"):
+        parse(text)
