@@ -31,21 +31,16 @@ INTERRUPT_S = 0.3
 SECOND = 1_000_000_000
 
 
-class Rig(Protocol):
-    def set_input(self, port: int, value: int, address: int | None = None) -> None: ...
-    def power_on(self, address: int | None = None) -> None: ...
-
-
 class Context(Protocol):
-    """What a fault may use of the relay."""
+    """What a fault may use of the relay (and, through it, the units' test rig)."""
 
-    rig: Rig
-
+    def now(self) -> int: ...
     def vectors(self) -> int: ...
     def in_packet(self, address: int | None) -> bool: ...
     def checksums(self, address: int | None) -> bool: ...
     def note_fault(self, kind: str, detail: str) -> None: ...
     def power_on(self, address: int) -> None: ...
+    def set_input(self, port: int, value: int, address: int) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -200,22 +195,18 @@ class QueueFull(Fault):
     def describe(self) -> str:
         return f"the queue is full for {QUEUE_FULL_S:g} s from {self.target}"
 
-    def _active(self, ctx: Context, now: int | None = None) -> bool:
-        if self.until is not None:
-            return now is None or now < self.until
-        return self.target.reached(ctx)
+    def _active(self, ctx: Context) -> bool:
+        if self.until is None:                    # the window opens at the target
+            return self.target.reached(ctx)
+        return ctx.now() < self.until
 
     def hold(self, partial: bytes, ctx: Context) -> bool:
         return self._active(ctx)
 
-    def tick(self, now: int, ctx: Context) -> None:
-        if self.until is not None and now >= self.until and not self._faked:
-            self._faked.add(-1)      # over: never again
-
     def frame(self, ex: Exchange, ctx: Context) -> bytes | None:
         raw = ex.frame.raw + b"\r"
         f = ex.parsed
-        if not self._active(ctx, ex.frame.end) or -1 in self._faked or f.command is None:
+        if not self._active(ctx) or f.command is None:
             return raw
         packet = ctx.in_packet(f.address)
         if f.command in ("L", "C") and not packet:
@@ -225,7 +216,7 @@ class QueueFull(Fault):
         else:
             return raw
         if self.until is None:
-            self.until = ex.frame.end + round(QUEUE_FULL_S * SECOND)
+            self.until = ctx.now() + round(QUEUE_FULL_S * SECOND)
         self.injected = True
         self._faked.add(ex.n)
         ex.fault = self.kind
@@ -273,7 +264,7 @@ class Interrupt(Fault):
 
     def _set(self, level: int, ctx: Context) -> None:
         value = 0xFF & ~(1 << self.bit) | (level << self.bit)
-        ctx.rig.set_input(self.port, value, self.address)
+        ctx.set_input(self.port, value, self.address)
 
     def after(self, ex: Exchange, ctx: Context) -> None:
         if self.injected or not self.target.reached(ctx) or ex.answered_at is None:

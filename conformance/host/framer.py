@@ -8,10 +8,12 @@ what the host sent, and when.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from itertools import pairwise
 
-BANG, CR, LF = 0x21, 0x0D, 0x0A
+CR, LF = 0x0D, 0x0A
+_SPECIAL = re.compile(rb"[!\r]")
 #: an unterminated frame is kept up to this many bytes (the rest is only counted)
 KEEP = 4096
 
@@ -74,39 +76,62 @@ class HostFramer:
     def last_byte_at(self) -> int | None:
         return self._times[-1] if self._times else None
 
-    def feed_byte(self, byte: int, t: int) -> HostFrame | Fragment | None:
-        """One byte; returns the frame or fragment it completed, if any (a fragment cut
-        by `!` is returned, the new frame goes on)."""
-        done: HostFrame | Fragment | None = None
-        if byte == BANG:
-            done = self._close_stray() or self._cut(t)
-            self._raw, self._times = bytearray(b"!"), [t]
-        elif self._raw:
-            if byte == CR:
-                done = HostFrame(bytes(self._raw), self._times, t)
+    def feed(self, data: bytes, t: int) -> list[tuple[int, HostFrame | Fragment]]:
+        """A chunk of bytes that arrived at ``t``; returns what it completed, each with
+        the offset in ``data`` just after its last byte (a fragment cut by `!` ends
+        before that `!`; the new frame goes on)."""
+        events: list[tuple[int, HostFrame | Fragment]] = []
+        i, n = 0, len(data)
+        while i < n:
+            if not self._raw:
+                bang = data.find(b"!", i)
+                end = n if bang < 0 else bang
+                if end > i and self._after_cr and data[i] == LF:
+                    events.append((i + 1, self._emit(Fragment("lf", b"\n", t, t))))
+                    i += 1
+                self._after_cr = False
+                if end > i:
+                    if not self._stray:
+                        self._stray_at = t
+                    self._stray += data[i:end]
+                if bang < 0:
+                    break
+                stray = self._close_stray()
+                if stray is not None:
+                    events.append((bang, stray))
+                self._raw, self._times = bytearray(b"!"), [t]
+                i = bang + 1
+                continue
+            m = _SPECIAL.search(data, i)
+            end = n if m is None else m.start()
+            room = min(end - i, KEEP - len(self._raw))
+            if room > 0:
+                self._raw += data[i : i + room]
+                self._times += [t] * room
+            if m is None:
+                break
+            if data[end] == CR:
+                events.append((end + 1, self._emit(HostFrame(bytes(self._raw), self._times, t))))
                 self._raw, self._times = bytearray(), []
                 self._after_cr = True
-                self.out.append(done)
-                return done
-            if len(self._raw) < KEEP:
-                self._raw.append(byte)
-                self._times.append(t)
-        elif byte == LF and self._after_cr:
-            done = Fragment("lf", b"\n", t, t)
-        else:
-            if not self._stray:
-                self._stray_at = t
-            self._stray.append(byte)
-        self._after_cr = False
-        if done is not None:
-            self.out.append(done)
-        return done
+            else:
+                cut = self._cut(t)
+                assert cut is not None
+                events.append((end, cut))
+                self._raw, self._times = bytearray(b"!"), [t]
+            i = end + 1
+        return events
+
+    def _emit(self, item: HostFrame | Fragment) -> HostFrame | Fragment:
+        self.out.append(item)
+        return item
 
     def _cut(self, t: int) -> Fragment | None:
         if not self._raw:
             return None
         frag = Fragment("cut", bytes(self._raw), self._times[0], t)
         self._raw, self._times = bytearray(), []
+        self.out.append(frag)
         return frag
 
     def _close_stray(self) -> Fragment | None:
@@ -114,10 +139,9 @@ class HostFramer:
             return None
         frag = Fragment("stray", bytes(self._stray), self._stray_at, self._stray_at)
         self._stray = bytearray()
+        self.out.append(frag)
         return frag
 
     def finish(self, t: int) -> list[Fragment]:
         """The end of the run: an unfinished frame or stray bytes become fragments."""
-        done = [f for f in (self._close_stray(), self._cut(t)) if f is not None]
-        self.out += done
-        return done
+        return [f for f in (self._close_stray(), self._cut(t)) if f is not None]

@@ -11,6 +11,7 @@ import math
 import re
 import struct
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
@@ -26,6 +27,7 @@ _DEC = re.compile(r"-?[0-9]+\Z")
 _HEX = re.compile(r"[0-9A-Fa-f]+\Z")
 _FLOAT = re.compile(r"-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?\Z")
 _SUM = re.compile(rb",([0-9A-Fa-f]{2})\Z")
+_PRINTABLE = re.compile(rb"[\x20-\x7e]*")
 #: what a host might put between parameters instead of a comma (spec 3 [M] "commas")
 _SEPARATORS = re.compile(r"[ ;:\t]")
 #: commands only units with checksums and packets have (spec 1: the GVE54 lacks them)
@@ -105,21 +107,43 @@ class ParsedFrame:
     def problem(self, rule: str, what: str) -> None:
         self.problems.append(Problem(rule, what))
 
-    def check(self, ok: bool, rule: str, what: str) -> bool:
-        """Hold the frame to ``rule``; record ``what`` when it breaks it."""
+    def check(self, ok: bool, rule: str, what: str | Callable[[], str]) -> bool:
+        """Hold the frame to ``rule``; record ``what`` (text, or a function that writes
+        it, called only then) when it breaks it."""
         self.judged.add(rule)
         if not ok:
-            self.problem(rule, what)
+            self.problem(rule, what if isinstance(what, str) else what())
         return ok
 
 
 def parse_frame(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFrame:
     """Judge one frame; ``units`` maps the addresses on the line to their profiles,
     ``checksums`` is the checksum mode the addressed unit is in (spec 6)."""
+    return _parse(raw, units, checksums)
+
+
+class LineGrammar:
+    """:func:`parse_frame` for one line, remembering its answers: hosts repeat frames
+    (polls, retries). A parsed frame is shared between equal frames: do not change it."""
+
+    def __init__(self, units: dict[int, Profile], size: int = 4096) -> None:
+        self.units, self.size = units, size
+        self._seen: dict[tuple[bytes, bool], ParsedFrame] = {}
+
+    def parse(self, raw: bytes, checksums: bool) -> ParsedFrame:
+        found = self._seen.get((raw, checksums))
+        if found is None:
+            found = self._seen[raw, checksums] = _parse(raw, self.units, checksums)
+            if len(self._seen) > self.size:
+                self._seen.pop(next(iter(self._seen)))
+        return found
+
+
+def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFrame:
     f = ParsedFrame(raw)
     f.check(len(raw) <= MAX_FRAME, "3.frame.max-length",
-            f"{len(raw)} bytes, more than {MAX_FRAME}")
-    f.check(all(0x20 <= b <= 0x7E for b in raw), "3.frame.grammar",
+            lambda: f"{len(raw)} bytes, more than {MAX_FRAME}")
+    f.check(_PRINTABLE.fullmatch(raw) is not None, "3.frame.grammar",
             "a byte that is not printable ASCII inside the frame")
     digit = raw[1:2]
     if not f.check(digit.isdigit() and int(digit) <= 7, "3.frame.grammar",
@@ -128,7 +152,7 @@ def parse_frame(raw: bytes, units: dict[int, Profile], checksums: bool) -> Parse
     f.address = int(digit)
     profile = units.get(f.address)
     if not f.check(profile is not None, "2.link.addressed-only",
-                   f"address {f.address}: no unit on the line has it"):
+                   lambda: f"address {f.address}: no unit on the line has it"):
         return f
     assert profile is not None
     body = raw[2:]
@@ -140,7 +164,7 @@ def parse_frame(raw: bytes, units: dict[int, Profile], checksums: bool) -> Parse
             f.checksum = m.group(1).decode()
             expected = byte_sum(raw[: len(raw) - 2])
             f.check(int(f.checksum, 16) == expected, "6.checksum.sum",
-                    f"checksum {f.checksum}, the bytes sum to {expected:02X}")
+                    lambda: f"checksum {f.checksum}, the bytes sum to {expected:02X}")
             body = body[: m.start()]
     f.body = body.decode("latin-1")
     _command(f, profile)
@@ -153,9 +177,9 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
     upper = _longest_prefix(f.body.upper(), table)
     lower = name is None and upper is not None
     f.check(not lower, "3.frame.upper-case",
-            f"command letters `{f.body[: len(upper or '')]}` are not upper case")
+            lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
     if not f.check(name is not None or lower, "1.profile.command-set",
-                   f"`{f.body[:3]}…` is no command of spec 10") or name is None:
+                   lambda: f"`{f.body[:3]}…` is no command of spec 10") or name is None:
         return
     command = table[name]
     f.command = name
@@ -165,7 +189,7 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
     where = f"address {f.address} of the {profile.name}" if spindle else profile.name
     if not f.check(command.known_as in allowed,
                    "1.profile.gve54-no-checksums" if family_lacks else "1.profile.command-set",
-                   f"`{name}`: the {where} has no such command"):
+                   lambda: f"`{name}`: the {where} has no such command"):
         return
     _params(f, command, f.body[len(name):], profile, spindle)
 
@@ -197,8 +221,8 @@ def _params(f: ParsedFrame, command: Command, text: str, profile: Profile,
     elif command.repeat == "axes" and len(parts) > len(profile.axes):
         rule = "1.profile.axes"
     if not f.check(len(parts) in counts, rule,
-                   f"`{command.name}` takes {' or '.join(map(str, counts))} parameter(s), "
-                   f"the frame has {len(parts)}"):
+                   lambda: f"`{command.name}` takes {' or '.join(map(str, counts))} "
+                           f"parameter(s), the frame has {len(parts)}"):
         return
     fields = [*command.fields, *[command.fields[-1]] * (len(parts) - len(command.fields))]
     for spec, value in zip(fields, parts, strict=True):
@@ -231,7 +255,7 @@ def _value(spec: Field, text: str, command: Command, profile: Profile,
     value = int(text, base)
     lo, hi = _bounds(spec, profile, spindle and command.name == "V")
     rules = ("12.spindle.speed",) if spindle and command.name == "V" else command.rules
-    rule = _applicable(rules, profile)
+    rule = _applicable(rules, profile.name, profile.family)
     return rule, None if lo <= value <= hi else (f"`{command.name}`: {value} outside "
                                                  f"{lo}..{hi}")
 
@@ -247,10 +271,11 @@ def _bounds(spec: Field, profile: Profile, spindle: bool) -> tuple[int, int]:
     return r.lo, r.hi
 
 
-def _applicable(rules: tuple[str, ...], profile: Profile) -> str:
+@cache
+def _applicable(rules: tuple[str, ...], name: str, family: str) -> str:
     known = load_rules()
     for rule in rules:
-        if rule in known and known[rule].applies_to(profile.name, profile.family):
+        if rule in known and known[rule].applies_to(name, family):
             return rule
     return "5.code.range"
 

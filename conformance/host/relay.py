@@ -1,17 +1,20 @@
 """The relay: the suite plays the unit to a host program (issue 11 item 1).
 
 The host's bytes come in on a port (pty, TCP, serial device), are timed as they arrive and
-passed on at once to emulated units on a real-time line; the units' answers go back to
-the host. Between the two a fault may act at one point of the job (faults.py). Every
-byte both ways is recorded with its instant (recording.py), and each frame is paired
-with the answer the unit gave it, so that the host rules (checks.py) and the motion the
-unit executed (unitview.py) can be judged from the wire alone.
+passed on at once to emulated units; the units' answers go back to the host. The units'
+line keeps virtual time, which the relay brings up to the wall clock before every move:
+the units act in real time, yet the relay never sleeps on them, and an answer is given to
+the host no sooner than the line could have carried it at its baud rate. Between the two
+a fault may act at one point of the job (faults.py). Every byte both ways is recorded
+with its instant (recording.py), and each frame is paired with the answer the unit gave
+it, so that the host rules (checks.py) and the motion the unit executed (unitview.py) can
+be judged from the wire alone.
 
-Answers are paired by time: the line delivers a unit's answer within a few byte times of
-the frame's CR (the units answer at once, spec 2), so after passing a frame the relay
-waits that long for its answer. `H` and `W` answer when the motion has stopped; their
-answers, and the watchdog's `2` to an unfinished frame (spec 3), come later and are
-taken as they arrive.
+Answers are paired by time: a unit answers at once (spec 2), so an answer's first byte
+follows the frame's CR by one byte time; after passing a frame the relay reads the line
+that long (in the line's time) for its answer. `H` and `W` answer when the motion has
+stopped; their answers, and the watchdog's `2` to an unfinished frame (spec 3), come
+later and are taken as they arrive.
 """
 
 from __future__ import annotations
@@ -24,9 +27,9 @@ from dataclasses import dataclass
 
 import serial
 
-from conformance.host.faults import Fault, Rig
-from conformance.host.framer import Fragment, HostFrame, HostFramer
-from conformance.host.grammar import parse_frame
+from conformance.host.faults import Fault
+from conformance.host.framer import HostFrame, HostFramer
+from conformance.host.grammar import LineGrammar
 from conformance.host.ports import HostPort
 from conformance.host.recording import Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView, by_address, profiles_by_address
@@ -35,8 +38,6 @@ MS = 1_000_000
 SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
-#: how long after its last byte is due an answer may still come (scheduling slack)
-SLACK = 2 * MS
 #: how long the relay sleeps when nothing is due, and when something soon may be
 IDLE_S, BUSY_S = 0.02, 0.002
 #: a loop turn later than this is a stall of the relay itself (not held against hosts)
@@ -61,9 +62,10 @@ class Relay:
     def __init__(self, port: HostPort, unit: serial.SerialBase, views: list[UnitView],
                  fault: Fault, baud: int) -> None:
         self.port, self.unit, self.views, self.fault = port, unit, views, fault
-        self.rig: Rig = unit.line  # type: ignore[attr-defined]
+        self.line = unit.line  # type: ignore[attr-defined]  (the gve:// rig and clock)
         self.view_at = by_address(views)
         self.units = profiles_by_address(views)
+        self.grammar = LineGrammar(self.units)
         self.byte_ns = round(10 * SECOND / baud)
         self.rec = Recording(now())
         self.framer = HostFramer()
@@ -71,7 +73,6 @@ class Relay:
         self.outq: deque[Outgoing] = deque()
         self.deferred: deque[Exchange] = deque()
         self.from_unit = bytearray()
-        self.unit_free = 0                 # when the line to the units is free again
         self.last_host = self.rec.origin   # when the host last sent anything
         self.last_given = self.rec.origin  # when the host was last given anything
         self._settings: str | None = None
@@ -95,8 +96,25 @@ class Relay:
         self.rec.fault(now(), kind, detail)
 
     def power_on(self, address: int) -> None:
-        self.rig.power_on(address)
+        self._sync()
+        self.line.power_on(address)
         self.view_at[address].power_on(now())
+
+    def set_input(self, port: int, value: int, address: int) -> None:
+        self._sync()
+        self.line.set_input(port, value, address)
+
+    # -- the line's clock --------------------------------------------------------------------
+    def _sync(self) -> None:
+        """Bring the line's virtual clock up to the wall clock (never back: after a frame
+        it runs ahead by the frame's own line time, as a real line would be busy)."""
+        behind = now() - self.rec.origin - self.line.now
+        if behind > 0:
+            self.line.advance(behind / SECOND)
+
+    def _on_line(self) -> int:
+        """The wall-clock instant the line has reached."""
+        return self.rec.origin + self.line.now
 
     # -- the loop ---------------------------------------------------------------------------
     def step(self, max_wait: float = IDLE_S) -> None:
@@ -109,6 +127,7 @@ class Relay:
             self.rec.stalls.append((start + round(wait * SECOND), woke))
         if ready:
             self.take_host(self.port.read(), woke)
+        self._sync()
         self.take_unit()
         self.fault.tick(now(), self)
         self.deliver()
@@ -126,6 +145,7 @@ class Relay:
     def finish(self) -> None:
         """The host is gone: take its last bytes, close its unfinished frame."""
         self.take_host(self.port.read(), now())
+        self._sync()
         self.take_unit()
         for frag in self.framer.finish(now()):
             self.rec.fragments.append(frag)
@@ -137,23 +157,20 @@ class Relay:
         self.rec.host_bytes(data, t)
         self.last_host = t
         self._sample_settings(t)
-        for byte in data:
-            done = self.framer.feed_byte(byte, t)
-            if isinstance(done, Fragment):
-                self.rec.fragments.append(done)
-                if done.kind == "cut" and self.held:
-                    self._pass(bytes(self.held))       # the unit sees it cut off too
-                    self.held.clear()
+        at = 0
+        for end, done in self.framer.feed(data, t):
+            self.held += data[at:end]
+            at = end
             if isinstance(done, HostFrame):
-                self.held.append(byte)
                 self._complete(done)
-            elif self.framer.in_frame:
-                self.held.append(byte)
-                if not self.fault.hold(self.framer.partial, self):
-                    self._pass(bytes(self.held))
-                    self.held.clear()
             else:
-                self._pass(bytes([byte]))               # noise: the unit ignores it
+                self.rec.fragments.append(done)
+        self.held += data[at:]
+        # the bytes of this chunk go on at once, unless a fault holds a frame back
+        if self.held and not (self.framer.in_frame
+                              and self.fault.hold(self.framer.partial, self)):
+            self._pass(bytes(self.held))
+            self.held.clear()
 
     def _sample_settings(self, t: int) -> None:
         seen = self.port.settings()
@@ -162,26 +179,28 @@ class Relay:
             self.rec.settings.append((t, seen))
 
     def _pass(self, data: bytes) -> None:
+        self._sync()
         self.unit.write(data)
-        self.unit_free = max(self.unit_free, now()) + len(data) * self.byte_ns
 
     def _complete(self, frame: HostFrame) -> None:
         address = frame.raw[1] - 0x30 if len(frame.raw) > 1 else None
         view = self.view_at.get(address) if address is not None else None
-        parsed = parse_frame(frame.raw, self.units, view is not None and view.checksums)
+        parsed = self.grammar.parse(frame.raw, view is not None and view.checksums)
         ex = Exchange(len(self.rec.exchanges), frame, parsed, vectors_before=self.vectors())
         self.rec.exchanges.append(ex)
-        whole = bytes(self.held) == frame.raw + b"\r"
-        rest = bytes(self.held)
-        self.held.clear()
+        held, self.held = bytes(self.held), bytearray()
+        whole = held.endswith(frame.raw + b"\r")
+        if whole and len(held) > len(frame.raw) + 1:   # noise, or a cut frame, before it
+            self._pass(held[: len(held) - len(frame.raw) - 1])
+        self._sync()
         self.take_unit()                     # whatever came before belongs to no frame
         if whole:
             sent = self.fault.frame(ex, self)
             ex.to_unit = sent
-        else:
-            sent, ex.to_unit = rest, frame.raw + b"\r"
+        else:                                # its first bytes went on already
+            sent, ex.to_unit = held, frame.raw + b"\r"
         if sent:
-            self._pass(sent)
+            self.unit.write(sent)            # the line's clock is the wall clock's now
         lines = self._answer(ex) if sent and sent.endswith(b"\r") else []
         if not lines and parsed.command in DEFERRED and sent:
             self.deferred.append(ex)         # booked when its answer comes
@@ -189,33 +208,32 @@ class Relay:
         self._answered(ex, lines)
 
     def _answer(self, ex: Exchange) -> list[bytes]:
-        """The lines the unit answers right away (`>` answers two, spec 8)."""
-        first = self._line(self.unit_free + 2 * self.byte_ns + SLACK)
+        """The lines the unit answers right away (`>` answers two, spec 8): the first
+        byte of an answer is complete one byte time after the frame's CR."""
+        first = self._line(self.byte_ns)
         if first is None:
             return []
         if ex.parsed.command != ">":
             return [first]
-        second = self._line(now() + (MAX_LINE + 2) * self.byte_ns + SLACK)
+        second = self._line(self.byte_ns)
         return [first] if second is None else [first, second]
 
-    def _line(self, first_by: int) -> bytes | None:
-        """One answer line whose first byte comes by ``first_by``, or None."""
-        deadline = first_by
-        while True:
-            cr = self.from_unit.find(b"\r")
-            if cr >= 0:
-                line = bytes(self.from_unit[: cr + 1])
-                del self.from_unit[: cr + 1]
-                return line
-            left = deadline - now()
-            if left <= 0:
+    def _line(self, within: int) -> bytes | None:
+        """One answer line whose first byte comes within ``within`` ns of line time."""
+        cr = self.from_unit.find(b"\r")
+        if cr < 0:
+            self.unit.timeout = (within + 1) / SECOND
+            head = self.unit.read(1)
+            if not head:
                 return None
-            self.unit.timeout = left / SECOND
-            data = self.unit.read(1)
-            if data:
-                data += self.unit.read(self.unit.in_waiting)
-                self.from_unit += data
-                deadline = max(deadline, now() + MAX_LINE * self.byte_ns + SLACK)
+            self.unit.timeout = (MAX_LINE * self.byte_ns + 1) / SECOND
+            self.from_unit += head + self.unit.read_until(b"\r")
+            cr = self.from_unit.find(b"\r")
+            if cr < 0:
+                return None
+        line = bytes(self.from_unit[: cr + 1])
+        del self.from_unit[: cr + 1]
+        return line
 
     def _book(self, ex: Exchange) -> None:
         for view in self.views:
@@ -223,13 +241,14 @@ class Relay:
 
     def _answered(self, ex: Exchange, lines: list[bytes]) -> None:
         ex.answer = lines
-        ex.answered_at = now() if lines else None
+        ex.answered_at = self._on_line() if lines else None
         self._book(ex)
         if lines:
             out = self.fault.answer(ex, self)
             if out.data is not None:
                 ex.delivered = out.data
-                self._enqueue(Outgoing(now() + round(out.delay * SECOND), out.data, ex))
+                self._enqueue(Outgoing(self._on_line() + round(out.delay * SECOND), out.data,
+                                       ex))
         self.fault.after(ex, self)
 
     # -- units -> host ---------------------------------------------------------------------
@@ -244,27 +263,23 @@ class Relay:
             if self.deferred:
                 self._answered(self.deferred.popleft(), [line])
             else:
-                u = Unsolicited([line], now())
+                u = Unsolicited([line], self._on_line())
                 self.rec.unsolicited.append(u)
-                self._enqueue(Outgoing(now(), line, unsolicited=u))
+                self._enqueue(Outgoing(u.t, line, unsolicited=u))
 
     def _enqueue(self, item: Outgoing) -> None:
         if self.outq:                       # the line to the host is first in, first out
             item.release = max(item.release, self.outq[-1].release)
         self.outq.append(item)
 
-    def _host_waiting(self) -> bool:
-        return bool(select.select([self.port.fileno()], [], [], 0)[0])
-
     def deliver(self) -> None:
         """Give the host what is due; bytes it sent before are timed first, so that a
         frame sent before its previous answer shows as such (spec 2)."""
         while self.outq and self.outq[0].release <= now():
-            if self._host_waiting():
-                data = self.port.read()
-                if data:
-                    self.take_host(data, now())
-                    continue
+            data = self.port.read()          # never blocks
+            if data:
+                self.take_host(data, now())
+                continue
             item = self.outq[0]
             n = self.port.write(item.data)
             if n == 0:

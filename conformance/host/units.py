@@ -1,6 +1,7 @@
-"""The emulated units the relay plays to a host: the reference emulator on the wall clock,
-opened through its public pyserial URL (``gve://...&realtime=1``), its ``.line`` the test
-rig (inputs, power). Nothing here looks inside the emulator."""
+"""The emulated units the relay plays to a host: the reference emulator, opened through its
+public pyserial URL (``gve://...``); its ``.line`` is the test rig (inputs, power) and the
+line's clock, which the relay keeps on the wall clock (relay.py). Nothing here looks
+inside the emulator."""
 
 from __future__ import annotations
 
@@ -26,8 +27,8 @@ def load_units(specs: list[str]) -> list[tuple[Profile, int]]:
 
 
 def open_line(units: list[tuple[Profile, int]], baud: int) -> serial.SerialBase:
-    """A line with these units, in real time (the host's bytes come when they come)."""
+    """A line with these units at ``baud``, its clock at 0."""
     import emulator  # noqa: F401  (registers the gve:// scheme with pyserial)
 
     query = "&".join(f"unit={p.name}@{a}" for p, a in units)
-    return serial.serial_for_url(f"gve://?{query}&baud={baud}&realtime=1", timeout=0)
+    return serial.serial_for_url(f"gve://?{query}&baud={baud}", timeout=0)

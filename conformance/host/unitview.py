@@ -58,6 +58,7 @@ class UnitView:
     status: list[int] = field(default_factory=lambda: [0] * 7)
     executed: list[Step] = field(default_factory=list)
     deaf_until: int = 0
+    vectors: int = 0                    # how many vectors the unit has accepted so far
 
     def __post_init__(self) -> None:
         spindle = self.profile.spindle
@@ -72,11 +73,6 @@ class UnitView:
         self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T,
                       "VK": r.VK, "VL": tuple(r.VL), "XM": r.XM}
         self.status = list(r.status)
-
-    @property
-    def vectors(self) -> int:
-        """How many vectors the unit has accepted so far."""
-        return sum(1 for s in self.executed if s.kind in VECTORS)
 
     def power_on(self, t: int) -> None:
         """The unit restarted (the rig's power cycle): reset state, deaf for a while."""
@@ -136,6 +132,7 @@ class UnitView:
             if any(values):
                 modal = tuple((k, self.modal[k]) for k in sorted(self.modal))
                 self.executed.append(Step(name, values, modal))
+                self.vectors += 1
         elif name in ("VK", "VN"):
             self.modal["VK"] = name == "VK"
         elif name == "VL":
