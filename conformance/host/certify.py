@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import TextIO
 
 from conformance.host import oracle, probe
-from conformance.host.checks import Line, judge
+from conformance.host.checks import LineFacts, judge
 from conformance.host.faults import Fault
 from conformance.host.oracle import HostResult, Outcome
 from conformance.host.ports import HostPort, open_port
@@ -137,7 +137,7 @@ def baseline_of(out: Outcome) -> Baseline | None:
 
 def grade(plan: Plan, sc: Scenario, out: Outcome, baseline: Baseline | None) -> HostResult:
     units = profiles_by_address(out.views)
-    line = Line(out.views, units, plan.baud, out.recording.origin, out.exit_code)
+    line = LineFacts(out.views, units, plan.baud, out.recording.origin, out.exit_code)
     g = oracle.Grader(sc, plan.strict)
     oracle.wire_checks(g, judge(out.recording, line))
     oracle.motion_checks(g, out, baseline)

@@ -1,8 +1,8 @@
 """The host rules, judged on the wire after each run (issue 11 item 2): one function per
 kind of evidence, each naming the rules of fixtures/rules.toml it judges.
 
-:data:`HOST_CHECKS` maps every rule a host can fail here to the check that judges it, so
-that coverage can count the host role (``conformance/coverage.py``). Verdicts come from
+:data:`WIRE_CHECKS` maps every rule a host can fail here to the check that judges it
+(``oracle.HOST_CHECKS`` adds the rules the executed motion judges). Verdicts come from
 the rules' tags, as for units; a finding may carry its own tag where the spec's preamble
 says so (a hang is a FAIL whatever the tag).
 """
@@ -36,7 +36,7 @@ class Finding:
 
 
 @dataclass
-class Line:
+class LineFacts:
     """What the checks need to know about the line and the run."""
 
     views: list[UnitView]
@@ -60,14 +60,14 @@ class Judgement:
         self.findings.append(Finding(rule, t, frame, what, tag))
 
 
-Check = Callable[[Recording, Line, Judgement], None]
+Check = Callable[[Recording, LineFacts, Judgement], None]
 
 
-def _at(t: int, line: Line) -> int:
+def _at(t: int, line: LineFacts) -> int:
     return t - line.origin
 
 
-def frames(rec: Recording, line: Line, out: Judgement) -> None:
+def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """Each frame on its own: grammar, address, command, parameters, checksum, length
     (grammar.py), and a member of a packet carrying its own checksum (spec 7)."""
     for ex in rec.exchanges:
@@ -88,7 +88,7 @@ def frames(rec: Recording, line: Line, out: Judgement) -> None:
                     "a LF after CR (units ignore it, spec 3 [D])", "D-info")
 
 
-def refusals(rec: Recording, line: Line, out: Judgement) -> None:
+def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A frame the unit refused as unknown, for syntax or for range is the host's fault
     (spec 5), unless a fault of ours made it so."""
     rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
@@ -101,7 +101,7 @@ def refusals(rec: Recording, line: Line, out: Judgement) -> None:
                     f"the unit answered {answer}")
 
 
-def gaps(rec: Recording, line: Line, out: Judgement) -> None:
+def gaps(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """The pauses between a frame's bytes stay below the unit's watchdog (spec 3): the
     slowest one is measured and shown; a pause while the relay itself was late is not
     held against the host."""
@@ -124,7 +124,7 @@ def gaps(rec: Recording, line: Line, out: Judgement) -> None:
                     f"{line.watchdog_ms} ms)")
 
 
-def simplex(rec: Recording, line: Line, out: Judgement) -> None:
+def simplex(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """No frame before the previous one is answered (spec 2), unless the host waited at
     least PATIENCE_MS and gave the answer up for lost."""
     out.judged.add("2.link.simplex")
@@ -142,7 +142,7 @@ def simplex(rec: Recording, line: Line, out: Judgement) -> None:
             previous = ex
 
 
-def packets(rec: Recording, line: Line, out: Judgement) -> None:
+def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """`*E n` gives the members sent since `*S`, and only `C` and `B` are members
     (spec 7)."""
     members: dict[int, int | None] = {}
@@ -184,7 +184,7 @@ def summed(ex: Exchange) -> bool:
     return "6.checksum.sum" in ex.parsed.judged
 
 
-def restarts(rec: Recording, line: Line, out: Judgement) -> None:
+def restarts(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """After `J` the host sends nothing until the unit is ready again (spec 2)."""
     for ex in rec.exchanges:
         if ex.parsed.command != "J" or ex.code != 0 or ex.delivered_at is None:
@@ -200,7 +200,7 @@ def restarts(rec: Recording, line: Line, out: Judgement) -> None:
                     f"answered (the unit restarts for {profile.restart_ms} ms)")
 
 
-def recovery(rec: Recording, line: Line, out: Judgement) -> None:
+def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """After an answer the host did not get whole, it asks `@` (and `>`) before anything
     else and never resends a vector blindly (spec 8); in checksum mode an answer whose
     checksum fails is not trusted (spec 6)."""
@@ -246,7 +246,7 @@ def _resends(ex: Exchange, nxt: Exchange) -> bool:
     return nxt.frame.raw == ex.frame.raw
 
 
-def queue_full(rec: Recording, line: Line, out: Judgement) -> None:
+def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A vector or packet refused with 1 is sent again later (spec 5, 10.1). Not judged
     when the host had to be stopped (it hung: that is its own finding)."""
     if line.exit_code is None:
@@ -266,7 +266,7 @@ def queue_full(rec: Recording, line: Line, out: Judgement) -> None:
                     "refused with 1 (queue full) and never sent again")
 
 
-def port_settings(rec: Recording, line: Line, out: Judgement) -> None:
+def port_settings(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """The host sets its port to 8N1 at the line's baud rate (spec 2), as far as the
     port shows it (a pseudo-terminal does; TCP does not)."""
     if not rec.settings:
@@ -280,7 +280,7 @@ def port_settings(rec: Recording, line: Line, out: Judgement) -> None:
             return
 
 
-def unsolicited(rec: Recording, line: Line, out: Judgement) -> None:
+def unsolicited(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """Answers that belong to no complete frame: the unit's watchdog dropped a frame the
     host left unfinished (spec 3)."""
     for u in rec.unsolicited:
@@ -297,8 +297,8 @@ def _ours(u: Unsolicited, rec: Recording) -> bool:
 CHECKS: tuple[Check, ...] = (frames, refusals, gaps, simplex, packets, restarts, recovery,
                              queue_full, port_settings, unsolicited)
 
-#: every rule a host can fail on the wire -> the check that judges it (for coverage)
-HOST_CHECKS: dict[str, Check] = {
+#: every rule a host can fail on the wire -> the check that judges it
+WIRE_CHECKS: dict[str, Check] = {
     **{rule: frames for rule in (
         "3.frame.grammar", "3.frame.max-length", "3.frame.upper-case", "2.link.addressed-only",
         "1.profile.command-set", "1.profile.gve54-no-checksums", "1.profile.axes",
@@ -323,7 +323,7 @@ HOST_CHECKS: dict[str, Check] = {
 }
 
 
-def judge(rec: Recording, line: Line) -> Judgement:
+def judge(rec: Recording, line: LineFacts) -> Judgement:
     out = Judgement()
     for check in CHECKS:
         check(rec, line, out)

@@ -18,10 +18,11 @@ executed motion against the clean run's.
 from __future__ import annotations
 
 import difflib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 from conformance.case import Check
-from conformance.host.checks import Judgement, findings_by_rule
+from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
 from conformance.host.faults import Fault
 from conformance.host.probe import Final
 from conformance.host.recording import Recording
@@ -206,6 +207,16 @@ def interrupt_checks(g: Grader, rec: Recording) -> None:
             "it answered with " + ", ".join(sorted({ex.parsed.command or "?" for ex in later
                                                    if ex.parsed.command in REACTIONS}))
             if noticed else "it went on as if nothing had happened")
+
+
+#: every rule a host certification can FAIL a host by -> the check that judges it: the
+#: wire's (checks.py) and the executed motion's. Coverage counts the host role by it.
+HOST_CHECKS: dict[str, Callable] = {
+    **WIRE_CHECKS,
+    "8.recovery.exactly-once": motion_checks,
+    "8.recovery.finishes": motion_checks,
+    "4.response.inta-bit": interrupt_checks,
+}
 
 
 def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:

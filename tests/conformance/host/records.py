@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from conformance.host.checks import Line, judge
+from conformance.host.checks import LineFacts, judge
 from conformance.host.framer import HostFrame
 from conformance.host.grammar import parse_frame
 from conformance.host.recording import Exchange, Recording
@@ -45,7 +45,7 @@ class Wire:
 
     def judge(self):
         views = line_views([(p, a) for a, p in self.units.items()])
-        return judge(self.rec, Line(views, self.units, 115200, 0, exit_code=0))
+        return judge(self.rec, LineFacts(views, self.units, 115200, 0, exit_code=0))
 
 
 def broken(j) -> dict[str, list[str]]:

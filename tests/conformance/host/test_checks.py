@@ -3,7 +3,8 @@ is and kept where it is not."""
 
 from __future__ import annotations
 
-from conformance.host.checks import HOST_CHECKS, PATIENCE_MS
+from conformance.host.checks import PATIENCE_MS
+from conformance.host.oracle import HOST_CHECKS
 from gve_fixtures.rules import load_rules
 from tests.conformance.host.records import Wire, broken
 
