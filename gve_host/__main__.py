@@ -24,9 +24,11 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--job", help="the job file (see gve_host/jobs/)")
     ap.add_argument("--address", type=int, default=0, choices=range(8), metavar="0..7")
     ap.add_argument("--baud", type=int, default=115200)
-    ap.add_argument("--checksums", action="store_true", help="use checksum mode (spec 6)")
-    ap.add_argument("--packets", type=int, default=0, metavar="N",
-                    help="send runs of C/B as packets of up to N members (spec 7)")
+    ap.add_argument("--checksums", action="store_true",
+                    help="use checksum mode (spec 6; also `use checksums` in the job)")
+    ap.add_argument("--packets", type=int, default=None, metavar="N",
+                    help="send runs of C/B as packets of up to N members (spec 7; also "
+                         "`use packets N` in the job)")
     ap.add_argument("--char-gap", type=float, default=0.0, metavar="MS",
                     help="send one byte at a time, pausing MS milliseconds after each")
     ap.add_argument("--timeout", type=float, default=0.25, metavar="S",
@@ -48,10 +50,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not args.port or not args.job:
             raise ValueError("give a PORT and --job FILE")
-        if args.packets < 0 or args.char_gap < 0 or args.timeout <= 0:
+        if (args.packets or 0) < 0 or args.char_gap < 0 or args.timeout <= 0:
             raise ValueError("--packets, --char-gap and --timeout take positive numbers")
         bugs = Bugs(args.bug)
-        steps = job.load(args.job)
+        work = job.load(args.job)
         stop = serial.STOPBITS_TWO if bugs.on("two-stop-bits") else serial.STOPBITS_ONE
         port = serial.serial_for_url(args.port, baudrate=args.baud, bytesize=8,
                                      parity="N", stopbits=stop, timeout=args.timeout)
@@ -60,10 +62,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     session = Session(port, args.address, timeout=args.timeout,
                       char_gap=args.char_gap / 1000, bugs=bugs)
-    driver = Driver(session, checksums=args.checksums, packets=args.packets,
+    packets = work.packets if args.packets is None else args.packets
+    driver = Driver(session, checksums=args.checksums or work.checksums, packets=packets,
                     hold_limit=args.hold_limit)
     try:
-        driver.run(steps)
+        driver.run(work.steps)
     except JobFailed as err:
         print(f"gve_host: {err}", file=sys.stderr)
         return 1

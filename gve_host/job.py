@@ -5,6 +5,9 @@
     L1000,0,0           and checksum
     wait                wait until the motion so far has ended (`L0,0,0`, spec 10.1)
     position 1000,0,0   wait, then read `PF` and stop the job unless the unit is there
+    use checksums       how to talk (before the first step; `--checksums` and
+    use packets 4       `--packets N` on the command line say the same): checksum
+                        mode (spec 6); runs of `C`/`B` as packets of up to N (spec 7)
 """
 
 from __future__ import annotations
@@ -28,18 +31,34 @@ class Step:
         return self.kind == "command" and self.body[:1] in ("C", "B")
 
 
+@dataclass
+class Job:
+    steps: list[Step]
+    checksums: bool = False
+    packets: int = 0
+
+
 class JobError(ValueError):
     """A job file that cannot be run; the message names the line."""
 
 
-def parse(text: str, name: str = "job") -> list[Step]:
-    steps = []
+def parse(text: str, name: str = "job") -> Job:
+    job = Job([])
+    steps = job.steps
     for number, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
         word, _, rest = line.partition(" ")
-        if word == "wait" and not rest:
+        if word == "use" and not steps:
+            what, _, n = rest.partition(" ")
+            if what == "checksums" and not n:
+                job.checksums = True
+            elif what == "packets" and n.isdigit():
+                job.packets = int(n)
+            else:
+                raise JobError(f"{name}:{number}: `use checksums` or `use packets N`")
+        elif word == "wait" and not rest:
             steps.append(Step("wait"))
         elif word == "position":
             try:
@@ -50,12 +69,12 @@ def parse(text: str, name: str = "job") -> list[Step]:
         elif _BODY.match(line):
             steps.append(Step("command", line))
         else:
-            raise JobError(f"{name}:{number}: not a command body, `wait` or `position`: "
-                           f"{line!r}")
-    return steps
+            raise JobError(f"{name}:{number}: not a command body, `wait`, `position` or "
+                           f"`use` (before the first step): {line!r}")
+    return job
 
 
-def load(path: str | Path) -> list[Step]:
+def load(path: str | Path) -> Job:
     p = Path(path)
     try:
         return parse(p.read_text(encoding="ascii"), p.name)

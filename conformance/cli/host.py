@@ -122,7 +122,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    print(f"\n{len(result.results)} scenarios on {plan.profile}: {summary}")
+    print(f"\n{len(result.results)} scenarios on {plan.profile}: {summary}"
+          f"{' (interrupted by Ctrl-C: the hosts were stopped)' if result.interrupted else ''}")
     clean = next((r for r in result.results if r.id.endswith(".clean")), None)
     if clean is not None:
         print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the clean "
@@ -130,7 +131,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_reports:
         folder = write_reports(result, args.report_dir)
         print(f"reports: {folder}/junit.xml, results.json, report.html")
-    return 1 if any(failing(r.verdict) for r in result.results) else 0
+    bad = any(failing(r.verdict) for r in result.results)
+    return 1 if bad or result.interrupted else 0
 
 
 if __name__ == "__main__":

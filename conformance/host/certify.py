@@ -15,10 +15,11 @@ import select
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TextIO
 
 from conformance.host import oracle, probe
@@ -50,6 +51,8 @@ class Plan:
     host_timeout: float = 5.0
     strict: bool = False
     jobs: int = 4
+    stop: threading.Event = field(default_factory=threading.Event)   # Ctrl-C
+    baseline: Baseline | None = None      # what the clean run showed, once it has run
 
     @property
     def profile(self) -> str:
@@ -83,43 +86,55 @@ def run_once(plan: Plan, fault: Fault, port: HostPort, *,
     views = line_views(plan.units)
     relay = Relay(port, line, views, fault, plan.baud)
     start = time.monotonic()
-    output = ""
     try:
         if plan.command is None:
             assert done is not None
-            said: list[int] = []
-
-            def answered() -> bool:
-                code = done()
-                if code is not None:
-                    said.append(code)
-                return code is not None
-
-            relay.serve(answered, None, None)
-            hung = said[-1] < 0
-            ended, code = ("silent", None) if hung else ("operator", said[-1])
+            ended, code, output = _attended_run(relay, done)
         else:
-            argv = [a.replace("{port}", port.name) for a in plan.command]
-            with tempfile.TemporaryFile() as log:
-                try:
-                    proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
-                                            stderr=subprocess.STDOUT, start_new_session=True)
-                except OSError as err:
-                    raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
-                ended = relay.serve(lambda: proc.poll() is not None, plan.host_timeout,
-                                    limit)
-                ended = "exited" if ended == "done" else ended
-                if ended != "exited":
-                    _stop(proc)
-                code = proc.returncode if ended == "exited" else None
-                log.seek(0)
-                output = log.read()[-4000:].decode("utf-8", "replace")
+            ended, code, output = _launched_run(relay, plan, port, limit)
         seconds = time.monotonic() - start
         relay.finish()
         finals = {v.address: probe.final_state(line, v, relay.rec) for v in views}
     finally:
         line.close()
     return Outcome(relay.rec, views, finals, code, ended, seconds, fault, output)
+
+
+def _attended_run(relay: Relay, done: Callable[[], int | None]) -> tuple[str, int | None, str]:
+    said: list[int] = []
+
+    def answered() -> bool:
+        code = done()
+        if code is not None:
+            said.append(code)
+        return code is not None
+
+    relay.serve(answered, None, None)
+    return ("silent", None, "") if said[-1] < 0 else ("operator", said[-1], "")
+
+
+def _launched_run(relay: Relay, plan: Plan, port: HostPort,
+                  limit: float) -> tuple[str, int | None, str]:
+    """Start the host, relay until it exits (or hangs, or Ctrl-C), stop it if need be."""
+    argv = [a.replace("{port}", port.name) for a in plan.command or []]
+    with tempfile.TemporaryFile() as log:
+        try:
+            proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+        except OSError as err:
+            raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
+        try:
+            ended = relay.serve(lambda: proc.poll() is not None or plan.stop.is_set(),
+                                plan.host_timeout, limit)
+        finally:
+            if proc.poll() is None:
+                _stop(proc)
+        if plan.stop.is_set() and ended == "done":
+            ended = "interrupted"
+        ended = "exited" if ended == "done" else ended
+        log.seek(0)
+        output = log.read()[-4000:].decode("utf-8", "replace")
+    return ended, proc.returncode if ended == "exited" else None, output
 
 
 def baseline_of(out: Outcome) -> Baseline | None:
@@ -135,106 +150,96 @@ def baseline_of(out: Outcome) -> Baseline | None:
     return b
 
 
-def grade(plan: Plan, sc: Scenario, out: Outcome, baseline: Baseline | None) -> HostResult:
+def grade(plan: Plan, sc: Scenario, out: Outcome) -> HostResult:
+    """The scenario's result, against the plan's baseline (the clean run's)."""
     units = profiles_by_address(out.views)
     line = LineFacts(out.views, units, plan.baud, out.recording.origin, out.exit_code)
     g = oracle.Grader(sc, plan.strict)
     oracle.wire_checks(g, judge(out.recording, line))
-    oracle.motion_checks(g, out, baseline)
+    oracle.motion_checks(g, out, plan.baseline)
     if sc.name == "interrupt":
         oracle.interrupt_checks(g, out.recording)
     return oracle.result(g, out, plan.profile, plan.target)
 
 
-def _fault_limit(plan: Plan, baseline: Baseline) -> float:
+def _fault_limit(plan: Plan) -> float:
+    """How long a fault run may take: twice the clean one, and time to give up."""
     restart = max(p.restart_ms for p, _ in plan.units) / 1000
-    return 2 * baseline.seconds + 2 * plan.host_timeout + restart
+    seconds = plan.baseline.seconds if plan.baseline is not None else CLEAN_LIMIT_S
+    return 2 * seconds + 2 * plan.host_timeout + restart
 
 
-def launched(plan: Plan, on_result: Callable[[HostResult], None]) -> list[HostResult]:
-    """Every scenario of ``plan`` with its host program started for each."""
-    def run(sc: Scenario, fault: Fault, baseline: Baseline | None) -> HostResult:
+def launched(plan: Plan, on_result: Callable[[HostResult], None]) -> None:
+    """Every scenario of ``plan`` with its host program started for each: the clean run,
+    then the others side by side; ``on_result`` gets them in scenario order."""
+    def run(sc: Scenario, fault: Fault, limit: float) -> Outcome:
         port = open_port(plan.port, plan.baud)
         try:
-            limit = CLEAN_LIMIT_S if baseline is None else _fault_limit(plan, baseline)
-            out = run_once(plan, fault, port, limit=limit)
+            return run_once(plan, fault, port, limit=limit)
         finally:
             port.close()
-        return grade(plan, sc, out, baseline)
 
     clean, rest = plan.scenarios[0], plan.scenarios[1:]
-    port = open_port(plan.port, plan.baud)
-    try:
-        out = run_once(plan, Fault(), port)
-    finally:
-        port.close()
-    baseline = baseline_of(out)
-    results = [grade(plan, clean, out, baseline)]
-    on_result(results[0])
-    pending: list[tuple[int, Scenario, Fault]] = []
-    slots: list[HostResult | None] = [None] * len(rest)
-    for i, sc in enumerate(rest):
-        made = _build(sc, baseline, plan)
-        if isinstance(made, HostResult):
-            slots[i] = made
-        else:
-            pending.append((i, sc, made))
+    out = run(clean, Fault(), CLEAN_LIMIT_S)
+    plan.baseline = baseline_of(out)
+    on_result(grade(plan, clean, out))
+    made = [_build(sc, plan) for sc in rest]
     workers = plan.jobs if plan.parallel else 1
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        futures = {pool.submit(run, sc, fault, baseline): i for i, sc, fault in pending}
-        for future, i in futures.items():
-            slots[i] = future.result()
-    for r in slots:
-        assert r is not None
-        on_result(r)
-        results.append(r)
-    return results
+        futures = [m if isinstance(m, HostResult) else
+                   pool.submit(lambda sc, m: grade(plan, sc, run(sc, m, _fault_limit(plan))),
+                               sc, m)
+                   for sc, m in zip(rest, made, strict=True)]
+        try:
+            for f in futures:
+                on_result(f if isinstance(f, HostResult) else f.result())
+        except KeyboardInterrupt:
+            plan.stop.set()                     # every relay stops, every host is killed
+            for f in futures:
+                if not isinstance(f, HostResult):
+                    f.cancel()
+            raise
 
 
-def _build(sc: Scenario, baseline: Baseline | None, plan: Plan) -> Fault | HostResult:
-    if baseline is None:
+def _build(sc: Scenario, plan: Plan) -> Fault | HostResult:
+    """The scenario's fault, or its result when it cannot run."""
+    if plan.baseline is None:
         return oracle.skipped(sc, COULD_NOT_TEST, "no baseline: the host did not finish "
                               "its job on the clean line", plan.profile, plan.target)
-    made = sc.build(baseline)
+    made = sc.build(plan.baseline)
     if isinstance(made, str):
         return oracle.skipped(sc, MISSING, made, plan.profile, plan.target)
     return made
 
 
 def attended(plan: Plan, on_result: Callable[[HostResult], None], console: TextIO,
-             operator: TextIO) -> list[HostResult]:
+             operator: TextIO) -> None:
     """Every scenario in turn on one port; the operator runs the host and reports."""
     port = open_port(plan.port, plan.baud)
-    results: list[HostResult] = []
-    baseline: Baseline | None = None
-    gone = False
+    gone: dict[str, bool] = {}
     print(f"port: {port.name}", file=console, flush=True)
     try:
         for n, sc in enumerate(plan.scenarios, 1):
-            made = Fault() if sc.name == "clean" else _build(sc, baseline, plan)
-            if isinstance(made, HostResult) or gone:
-                r = made if isinstance(made, HostResult) else oracle.skipped(
-                    sc, COULD_NOT_TEST, "the operator ended the session", plan.profile,
-                    plan.target)
-                results.append(r)
-                on_result(r)
+            made = Fault() if sc.name == "clean" else _build(sc, plan)
+            if gone:
+                made = oracle.skipped(sc, COULD_NOT_TEST, "the operator ended the session",
+                                      plan.profile, plan.target)
+            if isinstance(made, HostResult):
+                on_result(made)
                 continue
             port.read()                          # what an earlier run left unread
             print(f"[{n}/{len(plan.scenarios)}] {sc.id}: {sc.title}.\n"
                   f"  Start the host's job on {port.name} now. When it has ended, type "
                   "`done` (it finished), `failed` (it reported an error or gave up) or "
                   "`hung` (it stopped answering), then Enter.", file=console, flush=True)
-            state: dict[str, bool] = {}
-            out = run_once(plan, made, port, done=lambda s=state: _operator(operator, s))
-            gone = state.get("gone", False)
+            out = run_once(plan, made, port, done=lambda: _operator(operator, gone))
             if sc.name == "clean":
-                baseline = baseline_of(out)
-            r = grade(plan, sc, out, baseline)
-            results.append(r)
-            on_result(r)
+                plan.baseline = baseline_of(out)
+            on_result(oracle.skipped(sc, COULD_NOT_TEST, "the operator ended the session "
+                                     "before saying how the job ended", plan.profile,
+                                     plan.target) if gone else grade(plan, sc, out))
     finally:
         port.close()
-    return results
 
 
 def _operator(stream: TextIO, state: dict[str, bool]) -> int | None:
@@ -255,11 +260,21 @@ def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
             console: TextIO | None = None, operator: TextIO | None = None) -> RunResult:
     run = RunResult(run_id, targets=[plan.target], settings="host")
     start = time.monotonic()
-    if plan.command is None:
-        assert console is not None and operator is not None
-        results = attended(plan, on_result, console, operator)
-    else:
-        results = launched(plan, on_result)
+    results: list[HostResult] = []
+
+    def keep(r: HostResult) -> None:
+        results.append(r)
+        on_result(r)
+
+    try:
+        if plan.command is None:
+            assert console is not None and operator is not None
+            attended(plan, keep, console, operator)
+        else:
+            launched(plan, keep)
+    except KeyboardInterrupt:
+        plan.stop.set()
+        run.interrupted = True
     run.results = list(results)
     run.seconds = time.monotonic() - start
     run.frames = sum(r.frames for r in results)

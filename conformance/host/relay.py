@@ -38,8 +38,8 @@ MS = 1_000_000
 SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
-#: how long the relay sleeps when nothing is due, and when something soon may be
-IDLE_S, BUSY_S = 0.02, 0.002
+#: the longest the relay waits for the host before it looks at the units again
+IDLE_S = 0.02
 #: a loop turn later than this is a stall of the relay itself (not held against hosts)
 STALL = 20 * MS
 #: commands that answer when the motion has stopped (spec 2)
@@ -136,10 +136,10 @@ class Relay:
             self.rec.stalls.append((woke, done))
 
     def _wait(self, max_wait: float) -> float:
+        """Until the next answer is due to the host; the units' own events (an `H`
+        answer, the watchdog) are looked at every turn, ``IDLE_S`` at the most apart."""
         if self.outq:
             return max(0.0, min(max_wait, (self.outq[0].release - now()) / SECOND))
-        if self.deferred or self.framer.in_frame or self.from_unit:
-            return min(max_wait, BUSY_S)
         return max_wait
 
     def finish(self) -> None:

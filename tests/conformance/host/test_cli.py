@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
+import time
+
 import pytest
 
 from conformance.cli import main
@@ -38,3 +44,25 @@ def test_the_scenario_list(capsys):
     assert main(["host", "--list"]) == 0
     out = capsys.readouterr().out
     assert "2.host.clean" in out and "8.host.lost-answer.vector" in out
+
+
+@pytest.mark.pty
+def test_ctrl_c_stops_every_host_and_says_so(tmp_path):
+    """SIGINT while hosts run: they are stopped, what finished is reported, exit 1."""
+    pids = tmp_path / "pids"
+    host = tmp_path / "host.sh"          # a host that never ends, and says who it is
+    host.write_text(f"#!/bin/sh\necho $$ >> {pids}\nexec sleep 60\n")
+    host.chmod(0o755)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "conformance", "host", "--profile", "GVE84-100",
+         "--no-reports", "--host-timeout", "30", "--", str(host), "{port}"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 20
+    while not (pids.exists() and pids.read_text().strip()) and time.monotonic() < deadline:
+        time.sleep(0.05)               # wait for the host to have started
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=30)
+    assert proc.returncode == 1 and "interrupted by Ctrl-C" in out and "Traceback" not in out
+    for pid in map(int, pids.read_text().split()):
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)              # the host is gone
