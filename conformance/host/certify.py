@@ -117,17 +117,22 @@ def _launched_run(relay: Relay, plan: Plan, port: HostPort,
                   limit: float) -> tuple[str, int | None, str]:
     """Start the host, relay until it exits (or hangs, or Ctrl-C), stop it if need be."""
     argv = [a.replace("{port}", port.name) for a in plan.command or []]
+    proc: subprocess.Popen | None = None
     with tempfile.TemporaryFile() as log:
         try:
-            proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
-                                    stderr=subprocess.STDOUT, start_new_session=True)
-        except OSError as err:
-            raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
-        try:
+            # Ctrl-C waits until the host is known, so that it is stopped, never orphaned
+            old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+            try:
+                proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
+                                        stderr=subprocess.STDOUT, start_new_session=True)
+            except OSError as err:
+                raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, old)
             ended = relay.serve(lambda: proc.poll() is not None or plan.stop.is_set(),
                                 plan.host_timeout, limit)
         finally:
-            if proc.poll() is None:
+            if proc is not None and proc.poll() is None:
                 _stop(proc)
         if plan.stop.is_set() and ended == "done":
             ended = "interrupted"
