@@ -110,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         failed = sorted((c for c in r.checks if not c["ok"]),
                         key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
         if failed:
-            line += f"  -- {failed[0]['rule']}: {failed[0]['what']} ({failed[0]['observed']})"
+            line += f"  -- {failed[0]['what']} ({failed[0]['observed']})"
         elif r.verdict != PASS and r.notes:
             line += f"  -- {r.notes[0]}"
         print(line, flush=True)

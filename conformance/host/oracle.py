@@ -107,7 +107,9 @@ class Grader:
         tag = tag or load_rules()[rule].tag
         if self.scenario.info and tag != "D-info":
             tag = "D-info"
-        self.checks.append(Check(ok, what, observed, load_rules()[rule].text, tag, rule))
+        # the rule's ID leads the text, so that every report shows it
+        self.checks.append(Check(ok, f"{rule}: {what}", observed, load_rules()[rule].text,
+                                 tag, rule))
 
     def verdict(self) -> str:
         failed = [grade(c.tag, self.strict) for c in self.checks if not c.ok]
@@ -120,7 +122,7 @@ def wire_checks(g: Grader, j: Judgement) -> None:
         for tag in sorted(tags, key=str):
             mine = [f for f in findings if f.tag == tag]
             if not mine:
-                g.check(True, rule, load_rules()[rule].text, "kept in every frame")
+                g.check(True, rule, "kept in every frame")
                 continue
             first = mine[0]
             g.check(False, rule, first.what,
