@@ -1,4 +1,5 @@
-"""The oracle's words for a motion that differs from the clean run's."""
+"""The oracle names the first difference between the clean run's motion and a fault run's:
+the vector, and whether it ran twice, never ran, or ran under another setting."""
 
 from __future__ import annotations
 
@@ -14,14 +15,16 @@ def test_the_same_motion():
 
 
 def test_a_vector_run_twice():
-    assert difference([A, B, C], [A, B, B, C]) == "`C2,0,0` ran twice"
+    said = difference([A, B, C], [A, B, B, C])
+    assert said is not None and "C2,0,0" in said and "twice" in said
 
 
 def test_a_vector_lost():
-    assert difference([A, B, C], [A, C]) == "`C2,0,0` (step 2 of the job) never ran"
+    said = difference([A, B, C], [A, C])
+    assert said is not None and "C2,0,0" in said and "never ran" in said
 
 
 def test_a_vector_under_another_setting():
     slow = Step("C", (2, 0, 0), (("V", 500),))
-    assert difference([A, B, C], [A, slow, C]) == \
-        "step 2, `C2,0,0`, ran with V500 instead of V1000"
+    said = difference([A, B, C], [A, slow, C])
+    assert said is not None and "C2,0,0" in said and "V500" in said and "V1000" in said
