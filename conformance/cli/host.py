@@ -15,15 +15,13 @@ from __future__ import annotations
 import argparse
 import fnmatch
 import sys
-import time
-import uuid
 
+from conformance.cli.ending import counted, end, new_run_id, progress
 from conformance.host.certify import HostStartError, Plan, certify
-from conformance.host.oracle import HostResult
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
-from conformance.reports import write_reports
-from conformance.verdict import ORDER, PASS, failing, grade
+from conformance.runner import CaseResult
+from conformance.verdict import ORDER, PASS, grade
 from gve_fixtures.profile import ProfileError
 
 
@@ -101,38 +99,27 @@ def main(argv: list[str] | None = None) -> int:
     except Usage as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
-    run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-
-    def show(r: HostResult) -> None:
-        if args.quiet and r.verdict == PASS:
-            return
-        line = f"{r.verdict:15} {r.id} [{r.profile}]"
+    def worst(r: CaseResult) -> str | None:
+        """The check that graded the scenario worst, or why it did not run."""
         failed = sorted((c for c in r.checks if not c["ok"]),
                         key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
         if failed:
-            line += f"  -- {failed[0]['what']} ({failed[0]['observed']})"
-        elif r.verdict != PASS and r.notes:
-            line += f"  -- {r.notes[0]}"
-        print(line, flush=True)
+            return f"{failed[0]['what']} ({failed[0]['observed']})"
+        return r.notes[0] if r.verdict != PASS and r.notes else None
 
     try:
-        result = certify(plan, run_id, show, console=sys.stdout, operator=sys.stdin)
+        result = certify(plan, new_run_id(), progress(args.quiet, worst), console=sys.stdout,
+                         operator=sys.stdin)
     except (HostStartError, ValueError) as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
-    counts = result.counts()
-    summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    print(f"\n{len(result.results)} scenarios on {plan.profile}: {summary}"
+    print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
           f"{' (interrupted by Ctrl-C: the hosts were stopped)' if result.interrupted else ''}")
     clean = next((r for r in result.results if r.id.endswith(".clean")), None)
     if clean is not None:
         print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the clean "
               f"line; {result.frames} frames")
-    if not args.no_reports:
-        folder = write_reports(result, args.report_dir)
-        print(f"reports: {folder}/junit.xml, results.json, report.html")
-    bad = any(failing(r.verdict) for r in result.results)
-    return 1 if bad or result.interrupted else 0
+    return end(result, None if args.no_reports else args.report_dir)
 
 
 if __name__ == "__main__":

@@ -7,15 +7,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
-import uuid
 
 from conformance.catalogue import select
-from conformance.reports import write_reports
+from conformance.cli.ending import counted, end, new_run_id, progress
 from conformance.runner import CaseResult, run
 from conformance.settings import PROFILES
 from conformance.targets import DEFAULT_MAX_TRAVEL, parse_target
-from conformance.verdict import ORDER, PASS, failing
 from gve_fixtures.profile import available_profiles
 
 
@@ -59,28 +56,17 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, LookupError) as err:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
-    run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
 
-    def show(r: CaseResult) -> None:
-        if args.quiet and r.verdict == PASS:
-            return
-        line = f"{r.verdict:15} {r.id} [{r.profile}]"
-        if r.failed_checks:
-            c = r.failed_checks[0]
-            line += f"  -- {c['what']}: observed {c['observed']!r}, expected {c['expected']!r}"
-        print(line, flush=True)
+    def first_failed(r: CaseResult) -> str | None:
+        c = r.failed_checks[0] if r.failed_checks else None
+        return c and f"{c['what']}: observed {c['observed']!r}, expected {c['expected']!r}"
 
-    result = run(targets, cases, settings_name=args.settings, run_id=run_id, on_result=show)
-    counts = result.counts()
-    summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    print(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
+    result = run(targets, cases, settings_name=args.settings, run_id=new_run_id(),
+                 on_result=progress(args.quiet, first_failed))
+    print(f"\n{len(result.results)} case runs on {len(targets)} target(s): {counted(result)}")
     print(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
           f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
-    if not args.no_reports:
-        folder = write_reports(result, args.report_dir)
-        print(f"reports: {folder}/junit.xml, results.json, report.html")
-    bad = any(failing(r.verdict) for r in result.results)
-    return 1 if bad or result.interrupted else 0
+    return end(result, None if args.no_reports else args.report_dir)
 
 
 if __name__ == "__main__":
