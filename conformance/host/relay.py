@@ -38,8 +38,12 @@ MS = 1_000_000
 SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
+#: most answers are this short or shorter (`0,5C`, `0,-1000,2000,50,xx`)
+SHORT = 24
 #: the longest the relay waits for the host before it looks at the units again
 IDLE_S = 0.02
+#: how far the line's clock may lag the wall clock before the relay brings it up
+LAG = MS // 2
 #: a loop turn later than this is a stall of the relay itself (not held against hosts)
 STALL = 20 * MS
 #: commands that answer when the motion has stopped (spec 2)
@@ -107,9 +111,10 @@ class Relay:
     # -- the line's clock --------------------------------------------------------------------
     def _sync(self) -> None:
         """Bring the line's virtual clock up to the wall clock (never back: after a frame
-        it runs ahead by the frame's own line time, as a real line would be busy)."""
+        it runs ahead by the frame's own line time, as a real line would be busy). Less
+        than ``LAG`` behind is near enough: the units' times are in milliseconds."""
         behind = now() - self.rec.origin - self.line.now
-        if behind > 0:
+        if behind > LAG:
             self.line.advance(behind / SECOND)
 
     def _on_line(self) -> int:
@@ -219,15 +224,17 @@ class Relay:
         return [first] if second is None else [first, second]
 
     def _line(self, within: int) -> bytes | None:
-        """One answer line whose first byte comes within ``within`` ns of line time."""
+        """One answer line whose first byte comes within ``within`` ns of line time. One
+        read covers a short answer whole; a frame that gets none lets the line's clock
+        run that much ahead, which only ever shortens the gaps the units see."""
         cr = self.from_unit.find(b"\r")
         if cr < 0:
-            self.unit.timeout = (within + 1) / SECOND
-            head = self.unit.read(1)
-            if not head:
-                return None
-            self.unit.timeout = (MAX_LINE * self.byte_ns + 1) / SECOND
-            self.from_unit += head + self.unit.read_until(b"\r")
+            self.unit.timeout = (within + SHORT * self.byte_ns) / SECOND
+            got = self.unit.read_until(b"\r")
+            if got and not got.endswith(b"\r"):
+                self.unit.timeout = (MAX_LINE * self.byte_ns) / SECOND
+                got += self.unit.read_until(b"\r")
+            self.from_unit += got
             cr = self.from_unit.find(b"\r")
             if cr < 0:
                 return None
