@@ -2,16 +2,23 @@
 items with ``pytest --gve-target emu:GVE84-100`` (any target of the command line).
 
 Inert unless ``--gve-target`` is given (or ``pytest --pyargs conformance``, which runs
-against the default emulator target), so it never changes other pytest runs.
+against the default emulator target), so it never changes other pytest runs. A mistake
+in the options is a usage error before anything is sent; one session per target lasts
+the whole pytest run and puts the unit back at its end (also after Ctrl-C).
 """
 
 from __future__ import annotations
 
 import pytest
 
+from conformance.link.interrupts import Interrupts
 from conformance.runner import CaseResult, run_case
-from conformance.targets import DEFAULT_MAX_TRAVEL, parse_target
+from conformance.settings import PROFILES
+from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+
+_TARGETS = pytest.StashKey[list[Target]]()
+_INTERRUPTS = pytest.StashKey[Interrupts]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -20,7 +27,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                 help="run the suite's cases against this target (emu:PROFILE, serial:..., tcp:...)")
     g.addoption("--gve-profile", default=None, help="the profile a serial/tcp target behaves as")
     g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
-    g.addoption("--gve-settings", default="ci", help="Hypothesis settings profile")
+    g.addoption("--gve-settings", default=None,
+                help="Hypothesis settings profile (default: ci on the emulator, hardware on "
+                     "serial/tcp targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
 
@@ -32,12 +41,16 @@ class CaseFailed(Exception):
 
 
 class GveItem(pytest.Item):
-    def __init__(self, *, case, target, settings_name: str, **kw) -> None:
+    def __init__(self, *, case, target, settings_name: str | None, **kw) -> None:
         super().__init__(**kw)
         self.case, self.target, self.settings_name = case, target, settings_name
 
     def runtest(self) -> None:
-        result = run_case(self.case, self.target, self.settings_name)
+        interrupts = self.config.stash[_INTERRUPTS]
+        with interrupts.catching_sigint():
+            result = run_case(self.case, self.target, self.settings_name)
+        if result.interrupted:
+            raise KeyboardInterrupt
         if result.verdict in (MISSING, COULD_NOT_TEST):
             pytest.skip(f"{result.verdict}: {'; '.join(result.notes)[:200]}")
         if result.verdict in (FAIL, ERROR):
@@ -56,20 +69,62 @@ class GveItem(pytest.Item):
         return "gve-conformance", None, f"{self.case.id} [{self.target.profile.name}]"
 
 
-def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
-                                  items: list[pytest.Item]) -> None:
+def _specs(config: pytest.Config) -> list[str]:
     specs = config.getoption("--gve-target")
     if not specs and config.getoption("pyargs") and "conformance" in config.args:
         specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
+    return specs
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Check every option before anything is collected or sent (a usage error, not an
+    INTERNALERROR or a failed test per case)."""
+    specs = _specs(config)
     if not specs:
+        return
+    settings = config.getoption("--gve-settings")
+    if settings is not None and settings not in PROFILES:
+        raise pytest.UsageError(f"--gve-settings {settings!r}: one of {', '.join(PROFILES)}")
+    from conformance.catalogue import select
+    globs = config.getoption("--gve-cases")
+    if globs and not select(globs):
+        raise pytest.UsageError(f"--gve-cases {' '.join(globs)}: no case matches")
+    interrupts = Interrupts()
+    targets = []
+    try:
+        for spec in specs:
+            target = parse_target(spec, profile=config.getoption("--gve-profile"),
+                                  allow_destructive=config.getoption("--gve-allow-destructive"),
+                                  max_travel=config.getoption("--gve-max-travel"))
+            target.preflight()
+            target.begin(interrupts)
+            targets.append(target)
+    except (ValueError, LookupError) as err:
+        for t in targets:
+            t.close()
+        raise pytest.UsageError(str(err)) from None
+    config.stash[_TARGETS] = targets
+    config.stash[_INTERRUPTS] = interrupts
+
+
+def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
+                                  items: list[pytest.Item]) -> None:
+    targets = config.stash.get(_TARGETS, [])
+    if not targets:
         return
     from conformance.catalogue import select
     globs = config.getoption("--gve-cases") or None
-    for spec in specs:
-        target = parse_target(spec, profile=config.getoption("--gve-profile"),
-                              allow_destructive=config.getoption("--gve-allow-destructive"),
-                              max_travel=config.getoption("--gve-max-travel"))
+    for target in targets:
         for case in select(globs):
             items.append(GveItem.from_parent(
                 session, name=f"{case.id}[{target.profile.name}]", case=case, target=target,
                 settings_name=config.getoption("--gve-settings")))
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """The end of the pytest run (also after Ctrl-C): every session puts its unit back."""
+    for target in config.stash.get(_TARGETS, []):
+        report = target.session.finish()
+        target.close()
+        for problem in report.problems:
+            print(f"gve-conformance: PROBLEM on {target.info.spec}: {problem}")

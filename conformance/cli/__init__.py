@@ -14,6 +14,8 @@ import sys
 
 #: subcommand -> (module, one line for the help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
+                 "with the catalogue until a case FAILs it"),
     "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
 }
 

@@ -90,9 +90,10 @@ def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
 
 def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A frame the unit refused as unknown, for syntax or for range is the host's fault
-    (spec 5), unless a fault of ours made it so."""
+    (spec 5), unless a fault of ours made it so; so is one refused as "not while moving"
+    (7): the host did not wait for the motion to end, as `L0,0,0` lets it (spec 10.1)."""
     rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
-             ErrorCode.RANGE: "5.code.range"}
+             ErrorCode.RANGE: "5.code.range", ErrorCode.BUSY: "10.1.queue.wait-idiom"}
     out.judged |= set(rules.values())
     for ex in rec.exchanges:
         if ex.fault is None and ex.code in rules:
@@ -308,6 +309,7 @@ WIRE_CHECKS: dict[str, Check] = {
         "5.code.syntax", "5.code.range", "6.checksum.sum", "10.cmd.vector", "10.cmd.modal",
         "10.cmd.accel-range", "10.cmd.axis-limits", "10.cmd.output", "12.spindle.speed")},
     "5.code.unknown": refusals,
+    "10.1.queue.wait-idiom": refusals,
     "3.frame.watchdog": gaps,
     "2.link.simplex": simplex,
     "7.packet.count": packets,

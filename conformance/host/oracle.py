@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 from conformance.case import Check
+from conformance.coverage import register_host_check
 from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
 from conformance.host.faults import Fault
 from conformance.host.probe import Final
@@ -212,13 +213,25 @@ def interrupt_checks(g: Grader, rec: Recording) -> None:
 
 
 #: every rule a host certification can FAIL a host by -> the check that judges it: the
-#: wire's (checks.py) and the executed motion's. Coverage counts the host role by it.
+#: wire's (checks.py) and the executed motion's.
 HOST_CHECKS: dict[str, Callable] = {
     **WIRE_CHECKS,
     "8.recovery.exactly-once": motion_checks,
     "8.recovery.finishes": motion_checks,
     "4.response.inta-bit": interrupt_checks,
 }
+
+
+def _register() -> None:
+    """Tell coverage (``gve-conformance --coverage host``) which rules each check judges."""
+    judged: dict[str, list[str]] = {}
+    for rule, check in HOST_CHECKS.items():
+        judged.setdefault(f"host.{check.__name__}", []).append(rule)
+    for name, rules in judged.items():
+        register_host_check(name, rules)
+
+
+_register()
 
 
 def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:

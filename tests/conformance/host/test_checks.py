@@ -123,7 +123,9 @@ def test_refusals_are_the_hosts_fault():
     w.frame(b"!0l100,0,0", 0, answer=b"3\r")
     w.frame(b"!0V1000.0", 10, answer=b"4\r")
     w.frame(b"!0SW8,F1", 20, answer=b"5\r")
+    w.frame(b"!0N", 30, answer=b"7\r")                # while moving (spec 5, 10.1)
     found = broken(w.judge())
+    assert found["10.1.queue.wait-idiom"] == ["!0N"]
     assert found["5.code.unknown"] == ["!0l100,0,0"]
     assert found["5.code.syntax"] == ["!0V1000.0"]
     assert found["5.code.range"] == ["!0SW8,F1"]
@@ -141,3 +143,12 @@ def test_port_settings():
     w = Wire()
     w.rec.settings.append((0, "115200 8N2"))
     assert broken(w.judge())["2.link.serial-8n1"] == ["(port settings)"]
+
+
+def test_coverage_counts_the_host_checks():
+    from conformance.coverage import coverage
+
+    (pc,) = coverage(["GVE84-100"], role="host", cases=[])
+    assert "8.recovery.exactly-once" in next(s for s in pc.sections if s.section == "8").covered
+    # all but 11.golden.g2, the example of a checksummed frame: 6.checksum.sum judges it
+    assert pc.covered >= pc.total - 1
