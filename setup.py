@@ -10,7 +10,7 @@ import sys
 from setuptools import find_packages, setup
 from setuptools.command.build_ext import build_ext
 
-packages = [*find_packages(include=["emulator*", "conformance*"]), "gve_fixtures"]
+packages = [*find_packages(include=["emulator*", "conformance*", "gve_host*"]), "gve_fixtures"]
 
 
 class OptionalBuildExt(build_ext):

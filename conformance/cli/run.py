@@ -126,6 +126,8 @@ def _main(argv: list[str] | None) -> int:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
         return 0
     if args.coverage:
+        if args.coverage == "host":
+            import conformance.host.oracle  # noqa: F401  (registers the host checks)
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
