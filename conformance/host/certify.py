@@ -31,6 +31,7 @@ from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.units import open_line
 from conformance.host.unitview import line_views, profiles_by_address
+from conformance.metadata import now_iso
 from conformance.runner import RunResult
 from conformance.verdict import COULD_NOT_TEST, MISSING
 from gve_fixtures.profile import Profile
@@ -264,6 +265,9 @@ def _operator(stream: TextIO, state: dict[str, bool]) -> int | None:
 def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
             console: TextIO | None = None, operator: TextIO | None = None) -> RunResult:
     run = RunResult(run_id, targets=[plan.target], settings="host")
+    # a certification's evidence is its wire log both ways with the faults marked on it:
+    # every scenario keeps it whole, passing or not
+    run.meta.started, run.meta.full_logs = now_iso(), True
     start = time.monotonic()
     results: list[HostResult] = []
 
@@ -283,4 +287,5 @@ def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
     run.results = list(results)
     run.seconds = time.monotonic() - start
     run.frames = sum(r.frames for r in results)
+    run.meta.finished = now_iso()
     return run
