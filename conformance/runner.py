@@ -9,6 +9,7 @@ from dataclasses import asdict, dataclass, field
 
 from conformance import settings as settings_profiles
 from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetyStop
+from conformance.metadata import RunMeta
 from conformance.targets import Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, MISSING, PASS, grade, worst
 
@@ -27,6 +28,7 @@ class CaseResult:
     notes: list[str] = field(default_factory=list)
     wire_log: list[str] = field(default_factory=list)
     artifacts: dict[str, str] = field(default_factory=dict)
+    traces: list[dict] = field(default_factory=list)      # CaseContext.trace
     seconds: float = 0.0
     frames: int = 0
 
@@ -47,6 +49,7 @@ class RunResult:
     seconds: float = 0.0
     frames: int = 0
     interrupted: bool = False
+    meta: RunMeta = field(default_factory=RunMeta)
 
     def counts(self) -> dict[str, int]:
         out: dict[str, int] = {}
@@ -55,7 +58,8 @@ class RunResult:
         return out
 
 
-def run_case(case: Case, target: Target, settings_name: str = "ci") -> CaseResult:
+def run_case(case: Case, target: Target, settings_name: str = "ci",
+             seed: int | None = None) -> CaseResult:
     profile = target.profile
     result = CaseResult(case.id, case.section, case.rule, case.tag, case.source,
                         profile.name, target.info.spec, PASS)
@@ -70,7 +74,7 @@ def run_case(case: Case, target: Target, settings_name: str = "ci") -> CaseResul
         result.verdict, result.notes = COULD_NOT_TEST, ["destructive: needs --allow-destructive"]
         return result
     ctx = CaseContext(case, profile, target.info, settings_profiles.get(settings_name),
-                      target.open_link)
+                      target.open_link, seed=seed)
     start = time.perf_counter()
     verdicts: list[str] = []
     try:
@@ -100,7 +104,7 @@ def run_case(case: Case, target: Target, settings_name: str = "ci") -> CaseResul
     result.verdict = worst(verdicts)
     result.checks = [asdict(c) for c in ctx.checks]
     result.notes = ctx.notes
-    result.artifacts = ctx.artifacts
+    result.artifacts, result.traces = ctx.artifacts, ctx.traces
     result.wire_log = [line for link in ctx.links for line in
                        ["# link", *link.transcript_lines()]]
     result.frames = sum(link.frames for link in ctx.links)
@@ -108,13 +112,14 @@ def run_case(case: Case, target: Target, settings_name: str = "ci") -> CaseResul
 
 
 def run(targets: list[Target], cases: list[Case], *, settings_name: str = "ci",
-        run_id: str = "", on_result: Callable[[CaseResult], None] | None = None) -> RunResult:
+        run_id: str = "", on_result: Callable[[CaseResult], None] | None = None,
+        seed: int | None = None) -> RunResult:
     run = RunResult(run_id, targets=[t.info.spec for t in targets], settings=settings_name)
     start = time.perf_counter()
     try:
         for target in targets:
             for case in cases:
-                r = run_case(case, target, settings_name)
+                r = run_case(case, target, settings_name, seed)
                 run.results.append(r)
                 run.frames += r.frames
                 if on_result:

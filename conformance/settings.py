@@ -1,6 +1,9 @@
-"""Hypothesis settings profiles for the machines (issue 4 item 5)."""
+"""Hypothesis settings profiles for the machines (issue 4 item 5) and the run's seed
+(issue 12 item 7)."""
 
 from __future__ import annotations
+
+import secrets
 
 from hypothesis import HealthCheck, Phase, settings
 
@@ -14,6 +17,9 @@ PROFILES = {
     # real time is dear: no shrinking (a failing example is reported as it ran)
     "hardware": settings(max_examples=3, stateful_step_count=10, derandomize=True,
                          phases=[Phase.explicit, Phase.generate], **_COMMON),
+    # the mutation score: ci's examples, a failure counts as it is found (no shrinking)
+    "mutation": settings(max_examples=8, stateful_step_count=12, derandomize=True,
+                         phases=[Phase.explicit, Phase.generate], **_COMMON),
 }
 
 
@@ -22,3 +28,14 @@ def get(name: str) -> settings:
         return PROFILES[name]
     except KeyError:
         raise ValueError(f"unknown settings profile {name!r}: {', '.join(PROFILES)}") from None
+
+
+def run_seed(name: str, seed: int | None = None) -> int | None:
+    """The seed a run records and gives the machines: ``seed`` when given (it overrides
+    derandomization), else None for derandomized settings (every run draws the same
+    examples) and a fresh random one for the others, so that any run can be replayed."""
+    if seed is not None:
+        return seed
+    if get(name).derandomize:
+        return None
+    return secrets.randbits(32)

@@ -11,17 +11,17 @@ def show(r: Response | None) -> str:
 
 
 def answers(ctx: CaseContext, r: Response | None, text: str, what: str, *,
-            tag: str | None = None) -> bool:
+            tag: str | None = None, rule: str | None = None) -> bool:
     """Expect the answer's exact bytes (``text`` without the final CR)."""
     return ctx.expect(r is not None and r.raw == text.encode() + b"\r", what,
-                      observed=show(r), expected=text, tag=tag)
+                      observed=show(r), expected=text, tag=tag, rule=rule)
 
 
 def code(ctx: CaseContext, r: Response | None, value: int, what: str, *,
-         tag: str | None = None, inta: bool | None = None) -> bool:
+         tag: str | None = None, inta: bool | None = None, rule: str | None = None) -> bool:
     ok = r is not None and r.code == value and (inta is None or r.inta == inta)
     shown = f"{value + (8 if inta else 0):X}" if inta is not None else str(value)
-    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag)
+    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag, rule=rule)
 
 
 def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
@@ -66,12 +66,12 @@ def index(ctx: CaseContext) -> int | None:
 
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
-                tag: str | None = None) -> bool:
+                tag: str | None = None, rule: str | None = None) -> bool:
     """Expect the index to have advanced by ``frames`` since ``before`` (spec 8)."""
     after = index(ctx)
     expected = None if before is None else (before + frames) % 256
     return ctx.expect(after is not None and after == expected, what, observed=after,
-                      expected=expected, tag=tag)
+                      expected=expected, tag=tag, rule=rule)
 
 
 def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:

@@ -1,4 +1,4 @@
-"""The default job of `gve-conformance`: run the suite, print verdicts, write reports.
+"""The default job of `gve-conformance`: run the suite, show progress, write reports.
 
 With no arguments: the whole suite against the embedded emulator, every profile.
 """
@@ -11,11 +11,13 @@ import time
 import uuid
 
 from conformance.catalogue import select
-from conformance.reports import write_reports
-from conformance.runner import CaseResult, run
-from conformance.settings import PROFILES
-from conformance.targets import DEFAULT_MAX_TRAVEL, parse_target
-from conformance.verdict import ORDER, PASS, failing
+from conformance.cli.progress import Progress
+from conformance.metadata import RunMeta, now_iso
+from conformance.reports import write_junit, write_reports
+from conformance.runner import run
+from conformance.settings import PROFILES, run_seed
+from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
+from conformance.verdict import FAILED, ORDER, overall
 from gve_fixtures.profile import available_profiles
 
 
@@ -30,6 +32,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
     ap.add_argument("--settings", default="ci", choices=sorted(PROFILES),
                     help="Hypothesis settings profile (default ci)")
+    ap.add_argument("--seed", type=int, metavar="N",
+                    help="the Hypothesis machines' seed: the same N replays the same examples "
+                         "(default: a fresh one, printed; none for derandomized settings)")
     ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in steps per axis")
     ap.add_argument("--allow-destructive", action="store_true",
@@ -37,17 +42,50 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
     ap.add_argument("--no-reports", action="store_true")
+    ap.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
+    ap.add_argument("--full-logs", action="store_true",
+                    help="whole wire logs in the reports for passing cases too")
+    ap.add_argument("--operator-name", default="", metavar="NAME",
+                    help="who ran the suite, for the report")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
+    ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
+                    help="print which rules of the spec the (selected) cases can fail, per "
+                         "section and profile, and the rules without one; exit 0")
     ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
     return ap.parse_args(argv)
 
 
+def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
+          seed: int | None) -> RunMeta:
+    meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
+                   settings=args.settings, seed=seed, mutant=args.mutant,
+                   destructive=args.allow_destructive, max_travel=args.max_travel,
+                   cases=args.cases, exclude=args.exclude, full_logs=args.full_logs)
+    for target in targets:
+        t = meta.target(target.info.spec)
+        t.kind, t.profile = target.info.kind, target.profile.name
+        t.profile_chosen = "emulated" if target.info.kind == "emu" else "--profile"
+        t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+    return meta
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parse_args(argv)
     cases = select(args.cases or None, args.exclude or None)
     if args.list:
         for c in cases:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
+        return 0
+    if args.coverage:
+        from conformance.coverage import coverage, format_coverage
+        profiles = [args.profile] if args.profile else None
+        try:
+            report = coverage(profiles, role=args.coverage, cases=cases)
+        except LookupError as err:
+            print(f"gve-conformance: {err}", file=sys.stderr)
+            return 2
+        print(format_coverage(report, args.coverage))
         return 0
     every = [f"emu:{name}" for name in available_profiles()]
     # no --target, or emu:all: the embedded emulator on every profile
@@ -60,27 +98,32 @@ def main(argv: list[str] | None = None) -> int:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
     run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-
-    def show(r: CaseResult) -> None:
-        if args.quiet and r.verdict == PASS:
-            return
-        line = f"{r.verdict:15} {r.id} [{r.profile}]"
-        if r.failed_checks:
-            c = r.failed_checks[0]
-            line += f"  -- {c['what']}: observed {c['observed']!r}, expected {c['expected']!r}"
-        print(line, flush=True)
-
-    result = run(targets, cases, settings_name=args.settings, run_id=run_id, on_result=show)
+    seed = run_seed(args.settings, args.seed)
+    meta = _meta(args, argv, targets, seed)
+    print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
+          f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
+          "examples; --seed N for others)", flush=True)
+    progress = Progress(len(targets) * len(cases), quiet=args.quiet)
+    try:
+        result = run(targets, cases, settings_name=args.settings, run_id=run_id,
+                     on_result=progress.result, seed=seed)
+    finally:
+        progress.close()
+    meta.finished = now_iso()
+    result.meta = meta
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
+    verdict, reason = overall([r.verdict for r in result.results], result.interrupted)
     print(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
     print(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
           f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
     if not args.no_reports:
         folder = write_reports(result, args.report_dir)
-        print(f"reports: {folder}/junit.xml, results.json, report.html")
-    bad = any(failing(r.verdict) for r in result.results)
-    return 1 if bad or result.interrupted else 0
+        print(f"reports: {folder}/report.html, results.json, junit.xml")
+    if args.junitxml:
+        print(f"JUnit XML: {write_junit(result, args.junitxml)}")
+    print(f"{verdict}: {reason}")
+    return 1 if verdict == FAILED else 0
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@ example starts from a fresh link, a failing example's wire log is saved as a tra
 
 from __future__ import annotations
 
+from hypothesis import seed
 from hypothesis.errors import Flaky
 from hypothesis.stateful import RuleBasedStateMachine, run_state_machine_as_test
 
@@ -12,6 +13,8 @@ from conformance.case import CaseContext
 def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
     """Run ``machine`` with ctx.settings; a failure becomes a failed check of the case."""
     machine.ctx = ctx  # type: ignore[attr-defined]
+    # every run sets the seed: None leaves the examples to the settings (derandomized)
+    seed(ctx.seed)(machine)
     try:
         run_state_machine_as_test(machine, settings=ctx.settings)
     except Flaky as err:

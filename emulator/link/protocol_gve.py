@@ -29,7 +29,7 @@ class Serial(SerialBase):
         try:
             spec = parse_url(self._port)
             units = spec.build_units()
-        except (ValueError, OSError) as err:
+        except (ValueError, LookupError, ImportError, OSError) as err:
             raise SerialException(f"gve://: {err}") from err
         baud = spec.line_baud(units)
         self._baudrate = baud
@@ -75,8 +75,7 @@ class Serial(SerialBase):
             if len(out) >= size or (terminator and out.endswith(terminator)):
                 return bytes(out)
             now = line.now
-            nxt = [x for x in (line._rx[0][0] if line._rx else None, line.next_deadline(),
-                               deadline) if x is not None]
+            nxt = [x for x in (line.wake_instant(), deadline) if x is not None]
             if deadline is not None and now >= deadline:
                 return bytes(out)
             wait = (min(nxt) - now) / SECOND if nxt else 0.05
@@ -89,7 +88,7 @@ class Serial(SerialBase):
 
     def reset_input_buffer(self) -> None:
         if self.line is not None:
-            self.line._rx.clear()
+            self.line.discard_received()
 
     def reset_output_buffer(self) -> None:
         pass

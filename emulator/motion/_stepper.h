@@ -22,6 +22,8 @@ typedef struct stepper stepper;
 
 stepper *st_new(int axes, int64_t max_rate);
 void st_free(stepper *m);
+/* deliberate deviations from the model (interface.py Deviation), for mutants */
+void st_set_deviations(stepper *m, int flags);
 int64_t st_acc_time(int64_t v, int64_t a, int64_t m);
 int64_t st_acc_count(int64_t v, int64_t a, int64_t tau);
 /* floor(sqrt(hi·2^64 + lo)), exact */
@@ -47,6 +49,10 @@ void st_restore_begin(stepper *m, int64_t t, int64_t *here);
 int st_restore_add(stepper *m, const st_vector *v, int64_t done);
 void st_restore_end(stepper *m, const int64_t *here, int halted, int64_t t);
 void st_set_position(stepper *m, int axis, int64_t value, int64_t t);
+/* the W reference run: the axis moves by delta outside the planner (counter and axis) */
+void st_jump(stepper *m, int axis, int64_t delta, int64_t t);
+void st_physical(stepper *m, int64_t t, int64_t *out);
+void st_excursion(stepper *m, int64_t t, int64_t *lo, int64_t *hi);
 void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel);
 void st_scale_velocity(stepper *m, int64_t num, int64_t den, int64_t t, int accel);
 void st_set_multiplier(stepper *m, int64_t percent, int64_t t);

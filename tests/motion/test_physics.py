@@ -12,8 +12,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import SECOND, Vector, c_available, create
 from emulator.motion.arith import acc_count, acc_time
+from emulator.motion.factory import c_available, create
+from emulator.motion.interface import SECOND, Vector
 
 MAX_RATE = 100_000
 AXES = 3

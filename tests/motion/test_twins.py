@@ -9,8 +9,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import Vector, c_available, create
 from emulator.motion.arith import acc_count, acc_time
+from emulator.motion.factory import c_available, create
+from emulator.motion.interface import Deviation, Vector
 
 pytestmark = pytest.mark.skipif(not c_available(), reason="the C stepper core is not built "
                                 "(the emulator falls back to the Python twin)")
@@ -56,11 +57,13 @@ def ops(axes: int, max_rate: int):
         st.tuples(st.just("restore"), st.none()),
         st.tuples(st.just("clear"), st.none()),
         st.tuples(st.just("set"), st.tuples(st.integers(0, axes - 1), st.integers(-1000, 1000))),
+        st.tuples(st.just("jump"), st.tuples(st.integers(0, axes - 1), st.integers(-1000, 1000))),
     ), max_size=25)
 
 
 def observe(m, t: int):
-    return (m.position(t), m.flags(t), m.queued(t), m.next_event(), m.drain_instant())
+    return (m.position(t), m.physical(t), m.excursion(t), m.flags(t), m.queued(t),
+            m.next_event(), m.drain_instant())
 
 
 @pytest.mark.parametrize(("axes", "max_rate"),
@@ -68,7 +71,10 @@ def observe(m, t: int):
 @given(data=st.data())
 @SETTINGS
 def test_twins_agree_step_by_step(axes, max_rate, data):
-    py, c = create(axes, max_rate, stepper="python"), create(axes, max_rate, stepper="c")
+    # the deliberate deviations (mutants) too: both cores plant them alike
+    deviations = Deviation(data.draw(st.sampled_from([0, 0, 0, *(1 << i for i in range(6))])))
+    py = create(axes, max_rate, stepper="python", deviations=deviations)
+    c = create(axes, max_rate, stepper="c", deviations=deviations)
     t = 0
     saves = {}
     for op, arg in data.draw(ops(axes, max_rate)):
@@ -98,6 +104,8 @@ def test_twins_agree_step_by_step(axes, max_rate, data):
                 m.clear(t)
             elif op == "set":
                 m.set_position(*arg, t)
+            elif op == "jump":
+                m.jump(*arg, t)
         if op == "keep":
             assert saves["py"] == saves["c"]
         t = max(t, py.now)

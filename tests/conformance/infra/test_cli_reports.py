@@ -18,8 +18,9 @@ def test_a_run_writes_three_reports(tmp_path, capsys):
     suites = ET.parse(folder / "junit.xml").getroot()
     cases = suites.findall("./testsuite/testcase")
     assert cases and all(c.get("name") and c.get("classname") and c.get("time") for c in cases)
-    # the junit-10 schema: a testcase holds only these, the result before system-out
-    allowed = ["skipped", "error", "failure", "system-out", "system-err"]
+    # a testcase holds only these (its properties first, as pytest writes them), the
+    # result before system-out
+    allowed = ["properties", "skipped", "error", "failure", "system-out", "system-err"]
     for c in cases:
         tags = [child.tag for child in c]
         assert all(t in allowed for t in tags) and tags == sorted(tags, key=allowed.index)
