@@ -3,15 +3,27 @@ items with ``pytest --gve-target emu:GVE84-100`` (any target of the command line
 
 Inert unless ``--gve-target`` is given (or ``pytest --pyargs conformance``, which runs
 against the default emulator target), so it never changes other pytest runs.
+
+Fleets (pytest-xdist, ``-n N``): the items of a target that holds a port (serial, TCP)
+form one xdist group (``--dist loadgroup``, which the plugin sets), so that one worker has
+the port for the whole run; items of an ``emu:`` target (a fresh unit in process for
+every link) spread over the workers.
 """
 
 from __future__ import annotations
 
+import re
+from contextlib import ExitStack
+from pathlib import Path
+
 import pytest
 
+from conformance import settings as settings_profiles
 from conformance.runner import CaseResult, run_case
-from conformance.targets import DEFAULT_MAX_TRAVEL, parse_target
+from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+
+DEFAULT_TARGET = "emu:GVE84-100"    # `pytest --pyargs conformance`
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -23,6 +35,45 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--gve-settings", default="ci", help="Hypothesis settings profile")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
+    g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",
+                help="where the machines keep failing examples, tried first on the next run "
+                     f"(default: {settings_profiles.DEFAULT_DATABASE}/ in the rootdir)")
+
+
+def _specs(config: pytest.Config) -> list[str]:
+    specs = config.getoption("--gve-target")
+    if not specs and config.getoption("pyargs") and "conformance" in config.args:
+        specs = [DEFAULT_TARGET]
+    return list(dict.fromkeys(specs))       # a target named twice runs once
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if not _specs(config):
+        return
+    where = config.getoption("--gve-hypothesis-db")
+    if where is None:
+        where = str(Path(config.rootpath, settings_profiles.DEFAULT_DATABASE))
+    run = ExitStack()
+    try:
+        run.enter_context(settings_profiles.example_database(where))
+    except ValueError as err:
+        raise pytest.UsageError(f"--gve-hypothesis-db: {err}") from None
+    config.add_cleanup(run.close)
+    # xdist's controller: only groups keep a port on one worker, whatever --dist said
+    if getattr(config.option, "dist", "no") not in ("no", "loadgroup"):
+        config.option.dist = "loadgroup"
+
+
+def _on_xdist_worker(config: pytest.Config) -> bool:
+    return hasattr(config, "workerinput")
+
+
+def worker_group(target: Target) -> str | None:
+    """The xdist group of a target's items: its port, or None (emu: nothing shared)."""
+    if target.info.kind == "emu":
+        return None
+    # loadgroup reads the group after a node ID's last '@', past its last ']'
+    return "gve-port:" + re.sub(r"[@\[\]]", "_", target.url)
 
 
 class CaseFailed(Exception):
@@ -58,9 +109,7 @@ class GveItem(pytest.Item):
 
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
                                   items: list[pytest.Item]) -> None:
-    specs = config.getoption("--gve-target")
-    if not specs and config.getoption("pyargs") and "conformance" in config.args:
-        specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
+    specs = _specs(config)
     if not specs:
         return
     from conformance.catalogue import select
@@ -69,7 +118,10 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
         target = parse_target(spec, profile=config.getoption("--gve-profile"),
                               allow_destructive=config.getoption("--gve-allow-destructive"),
                               max_travel=config.getoption("--gve-max-travel"))
+        # on an xdist worker the node ID names the group, as xdist_group marks do
+        group = worker_group(target) if _on_xdist_worker(config) else None
         for case in select(globs):
+            name = f"{case.id}[{spec}]"
             items.append(GveItem.from_parent(
-                session, name=f"{case.id}[{target.profile.name}]", case=case, target=target,
-                settings_name=config.getoption("--gve-settings")))
+                session, name=name, nodeid=f"::{name}@{group}" if group else None, case=case,
+                target=target, settings_name=config.getoption("--gve-settings")))

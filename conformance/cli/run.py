@@ -9,13 +9,15 @@ import argparse
 import sys
 import time
 import uuid
+from contextlib import ExitStack
+from pathlib import Path
 
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
 from conformance.metadata import RunMeta, now_iso
 from conformance.reports import write_junit, write_reports
 from conformance.runner import run
-from conformance.settings import PROFILES, run_seed
+from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import FAILED, ORDER, overall
 from gve_fixtures.profile import available_profiles
@@ -41,6 +43,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="real units: allow J and EEPROM writes (backed up and restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
+    ap.add_argument("--run-id", metavar="NAME",
+                    help="the report folder's name (default: date, time and a random tag)")
+    ap.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                    help="run the targets in N parallel processes: one report per target "
+                         "under reports/<run id>/ and a summary across them")
+    ap.add_argument("--hypothesis-db", metavar="DIR|redis://HOST:PORT/N|none",
+                    help="where the machines keep failing examples, tried first by the next "
+                         "run (redis: by every bench sharing it); default: "
+                         f"REPORT_DIR/{DEFAULT_DATABASE}, none with --no-reports")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
     ap.add_argument("--full-logs", action="store_true",
@@ -71,7 +82,20 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = parse_args(argv)
+    return execute(parse_args(argv), argv)
+
+
+def example_database_of(args: argparse.Namespace) -> str | None:
+    """Where the run keeps failing examples (docs/ci.md): --hypothesis-db, else a folder
+    beside the reports (nowhere when the run writes no reports)."""
+    if args.hypothesis_db is not None:
+        return args.hypothesis_db
+    return None if args.no_reports else str(Path(args.report_dir, DEFAULT_DATABASE))
+
+
+def execute(args: argparse.Namespace, argv: list[str]) -> int:
+    """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
+    fleet runs for its one target."""
     cases = select(args.cases or None, args.exclude or None)
     if args.list:
         for c in cases:
@@ -97,8 +121,26 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, LookupError) as err:
         print(f"gve-conformance: {err}", file=sys.stderr)
         return 2
-    run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+    if args.jobs < 1:
+        print("gve-conformance: --jobs must be 1 or more", file=sys.stderr)
+        return 2
+    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
     seed = run_seed(args.settings, args.seed)
+    database = example_database_of(args)
+    with ExitStack() as run_scope:
+        try:
+            run_scope.enter_context(example_database(database))
+        except ValueError as err:
+            print(f"gve-conformance: --hypothesis-db: {err}", file=sys.stderr)
+            return 2
+        if args.jobs > 1 and len(targets) > 1:
+            from conformance.cli.fleet import run_fleet
+            return run_fleet(args, argv, specs, run_id, seed, database)
+        return _run(args, argv, targets, cases, run_id, seed)
+
+
+def _run(args: argparse.Namespace, argv: list[str], targets: list[Target], cases: list,
+         run_id: str, seed: int | None) -> int:
     meta = _meta(args, argv, targets, seed)
     print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
           f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
