@@ -4,6 +4,7 @@ so that the next run, or another bench, tries them first."""
 
 from __future__ import annotations
 
+import os
 import secrets
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -104,10 +105,14 @@ def _check(where: str) -> None:
     if where.startswith(REDIS_SCHEMES):
         _redis_client(where)
         return
-    try:
-        Path(where).mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise ValueError(f"example database {where}: {err.strerror or err}") from None
+    # created when the first failing example is saved: a run that fails nothing leaves
+    # no folder behind
+    path = Path(where).absolute()
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"example database {where}: not a directory")
+    parent = next(p for p in (path, *path.parents) if p.exists())
+    if not (parent.is_dir() and os.access(parent, os.W_OK | os.X_OK)):
+        raise ValueError(f"example database {where}: {parent} is not a writable directory")
 
 
 def _redis(url: str, profile: str) -> ExampleDatabase:

@@ -47,7 +47,8 @@ class Member:
     label: str                      # its report folder's name
     process: subprocess.Popen | None = None
     status: int | None = None       # the process's exit status
-    lines: int = 0                  # output lines relayed
+    started: float = 0.0            # seconds since the fleet began, when it started
+    ended: float | None = None      # ... and when it ended
     result: dict = field(default_factory=dict)   # its results.json, once written
 
 
@@ -80,7 +81,7 @@ def run_fleet(args: argparse.Namespace, argv: list[str], specs: list[str], run_i
     jobs = min(args.jobs, len(members))
     print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
-    interrupted = _run_members(members, folder, jobs)
+    interrupted = _run_members(members, folder, jobs, start)
     seconds = time.perf_counter() - start
     for m in members:
         (folder / f"{m.label}.job.json").unlink(missing_ok=True)
@@ -101,10 +102,10 @@ def run_fleet(args: argparse.Namespace, argv: list[str], specs: list[str], run_i
     return 1 if summary["verdict"] != PASSED else 0
 
 
-def _run_members(members: list[Member], folder: Path, jobs: int) -> bool:
+def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -> bool:
     """Run the members' processes, at most ``jobs`` at once; True when interrupted."""
     pending, running = deque(members), []
-    finished: queue.Queue[Member] = queue.Queue()
+    wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
     out_lock = threading.Lock()
     interrupted = False
 
@@ -118,9 +119,10 @@ def _run_members(members: list[Member], folder: Path, jobs: int) -> bool:
                 while pending and len(running) < jobs and not interrupted:
                     m = pending.popleft()
                     running.append(m)
-                    _start(m, folder, finished, out_lock)
+                    _start(m, folder, start, wake, out_lock)
                 with contextlib.suppress(queue.Empty):
-                    running.remove(finished.get(timeout=0.5))
+                    wake.get(timeout=0.5)
+                running = [m for m in running if m.status is None]
             except KeyboardInterrupt:
                 interrupted = True
                 pending.clear()
@@ -135,8 +137,10 @@ def _run_members(members: list[Member], folder: Path, jobs: int) -> bool:
     return interrupted
 
 
-def _start(m: Member, folder: Path, finished: queue.Queue, out_lock: threading.Lock) -> None:
+def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
+           out_lock: threading.Lock) -> None:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
+    m.started = time.perf_counter() - start
     m.process = subprocess.Popen(
         [sys.executable, "-m", "conformance.cli.fleet_member",
          str(folder / f"{m.label}.job.json")],
@@ -146,11 +150,12 @@ def _start(m: Member, folder: Path, finished: queue.Queue, out_lock: threading.L
     def relay() -> None:
         assert m.process is not None and m.process.stdout is not None
         for line in m.process.stdout:
-            m.lines += 1
             with out_lock:
                 print(f"[{m.label}] {line}".rstrip(), flush=True)
-        m.status = m.process.wait()
-        finished.put(m)
+        status = m.process.wait()
+        m.ended = time.perf_counter() - start
+        m.status = status               # last: the member counts as done from here
+        wake.put(m)
 
     threading.Thread(target=relay, name=f"fleet-{m.label}", daemon=True).start()
 
@@ -165,14 +170,14 @@ def _summary(members: list[Member], run_id: str, seconds: float, interrupted: bo
                      "verdict": r.get("verdict", FAILED),
                      "reason": r.get("reason", "the target's process wrote no results"),
                      "counts": r.get("counts", {}), "seconds": r.get("seconds"),
-                     "frames": r.get("frames", 0), "interrupted": r.get("interrupted", True)})
-    failed = [row for row in rows if row["verdict"] != PASSED]
-    if failed:
-        verdict, reason = FAILED, f"{len(failed)} of {len(rows)} targets failed"
-    elif interrupted:
-        verdict, reason = FAILED, "interrupted before every target had run"
-    else:
-        verdict, reason = PASSED, f"all {len(rows)} targets passed"
+                     "frames": r.get("frames", 0), "interrupted": r.get("interrupted", False),
+                     "started": round(m.started, 3),
+                     "ended": None if m.ended is None else round(m.ended, 3)})
+    failed = [row for row in rows if row["verdict"] != PASSED and not row["interrupted"]]
+    why = ([f"{len(failed)} of {len(rows)} targets failed"] if failed else []) + (
+        ["interrupted before every target had run"] if interrupted else [])
+    verdict, reason = (FAILED, "; ".join(why)) if why else (
+        PASSED, f"all {len(rows)} targets passed")
     return {"run_id": run_id, "verdict": verdict, "reason": reason,
             "seconds": round(seconds, 3), "interrupted": interrupted, "counts": counts,
             "targets": rows}
