@@ -50,6 +50,9 @@ class RunMeta:
     operator_steps: bool = False            # a technician was asked for hand steps
     confirmed: str = ""                     # how motion was allowed: "asked", "--yes", ""
     targets: list[TargetMeta] = field(default_factory=list)
+    # the spec's rules the selected cases can fail, per profile: {profile, covered, total,
+    # sections: [{section, covered (a count), uncovered (rule IDs)}]}
+    coverage: list[dict] = field(default_factory=list)
 
     def target(self, spec: str) -> TargetMeta:
         """The entry for ``spec`` (made when missing)."""

@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass, field
 from conformance import settings as settings_profiles
 from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetyStop
 from conformance.metadata import RunMeta
+from conformance.operator import Console, Hands
 from conformance.targets import Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, MISSING, PASS, grade, worst
 
@@ -59,7 +60,7 @@ class RunResult:
 
 
 def run_case(case: Case, target: Target, settings_name: str = "ci",
-             seed: int | None = None) -> CaseResult:
+             seed: int | None = None, console: Console | None = None) -> CaseResult:
     profile = target.profile
     result = CaseResult(case.id, case.section, case.rule, case.tag, case.source,
                         profile.name, target.info.spec, PASS)
@@ -75,6 +76,7 @@ def run_case(case: Case, target: Target, settings_name: str = "ci",
         return result
     ctx = CaseContext(case, profile, target.info, settings_profiles.get(settings_name),
                       target.open_link, seed=seed)
+    ctx.operator = Hands(lambda: ctx.link, console)
     start = time.perf_counter()
     verdicts: list[str] = []
     try:
@@ -113,13 +115,13 @@ def run_case(case: Case, target: Target, settings_name: str = "ci",
 
 def run(targets: list[Target], cases: list[Case], *, settings_name: str = "ci",
         run_id: str = "", on_result: Callable[[CaseResult], None] | None = None,
-        seed: int | None = None) -> RunResult:
+        seed: int | None = None, console: Console | None = None) -> RunResult:
     run = RunResult(run_id, targets=[t.info.spec for t in targets], settings=settings_name)
     start = time.perf_counter()
     try:
         for target in targets:
             for case in cases:
-                r = run_case(case, target, settings_name, seed)
+                r = run_case(case, target, settings_name, seed, console)
                 run.results.append(r)
                 run.frames += r.frames
                 if on_result:

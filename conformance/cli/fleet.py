@@ -5,8 +5,10 @@ and ``index.html`` beside the targets' folders, and with ``--junitxml PATH`` one
 file with a testsuite per target.
 
 Each process is ``python -m conformance.cli.fleet_member JOB`` and runs the one target
-exactly as a single run would, with the fleet's seed and example database; its output
-comes back line by line behind the target's name. The processes live in process
+exactly as a single run would, with the fleet's seed and example database and the
+profile the fleet chose for it; the fleet has asked before moving (the members have no
+terminal: hand steps are COULD-NOT-TEST there). Its output comes back line by line
+behind the target's name. The processes live in process
 groups of their own: an interrupt (Ctrl-C or SIGTERM) reaches the fleet alone, which
 sends every running target one SIGINT, so that each halts its unit as a single run does,
 starts no other, waits for them and still reports.
@@ -33,6 +35,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from conformance.targets import Target
 from conformance.verdict import FAILED, ORDER, PASSED
 
 SUMMARY_JSON = "summary.json"
@@ -66,17 +69,22 @@ def labels(specs: list[str]) -> list[str]:
     return out
 
 
-def run_fleet(args: argparse.Namespace, argv: list[str], specs: list[str], run_id: str,
+def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], run_id: str,
               seed: int | None, database: str | None) -> int:
-    """Run ``specs`` as a fleet with the options of ``args``; the exit status."""
+    """Run ``targets`` (chosen, confirmed, their ports closed) as a fleet with the options
+    of ``args``; the exit status."""
     folder = (Path(tempfile.mkdtemp(prefix="gve-fleet-")) if args.no_reports
               else Path(args.report_dir, run_id))
     folder.mkdir(parents=True, exist_ok=True)
+    specs = [t.info.spec for t in targets]
     members = [Member(spec, label) for spec, label in zip(specs, labels(specs), strict=True)]
+    # asked and answered here: the members neither ask nor identify again
     child = dict(vars(args), jobs=1, report_dir=str(folder), no_reports=False, junitxml=None,
-                 seed=seed, hypothesis_db=database or "none")
-    for m in members:
-        job = {"args": dict(child, target=[m.spec], run_id=m.label), "argv": argv}
+                 seed=seed, hypothesis_db=database or "none", yes=True, operator=False,
+                 variant=None)
+    for m, target in zip(members, targets, strict=True):
+        job = {"args": dict(child, target=[m.spec], profile=target.profile.name,
+                            run_id=m.label), "argv": argv}
         (folder / f"{m.label}.job.json").write_text(json.dumps(job), encoding="utf-8")
     jobs = min(args.jobs, len(members))
     print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)

@@ -12,9 +12,14 @@ import uuid
 from contextlib import ExitStack
 from pathlib import Path
 
+from serial import SerialException
+
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
+from conformance.cli.unit import confirmed, record_identities, resolve
+from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
+from conformance.operator import Console
 from conformance.reports import write_junit, write_reports
 from conformance.runner import run
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
@@ -28,7 +33,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT; repeatable")
-    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target; 'auto': "
+                    "ask the unit (? and Q) and choose")
+    ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
+                    "say it: the variant (e.g. 100 for a GVE84-100)")
+    ap.add_argument("--yes", action="store_true",
+                    help="real units: move without asking first (unattended benches)")
+    ap.add_argument("--operator", action=argparse.BooleanOptionalAction, default=None,
+                    help="real units: ask a technician for hand steps (ground an input...); "
+                         "default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
@@ -66,7 +79,11 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return ap.parse_args(argv)
 
 
-def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
+class Refused(Exception):
+    """The run cannot start; the message says why (exit status 2)."""
+
+
+def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], cases: list,
           seed: int | None) -> RunMeta:
     meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
                    settings=args.settings, seed=seed, mutant=args.mutant,
@@ -75,9 +92,42 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target],
     for target in targets:
         t = meta.target(target.info.spec)
         t.kind, t.profile = target.info.kind, target.profile.name
-        t.profile_chosen = "emulated" if target.info.kind == "emu" else "--profile"
         t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
+                                        for s in d["sections"]]}
+                     for d in (pc.as_dict() for pc in coverage(
+                         sorted({t.profile.name for t in targets}), cases=cases))]
     return meta
+
+
+def prepare(args: argparse.Namespace, argv: list[str], cases: list, console: Console
+            ) -> tuple[list[Target], RunMeta]:
+    """The targets and the run's metadata: profiles chosen (``--profile auto`` asks the
+    units), identities recorded, motion confirmed on real units. Refused when not."""
+    every = [f"emu:{name}" for name in available_profiles()]
+    # no --target, or emu:all: the embedded emulator on every profile
+    specs = [s for t in args.target or ["emu:all"]
+             for s in (every if t.split("?")[0] == "emu:all" else [t])]
+    try:
+        chosen = [resolve(s, args.profile, args.variant, console) for s in specs]
+        targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
+                                max_travel=args.max_travel, mutant=args.mutant)
+                   for s, p, _ in chosen]
+        meta = _meta(args, argv, targets, cases, run_seed(args.settings, args.seed))
+        record_identities(targets, meta)
+    except (ValueError, LookupError, OSError, SerialException) as err:
+        raise Refused(str(err)) from err
+    for (_, _, how), target in zip(chosen, targets, strict=True):
+        meta.target(target.info.spec).profile_chosen = how
+    real = any(t.info.kind != "emu" for t in targets)
+    meta.operator_steps = (real and console.interactive if args.operator is None
+                           else args.operator)
+    if real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+        if not args.yes and not confirmed(targets, meta, console):
+            raise Refused("motion not confirmed, nothing that moves was sent (answer y, or "
+                          "give --yes on an unattended bench)")
+    return targets, meta
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -102,7 +152,6 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
         return 0
     if args.coverage:
-        from conformance.coverage import coverage, format_coverage
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
@@ -111,21 +160,9 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
             return 2
         print(format_coverage(report, args.coverage))
         return 0
-    every = [f"emu:{name}" for name in available_profiles()]
-    # no --target, or emu:all: the embedded emulator on every profile
-    specs = [s for t in args.target or ["emu:all"]
-             for s in (every if t.split("?")[0] == "emu:all" else [t])]
-    try:
-        targets = [parse_target(s, profile=args.profile, allow_destructive=args.allow_destructive,
-                                max_travel=args.max_travel, mutant=args.mutant) for s in specs]
-    except (ValueError, LookupError) as err:
-        print(f"gve-conformance: {err}", file=sys.stderr)
-        return 2
     if args.jobs < 1:
         print("gve-conformance: --jobs must be 1 or more", file=sys.stderr)
         return 2
-    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-    seed = run_seed(args.settings, args.seed)
     database = example_database_of(args)
     with ExitStack() as run_scope:
         try:
@@ -133,22 +170,36 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
         except ValueError as err:
             print(f"gve-conformance: --hypothesis-db: {err}", file=sys.stderr)
             return 2
+        console = Console()
+        try:
+            targets, meta = prepare(args, argv, cases, console)
+        except Refused as err:
+            print(f"gve-conformance: {err}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("\ngve-conformance: interrupted before the run, nothing that moves was sent",
+                  file=sys.stderr)
+            return 130
+        run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
         if args.jobs > 1 and len(targets) > 1:
             from conformance.cli.fleet import run_fleet
-            return run_fleet(args, argv, specs, run_id, seed, database)
-        return _run(args, argv, targets, cases, run_id, seed)
+            for target in targets:
+                target.close()          # each member opens its own port
+            return run_fleet(args, argv, targets, run_id, meta.seed, database)
+        return _run(args, targets, cases, meta, console, run_id)
 
 
-def _run(args: argparse.Namespace, argv: list[str], targets: list[Target], cases: list,
-         run_id: str, seed: int | None) -> int:
-    meta = _meta(args, argv, targets, seed)
+def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: RunMeta,
+         console: Console, run_id: str) -> int:
+    seed = meta.seed
     print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
           f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
           "examples; --seed N for others)", flush=True)
     progress = Progress(len(targets) * len(cases), quiet=args.quiet)
     try:
         result = run(targets, cases, settings_name=args.settings, run_id=run_id,
-                     on_result=progress.result, seed=seed)
+                     on_result=progress.result, seed=seed,
+                     console=console if meta.operator_steps else None)
     finally:
         progress.close()
     meta.finished = now_iso()

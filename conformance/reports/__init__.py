@@ -9,8 +9,8 @@ from pathlib import Path
 
 from conformance.reports.html import render_html
 from conformance.reports.junit import render_junit, write_junit
-from conformance.reports.logs import compact, compact_checks
-from conformance.reports.sections import section_name
+from conformance.reports.logs import compact, compact_checks, compact_traces
+from conformance.reports.sections import section_key, section_name
 from conformance.runner import RunResult
 from conformance.verdict import overall
 
@@ -21,25 +21,37 @@ def write_reports(run: RunResult, folder: str | Path) -> Path:
     out = Path(folder) / run.run_id
     out.mkdir(parents=True, exist_ok=True)
     write_junit(run, out / "junit.xml")
-    (out / "results.json").write_text(json.dumps(to_json(run)), encoding="utf-8")
+    (out / "results.json").write_text(json.dumps(to_json(run), separators=(",", ":")), encoding="utf-8")
     (out / "report.html").write_text(render_html(run), encoding="utf-8")
     return out
 
 
 def to_json(run: RunResult) -> dict:
     """The run as data: the same metadata and overall verdict as the page, every result
-    with its wire log as the page shows it (``wire_log_lines``: the whole log's length)."""
+    with its wire log and checks as the page shows them (``wire_log_lines``,
+    ``checks_total``: how many there were); a check names its rule only where it is not
+    the case's own. What a case is (rule, source, section name) is said once, in
+    ``cases``, not in each of its runs."""
     verdict, reason = overall([r.verdict for r in run.results], run.interrupted)
     results = []
     for r in run.results:
         d = r.to_dict()
-        d["section_name"] = section_name(r.section)
+        del d["rule"], d["source"]
+        d["seconds"] = round(r.seconds, 4)
         d["wire_log_lines"] = len(r.wire_log)
         d["wire_log"] = compact(r.wire_log, r.verdict, run.meta.full_logs)
         d["checks_total"] = len(r.checks)
-        d["checks"] = compact_checks(r.checks, run.meta.full_logs)
+        d["checks"] = [{k: v for k, v in c.items() if k != "rule" or v != r.rule}
+                       for c in compact_checks(r.checks, r.verdict, run.meta.full_logs)]
+        d["traces_total"] = len(r.traces)
+        d["traces"] = compact_traces(r.traces, r.verdict, run.meta.full_logs)
         results.append(d)
     return {"verdict": verdict, "reason": reason, "run_id": run.run_id,
             "meta": run.meta.to_dict(), "targets": run.targets, "settings": run.settings,
             "seconds": round(run.seconds, 3), "frames": run.frames,
-            "interrupted": run.interrupted, "counts": run.counts(), "results": results}
+            "interrupted": run.interrupted, "counts": run.counts(),
+            "sections": {s: section_name(s) for s in sorted({r.section for r in run.results},
+                                                            key=section_key)},
+            "cases": {r.id: {"rule": r.rule, "tag": r.tag, "source": r.source,
+                             "section": r.section} for r in run.results},
+            "results": results}

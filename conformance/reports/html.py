@@ -91,6 +91,36 @@ def _matrix(run: RunResult, sections: list[str]) -> list[str]:
     return out
 
 
+def _coverage(run: RunResult) -> list[str]:
+    """Which rules of the spec the run's cases can fail, per section and profile."""
+    report = run.meta.coverage
+    if not report:
+        return []
+    cells: dict[str, dict[str, str]] = {}
+    uncovered: dict[str, list[str]] = {}
+    for pc in report:
+        for s in pc["sections"]:
+            total = s["covered"] + len(s["uncovered"])
+            cells.setdefault(s["section"], {})[pc["profile"]] = f"{s['covered']}/{total}"
+            for rule in s["uncovered"]:
+                uncovered.setdefault(rule, []).append(pc["profile"])
+    profiles = [pc["profile"] for pc in report]
+    out = ["<h2>Coverage: rules of the spec the cases can fail</h2><table><tr><th>section</th>",
+           *(f"<th>{h(p)}</th>" for p in profiles), "</tr>"]
+    for s in sorted(cells, key=section_key):
+        out.append(f"<tr><td>{h(section_title(s))}</td>"
+                   + "".join(f"<td class='n'>{h(cells[s].get(p, ''))}</td>" for p in profiles)
+                   + "</tr>")
+    out.append("<tr><th>all</th>" + "".join(f"<th class='n'>{pc['covered']}/{pc['total']}</th>"
+                                           for pc in report) + "</tr></table>")
+    if uncovered:
+        out.append("<details><summary>Rules no selected case can fail "
+                   f"({len(uncovered)})</summary><ul>"
+                   + "".join(f"<li>{h(rule)}: {h(', '.join(ps))}</li>"
+                             for rule, ps in sorted(uncovered.items())) + "</ul></details>")
+    return out
+
+
 def _filters(sections: list[str]) -> str:
     boxes = "".join(f"<label class='{h(v)}'><input type='checkbox' value='{h(v)}' checked> "
                     f"{h(v)}</label>" for v in ORDER)
@@ -101,12 +131,9 @@ def _filters(sections: list[str]) -> str:
             "placeholder='case ID contains'></div>")
 
 
-def _pictures(r: CaseResult, drawn_at: str | None) -> list[str]:
-    """The case's traces drawn, or a link to where the same case passing on another
-    profile is drawn (the report must stay small; --full-logs draws every one)."""
-    if drawn_at is not None and r.traces:
-        return [f"<p class='why'>Pictures: as drawn for <a href='#{h(drawn_at)}'>"
-                f"{h(drawn_at)}</a> (every one: --full-logs).</p>"]
+def _pictures(r: CaseResult, full_logs: bool) -> list[str]:
+    """The case's traces drawn (for a passing case the position only: the report must
+    stay small; --full-logs draws the rate too)."""
     out = []
     for i, trace in enumerate(r.traces):
         key = f"{_anchor(r)}-{i}"
@@ -114,31 +141,36 @@ def _pictures(r: CaseResult, drawn_at: str | None) -> list[str]:
             svg = plots.step_train_chart(trace["pulses"], trace.get("axes", "XYZA"), key,
                                          trace.get("total"))
         else:
-            svg = plots.trace_chart(trace, key)
+            svg = plots.trace_chart(trace, key, rate=full_logs or r.verdict != PASS)
         out.append(f"<figure>{svg}</figure>" if svg else
                    f"<p class='why'>{h(trace.get('name', 'trace'))}: plots are off.</p>")
     return out
 
 
-def _case(r: CaseResult, full_logs: bool, drawn_at: str | None) -> list[str]:
+def _case(r: CaseResult, full_logs: bool, also: tuple[str, ...] = ()) -> list[str]:
+    """One case run; ``also``: the other profiles on which the same case passed too
+    (shown once, as its run on ``r.profile``)."""
     why = f" <span class='why'>— {h(r.notes[0])}</span>" if r.verdict in _WHY and r.notes \
         else ""
+    profiles = ", ".join((r.profile, *also))
     out = [f"<details class='case {h(r.verdict)}' id='{h(_anchor(r))}' "
-           f"data-verdict='{h(r.verdict)}' data-section='{h(r.section)}' "
-           f"data-id='{h(r.id)} [{h(r.profile)}]'{' open' if r.verdict in _OPEN else ''}>"
-           f"<summary><b>{h(r.verdict)}</b> {h(r.id)} [{h(r.profile)}] — {h(r.rule)}{why}"
+           f"data-verdict='{h(r.verdict)}' data-section='{h(r.section)}'"
+           f"{' open' if r.verdict in _OPEN else ''}>"
+           f"<summary><b>{h(r.verdict)}</b> {h(r.id)} [{h(profiles)}] — {h(r.rule)}{why}"
            "</summary>",
-           f"<p>Section {h(section_title(r.section))}, tag {h(r.tag)}, source {h(r.source)}, "
-           f"target {h(r.target)}, {r.seconds:.3f} s, {r.frames} frames.</p>"]
+           *([f"<p class='why'>Passed on {len(also) + 1} profiles; shown: its run on "
+              f"{h(r.profile)} (each run apart: --full-logs).</p>"] if also else []),
+           f"<p>Tag {h(r.tag)}, source {h(r.source)}, target {h(r.target)}, {r.seconds:.3f} s, "
+           f"{r.frames} frames.</p>"]
     if r.checks:
         out.append("<table><tr><th>ok</th><th>check</th><th>tag</th><th>observed</th>"
                    "<th>expected</th></tr>")
         out += [f"<tr class='{'PASS' if c['ok'] else 'FAIL'}'><td>{'yes' if c['ok'] else 'NO'}"
                 f"</td><td>{h(c['what'])}</td><td>{h(c['tag'])}</td><td>{h(c['observed'])}</td>"
                 f"<td>{h(c['expected'])}</td></tr>"
-                for c in compact_checks(r.checks, full_logs)]
+                for c in compact_checks(r.checks, r.verdict, full_logs)]
         out.append("</table>")
-    out += _pictures(r, drawn_at)
+    out += _pictures(r, full_logs)
     out += [f"<pre>{h(n)}</pre>" for n in r.notes]
     if r.wire_log:
         out.append("<pre>" + h("\n".join(compact(r.wire_log, r.verdict, full_logs))) + "</pre>")
@@ -152,21 +184,24 @@ def render_html(run: RunResult, full_logs: bool | None = None) -> str:
     full = run.meta.full_logs if full_logs is None else full_logs
     verdict, _ = overall([r.verdict for r in run.results], run.interrupted)
     sections = sorted({r.section for r in run.results}, key=section_key)
-    drawn: dict[str, str] = {}    # case ID -> the anchor of its first drawn run
     out = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
            f"<title>{verdict} — gve-conformance {h(run.run_id)}</title>",
            f"<style>{_asset('report.css')}</style></head><body>",
-           *_header(run), *_matrix(run, sections),
+           *_header(run), *_matrix(run, sections), *_coverage(run),
            "<h2 id='cases'>Cases</h2>", _filters(sections)]
     for s in sections:
         out.append(f"<section class='cases' id='sec-{h(s)}'><h3>{h(section_title(s))}</h3>")
         results = sorted((r for r in run.results if r.section == s),
-                         key=lambda r: (ORDER.index(r.verdict), r.id, r.profile))
+                         key=lambda r: (ORDER.index(r.verdict), r.id))
+        # the report must stay small: a case passing on several profiles shows once
+        passed: dict[str, list[CaseResult]] = {}
         for r in results:
-            drawn_at = None if full or r.verdict != PASS else drawn.get(r.id)
-            if r.traces and r.id not in drawn:
-                drawn[r.id] = _anchor(r)
-            out += _case(r, full, drawn_at)
+            if r.verdict == PASS and not full:
+                passed.setdefault(r.id, []).append(r)
+            else:
+                out += _case(r, full)
+        for first, *others in passed.values():
+            out += _case(first, full, tuple(o.profile for o in others))
         out.append("</section>")
     out.append(f"<script>{_asset('report.js')}</script></body></html>")
     return "\n".join(out)

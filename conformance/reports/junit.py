@@ -11,10 +11,10 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from conformance.reports.logs import compact
-from conformance.reports.sections import section_name
+from conformance.reports.sections import section_title
 from conformance.reports.text import clean
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, overall
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, overall
 
 
 def _message(r: CaseResult) -> str:
@@ -64,8 +64,8 @@ def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
             tc = _element(suite, "testcase", name=f"{r.id}[{r.profile}]",
                           classname=f"gve.{r.profile}.section{r.section}",
                           time=f"{r.seconds:.3f}")
-            _properties(tc, {"verdict": r.verdict, "tag": r.tag, "section": r.section,
-                             "section name": section_name(r.section), "source": r.source})
+            _properties(tc, {"verdict": r.verdict, "tag": r.tag,
+                             "section": section_title(r.section)})
             log = "\n".join(compact(r.wire_log, r.verdict, full))
             if r.verdict == FAIL:
                 _element(tc, "failure", log, message=_message(r), type=r.verdict)
@@ -74,6 +74,8 @@ def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
                          type=r.verdict)
             elif r.verdict in (MISSING, COULD_NOT_TEST):
                 _element(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
+            if r.verdict == PASS and not full:
+                continue            # its properties say it all; the JSON keeps the rest
             head = (f"verdict {r.verdict}; tag {r.tag}; section {r.section}; "
                     f"source {r.source}\nrule: {r.rule}\n")
             # the log once: in the failure or error when there is one

@@ -20,7 +20,7 @@ from functools import cache
 import numpy as np
 
 #: a line holds at most this many points (the report must stay small)
-MAX_POINTS = 120
+MAX_POINTS = 60
 #: the step train shows at most this many pulses
 MAX_PULSES = 120
 #: verdict colours, the same as the page's (report.css)
@@ -54,10 +54,13 @@ def _svg(fig, key: str) -> str:
     with rc_context({"svg.fonttype": "none", "svg.hashsalt": key, "path.simplify": True}):
         fig.savefig(out, format="svg", metadata={"Date": None})
     text = out.getvalue()
-    return _PATH.sub(_shorter, text[text.index("<svg"):])
+    text = _METADATA.sub("", text[text.index("<svg"):])
+    return _BETWEEN_TAGS.sub("><", _PATH.sub(_shorter, text))
 
 
 _PATH = re.compile(r' d="([^"]*)"')
+_METADATA = re.compile(r"<metadata>.*?</metadata>", re.S)
+_BETWEEN_TAGS = re.compile(r">\s+<")
 _DECIMALS = re.compile(r"(\d\.\d)\d+")
 
 
@@ -119,8 +122,8 @@ def _band(t: np.ndarray, model_t: np.ndarray, model: np.ndarray, seconds: float,
     return shifted.min(axis=0) - steps, shifted.max(axis=0) + steps
 
 
-def trace_chart(trace: dict, key: str) -> str | None:
-    """Position and rate against time: the target's samples over the model."""
+def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
+    """Position (and ``rate``) against time: the target's samples over the model."""
     if not available():
         return None
     st, sp = _columns(_thin(trace.get("samples") or []))
@@ -131,8 +134,8 @@ def trace_chart(trace: dict, key: str) -> str | None:
     width = max(sp.shape[1] if sp.size else 0, mp.shape[1] if mp.size else 0)
     moving = [i for i in range(width)
               if (sp.size and np.ptp(sp[:, i]) > 0) or (mp.size and np.ptp(mp[:, i]) > 0)]
-    fig = _figure(7.5, 4.4)
-    pos_ax, rate_ax = fig.subplots(2, 1, sharex=True)
+    fig = _figure(7.5, 4.4 if rate else 2.6)
+    pos_ax, rate_ax = fig.subplots(2, 1, sharex=True) if rate else (fig.add_subplot(), None)
     for i in moving or range(min(width, 1)):
         colour, name = _AXIS_COLOURS[i % 4], names[i] if i < len(names) else f"axis {i}"
         if mp.size:
@@ -141,24 +144,27 @@ def trace_chart(trace: dict, key: str) -> str | None:
             lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
             pos_ax.fill_between(grid, lo, hi, color=colour, alpha=0.15, linewidth=0)
             pos_ax.plot(grid, model_i, "--", color=colour, linewidth=1, label=f"{name} model")
-            rt, rv = _rate(grid, model_i[:, None])
-            rate_ax.plot(rt, rv[:, 0], "--", color=colour, linewidth=1)
+            if rate_ax is not None:
+                rt, rv = _rate(grid, model_i[:, None])
+                rate_ax.plot(rt, rv[:, 0], "--", color=colour, linewidth=1)
         if sp.size:
-            pos_ax.plot(st, sp[:, i], "-", color=colour, linewidth=1.2, label=f"{name} sampled")
-            rt, rv = _rate(st, sp[:, i:i + 1])
-            rate_ax.plot(rt, rv[:, 0], "-", color=colour, linewidth=1.2)
+            # samples are readings (PF) at instants: points, not a line between them
+            pos_ax.plot(st, sp[:, i], "o", color=colour, markersize=3.5, label=f"{name} read")
+            if rate_ax is not None:
+                rt, rv = _rate(st, sp[:, i:i + 1])
+                rate_ax.plot(rt, rv[:, 0], "o", color=colour, markersize=3.5)
     title = trace.get("name", "motion")
     params = trace.get("params") or {}
     if params:
         title += "  (" + ", ".join(f"{k} {v}" for k, v in params.items()) + ")"
     pos_ax.set_title(title, fontsize=9)
     pos_ax.set_ylabel("position (steps)")
-    rate_ax.set_ylabel("rate (steps/s)")
-    rate_ax.set_xlabel(f"time (s); band: ±{seconds:g} s, ±{steps:g} steps")
+    if rate_ax is not None:
+        rate_ax.set_ylabel("rate (steps/s)")
+    (rate_ax or pos_ax).set_xlabel(f"time (s); band: ±{seconds:g} s, ±{steps:g} steps")
     pos_ax.legend(fontsize=7, ncols=2)
-    for ax in (pos_ax, rate_ax):
+    for ax in (pos_ax, rate_ax or pos_ax):
         ax.tick_params(labelsize=8)
-        ax.grid(alpha=0.3)
     return _svg(fig, key)
 
 

@@ -10,7 +10,7 @@
     document.querySelectorAll('details.case').forEach(function (d) {
       var ok = shown[d.dataset.verdict] &&
         (!section.value || d.dataset.section === section.value) &&
-        (!want || d.dataset.id.toLowerCase().indexOf(want) >= 0);
+        (!want || d.id.toLowerCase().indexOf(want) >= 0);
       d.classList.toggle('hidden', !ok);
     });
     document.querySelectorAll('section.cases').forEach(function (s) {

@@ -81,7 +81,7 @@ def test_could_not_test_says_why_on_its_line(no_plots):
 
 def test_passing_logs_and_checks_are_folded_unless_full_logs(no_plots):
     page = render_html(toy_run())
-    assert "92 lines left out" in page and "42 more passed checks" in page
+    assert "96 lines left out" in page and "48 more passed checks" in page
     assert "0.000000050 &gt; !0@" not in page
     full = render_html(toy_run(full_logs=True))
     assert "lines left out" not in full and "0.000000050 &gt; !0@" in full
@@ -106,14 +106,16 @@ def test_motion_traces_are_drawn_as_inline_svg():
     assert "<?xml" not in page and "<!DOCTYPE svg" not in page
 
 
-def test_a_passing_case_on_several_profiles_is_drawn_once():
+def test_a_case_passing_on_several_profiles_shows_once():
     run = toy_run()
     twin = result("10.2.toy.moves", "PASS", traces=run.results[1].traces)
     twin.profile = "GVE84-50"
     run.results.append(twin)
     page = render_html(run)
-    assert page.count("trapezoid X") == 1
-    assert "href='#case-10.2.toy.moves-GVE84-100'" in page
+    assert page.count("trapezoid X") == 1 and page.count("<b>PASS</b> 10.2.toy.moves") == 1
+    assert "10.2.toy.moves [GVE84-100, GVE84-50]" in page and "Passed on 2 profiles" in page
+    each = render_html(run, full_logs=True)
+    assert each.count("<b>PASS</b> 10.2.toy.moves") == 2
 
 
 def test_without_matplotlib_the_page_says_plots_are_off(monkeypatch):

@@ -27,8 +27,7 @@ def test_junit_carries_timestamp_hostname_and_verdicts(tmp_path):
     assert cases["8.toy.lenient[GVE84-100]"]["verdict"] == "NON-STRICT"
     assert cases["9.toy.informs[GVE84-100]"]["verdict"] == "INFO"
     assert cases["10.5.toy.passes[GVE84-100]"] == {
-        "verdict": "PASS", "tag": "M", "section": "10.5", "section name": "KEEP / RESTORE",
-        "source": "spec"}
+        "verdict": "PASS", "tag": "M", "section": "10.5 KEEP / RESTORE"}
 
 
 def test_junit_is_well_formed_with_hostile_bytes(tmp_path):
@@ -47,9 +46,12 @@ def test_json_has_the_same_metadata_and_the_overall_verdict(tmp_path, no_plots):
     assert data["meta"]["started"] == "2026-11-25T10:00:00+01:00"
     assert data["meta"]["targets"][0]["processor_id"] == "25020304"
     passing = next(r for r in data["results"] if r["id"] == "10.5.toy.passes")
-    assert passing["wire_log_lines"] == 100 and len(passing["wire_log"]) == 9
-    assert passing["checks_total"] == 50 and len(passing["checks"]) == 9
-    assert passing["section_name"] == "KEEP / RESTORE"
+    assert passing["wire_log_lines"] == 100 and len(passing["wire_log"]) == 5
+    assert passing["checks_total"] == 50 and len(passing["checks"]) == 3
+    assert data["sections"]["10.5"] == "KEEP / RESTORE"
+    assert data["cases"]["10.5.toy.passes"]["rule"] == "a rule"
+    moving = next(r for r in data["results"] if r["id"] == "10.2.toy.moves")
+    assert moving["traces_total"] == 1 and moving["traces"] == []     # drawn on the page
     failing = next(r for r in data["results"] if r["id"] == "6.toy.fails")
     assert failing["wire_log"][-1] == f"< {HOSTILE}"       # JSON escapes by itself
     assert to_json(toy_run(full_logs=True))["results"][0]["wire_log_lines"] == 100
