@@ -63,7 +63,7 @@ def test_an_interrupt_halts_every_unit_and_still_reports(tcp_units, tmp_path):
     sends H and D to its unit, and writes its report; the fleet reports interrupted."""
     logs = [tmp_path / "unit-a.gvt", tmp_path / "unit-b.gvt"]
     ports = [tcp_units("--model", "GVE84-100", "--log", str(log)) for log in logs]
-    argv = [sys.executable, "-m", "conformance", "--profile", "GVE84-100", "--jobs", "2",
+    argv = [sys.executable, "-m", "conformance", "--profile", "GVE84-100", "--yes", "--jobs", "2",
             "--cases", "10.*", "--report-dir", str(tmp_path), "--run-id", "fleet"]
     for where in ports:
         argv += ["--target", f"tcp:{where}"]
