@@ -1,4 +1,5 @@
-"""Running cases against targets and collecting graded results (issue 4 items 1, 7)."""
+"""Running cases against targets and collecting graded results (issue 4 items 1, 7;
+issue 8: one session per target per run, Ctrl-C, a target that stops answering)."""
 
 from __future__ import annotations
 
@@ -9,10 +10,16 @@ from dataclasses import asdict, dataclass, field
 
 from conformance import settings as settings_profiles
 from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetyStop
+from conformance.link.framing import UnitDataError
+from conformance.link.interrupts import Interrupts
+from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
 from conformance.operator import Console, Hands
-from conformance.targets import Target
-from conformance.verdict import COULD_NOT_TEST, ERROR, MISSING, PASS, grade, worst
+from conformance.targets import SessionError, Target
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
+
+#: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
+ALWAYS = "always"
 
 
 @dataclass
@@ -32,6 +39,8 @@ class CaseResult:
     traces: list[dict] = field(default_factory=list)      # CaseContext.trace
     seconds: float = 0.0
     frames: int = 0
+    interrupted: bool = False       # Ctrl-C ended it
+    stopped: str = ""               # why the rest of the run on this target did not run
 
     @property
     def failed_checks(self) -> list[dict]:
@@ -51,6 +60,11 @@ class RunResult:
     frames: int = 0
     interrupted: bool = False
     meta: RunMeta = field(default_factory=RunMeta)
+    #: per target: its session's report (identity, envelope and largest excursion per
+    #: axis, what was restored, what could not be) — SessionReport.to_dict()
+    sessions: dict[str, dict] = field(default_factory=dict)
+    #: what could not be restored or verified: the top of every report, exit status 1
+    problems: list[str] = field(default_factory=list)
 
     def counts(self) -> dict[str, int]:
         out: dict[str, int] = {}
@@ -59,11 +73,21 @@ class RunResult:
         return out
 
 
-def run_case(case: Case, target: Target, settings_name: str = "ci",
+def settings_for(target: Target, chosen: str | None) -> str:
+    """The Hypothesis settings on ``target``: as chosen, else `hardware` on real units
+    (no shrinking in real time) and `ci` on the emulator."""
+    return chosen or ("ci" if target.info.kind == "emu" else "hardware")
+
+
+def _result(case: Case, target: Target, verdict: str = PASS) -> CaseResult:
+    return CaseResult(case.id, case.section, case.rule, case.tag, case.source,
+                      target.profile.name, target.info.spec, verdict)
+
+
+def run_case(case: Case, target: Target, settings_name: str | None = None,
              seed: int | None = None, console: Console | None = None) -> CaseResult:
     profile = target.profile
-    result = CaseResult(case.id, case.section, case.rule, case.tag, case.source,
-                        profile.name, target.info.spec, PASS)
+    result = _result(case, target)
     why = case.missing_for(profile)
     if why:
         result.verdict, result.notes = MISSING, [why]
@@ -74,11 +98,14 @@ def run_case(case: Case, target: Target, settings_name: str = "ci",
     if case.destructive and not target.info.allow_destructive:
         result.verdict, result.notes = COULD_NOT_TEST, ["destructive: needs --allow-destructive"]
         return result
-    ctx = CaseContext(case, profile, target.info, settings_profiles.get(settings_name),
-                      target.open_link, seed=seed)
+    session = target.session
+    ctx = CaseContext(case, profile, target.info,
+                      settings_profiles.get(settings_for(target, settings_name)),
+                      session.open_link, seed=seed)
     ctx.operator = Hands(lambda: ctx.link, console)
     start = time.perf_counter()
     verdicts: list[str] = []
+    ended = True
     try:
         case.func(ctx)
     except CouldNotTest as err:
@@ -90,14 +117,34 @@ def run_case(case: Case, target: Target, settings_name: str = "ci",
     except SafetyStop as err:
         verdicts.append(COULD_NOT_TEST)
         ctx.note(f"safety stop: {err}")
+    except UnitDataError as err:
+        ctx.expect(False, f"the unit's answer cannot be read: {err}", tag=ALWAYS)
+    except KeyboardInterrupt:
+        ended = False
+        result.interrupted = True
+        verdicts.append(COULD_NOT_TEST)
+        ctx.note("interrupted by Ctrl-C: H and D sent, the rest of the run not run")
+        if not session.interrupts.pending:
+            session.interrupts.count += 1       # raised without the handler (e.g. a test)
+        session.emergency_stop()
+    except TargetNotResponding as err:
+        ended = False
+        result.stopped = str(err)
+        ctx.expect(False, str(err), tag=ALWAYS)
+    except SessionError as err:
+        ended = False
+        result.stopped = str(err)
+        verdicts.append(COULD_NOT_TEST)
+        ctx.note(f"could not test: {err}")
     except Exception:
         verdicts.append(ERROR)
-        ctx.note("defect of the suite or the target's link:\n" + traceback.format_exc())
+        ctx.note("defect of the suite:\n" + traceback.format_exc())
     finally:
         for link in ctx.links:
-            if link.eeprom_backup:
-                for problem in link.restore_eeprom():
-                    ctx.expect(False, problem, tag="M")
+            if ended:
+                link.settle(final=True)
+            for violation in link.violations:
+                ctx.expect(False, violation, tag=ALWAYS)
     result.seconds = time.perf_counter() - start
     verdicts += [grade(c.tag, profile.implements_decisions) for c in ctx.checks if not c.ok]
     if not verdicts and not ctx.checks:
@@ -113,25 +160,72 @@ def run_case(case: Case, target: Target, settings_name: str = "ci",
     return result
 
 
-def run(targets: list[Target], cases: list[Case], *, settings_name: str = "ci",
+def run(targets: list[Target], cases: list[Case], *, settings_name: str | None = None,
         run_id: str = "", on_result: Callable[[CaseResult], None] | None = None,
         seed: int | None = None, console: Console | None = None) -> RunResult:
-    run = RunResult(run_id, targets=[t.info.spec for t in targets], settings=settings_name)
+    """Every case on every target, one session per target; Ctrl-C stops the run after
+    `H` and `D` and the restorations (docs/suite.md)."""
+    chosen = sorted({settings_for(t, settings_name) for t in targets})
+    run = RunResult(run_id, targets=[t.info.spec for t in targets],
+                    settings=", ".join(chosen) or (settings_name or "ci"))
+    interrupts = Interrupts()
     start = time.perf_counter()
-    try:
+
+    def add(r: CaseResult) -> None:
+        run.results.append(r)
+        run.frames += r.frames
+        if on_result:
+            on_result(r)
+
+    with interrupts.catching_sigint():
         for target in targets:
-            for case in cases:
-                r = run_case(case, target, settings_name, seed, console)
-                run.results.append(r)
-                run.frames += r.frames
-                if on_result:
-                    on_result(r)
-            target.close()
-    except KeyboardInterrupt:
-        run.interrupted = True
-        for target in targets:
-            if target.info.kind != "emu":
-                target.emergency_stop()
-            target.close()
+            if interrupts.stopped:
+                break
+            _run_target(target, cases, interrupts, settings_for(target, settings_name), add, run,
+                        seed, console)
+    run.interrupted = interrupts.stopped
     run.seconds = time.perf_counter() - start
     return run
+
+
+def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, settings: str,
+                add: Callable[[CaseResult], None], run: RunResult, seed: int | None,
+                console: Console | None) -> None:
+    session = target.begin(interrupts)
+    stopped = ""
+    try:
+        try:
+            session.start()
+        except (SessionError, TargetNotResponding) as err:
+            stopped = str(err)
+            if cases and isinstance(err, TargetNotResponding):
+                first = _result(cases[0], target, FAIL)
+                first.checks = [{"ok": False, "what": stopped, "observed": "", "expected": "",
+                                 "tag": ALWAYS, "rule": cases[0].rule}]
+                first.stopped = stopped
+                add(first)
+                cases = cases[1:]
+            elif isinstance(err, SessionError):
+                run.problems.append(stopped)
+        except KeyboardInterrupt:
+            session.emergency_stop()
+            return
+        for case in cases:
+            if stopped or interrupts.stopped:
+                if stopped:
+                    r = _result(case, target, COULD_NOT_TEST)
+                    r.notes = [f"not run: {stopped}"]
+                    add(r)
+                continue
+            r = run_case(case, target, settings, seed, console)
+            add(r)
+            stopped = r.stopped
+    finally:
+        try:
+            report = session.finish()
+        except KeyboardInterrupt:
+            report = session.report
+            report.problems.append("restorations abandoned (Ctrl-C pressed three times)")
+        run.sessions[target.info.spec] = report.to_dict()
+        run.problems += report.problems
+        target.close()

@@ -60,9 +60,9 @@ def fresh_reset(ctx: CaseContext) -> None:
 
 def index(ctx: CaseContext) -> int | None:
     r = ctx.link.send("@")
-    if r is None or r.code != 0 or not r.values or not r.values[0].isdigit():
+    if r is None or r.code != 0:
         return None
-    return int(r.values[0])
+    return r.dec()
 
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
@@ -93,4 +93,4 @@ def position(ctx: CaseContext) -> list[int] | None:
     r = ctx.link.send("PF")
     if r is None or r.code != 0 or len(r.values) < 3:
         return None
-    return [int(v) for v in r.values]
+    return r.decs()

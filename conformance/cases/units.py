@@ -125,7 +125,7 @@ def eeprom(ctx: CaseContext) -> None:
     link = ctx.link
     r = link.send("ER40")
     ctx.require(r is not None and r.code == 0, "ER40 answered")
-    old = int(r.values[0], 16)
+    old = r.hex()
     new = old ^ 0x5A
     answers(ctx, link.send("EW40,%02X" % new), "0", "EW40 → 0")
     answers(ctx, link.send("ER40"), "0,%02X" % new, "ER40 reads the new byte")

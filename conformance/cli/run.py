@@ -1,16 +1,21 @@
 """The default job of `gve-conformance`: run the suite, show progress, write reports.
 
 With no arguments: the whole suite against the embedded emulator, every profile.
+Everything a user can get wrong is refused before the first frame is sent, with one
+line on standard error and exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import tempfile
 import time
 import uuid
 from contextlib import ExitStack
 from pathlib import Path
+from typing import NoReturn
 
 from serial import SerialException
 
@@ -21,20 +26,32 @@ from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.reports import write_junit, write_reports
-from conformance.runner import run
+from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import FAILED, ORDER, overall
 from gve_fixtures.profile import available_profiles
 
+PROG = "gve-conformance"
+
+
+class UsageError(Exception):
+    """A mistake on the command line: one line, exit status 2, nothing sent."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(prog="gve-conformance", description=__doc__.splitlines()[0])
+    ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT; repeatable")
     ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target; 'auto': "
-                    "ask the unit (? and Q) and choose")
+                    "ask the unit (? and Q) and choose (with no --target: run the emulator "
+                    "as this profile)")
     ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
                     "say it: the variant (e.g. 100 for a GVE84-100)")
     ap.add_argument("--yes", action="store_true",
@@ -45,15 +62,18 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
-    ap.add_argument("--settings", default="ci", choices=sorted(PROFILES),
-                    help="Hypothesis settings profile (default ci)")
+    ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
+                    help="Hypothesis settings profile (default: ci on the emulator, "
+                         "hardware on serial/tcp targets)")
     ap.add_argument("--seed", type=int, metavar="N",
                     help="the Hypothesis machines' seed: the same N replays the same examples "
                          "(default: a fresh one, printed; none for derandomized settings)")
     ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
-                    help="real units: the motion envelope in steps per axis")
+                    help="real units: the motion envelope in full steps per axis either side "
+                         "of where the run began (default %(default)s)")
     ap.add_argument("--allow-destructive", action="store_true",
-                    help="real units: allow J and EEPROM writes (backed up and restored)")
+                    help="real units: allow J, W and EEPROM writes (EEPROM backed up and "
+                         "restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
     ap.add_argument("--run-id", metavar="NAME",
@@ -105,15 +125,19 @@ def prepare(args: argparse.Namespace, argv: list[str], cases: list, console: Con
     """The targets and the run's metadata: profiles chosen (``--profile auto`` asks the
     units), identities recorded, motion confirmed on real units. Refused when not."""
     every = [f"emu:{name}" for name in available_profiles()]
+    if args.profile and args.profile != "auto" and not args.target:
+        every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
     # no --target, or emu:all: the embedded emulator on every profile
     specs = [s for t in args.target or ["emu:all"]
              for s in (every if t.split("?")[0] == "emu:all" else [t])]
     try:
-        chosen = [resolve(s, args.profile, args.variant, console) for s in specs]
+        chosen = [resolve(s, None if s in every else args.profile, args.variant, console)
+                  for s in specs]
         targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
                                 max_travel=args.max_travel, mutant=args.mutant)
                    for s, p, _ in chosen]
         meta = _meta(args, argv, targets, cases, run_seed(args.settings, args.seed))
+        meta.settings = _settings_line(targets, args.settings)
         record_identities(targets, meta)
     except (ValueError, LookupError, OSError, SerialException) as err:
         raise Refused(str(err)) from err
@@ -132,7 +156,26 @@ def prepare(args: argparse.Namespace, argv: list[str], cases: list, console: Con
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    return execute(parse_args(argv), argv)
+    try:
+        args = parse_args(argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    return execute(args, argv)
+
+
+def _quiet_stdout() -> None:
+    """Standard output was closed by the reader: send the rest nowhere."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+
+
+def _say(text: str = "") -> None:
+    """A console line; a closed standard output does not stop a run on a real unit."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        _quiet_stdout()
 
 
 def example_database_of(args: argparse.Namespace) -> str | None:
@@ -145,8 +188,22 @@ def example_database_of(args: argparse.Namespace) -> str | None:
 
 def execute(args: argparse.Namespace, argv: list[str]) -> int:
     """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
-    fleet runs for its one target."""
+    fleet runs for its one target. A usage error is one line and exit status 2."""
+    try:
+        return _execute(args, argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:
+        _quiet_stdout()          # `gve-conformance --list | head -1`: end quietly
+        return 0
+
+
+def _execute(args: argparse.Namespace, argv: list[str]) -> int:
     cases = select(args.cases or None, args.exclude or None)
+    if not cases:
+        raise UsageError("no case matches " + " ".join(
+            [f"--cases {g!r}" for g in args.cases] + [f"--exclude {g!r}" for g in args.exclude]))
     if args.list:
         for c in cases:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
@@ -156,26 +213,24 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
         except LookupError as err:
-            print(f"gve-conformance: {err}", file=sys.stderr)
-            return 2
+            raise UsageError(str(err)) from None
         print(format_coverage(report, args.coverage))
         return 0
     if args.jobs < 1:
-        print("gve-conformance: --jobs must be 1 or more", file=sys.stderr)
-        return 2
+        raise UsageError("--jobs must be 1 or more")
+    if not args.no_reports:
+        _check_writable(Path(args.report_dir))
     database = example_database_of(args)
     with ExitStack() as run_scope:
         try:
             run_scope.enter_context(example_database(database))
         except ValueError as err:
-            print(f"gve-conformance: --hypothesis-db: {err}", file=sys.stderr)
-            return 2
+            raise UsageError(f"--hypothesis-db: {err}") from None
         console = Console()
         try:
             targets, meta = prepare(args, argv, cases, console)
         except Refused as err:
-            print(f"gve-conformance: {err}", file=sys.stderr)
-            return 2
+            raise UsageError(str(err)) from None
         except KeyboardInterrupt:
             print("\ngve-conformance: interrupted before the run, nothing that moves was sent",
                   file=sys.stderr)
@@ -186,15 +241,18 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
             for target in targets:
                 target.close()          # each member opens its own port
             return run_fleet(args, argv, targets, run_id, meta.seed, database)
+        _preflight(targets)
         return _run(args, targets, cases, meta, console, run_id)
 
 
 def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: RunMeta,
          console: Console, run_id: str) -> int:
     seed = meta.seed
-    print(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
-          f"seed: none (--settings {args.settings} is derandomized: every run draws the same "
-          "examples; --seed N for others)", flush=True)
+    _say(f"Hypothesis settings: {meta.settings}")
+    exact = args.settings or " and ".join(sorted({settings_for(t, None) for t in targets}))
+    _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
+         f"seed: none (--settings {exact} is derandomized: every run draws the same "
+         "examples; --seed N for others)")
     progress = Progress(len(targets) * len(cases), quiet=args.quiet)
     try:
         result = run(targets, cases, settings_name=args.settings, run_id=run_id,
@@ -207,16 +265,64 @@ def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: Run
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
     verdict, reason = overall([r.verdict for r in result.results], result.interrupted)
-    print(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
-    print(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
-          f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
+    _say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
+    _say(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
+         f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
+    for line in _session_lines(result):
+        _say(line)
     if not args.no_reports:
         folder = write_reports(result, args.report_dir)
-        print(f"reports: {folder}/report.html, results.json, junit.xml")
+        _say(f"reports: {folder}/report.html, results.json, junit.xml")
     if args.junitxml:
-        print(f"JUnit XML: {write_junit(result, args.junitxml)}")
-    print(f"{verdict}: {reason}")
-    return 1 if verdict == FAILED else 0
+        _say(f"JUnit XML: {write_junit(result, args.junitxml)}")
+    _say(f"{verdict}: {reason}")
+    return 1 if verdict == FAILED or result.problems else 0
+
+
+def _check_writable(folder: Path) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as err:
+        raise UsageError(f"cannot write reports to {folder}: {err.strerror or err}") from None
+
+
+def _preflight(targets: list[Target]) -> None:
+    for target in targets:
+        try:
+            target.preflight()
+        except (ValueError, LookupError) as err:
+            for t in targets:
+                t.close()
+            raise UsageError(str(err)) from None
+
+
+def _settings_line(targets: list[Target], chosen: str | None) -> str:
+    if chosen:
+        return chosen
+    kinds = {t.info.kind == "emu" for t in targets}
+    parts = (["ci on the emulator"] if True in kinds else []) + \
+        (["hardware on real units (no shrinking in real time)"] if False in kinds else [])
+    return ", ".join(parts) + " (--settings to choose)"
+
+
+def _session_lines(result: RunResult) -> list[str]:
+    """Per real target: the largest excursion, what was restored, what could not be."""
+    lines = []
+    for spec, s in result.sessions.items():
+        if not s["real"]:
+            continue
+        lines.append(f"{spec} ({s['profile']}"
+                     + (f", {s['identity'].get('version')}" if s["identity"] else "") + "):")
+        if s["excursion"]:
+            axes = ", ".join(f"{a} {lo:+g}..{hi:+g}" for a, (lo, hi)
+                             in zip(s["axes"], s["excursion"], strict=True))
+            lines.append(f"  largest excursion (full steps, envelope ±{s['max_travel']}): {axes}")
+        lines += [f"  restored: {r}" for r in s["restored"]]
+        lines += [f"  reset: {r}" for r in s["reset"]]
+    lines += [f"PROBLEM: {p}" for p in result.problems]
+    return lines
 
 
 if __name__ == "__main__":

@@ -2,13 +2,33 @@
 
 A frame is ``"!" address body ["," checksum] CR``; a response is
 ``code *("," value) ["," checksum] CR`` where the code's bit 3 is INTA.
+
+Unit bytes are read through :class:`Response`, whose accessors (``hex``, ``dec``,
+``decs``, indexing ``values``) raise :class:`UnitDataError` when the bytes are not what
+the protocol allows there: the runner turns that into a failed check showing the bytes,
+so a unit can never make the suite report ERROR.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
+from gve_fixtures.protocol import INTA_BIT
+from gve_fixtures.transcript import escape
+
 CR = b"\r"
+BANG = b"!"
+
+_HEX_BYTE = re.compile(r"[0-9A-F]{2}")
+_DECIMAL = re.compile(r"-?\d+")
+
+
+def readable(data: bytes) -> str:
+    """Bytes as text for people: printable ASCII as itself, the rest escaped as in
+    transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report."""
+    return "".join(chr(b) if 0x20 <= b <= 0x7E and b != 0x5C else escape(bytes([b]))
+                   for b in data)
 
 
 def byte_sum(data: bytes) -> int:
@@ -28,6 +48,27 @@ def frame(body: str, address: int = 0, checksum: bool | str = False) -> bytes:
     return head + b"," + str(checksum).encode("latin-1") + CR
 
 
+class UnitDataError(AssertionError):
+    """Unit bytes that are not what the protocol allows where the suite reads them.
+
+    An AssertionError, so that a Hypothesis machine reports it as a failed invariant;
+    the runner records it as a failed check (always FAIL) with the bytes."""
+
+
+class Values(list):
+    """A response's values: indexing past the end is the unit's fault, not the suite's."""
+
+    def __init__(self, items: list[str], raw: bytes) -> None:
+        super().__init__(items)
+        self.raw = raw
+
+    def __getitem__(self, index):
+        try:
+            return super().__getitem__(index)
+        except IndexError:
+            raise UnitDataError(f"the answer {readable(self.raw)} has no value {index}") from None
+
+
 @dataclass
 class Response:
     """One answer as the suite reads it."""
@@ -36,7 +77,7 @@ class Response:
     lines: list[bytes] = field(default_factory=list)
     code: int | None = None
     inta: bool | None = None
-    values: list[str] = field(default_factory=list)
+    values: Values = field(default_factory=lambda: Values([], b""))
     checksum: str | None = None
     checksum_ok: bool | None = None
     well_formed: bool = False
@@ -45,10 +86,34 @@ class Response:
 
     @property
     def text(self) -> str:
-        return self.raw.decode("latin-1").replace("\r", "\\r")
+        """The bytes as readable text: printable ASCII as itself, the rest escaped
+        (``\\r``, ``\\x00``), so a report can never carry a raw control byte."""
+        return readable(self.raw)
 
     def __str__(self) -> str:
         return self.text
+
+    # -- safe accessors: the unit's fault when the bytes are not there ---------------------
+    def _fail(self, what: str) -> UnitDataError:
+        return UnitDataError(f"the answer {self.text} {what}")
+
+    def hex(self, index: int = 0) -> int:
+        """Value ``index`` as two upper-case hex digits (status words, ports, EEPROM bytes)."""
+        text = self.values[index]
+        if not _HEX_BYTE.fullmatch(text):
+            raise self._fail(f"has {text!r} where two hex digits belong")
+        return int(text, 16)
+
+    def dec(self, index: int = 0) -> int:
+        """Value ``index`` as a decimal integer (positions, counts, the index)."""
+        text = self.values[index]
+        if not _DECIMAL.fullmatch(text):
+            raise self._fail(f"has {text!r} where a decimal number belongs")
+        return int(text)
+
+    def decs(self) -> list[int]:
+        """Every value as a decimal integer."""
+        return [self.dec(i) for i in range(len(self.values))]
 
 
 def parse_response(raw: bytes, *, summed: bool, lines: int = 1) -> Response:
@@ -56,7 +121,7 @@ def parse_response(raw: bytes, *, summed: bool, lines: int = 1) -> Response:
     the response proper, as after `>`)."""
     parts = raw.split(CR)
     got = [p for p in parts[:-1]]
-    r = Response(raw=raw, lines=got)
+    r = Response(raw=raw, lines=got, values=Values([], raw))
     if len(got) != lines or parts[-1] != b"":
         return r
     last = got[-1]
@@ -66,17 +131,73 @@ def parse_response(raw: bytes, *, summed: bool, lines: int = 1) -> Response:
     if len(head) != 1 or head not in "0123456789ABCDEF":
         return r
     value = int(head, 16)
-    r.code, r.inta = value & 7, bool(value & 8)
+    r.code, r.inta = value & 7, bool(value & INTA_BIT)
     values = fields[1:]
     if summed:
         if not values or len(values[-1]) != 2:
             r.checksum_ok = False
-            r.values = values
+            r.values = Values(values, raw)
             return r
         r.checksum = values[-1]
         upto = last[: len(last) - 2]
         r.checksum_ok = r.checksum == "%02X" % byte_sum(upto)
         values = values[:-1]
-    r.values = values
+    r.values = Values(values, raw)
     r.well_formed = all(v != "" for v in values) and (not summed or bool(r.checksum_ok))
     return r
+
+
+# -- the host's side: frames in a stream of bytes (spec 3) -----------------------------------
+@dataclass(frozen=True)
+class HostFrame:
+    """One complete command frame as a unit would take it from the line."""
+
+    address: int | None          # None: the byte after '!' is not an address digit
+    text: str                    # from the byte after the address to the byte before CR
+    raw: bytes                   # the frame's bytes from '!' through CR
+
+    def bodies(self, summed: bool | None) -> list[str]:
+        """The frame's possible bodies: without the checksum when ``summed``, as it is
+        when not, and both when the checksum mode is not known."""
+        head, comma, tail = self.text.rpartition(",")
+        stripped = head if comma and re.fullmatch(r"[0-9A-Fa-f]{2}", tail) else None
+        if summed is True:
+            return [stripped if stripped is not None else self.text]
+        if summed is False or stripped is None:
+            return [self.text]
+        return [self.text, stripped]
+
+
+class HostFramer:
+    """Frames the host's outgoing bytes as a unit does (spec 3): bytes before '!' are
+    ignored, a '!' restarts an unfinished frame, CR ends one (a LF after it is noise).
+    The unfinished tail is kept, so a frame sent in pieces is seen when it completes."""
+
+    def __init__(self) -> None:
+        self.pending = b""
+
+    def frames(self, data: bytes, *, commit: bool = True) -> list[HostFrame]:
+        """The frames ``data`` completes; with ``commit=False`` the state is unchanged
+        (to judge bytes before they are written)."""
+        buffer = self.pending + data
+        out = []
+        start = buffer.find(BANG)
+        rest = b"" if start < 0 else buffer[start:]
+        while rest:
+            nxt = rest.find(BANG, 1)
+            end = rest.find(CR)
+            if end < 0 or (0 <= nxt < end):
+                if nxt < 0:
+                    break                    # unfinished: wait for more bytes
+                rest = rest[nxt:]            # '!' restarts the frame
+                continue
+            raw = rest[: end + 1]
+            digit = raw[1:2]
+            address = int(digit) if digit.isdigit() else None
+            out.append(HostFrame(address, raw[2:-1].decode("latin-1"), raw))
+            after = rest[end + 1:]
+            nxt = after.find(BANG)
+            rest = b"" if nxt < 0 else after[nxt:]
+        if commit:
+            self.pending = rest
+        return out

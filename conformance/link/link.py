@@ -2,43 +2,72 @@
 
 On the embedded emulator the port is a ``gve://`` pyserial object in virtual time:
 waiting and timeouts advance the virtual clock, nothing sleeps. On serial and TCP
-targets time is real and timeouts come from the baud rate.
+targets time is real and timeouts come from the baud rate and the command.
+
+Every byte the link writes is framed as a unit would frame it, and every complete frame
+is judged by the run's :class:`~conformance.link.safety.Guard` before the first byte
+goes out and booked with its answer afterwards: frames built by :meth:`Link.send`, raw
+bytes of :meth:`Link.send_raw` (golden replays, noise) and frames changed by an injected
+fault alike.
+
+Answers belong to their frame (issue 8 item 5): bytes that arrive before a frame is
+sent are logged as unsolicited and never read as its answer; after a frame timed out
+the link waits for a quiet line before the next one (real time), so a late answer is
+not taken for a later frame's; bytes after a complete answer are recorded in
+:attr:`Link.violations` ("answered twice"), which fail the case that sent the frame.
 """
 
 from __future__ import annotations
 
-import re
 import time
 from collections.abc import Callable
 
 from conformance.link.faults import Fault
-from conformance.link.framing import CR, Response, frame, parse_response
-from conformance.link.safety import Guard, SafetyStop
+from conformance.link.framing import (
+    CR,
+    HostFrame,
+    HostFramer,
+    Response,
+    frame,
+    parse_response,
+    readable,
+)
+from conformance.link.safety import Guard
+from gve_fixtures.protocol import St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
 SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
-#: H and W answer when the motion has stopped
-SLOW = {"H": 120.0, "W": 600.0}
+#: real time: after a frame timed out, how long the line must stay quiet before the next
+#: frame (an answer later than this after its timeout could still be misread)
+QUIET = 2.5
+#: real time: at the end of a case, how long to listen for bytes still on their way
+END_QUIET = 0.05
+
+# what the last frame left on the line
+_ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
 
 
 class Link:
-    def __init__(self, port, *, address: int = 0, baud: int = 115200,
-                 virtual: bool = False, guard: Guard | None = None,
-                 rig=None) -> None:
+    def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
+                 virtual: bool = False, rig=None) -> None:
         self.port = port
         self.address = address
         self.baud = baud
         self.virtual = virtual
-        self.guard = guard or Guard(enforce=False, max_travel=0, allow_destructive=True)
+        self.guard = guard
         self.rig = rig
         self.checksums = False
         self.log: list[Record] = []
         self.frames = 0
+        self.violations: list[str] = []
         self._faults: list[Fault] = []
+        self._framer = HostFramer()
+        self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
+        self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
+        self._dropped = False
         self._origin = self._clock()
-        self.eeprom_backup: dict[int, int] = {}
 
     # -- time ------------------------------------------------------------------------------
     def _clock(self) -> int:
@@ -55,19 +84,30 @@ class Link:
 
     def wait(self, seconds: float) -> bytes:
         """Let ``seconds`` pass; returns whatever arrived meanwhile."""
+        self.guard.check_idle()
         if self.virtual:
             self.port.line.advance(seconds)
             data = self.port.read(self.port.in_waiting)
         else:
-            end = time.monotonic() + seconds
-            data = bytearray()
-            while time.monotonic() < end:
-                self.port.timeout = max(0.0, end - time.monotonic())
-                data += self.port.read(max(1, self.port.in_waiting))
-            data = bytes(data)
+            data = self._listen(seconds, stop_early=False)
         if data:
             self._record(UNIT, data)
+            self._after_answer(data, "during a wait")
+        self._last = (_UNASKED, b"", b"")
         return data
+
+    def _listen(self, seconds: float, *, stop_early: bool) -> bytes:
+        """Real time: read for ``seconds`` (``stop_early``: until the line has been quiet
+        that long); Ctrl-C ends the wait."""
+        end = time.monotonic() + seconds
+        data = bytearray()
+        while time.monotonic() < end and not self.guard.interrupts.pending:
+            self.port.timeout = min(0.05, max(0.0, end - time.monotonic()))
+            got = self.port.read(max(1, self.port.in_waiting))
+            data += got
+            if got and stop_early:
+                end = time.monotonic() + seconds
+        return bytes(data)
 
     def _pause(self, seconds: float) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
@@ -94,54 +134,80 @@ class Link:
     def note(self, text: str) -> None:
         self.log.append(Record("=", f"note {text}".encode("ascii", "replace"), self.now))
 
-    def send_raw(self, data: bytes) -> None:
-        """Bytes exactly as given (host faults apply)."""
+    def _transmit(self, data: bytes, summed: bool | None) -> list[HostFrame]:
+        """Write ``data`` (host faults apply) once the guard has judged every frame it
+        completes; returns those frames."""
+        self._book_unbooked(None)
         fault = self._fault("host")
         pieces = fault.apply(data) if fault else [(data, 0.0)]
+        wire = b"".join(p for p, _ in pieces)
+        frames = self._framer.frames(wire, commit=False)
+        self.guard.check_frames(frames, summed)
+        self.settle()
+        self._framer.frames(wire)
         if fault:
             self.note(f"fault host {fault.kind} {fault.params}")
+        self._dropped = not wire
         for piece, pause in pieces:
             if pause:
                 self._pause(pause)
             if piece:
                 self._record(HOST, piece)
                 self.port.write(piece)
+        if frames:
+            self._last = (_UNASKED, frames[-1].raw, b"")
+        return frames
+
+    def send_raw(self, data: bytes) -> None:
+        """Bytes exactly as given (host faults apply). Every frame they complete is
+        judged and booked like any other; its answer is whatever :meth:`read_response`
+        reads next."""
+        self._unbooked = self._transmit(data, None)
 
     def send(self, body: str, *, lines: int = 1, answer: bool = True,
              checksum: bool | str = "auto", address: int | None = None,
              timeout: float | None = None) -> Response | None:
         """Send one command frame and read its answer (None when none came in time)."""
-        backup = self.guard.check(body)
-        for a in backup:
-            self._backup(a)
         summed = self.checksums if checksum == "auto" else checksum
         address = self.address if address is None else address
-        self.drain_unsolicited()
         data = frame(body, address, summed)
         self.frames += 1
         sent_at = self.now
-        self.send_raw(data)
+        sent = self._transmit(data, summed is not False)
         if not answer:
+            self._book(sent, None)
             return None
-        name = body[:1]
-        wait = timeout if timeout is not None else SLOW.get(name, MARGIN + self.byte_seconds(
-            len(data) + 64))
+        if timeout is None:
+            slow = self.guard.answer_seconds(body)
+            timeout = MARGIN + self.byte_seconds(len(data) + 64) + (slow or 0.0)
         # the answer is summed iff the mode is on after the command (spec 6, 10 J)
         after = {"%+": True, "%-": False, "J": False}.get(body, self.checksums)
-        r = self.read_response(wait, lines, summed=after)
-        if r is None:
-            return None
-        r.sent_at = sent_at
-        self._learn(body, r)
+        self._unbooked = sent
+        r = self.read_response(timeout, lines, summed=after)
+        if r is not None:
+            r.sent_at = sent_at
         return r
 
-    def _learn(self, body: str, r: Response) -> None:
-        if r.code == 0:
-            if body == "%+":
-                self.checksums = True
-            elif body == "%-" or body == "J":
-                self.checksums = False
-            self.guard.accepted(body)
+    def _book(self, frames: list[HostFrame], answer: Response | None) -> None:
+        """Book frames with the answer to the last one (the others got none)."""
+        for i, f in enumerate(frames):
+            r = answer if i == len(frames) - 1 else None
+            body = f.bodies(self.checksums)[0]
+            address = self.address if f.address is None else f.address
+            if r is not None and r.code == 0 and address in self.guard.addresses:
+                self._learn(body)
+            self.guard.accepted(body, r, address)
+
+    def _book_unbooked(self, answer: Response | None) -> None:
+        frames, self._unbooked = self._unbooked, []
+        self._book(frames, answer)
+
+    def _learn(self, body: str) -> None:
+        """The host's belief about the checksum mode follows the commands that set it."""
+        if body == "%+":
+            self.checksums = True
+        elif body in ("%-", "J"):
+            self.checksums = False
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
                       summed: bool | None = None) -> Response | None:
@@ -155,30 +221,60 @@ class Link:
                 break
             self.port.timeout = MARGIN
         data = bytes(raw)
+        summed = self.checksums if summed is None else summed
+        real = parse_response(data, summed=summed, lines=lines) if data else None
         if data:
             self._record(UNIT, data)
+            real.received_at = self.now
+        self._last = (_ANSWERED if real is not None and real.code is not None else _TIMED_OUT,
+                      self._last[1], data)
+        if not self.virtual and data and self.port.in_waiting:
+            self.settle()                        # a second answer right behind the first
+        self._book_unbooked(real)
+        r = real
         fault = self._fault("unit")
         if fault is not None:
             self.note(f"fault unit {fault.kind} {fault.params}")
             pieces = fault.apply(data) if data else []
-            data = b"".join(p for p, _ in pieces)
-        if not data:
-            return None
-        r = parse_response(data, summed=self.checksums if summed is None else summed,
-                           lines=lines)
-        r.received_at = self.now
+            faulted = b"".join(p for p, _ in pieces)
+            r = parse_response(faulted, summed=summed, lines=lines) if faulted else None
+            if r is not None:
+                r.received_at = self.now
+        if not self._dropped:
+            self.guard.answered(real)
         return r
 
-    def drain_unsolicited(self) -> bytes:
-        """Bytes that arrived although nothing was asked (late or extra answers): they
-        are logged, so that they cannot pass for the answer to the next frame."""
+    def settle(self, *, final: bool = False) -> bytes:
+        """Take what arrived although nothing was asked, before the next frame (or, with
+        ``final``, at the end of a case): after a complete answer it is a second answer
+        (a violation), after a timeout a late one (a violation), else unsolicited. In
+        real time, after a timeout, wait until the line is quiet first."""
+        state = self._last[0]
+        data = b""
+        if not self.virtual:
+            if state == _TIMED_OUT and not self.guard.interrupts.pending:
+                data = self._listen(QUIET, stop_early=True)
+            elif final:
+                data = self._listen(END_QUIET, stop_early=True)
         waiting = self.port.in_waiting
-        if not waiting:
+        if waiting:
+            data += self.port.read(waiting)
+        if not data:
             return b""
-        data = self.port.read(waiting)
-        if data:
-            self._record(UNIT, data, "unsolicited")
+        self._record(UNIT, data, "unsolicited")
+        self._after_answer(data, "after")
+        self._last = (_UNASKED, b"", b"")
         return data
+
+    def _after_answer(self, data: bytes, when: str) -> None:
+        state, sent, answer = self._last
+        frame_text = readable(sent) or "the last frame"
+        if state == _ANSWERED:
+            self.violations.append(f"answered twice: {frame_text} got {readable(answer)}, "
+                                   f"then {readable(data)} {when}")
+        elif state == _TIMED_OUT:
+            self.violations.append(f"answered after its timeout: {frame_text} got "
+                                   f"{readable(data)} late")
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05) -> Response | None:
@@ -194,33 +290,15 @@ class Link:
 
     def wait_idle(self, max_seconds: float = 60.0) -> bool:
         """Poll SR6 until RUN = 0 (spec 10.3)."""
-        r = self.poll("SR6", lambda r: bool(r.values) and _hex(r.values[0]) is not None
-                      and not _hex(r.values[0]) & 0x40, max_seconds)
+        r = self.poll("SR6", lambda r: r.code == 0 and idle_st6(r), max_seconds)
         return r is not None
-
-    # -- EEPROM backup ----------------------------------------------------------------------
-    def _backup(self, address: int) -> None:
-        r = self.send("ER%02X" % address)
-        if r is None or r.code != 0 or not r.values:
-            raise SafetyStop(f"could not back up EEPROM {address:02X} before writing it")
-        self.eeprom_backup[address] = int(r.values[0], 16)
-        self.guard.eeprom_touched.add(address)
-
-    def restore_eeprom(self) -> list[str]:
-        """Write back every byte the session changed and verify it; returns problems."""
-        problems = []
-        for address, value in sorted(self.eeprom_backup.items()):
-            self.guard.eeprom_touched.add(address)
-            self.send("EW%02X,%02X" % (address, value))
-            r = self.send("ER%02X" % address)
-            if r is None or r.values[:1] != ["%02X" % value]:
-                problems.append(f"EEPROM {address:02X} not restored to {value:02X}")
-        self.eeprom_backup.clear()
-        return problems
 
     def transcript_lines(self) -> list[str]:
         return [rec.line() for rec in self.log]
 
 
-def _hex(text: str) -> int | None:
-    return int(text, 16) if re.fullmatch(r"[0-9A-F]{2}", text) else None
+def idle_st6(r: Response) -> bool:
+    """Whether an answer to `SR6` (or `F`) shows RUN = 0."""
+    text = r.values[0] if r.values else ""
+    return len(text) == 2 and all(c in "0123456789ABCDEF" for c in text) and \
+        not int(text, 16) & St6.RUN

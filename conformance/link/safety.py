@@ -1,65 +1,398 @@
-"""Safety on real units (issue 4 item 10): the motion envelope and destructive commands.
+"""The run-wide guard on a real unit (issue 8): every frame is judged here before it is
+sent and booked here after its answer, whoever sends it (a case, a machine, a golden
+replay's raw bytes, the diff runner, the session itself).
 
-Real units are machines with spindles. The link asks this guard before sending a frame:
-vectors that would take an axis beyond ``max_travel`` steps from where the session
-began are refused (:class:`SafetyStop`), `J` and EEPROM writes need
-``allow_destructive``, and every EEPROM byte is backed up before its first write so the
-link can restore it at the end (and verify it by reading back).
+Real units are machines with spindles. The guard refuses (:class:`SafetyStop`, the case
+ends COULD-NOT-TEST) a frame that could take an axis beyond ``max_travel`` full steps
+from where the run began (the :class:`~conformance.link.envelope.Envelope` keeps that for
+the whole run), `J`, `W` and EEPROM writes without ``allow_destructive``, an EEPROM write
+to a byte the session did not back up, and motion or destructive frames for an address
+that is not the unit's. It raises :class:`~conformance.link.interrupts.Interrupted`
+before any frame once Ctrl-C was pressed (except the session's `H`, `D` and
+restorations), and :class:`TargetNotResponding` after a few frames in a row got no
+answer.
+
+Public interface (docs/suite.md, "The session and its guard")::
+
+    guard.check(body, address)           # before sending: raises SafetyStop / Interrupted
+    guard.check_frames(frames, summed)   # the same for raw bytes, framed as a unit would
+    guard.accepted(body, response, address)   # after the answer (None: no answer seen)
 """
 
 from __future__ import annotations
 
+import contextlib
+import math
 import re
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+from conformance.link.envelope import INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
+from conformance.link.framing import HostFrame, Response
+from conformance.link.interrupts import Interrupted, Interrupts
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import St6
 
 
-class SafetyStop(Exception):
-    """A frame the suite refused to send to a real unit."""
+class SafetyStop(BaseException):
+    """A frame the suite refused to send to a real unit: the case ends COULD-NOT-TEST.
+
+    A BaseException, so that no case and no Hypothesis machine takes it for a failure
+    and tries the frame again."""
 
 
-_VECTOR = re.compile(r"([LC])(-?\d+(?:,-?\d+)*)$")
-_EEPROM_WRITE = re.compile(r"(EW|EFW|EUW)([0-9A-Fa-f]{1,2}),")
-_WIDTH = {"EW": 1, "EFW": 4, "EUW": 4}
+class TargetNotResponding(BaseException):
+    """Several frames in a row got no answer: the run stops for this target."""
 
 
-@dataclass
+#: commands of spec 10 whose names are longer than one letter, longest first
+_NAMES = ("EFW", "EUW", "EFR", "EUR", "EW", "ER", "*S", "*E", "VL", "VK", "VN", "XA", "XU",
+          "XD", "XM", "PF", "SR", "SW", "NX", "NY", "NZ", "NA", "I0", "I1", "I2")
+#: frames that can start an axis moving (and so ask the operator first)
+MOTION = frozenset({"L", "C", "*E", "G", "R", "W", "SW6"})
+#: frames that change what outlives the run: restart, reference run, EEPROM
+DESTRUCTIVE = frozenset({"J", "W", "EW", "EFW", "EUW"})
+_EEPROM_WIDTH = {"EW": 1, "EFW": 4, "EUW": 4}
+#: frames a unit answers at once inside an open packet, discarding it (spec 7)
+_PACKET_BREAKERS = frozenset({"H", "@", ">", "J"})
+#: consecutive frames without an answer after which the target is given up
+SILENCE_LIMIT = 4
+
+
+@dataclass(frozen=True)
+class Command:
+    """A frame's body as the guard reads it: leniently (a unit that is not conforming
+    may take `l` for `L` or `+5` for 5), so that no reading of it goes unjudged."""
+
+    name: str
+    params: str
+
+    @classmethod
+    def parse(cls, body: str) -> Command:
+        text = body.upper()
+        for name in _NAMES:
+            if text.startswith(name):
+                params = text[len(name):]
+                if name == "SW" and _number(params.split(",")[0]) == point(6):
+                    name = "SW6"             # writing ST6 may resume motion (spec 10.3)
+                return cls(name, params)
+        if text.startswith("N"):
+            return cls("N", text[1:])        # N followed by junk: N with a bad parameter
+        return cls(text[:1], text[1:])
+
+    def fields(self, count: int) -> list[Span]:
+        """The first ``count`` comma-separated integers (missing ones 0, unreadable ones
+        unbounded)."""
+        parts = self.params.split(",") if self.params else []
+        return [_number(parts[i]) if i < len(parts) else ZERO for i in range(count)]
+
+
+def _number(text: str, base: int = 10) -> Span:
+    text = text.strip().lstrip("+")
+    if text == "":
+        return ZERO
+    try:
+        return point(int(text, base))
+    except ValueError:
+        return UNKNOWN
+
+
+def outcome_of(r: Response | None) -> Outcome:
+    if r is None or r.code is None:
+        return Outcome.UNCLEAR
+    return Outcome.ACCEPTED if r.code == 0 else Outcome.REFUSED
+
+
 class Guard:
-    enforce: bool                      # False on the emulator: nothing to protect
-    max_travel: int
-    allow_destructive: bool
-    axes: int = 3
-    position: list[int] = field(default_factory=lambda: [0, 0, 0, 0])
-    eeprom_touched: set[int] = field(default_factory=set)
+    """One unit's run-wide guard (see the module's docstring)."""
 
-    def check(self, body: str) -> list[int]:
-        """Raise SafetyStop if ``body`` may not be sent; returns EEPROM addresses that
-        must be backed up first."""
+    def __init__(self, profile: Profile, address: int, *, enforce: bool, max_travel: int,
+                 allow_destructive: bool, interrupts: Interrupts | None = None) -> None:
+        self.profile = profile
+        self.address = address
+        self.enforce = enforce
+        self.max_travel = max_travel
+        self.allow_destructive = allow_destructive
+        self.interrupts = interrupts or Interrupts()
+        micro = profile.microstep
+        self.scale = profile.position_scale               # counter units per full step
+        self.envelope = Envelope(
+            len(profile.axes), max_travel * self.scale if enforce else INF,
+            tuple(micro.factors.values()) if micro else (1,),
+            micro.factors[micro.reset_mode] if micro else 1)
+        self.addresses = {address} | ({profile.spindle.address} if profile.spindle else set())
+        self.packet: list[list[Span]] = []       # C members since *S
+        self.packet_open = False
+        self.eeprom_backed: set[int] = set()     # bytes the session holds the originals of
+        self.eeprom_written: set[int] = set()    # bytes a frame sent may have changed
+        self.before_motion: Callable[[], bool | None] | None = None
+        self.motion_confirmed: bool | None = None
+        self.silences = 0
+        self.dead = False
+        self._own = 0                             # inside the session's own frames
+        self._emergency = 0
+
+    # -- who is sending ----------------------------------------------------------------------
+    @contextlib.contextmanager
+    def own_frames(self) -> Iterator[None]:
+        """The session's own frames (known state, snapshot, restorations): after Ctrl-C
+        these still go out, except motion."""
+        self._own += 1
+        try:
+            yield
+        finally:
+            self._own -= 1
+
+    @contextlib.contextmanager
+    def emergency(self) -> Iterator[None]:
+        """`H` and `D` after Ctrl-C: the frames that go out before anything else."""
+        self._emergency += 1
+        try:
+            yield
+        finally:
+            self._emergency -= 1
+
+    # -- before a frame ----------------------------------------------------------------------
+    def check_idle(self) -> None:
+        """Raise if the run must stop here (Ctrl-C; a target that stopped answering):
+        before every frame and every wait of a case."""
+        if self._emergency:
+            return
+        if self.interrupts.pending or (self.interrupts.stopped and not self._own):
+            raise Interrupted
+        if self.dead and not self._own:
+            raise TargetNotResponding(f"target not responding: {self.silences} frames "
+                                      "unanswered")
+
+    def check(self, body: str, address: int | None = None) -> None:
+        """Raise if the frame ``body`` for ``address`` may not be sent now."""
+        self.check_idle()
+        if self._emergency or not self.enforce:
+            return
+        command = Command.parse(body)
+        address = self.address if address is None else address
+        if address not in self.addresses:
+            if command.name in MOTION | DESTRUCTIVE:
+                raise SafetyStop(f"{body} for address {address}: another unit may be on "
+                                 "the line there; the suite moves and writes only its own")
+            return
+        if command.name in DESTRUCTIVE:
+            self._check_destructive(body, command)
+        if command.name in MOTION:
+            self._check_motion(body, command)
+
+    def check_frames(self, frames: list[HostFrame], summed: bool | None) -> None:
+        """:meth:`check` every reading of raw frames (with and without a trailing
+        checksum when the mode is not known)."""
+        for f in frames:
+            for body in f.bodies(summed):
+                self.check(body, f.address if f.address is not None else self.address)
+
+    def _check_destructive(self, body: str, command: Command) -> None:
+        if not self.allow_destructive:
+            raise SafetyStop(f"{body} restarts the unit, runs to a switch or writes EEPROM: "
+                             "needs --allow-destructive")
+        width = _EEPROM_WIDTH.get(command.name)
+        if width:
+            touched = self._eeprom_bytes(command, width)
+            lost = [a for a in touched if a not in self.eeprom_backed] if touched else [-1]
+            if lost:
+                shown = "?" if lost == [-1] else " ".join("%02X" % a for a in lost)
+                raise SafetyStop(f"{body}: EEPROM {shown} not backed up, so not written")
+            self.eeprom_written.update(touched)
+
+    def _eeprom_bytes(self, command: Command, width: int) -> list[int]:
+        start = _number(command.params.split(",")[0], 16)
+        if not start.exact:
+            return []
+        size = self.profile.eeprom.size
+        return [(int(start.lo) + i) % size for i in range(width)]
+
+    def _check_motion(self, body: str, command: Command) -> None:
+        if self.interrupts.stopped:
+            raise SafetyStop(f"{body}: no motion after Ctrl-C")
+        event = self._event(command, Outcome.UNCLEAR, None)
+        reach = self.envelope.would_reach(event) if event else self.envelope.reach()
+        axis = self.envelope.outside(reach)
+        if axis is not None:
+            span = reach[axis]
+            raise SafetyStop(
+                f"{body}: axis {self.profile.axes[axis]} could reach "
+                f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
+                f"from where the run began, beyond the envelope ±{self.max_travel}")
+        if reach != self.envelope.reach() or command.name in ("G", "R", "SW6"):
+            self._confirm_motion(body)
+
+    def _confirm_motion(self, body: str) -> None:
+        if self.motion_confirmed is None:
+            ask = self.before_motion
+            self.motion_confirmed = True if ask is None else ask() is not False
+        if not self.motion_confirmed:
+            raise SafetyStop(f"{body}: motion was not confirmed")
+
+    # -- after a frame ------------------------------------------------------------------------
+    def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
+        """Book the frame ``body`` with its answer (None when none was seen)."""
         if not self.enforce:
-            return []
-        m = _VECTOR.match(body)
-        if m:
-            steps = [int(x) for x in m.group(2).split(",")]
-            for i, s in enumerate(steps):
-                if abs(self.position[i] + s) > self.max_travel:
-                    raise SafetyStop(f"{body}: axis {i} would leave the envelope "
-                                     f"±{self.max_travel} steps")
-            return []
-        if body.startswith("W"):
-            raise SafetyStop("W moves to a switch: not run on real units by the suite")
-        if body == "J" and not self.allow_destructive:
-            raise SafetyStop("J restarts the unit: needs --allow-destructive")
-        e = _EEPROM_WRITE.match(body)
-        if e:
-            if not self.allow_destructive:
-                raise SafetyStop(f"{e.group(1)} writes EEPROM: needs --allow-destructive")
-            start = int(e.group(2), 16)
-            return [a for a in range(start, start + _WIDTH[e.group(1)])
-                    if a not in self.eeprom_touched]
-        return []
+            return
+        address = self.address if address is None else address
+        if address not in self.addresses:
+            return
+        command = Command.parse(body)
+        outcome = outcome_of(response)
+        if command.name in ("C", "B") and self.packet_open:
+            steps = command.fields(self.envelope.axes)
+            if command.name == "C":
+                self.packet.append(steps)
+            if response is not None:      # answered: the unit did not take it as a member
+                self.envelope.vector(steps, outcome, stand_alone=False)
+            return
+        event = self._event(command, outcome, None if response is None else response.code)
+        if event is not None:
+            event(self.envelope)
+        self._learn(command, response, outcome)
 
-    def accepted(self, body: str) -> None:
-        """Book a vector the unit accepted (answer code 0)."""
-        m = _VECTOR.match(body)
-        if m:
-            for i, s in enumerate(int(x) for x in m.group(2).split(",")):
-                self.position[i] += s
+    def _event(self, command: Command, outcome: Outcome,
+               code: int | None) -> Callable[[Envelope], None] | None:
+        """What ``command`` does to the envelope with ``outcome`` (None: nothing);
+        ``code`` is the answer's code when there was one."""
+        axes = self.envelope.axes
+        name = command.name
+        if name in ("L", "C"):
+            steps = command.fields(axes)
+            if name == "C" and self.packet_open:          # a member: judged with the packet
+                members = [*self.packet, steps]
+                return lambda e: _commit(e, members, outcome)
+            return lambda e: e.vector(steps, outcome, stand_alone=name == "L")
+        if name == "*E":
+            members = list(self.packet)
+            return lambda e: _commit(e, members, outcome)
+        if name == "D":
+            return lambda e: e.discard(outcome)
+        if name == "K":
+            return lambda e: e.discard(outcome, keep=True)
+        if name == "J":
+            return lambda e: e.discard(outcome, restart=True)
+        if name == "R":
+            return lambda e: e.restore(outcome)
+        if name in ("G", "SW6"):
+            return lambda e: e.unsettle()
+        if name == "N" or name in ("NX", "NY", "NZ", "NA"):
+            return self._counters(command, outcome)
+        if name == "W":
+            return self._reference(command, outcome, code)
+        if name == "M" and self.profile.microstep:
+            factor = self.profile.microstep.factors.get(command.params.strip())
+            return None if factor is None else (lambda e: e.mode(factor, outcome))
+        return None
+
+    def _counters(self, command: Command, outcome: Outcome) -> Callable[[Envelope], None]:
+        """`N` zeroes every counter, `N<axis> n` sets one; a value the guard cannot read
+        leaves that counter unknown."""
+        names = self.profile.axes
+        if command.name == "N":
+            known = not command.params              # N with junk: a bad parameter
+            values = {i: 0 if known else None for i in range(len(names))}
+        elif command.name[1] in names:
+            value = _number(command.params)
+            values = {names.index(command.name[1]): int(value.lo) if value.exact else None}
+        else:
+            values = {}
+        return lambda e: e.counters(values, outcome)
+
+    def _reference(self, command: Command, outcome: Outcome,
+                   code: int | None) -> Callable[[Envelope], None]:
+        """`W<axis>,n2,n3,n4,n5`: to the switch within n2, back within n4 (spec 10 W).
+        Answered 5 (no switch, or still active) the axis has moved all the same."""
+        names = self.profile.axes
+        axis = command.params[:1]
+        n2, _, n4, _ = Command("W", command.params[1:].lstrip(",")).fields(4)
+        if code == 5:
+            outcome = Outcome.ACCEPTED
+        zeroed = code == 0
+        if axis not in names or not (n2.exact and n4.exact):
+            every = range(len(names))
+            return lambda e: [e.reference(i, UNKNOWN, outcome, zeroed=True) for i in every]
+        to, back = int(n2.lo), abs(int(n4.lo))
+        travel = Span(min(0, to) - (back if to > 0 else 0), max(0, to) + (back if to < 0 else 0))
+        i = names.index(axis)
+        return lambda e: e.reference(i, travel, outcome, zeroed=zeroed)
+
+    def _learn(self, command: Command, r: Response | None, outcome: Outcome) -> None:
+        """What an answer tells beyond the command itself: packets open and close, the
+        unit shows it rests, a position is read."""
+        name = command.name
+        if name == "*S":
+            self.packet, self.packet_open = [], True
+        elif name == "*E":
+            self.packet_open = False
+            if outcome is not Outcome.UNCLEAR:
+                self.packet = []
+        elif name in _PACKET_BREAKERS:
+            self.packet_open = False
+        if outcome is not Outcome.ACCEPTED or r is None:
+            return
+        if (name == "SR" and _number(command.params) == point(6)) or name == "F":
+            st6 = r.values[0] if r.values else ""
+            if re.fullmatch(r"[0-9A-F]{2}", st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
+                self.envelope.ended()
+        elif name in ("P", "PF"):
+            axes = 2 if name == "P" else min(3, self.envelope.axes)
+            if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
+                self.envelope.observe({i: int(r.values[i]) for i in range(axes)})
+
+    # -- answers and silences ----------------------------------------------------------------
+    def answered(self, response: Response | None) -> None:
+        """Count frames in a row that got no answer (or bytes that are not one)."""
+        if response is not None and response.code is not None:
+            self.silences = 0
+            return
+        self.silences += 1
+        if self.silences >= SILENCE_LIMIT and not self._own and not self._emergency:
+            self.dead = True
+            raise TargetNotResponding(f"target not responding: {self.silences} frames "
+                                      "unanswered")
+
+    @property
+    def responding(self) -> bool:
+        return self.silences < SILENCE_LIMIT
+
+    # -- timing ---------------------------------------------------------------------------------
+    def stop_seconds(self) -> float:
+        """The longest a stop can take (`H` answers when it ends): braking at the
+        smallest acceleration over the longest distance the envelope allows (both
+        directions), or from the fastest rate where there is no envelope."""
+        a_min = self.profile.range("A").lo * 1000.0 * self.envelope.factor.lo
+        if math.isinf(self.envelope.limit):
+            return self.profile.max_rate / a_min
+        return math.sqrt(2 * 2 * self.envelope.limit / a_min)
+
+    def answer_seconds(self, body: str) -> float | None:
+        """How long `H` and `W` may take before they answer (None: at once)."""
+        command = Command.parse(body)
+        if command.name == "H":
+            return 2 * self.stop_seconds()
+        if command.name == "W":
+            n2, n3, n4, n5 = Command("W", command.params[1:].lstrip(",")).fields(4)
+            if all(x.exact for x in (n2, n3, n4, n5)) and n3.lo > 0 and n5.lo > 0:
+                return abs(n2.lo) / n3.lo + abs(n4.lo) / n5.lo + 4 * self.stop_seconds()
+            return 600.0
+        return None
+
+    # -- the report ---------------------------------------------------------------------------
+    def excursion(self) -> list[tuple[float, float]]:
+        """Per axis, the farthest the axis may have gone each way, in full steps."""
+        return [(_steps(s.lo, self.scale), _steps(s.hi, self.scale)) for s in self.envelope.seen]
+
+
+def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:
+    for steps in members:
+        e.vector(steps, outcome, stand_alone=False)
+
+
+def _steps(counter: float, scale: int) -> float:
+    """Counter units as full steps (GVE54 counters are sixteenths)."""
+    if math.isinf(counter):
+        return counter
+    value = counter / scale
+    return int(value) if value == int(value) else round(value, 4)

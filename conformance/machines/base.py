@@ -36,13 +36,13 @@ class UnitMachine(RuleBasedStateMachine):
     def index(self) -> int:
         r = self.link.send("@")
         assert r is not None and r.code == 0 and r.values, f"@ answered {r}"
-        return int(r.values[0])
+        return r.dec()
 
     def position(self) -> list[int]:
         r = self.link.send("PF")
         self.model.frame_arrived("P")
         assert r is not None and r.code == 0, f"PF answered {r}"
-        return [int(v) for v in r.values]
+        return r.decs()
 
     @invariant()
     def index_is_the_models(self) -> None:

@@ -33,7 +33,7 @@ class ErrorMachine(UnitMachine):
         r = self.link.send("SR6")
         self.model.frame_arrived("S")
         assert r is not None and r.code == 0 and r.values, f"SR6 answered {r}"
-        st6 = int(r.values[0], 16)
+        st6 = r.hex()
         assert r.inta == bool(st6 & INTA), f"the INTA bit of {r.text} disagrees with ST6"
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
         return (run and not inta) or bool(st6 & 0x01), run, inta

@@ -1,14 +1,17 @@
 """Targets: where the suite's links go, one small module per scheme (as pyserial's URL
 handlers are): ``emu:PROFILE`` (emu.py, the embedded emulator in virtual time),
 ``serial:PATH?baud=&address=`` and ``tcp:HOST:PORT`` (port.py, a unit or a clone's
-simulator in real time). :func:`parse_target` picks the module by the scheme."""
+simulator in real time). :func:`parse_target` picks the module by the scheme; the
+run-wide session (session.py) opens links and keeps the unit safe."""
 
 from __future__ import annotations
 
 from conformance.targets import emu, port
-from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, known_state
+from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
+from conformance.targets.session import Session, SessionError, SessionReport
 
-__all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Target", "known_state", "parse_target"]
+__all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Session", "SessionError", "SessionReport",
+           "Target", "TargetError", "parse_target"]
 
 #: scheme -> the module that parses it (``parse(kind, rest, **options) -> Target``)
 SCHEMES = {"emu": emu, "serial": port, "tcp": port}
@@ -16,12 +19,13 @@ SCHEMES = {"emu": emu, "serial": port, "tcp": port}
 
 def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bool = False,
                  max_travel: int = DEFAULT_MAX_TRAVEL, mutant: str | None = None) -> Target:
-    """A target from its command-line text (``emu:GVE84-100``, ``serial:/dev/ttyUSB0``...)."""
+    """A target from its command-line text (``emu:GVE84-100``, ``serial:/dev/ttyUSB0``...).
+    Raises TargetError (or LookupError for an unknown profile) with one line to show."""
     kind, _, rest = spec.partition(":")
     module = SCHEMES.get(kind)
     if module is None:
-        raise ValueError(f"unknown target {spec!r}: use "
-                         "emu:PROFILE, serial:PATH?baud=&address=, or tcp:HOST:PORT")
+        raise TargetError(f"unknown target {spec!r}: use "
+                          "emu:PROFILE, serial:PATH?baud=&address=, or tcp:HOST:PORT")
     return module.parse(kind, rest, spec=spec, profile=profile,
                         allow_destructive=allow_destructive, max_travel=max_travel,
                         mutant=mutant)

@@ -1,18 +1,24 @@
-"""A target: the profile expected of it, how to open links to it, and the known state
-a real unit is put into before each case (docs/suite.md)."""
+"""A target: the profile expected of it and how to reach it. Each scheme's module
+(emu.py, port.py) makes one; the run-wide :class:`~conformance.targets.session.Session`
+opens its links and keeps what must hold for the whole run (docs/suite.md)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import serial
 
 from conformance.case import TargetInfo
+from conformance.link.interrupts import Interrupts
 from conformance.link.link import Link
-from conformance.link.safety import Guard
+from conformance.targets.session import Session
 from gve_fixtures.profile import Profile
 
 DEFAULT_MAX_TRAVEL = 2000
+
+
+class TargetError(ValueError):
+    """A target that cannot be used as given (one line for the user, before any frame)."""
 
 
 @dataclass
@@ -23,61 +29,33 @@ class Target:
     baud: int
     url: str
     mutant: str | None = None
-    _port: serial.SerialBase | None = None
-    links: list[Link] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._session: Session | None = None
+
+    @property
+    def session(self) -> Session:
+        """The run's session on this target (a new one until :meth:`begin` names one)."""
+        if self._session is None:
+            self._session = Session(self)
+        return self._session
+
+    def begin(self, interrupts: Interrupts | None = None) -> Session:
+        """A new session for a run (Ctrl-C shared through ``interrupts``)."""
+        self._session = Session(self, interrupts)
+        return self._session
 
     def open_link(self, address: int | None = None) -> Link:
-        if self.info.kind == "emu":
-            import emulator  # noqa: F401  (registers gve://)
-            address = self.address if address is None else address
-            query = f"model={self.profile.name}&address={address}"
-            if self.mutant:
-                query += f"&mutant={self.mutant}"
-            port = serial.serial_for_url(f"gve://?{query}", timeout=0.25)
-            link = Link(port, address=address, baud=port.line.baud, virtual=True,
-                        rig=port.line)
-        else:
-            if address is not None and address != self.address:
-                from conformance.case import CouldNotTest
-                raise CouldNotTest(f"needs a unit at address {address}")
-            if self._port is None:
-                self._port = serial.serial_for_url(self.url, baudrate=self.baud, timeout=0.5)
-            guard = Guard(enforce=True, max_travel=self.info.max_travel,
-                          allow_destructive=self.info.allow_destructive,
-                          axes=len(self.profile.axes))
-            link = Link(self._port, address=self.address, baud=self.baud, guard=guard)
-            known_state(link, self.profile)
-        self.links.append(link)
-        return link
+        """A link in the known state, through the session."""
+        return self.session.open_link(address)
 
-    def emergency_stop(self) -> None:
-        """Ctrl-C on a real unit: H, then D."""
-        if self._port is not None:
-            for body in ("H", "D"):
-                self._port.write(f"!{self.address}{body}\r".encode())
-                self._port.timeout = 5
-                self._port.read_until(b"\r")
+    def preflight(self) -> None:
+        """Raise TargetError if the target cannot be used (checked before anything is
+        sent: the port opens, the options make sense)."""
+
+    def connect(self, address: int | None) -> tuple[serial.SerialBase, int, bool, object]:
+        """(port, baud, virtual time, rig or None) for a new link."""
+        raise NotImplementedError
 
     def close(self) -> None:
-        if self._port is not None:
-            self._port.close()
-            self._port = None
-
-
-RESET_SEQUENCE = ("H", "D", "SW0,00", "SW1,00", "SW2,00", "SW3,00", "SW4,00", "SW5,00",
-                  "XM100", "VN", "N")
-
-
-def known_state(link: Link, profile: Profile) -> None:
-    """Put a real unit into the state a case expects (docs/suite.md)."""
-    # H first: it is answered even inside an open packet, and discards it (spec 7)
-    link.send("H", checksum=True)
-    link.send("%-", checksum=True)          # harmless if checksums were off: an error
-    link.checksums = False
-    r = profile.reset
-    for body in (*RESET_SEQUENCE, f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"):
-        link.send(body)                      # a command the unit lacks just answers 3
-    link.send("G")                           # clears INTA left by H (6 when none)
-    link.send("D")
-    link.guard.position = [0, 0, 0, 0]
-    link.log.clear()
+        """Release what the target holds (a port)."""

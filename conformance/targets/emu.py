@@ -6,20 +6,11 @@ from __future__ import annotations
 
 from urllib.parse import parse_qs, urlsplit
 
+import serial
+
 from conformance.case import TargetInfo
-from conformance.targets.base import Target
+from conformance.targets.base import Target, TargetError
 from gve_fixtures.profile import load_profile
-
-
-def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
-    parts = urlsplit("x://h/" + rest)
-    name = parts.path.lstrip("/") or "GVE84-100"
-    q = parse_qs(parts.query)
-    mutant = q.get("mutant", [mutant])[-1]
-    p = load_profile(profile or name)
-    info = TargetInfo("emu", spec, True, True, True, max_travel)
-    return Target(info, p, p.address, p.default_baud, spec, mutant)
 
 
 def mutants() -> dict[str, tuple[str, str]]:
@@ -29,3 +20,33 @@ def mutants() -> dict[str, tuple[str, str]]:
     # an entry is (sections, description[, area]); the area defaults to the first section
     return {name: (spec[2] if len(spec) > 2 else spec[0].split(",")[0].strip(), spec[1])
             for name, spec in MUTANTS.items()}
+
+
+class EmuTarget(Target):
+    def preflight(self) -> None:
+        if self.mutant is not None and self.mutant not in mutants():
+            raise TargetError(f"unknown mutant {self.mutant!r} "
+                              f"(known: {', '.join(sorted(mutants()))})")
+
+    def connect(self, address: int | None):
+        import emulator  # noqa: F401  (registers gve://)
+        address = self.address if address is None else address
+        query = f"model={self.profile.name}&address={address}"
+        if self.mutant:
+            query += f"&mutant={self.mutant}"
+        port = serial.serial_for_url(f"gve://?{query}", timeout=0.25)
+        return port, port.line.baud, True, port.line
+
+
+def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
+          max_travel: int, mutant: str | None) -> Target:
+    parts = urlsplit("x://h/" + rest)
+    name = parts.path.lstrip("/") or "GVE84-100"
+    q = parse_qs(parts.query)
+    mutant = q.get("mutant", [mutant])[-1]
+    p = load_profile(name)
+    if profile is not None and load_profile(profile).name != p.name:
+        raise TargetError(f"--profile {profile} contradicts the target {spec} "
+                          f"(the emulator behaves as {p.name})")
+    info = TargetInfo("emu", spec, True, True, True, max_travel)
+    return EmuTarget(info, p, p.address, p.default_baud, spec, mutant)

@@ -1,14 +1,16 @@
 """``serial:PATH?baud=&address=`` and ``tcp:HOST:PORT``: a real unit or a clone's
-simulator in real time, one shared port put into a known state before each case.
-``serial:`` also takes any pyserial URL (``serial:rfc2217://host:port``,
-``serial:socket://host:port``, ``serial:loop://``), its own options kept."""
+simulator in real time, one port shared by every link of the run. ``serial:`` also
+takes any pyserial URL (``serial:rfc2217://host:port``, ``serial:socket://host:port``,
+``serial:loop://``), its own options kept."""
 
 from __future__ import annotations
 
 from urllib.parse import parse_qs, urlencode, urlsplit
 
+import serial
+
 from conformance.case import TargetInfo
-from conformance.targets.base import Target
+from conformance.targets.base import Target, TargetError
 from gve_fixtures.profile import available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
@@ -31,14 +33,64 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
     return f"socket://{host}", parse_qs(q_text)
 
 
+class PortTarget(Target):
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._port: serial.SerialBase | None = None
+
+    def preflight(self) -> None:
+        self._open()
+
+    def _open(self) -> serial.SerialBase:
+        if self._port is None:
+            try:
+                self._port = serial.serial_for_url(self.url, baudrate=self.baud, timeout=0.5)
+            except (serial.SerialException, OSError, ValueError) as err:
+                raise TargetError(f"{self.info.spec}: cannot open {self.url}: "
+                                  f"{_reason(err)}") from None
+        return self._port
+
+    def connect(self, address: int | None):
+        if address is not None and address != self.address:
+            from conformance.case import CouldNotTest
+            raise CouldNotTest(f"needs a unit at address {address}")
+        return self._open(), self.baud, False, None
+
+    def close(self) -> None:
+        if self._port is not None:
+            self._port.close()
+            self._port = None
+
+
+def _reason(err: Exception) -> str:
+    text = str(err).splitlines()[0] if str(err) else type(err).__name__
+    return text.split("] ", 1)[-1] if text.startswith("[Errno") else text
+
+
+def _number(q: dict, key: str, default: int, spec: str, lo: int, hi: int) -> int:
+    text = q.get(key, [str(default)])[-1]
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not lo <= value <= hi:
+        raise TargetError(f"{spec}: bad {key} {text!r}: a whole number {lo}..{hi}")
+    return value
+
+
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
           max_travel: int, mutant: str | None) -> Target:
     url, q = locate(kind, rest)
     if profile is None:
-        raise ValueError(f"{spec}: say which profile the unit should behave as "
-                         f"(--profile, one of {', '.join(available_profiles())})")
+        raise TargetError(f"{spec}: say which profile the unit should behave as "
+                          f"(--profile, one of {', '.join(available_profiles())})")
+    if mutant is not None:
+        raise TargetError(f"--mutant plants a bug in the embedded emulator; {spec} is not one")
+    if max_travel <= 0:
+        raise TargetError(f"--max-travel {max_travel}: the envelope needs a positive "
+                          "number of full steps")
     p = load_profile(profile)
-    baud = int(q.get("baud", [p.default_baud])[-1])
-    address = int(q.get("address", [p.address])[-1])
+    baud = _number(q, "baud", p.default_baud, spec, 1, 10_000_000)
+    address = _number(q, "address", p.address, spec, 0, 7)
     info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
-    return Target(info, p, address, baud, url)
+    return PortTarget(info, p, address, baud, url)

@@ -1,14 +1,15 @@
-"""Ctrl-C: the run stops, real units get H then D, and the reports of what ran are written."""
+"""Ctrl-C: the run stops, the interrupted case is reported as interrupted, and the
+reports of what ran are written (the real-unit side: tests/conformance/safety)."""
 
 from __future__ import annotations
 
 import json
 
-from conformance.case import Case, TargetInfo
+from conformance.case import Case
 from conformance.reports import write_reports
 from conformance.runner import run
-from conformance.targets import Target, parse_target
-from gve_fixtures.profile import load_profile
+from conformance.targets import parse_target
+from conformance.verdict import COULD_NOT_TEST, PASS
 
 
 def _ok(ctx) -> None:
@@ -16,40 +17,20 @@ def _ok(ctx) -> None:
 
 
 def _interrupt(ctx) -> None:
+    ctx.link.send("?")
     raise KeyboardInterrupt
 
 
-def test_ctrl_c_keeps_what_ran(tmp_path):
+def test_ctrl_c_keeps_what_ran_and_shows_the_interrupted_case(tmp_path):
     cases = [Case("1.test.before", _ok, "r", "M", "test"),
              Case("1.test.ctrl-c", _interrupt, "r", "M", "test"),
              Case("1.test.after", _ok, "r", "M", "test")]
     result = run([parse_target("emu:GVE84-100")], cases, run_id="ctrl-c")
     assert result.interrupted
-    assert [r.id for r in result.results] == ["1.test.before"]
+    assert [(r.id, r.verdict, r.interrupted) for r in result.results] == [
+        ("1.test.before", PASS, False), ("1.test.ctrl-c", COULD_NOT_TEST, True)]
+    assert any("interrupted by Ctrl-C" in n for n in result.results[1].notes)
     folder = write_reports(result, tmp_path)
-    assert json.loads((folder / "results.json").read_text())["interrupted"] is True
-
-
-class FakePort:
-    def __init__(self) -> None:
-        self.written: list[bytes] = []
-        self.timeout = 0.0
-
-    def write(self, data: bytes) -> int:
-        self.written.append(data)
-        return len(data)
-
-    def read_until(self, terminator: bytes) -> bytes:
-        return b"0\r"
-
-    def close(self) -> None:
-        pass
-
-
-def test_emergency_stop_sends_halt_then_delete():
-    info = TargetInfo("serial", "serial:/dev/fake", False, False, False, 2000)
-    target = Target(info, load_profile("GVE84-100"), 0, 115200, "/dev/fake")
-    port = FakePort()
-    target._port = port
-    target.emergency_stop()
-    assert port.written == [b"!0H\r", b"!0D\r"]
+    written = json.loads((folder / "results.json").read_text())
+    assert written["interrupted"] is True
+    assert written["results"][1]["interrupted"] is True

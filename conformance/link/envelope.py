@@ -1,0 +1,268 @@
+"""The motion envelope of a run (issue 8 item 1): where each axis may physically be, in
+counter units from where the run began, kept from the frames the unit accepted.
+
+Pure bookkeeping, no I/O. Every axis is a :class:`Span` (an interval: a position known
+exactly is a span of one point). A vector the unit may have accepted counts with its
+whole length until the unit has shown it ended (spec 10.1, 10.4, 10.5): the queue of
+one axis is kept as its total and its extreme prefix sums (:class:`Path`), so a queue of
+back-and-forth vectors costs its widest swing, not the sum of its lengths. A halted,
+kept or restored remainder counts whole.
+
+`N`, `N<axis>`, `J` and `W` move the counters, not the axes: they change the offset
+between a counter and the physical position, which is how a position read (`PF`, `P`)
+taken while nothing can move tells where the axes are.
+
+Each event takes an :class:`Outcome`: what the answer says happened. ``UNCLEAR`` (no
+answer, or bytes that are not one) assumes whichever of "done" and "not done" reaches
+farther, so the bookkeeping never underestimates where an axis can be; the guard judges
+a frame before it is sent by applying its event as ``UNCLEAR`` to a copy.
+"""
+
+from __future__ import annotations
+
+import copy
+import enum
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+INF = math.inf
+
+
+@dataclass(frozen=True)
+class Span:
+    """An interval of positions (or of offsets, or of factors); bounds may be infinite."""
+
+    lo: float
+    hi: float
+
+    def __add__(self, other: Span) -> Span:
+        return Span(self.lo + other.lo, self.hi + other.hi)
+
+    def __sub__(self, other: Span) -> Span:
+        return Span(self.lo - other.hi, self.hi - other.lo)
+
+    def times(self, factor: Span) -> Span:
+        ends = [a * b for a in (self.lo, self.hi) for b in (factor.lo, factor.hi)
+                if not (math.isinf(a) and b == 0)]
+        return Span(min(ends), max(ends))
+
+    def hull(self, other: Span) -> Span:
+        return Span(min(self.lo, other.lo), max(self.hi, other.hi))
+
+    def meet(self, other: Span) -> Span | None:
+        lo, hi = max(self.lo, other.lo), min(self.hi, other.hi)
+        return Span(lo, hi) if lo <= hi else None
+
+    @property
+    def exact(self) -> bool:
+        return self.lo == self.hi and not math.isinf(self.lo)
+
+    @property
+    def bounded(self) -> bool:
+        return not (math.isinf(self.lo) or math.isinf(self.hi))
+
+
+def point(value: float) -> Span:
+    return Span(value, value)
+
+
+ZERO = point(0)
+UNKNOWN = Span(-INF, INF)
+
+
+@dataclass(frozen=True)
+class Path:
+    """Vectors of one axis run in order from a start: their total and the lowest and
+    highest partial sums (0 included: where the path starts)."""
+
+    total: Span = ZERO
+    low: float = 0
+    high: float = 0
+
+    def then(self, step: Span) -> Path:
+        total = self.total + step
+        return Path(total, min(self.low, total.lo), max(self.high, total.hi))
+
+    @property
+    def swing(self) -> Span:
+        return Span(self.low, self.high)
+
+    def either(self, other: Path) -> Path:
+        """A path that covers this one and ``other`` run in any order: for a save that
+        may hold one or the other."""
+        return Path(self.swing.hull(other.swing), min(self.low, other.low),
+                    max(self.high, other.high))
+
+
+EMPTY = Path()
+
+
+class Outcome(enum.Enum):
+    ACCEPTED = "accepted"      # the unit answered the command with code 0
+    REFUSED = "refused"        # a well-formed error code: nothing of it was executed
+    UNCLEAR = "unclear"        # no answer, or bytes that are not one: maybe either
+
+
+class Envelope:
+    """One unit's axes for the whole run, in counter units from where the run began."""
+
+    def __init__(self, axes: int, limit: float, factors: Sequence[int] = (1,),
+                 reset_factor: int = 1) -> None:
+        self.axes = axes
+        self.limit = limit                       # counter units either side of the start
+        self.start = [ZERO] * axes               # where the queue begins (physical)
+        self.queue = [EMPTY] * axes              # accepted, not shown ended
+        self.saved: list[Path] | None = None     # K's save, counted whole
+        self.settled = True                      # nothing can be moving now
+        self.offset = [UNKNOWN] * axes           # physical = counter + offset
+        self.factor = Span(min(factors), max(factors))   # counter units per commanded step
+        self.reset_factor = reset_factor
+        self.seen = [ZERO] * axes                # every place an axis may have been
+
+    # -- what the unit may do ---------------------------------------------------------------
+    def reach(self) -> list[Span]:
+        """Per axis, every position the axis may be at now or reach with what it accepted."""
+        return [Span(s.lo + q.low, s.hi + q.high)
+                for s, q in zip(self.start, self.queue, strict=True)]
+
+    def would_reach(self, event: Callable[[Envelope], None]) -> list[Span]:
+        """The reach after ``event`` (applied to a copy): how to judge a frame before it
+        is sent."""
+        trial = copy.copy(self)
+        trial.start, trial.queue, trial.offset = list(self.start), list(self.queue), \
+            list(self.offset)
+        event(trial)
+        return trial.reach()
+
+    def outside(self, spans: list[Span]) -> int | None:
+        """The first axis whose span leaves the envelope, or None."""
+        for i, s in enumerate(spans):
+            if s.lo < -self.limit or s.hi > self.limit:
+                return i
+        return None
+
+    def position(self) -> list[float | None]:
+        """Where each axis rests, when that is known exactly (else None)."""
+        known = self.settled and all(q == EMPTY for q in self.queue)
+        return [s.lo if known and s.exact else None for s in self.start]
+
+    # -- events -------------------------------------------------------------------------------
+    def vector(self, steps: Sequence[Span], outcome: Outcome, *, stand_alone: bool) -> None:
+        """`L` (``stand_alone``: accepted only when nothing is queued or running) or `C`
+        with ``steps`` in commanded steps; also a packet member that was committed."""
+        if outcome is Outcome.REFUSED:
+            return
+        if stand_alone and outcome is Outcome.ACCEPTED:
+            self.ended()
+        moves = [s.times(self.factor) for s in steps]
+        if all(m == ZERO for m in moves):
+            return              # a zero-length vector completes as it becomes current
+        self.queue = [q.then(m) for q, m in zip(self.queue, moves, strict=True)]
+        self.settled = False
+        self._see()
+
+    def ended(self) -> None:
+        """The unit showed that everything it accepted has ended (RUN = 0, or an `L` or
+        `N` it took, which it takes only then)."""
+        self.start = [s + q.total for s, q in zip(self.start, self.queue, strict=True)]
+        self.queue = [EMPTY] * self.axes
+        self.settled = True
+
+    def discard(self, outcome: Outcome, *, keep: bool = False, restart: bool = False) -> None:
+        """`D` (the queue emptied where the axes stand), `K` (``keep``: the queue saved
+        whole) or `J` (``restart``: counters zeroed, micro-step mode reset)."""
+        if outcome is Outcome.REFUSED:
+            return
+        sure = outcome is Outcome.ACCEPTED
+        if keep:
+            self.saved = list(self.queue) if sure or self.saved is None else [
+                a.either(b) for a, b in zip(self.saved, self.queue, strict=True)]
+        self.start = self.reach()
+        self.queue = [EMPTY] * self.axes
+        if restart:
+            if sure:
+                self.saved = None
+            self.offset = list(self.start) if sure else [
+                o.hull(s) for o, s in zip(self.offset, self.start, strict=True)]
+            reset = point(self.reset_factor)
+            self.factor = reset if sure else self.factor.hull(reset)
+        self.settled = sure
+
+    def restore(self, outcome: Outcome) -> None:
+        """`R`: the saved queue, whole, runs from where the axes stand after `G`."""
+        if outcome is Outcome.REFUSED:
+            return
+        saved = self.saved or [EMPTY] * self.axes
+        self.start = self.reach()
+        if outcome is Outcome.ACCEPTED:
+            self.queue, self.saved = list(saved), None
+        else:
+            self.queue = [Path(q.swing, q.low, q.high) for q in saved]
+        self.settled = outcome is Outcome.ACCEPTED and all(q == EMPTY for q in self.queue)
+        self._see()
+
+    def counters(self, values: dict[int, int | None], outcome: Outcome) -> None:
+        """`N` (every axis to 0) or `N<axis> n`: the counters move, the axes do not. The
+        unit takes them only when nothing runs (spec 5: 7 whenever RUN = 1). A value of
+        None: the counter's new value is not known."""
+        if outcome is Outcome.REFUSED:
+            return
+        if outcome is Outcome.ACCEPTED:
+            self.ended()
+        for axis, value in values.items():
+            here = self.start[axis] + self.queue[axis].total
+            new = UNKNOWN if value is None else here - point(value)
+            self.offset[axis] = new if outcome is Outcome.ACCEPTED else self.offset[axis].hull(new)
+
+    def reference(self, axis: int, travel: Span, outcome: Outcome, *, zeroed: bool) -> None:
+        """`W`: the axis moves anywhere within ``travel`` (to the switch and back); the
+        counter is 0 where the switch releases (``zeroed``) or moved with the axis."""
+        if outcome is Outcome.REFUSED:
+            return
+        if outcome is Outcome.ACCEPTED:
+            self.ended()
+        else:
+            self.start = self.reach()
+            self.queue = [EMPTY] * self.axes
+        self.start[axis] = self.start[axis] + travel
+        if zeroed or outcome is Outcome.UNCLEAR:
+            self.offset[axis] = self.start[axis] if outcome is Outcome.ACCEPTED else \
+                self.offset[axis].hull(self.start[axis])
+        self.settled = outcome is Outcome.ACCEPTED
+        self._see()
+
+    def mode(self, factor: int, outcome: Outcome) -> None:
+        """GVE54 `M`: later vectors are in steps of ``factor`` counter units (spec 10.7)."""
+        if outcome is Outcome.ACCEPTED:
+            self.factor = point(factor)
+        elif outcome is Outcome.UNCLEAR:
+            self.factor = self.factor.hull(point(factor))
+
+    def unsettle(self) -> None:
+        """Something may have started motion that the bookkeeping already counts (`G`,
+        `SW6`)."""
+        if any(q != EMPTY for q in self.queue):
+            self.settled = False
+
+    # -- what the unit says ------------------------------------------------------------------
+    def origin(self, counters: dict[int, int]) -> None:
+        """The first position read: the counters where the run begins."""
+        for axis, value in counters.items():
+            self.offset[axis] = point(-value)
+
+    def observe(self, counters: dict[int, int]) -> None:
+        """A position read (`PF`, `P`). Only while nothing can move does it tell where an
+        axis rests; a read that contradicts the bookkeeping wins (the unit moved by
+        other means, e.g. a hand-wheel)."""
+        if not self.settled or any(q != EMPTY for q in self.queue):
+            return
+        for axis, value in counters.items():
+            if not self.offset[axis].bounded:
+                continue
+            read = point(value) + self.offset[axis]
+            self.start[axis] = self.start[axis].meet(read) or read
+        self._see()
+
+    def _see(self) -> None:
+        self.seen = [a.hull(b) for a, b in zip(self.seen, self.reach(), strict=True)]

@@ -1,0 +1,62 @@
+"""Ctrl-C during a run (issue 8 item 4).
+
+The first SIGINT does not raise where it lands: it is counted, the frame in flight gets
+its answer (or times out), and the link raises :class:`Interrupted` before the next
+frame, so that the next frame on the line is the session's `H`, then `D`. A signal
+during the restorations that follow stops them the same way (`H`, `D` again, the rest
+skipped). A third signal raises KeyboardInterrupt at once.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+
+
+class Interrupted(KeyboardInterrupt):
+    """Raised by the link before a frame once Ctrl-C was pressed: no frame of a case, a
+    teardown or a machine goes out after the signal."""
+
+
+class Interrupts:
+    """The run's Ctrl-C state, shared by every session of the run."""
+
+    #: signals after which KeyboardInterrupt is raised wherever the program is
+    HARD = 3
+
+    def __init__(self) -> None:
+        self.count = 0        # signals received
+        self.handled = 0      # signals the sessions have answered with H and D
+
+    @property
+    def pending(self) -> bool:
+        """A signal that no `H` has answered yet."""
+        return self.count > self.handled
+
+    @property
+    def stopped(self) -> bool:
+        return self.count > 0
+
+    def signal(self, *_: object) -> None:
+        self.count += 1
+        if self.count >= self.HARD:
+            raise KeyboardInterrupt
+
+    def handle(self) -> None:
+        """The sessions sent H and D for every signal so far."""
+        self.handled = self.count
+
+    @contextlib.contextmanager
+    def catching_sigint(self) -> Iterator[Interrupts]:
+        """SIGINT counts here while the block runs (main thread only; elsewhere the
+        default behaviour stays)."""
+        if threading.current_thread() is not threading.main_thread():
+            yield self
+            return
+        previous = signal.signal(signal.SIGINT, self.signal)
+        try:
+            yield self
+        finally:
+            signal.signal(signal.SIGINT, previous)

@@ -1,0 +1,388 @@
+"""The run-wide session on one target (issue 8): one per target per run.
+
+It owns what must hold for the whole run on one unit, across links, cases and Hypothesis
+examples:
+
+- the :class:`~conformance.link.safety.Guard` every link of the run shares (the motion
+  envelope in physical steps, the destructive guard, Ctrl-C, the count of unanswered
+  frames), whose interface it offers (:meth:`Session.check`, :meth:`Session.check_raw`,
+  :meth:`Session.accepted`) to whoever sends frames by other means;
+- the unit as found (:meth:`start`, before the first case): its identity (`?`, `Q`),
+  its checksum mode, ST0..ST5, where the axes are, and — when destructive commands are
+  allowed — every EEPROM byte, before the run's first EEPROM write;
+- the known state a case starts from (:meth:`open_link`): `H`, `D`, the reset values of
+  what cannot be read, the axes back where the run began, counters zeroed;
+- Ctrl-C (:meth:`emergency_stop`: `H`, then `D`) and the restorations
+  (:meth:`finish`): EEPROM and status words put back and verified by reading back, the
+  checksum mode as found, what cannot be read set to the reset state; what could not be
+  restored goes into :attr:`report` as a problem.
+
+On the embedded emulator every link is a fresh unit: nothing to protect or restore; the
+session still carries Ctrl-C and the count of unanswered frames.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any, Protocol
+
+from conformance.case import CouldNotTest, TargetInfo
+from conformance.link.framing import HostFramer, Response
+from conformance.link.interrupts import Interrupted, Interrupts
+from conformance.link.link import MARGIN, Link
+from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import St6
+
+
+class Reachable(Protocol):
+    """What a session needs of its target (conformance.targets.base.Target)."""
+
+    info: TargetInfo
+    profile: Profile
+    address: int
+
+    def connect(self, address: int | None) -> tuple[Any, int, bool, Any]: ...
+
+#: status words restored at the end, polarity before causes before enables (an enable
+#: written last finds its polarity and cause already in place)
+RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
+
+
+class SessionError(Exception):
+    """The session cannot begin on this target (one line for the user)."""
+
+
+@dataclass
+class SessionReport:
+    """What the session found, did and could not do: for the console and the reports."""
+
+    target: str
+    profile: str
+    axes: list[str]
+    real: bool
+    identity: dict[str, str] = field(default_factory=dict)
+    max_travel: int | None = None                   # full steps either side; None: emulator
+    excursion: list[list[float]] | None = None      # per axis [min, max] in full steps
+    found: dict[str, str] = field(default_factory=dict)
+    restored: list[str] = field(default_factory=list)
+    reset: list[str] = field(default_factory=list)   # could not be read: set to reset state
+    problems: list[str] = field(default_factory=list)
+    interrupted: bool = False
+    not_responding: str = ""
+    wire_log: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+class Session:
+    def __init__(self, target: Reachable, interrupts: Interrupts | None = None) -> None:
+        self.target = target
+        self.profile = target.profile
+        self.interrupts = interrupts or Interrupts()
+        info = target.info
+        self.real = info.kind != "emu"
+        self.guard = Guard(self.profile, target.address, enforce=self.real,
+                           max_travel=info.max_travel, allow_destructive=info.allow_destructive,
+                           interrupts=self.interrupts)
+        self.identity: dict[str, str] = {}
+        self.status: dict[int, int] = {}           # ST0..ST5 as found
+        self.checksums: bool | None = None         # the checksum mode as found
+        self.eeprom: dict[int, int] = {}           # EEPROM bytes as found
+        self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
+                                    self.real, max_travel=info.max_travel if self.real else None)
+        self.started = False
+        self.failed = ""                           # why the session could not begin
+        self.finished = False
+        self._link: Link | None = None             # the latest link (its checksum belief)
+
+    # -- the guard's interface, for frames sent by other means ---------------------------------
+    @property
+    def before_motion(self) -> Callable[[], bool | None] | None:
+        """Called once before the run's first frame that can move an axis; returning
+        False refuses every motion frame of the run (SafetyStop)."""
+        return self.guard.before_motion
+
+    @before_motion.setter
+    def before_motion(self, ask: Callable[[], bool | None] | None) -> None:
+        self.guard.before_motion = ask
+
+    def check(self, body: str, address: int | None = None) -> None:
+        """Raise SafetyStop (or Interrupted, TargetNotResponding) if ``body`` may not go."""
+        self.guard.check(body, address)
+
+    def check_raw(self, data: bytes) -> None:
+        """:meth:`check` every frame ``data`` holds, framed as a unit would."""
+        self.guard.check_frames(HostFramer().frames(data), None)
+
+    def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
+        """Book ``body`` with its answer (None: none seen)."""
+        self.guard.accepted(body, response, address)
+
+    # -- links ----------------------------------------------------------------------------------
+    def _new_link(self, address: int | None = None) -> Link:
+        port, baud, virtual, rig = self.target.connect(address)
+        link = Link(port, self.guard, address=self.target.address if address is None else address,
+                    baud=baud, virtual=virtual, rig=rig)
+        if self._link is not None and not virtual:
+            link.checksums = self._link.checksums
+        self._link = link
+        return link
+
+    def open_link(self, address: int | None = None) -> Link:
+        """A link in the known state (on the emulator: a new unit, at ``address``)."""
+        self.start()
+        self.guard.check_idle()
+        link = self._new_link(address)
+        if self.real:
+            with self.guard.own_frames():
+                self._known_state(link)
+            link.log.clear()
+        return link
+
+    # -- the unit as found ----------------------------------------------------------------------
+    def start(self) -> None:
+        """Read the unit as found, before the first case (real units only)."""
+        if self.failed:
+            raise SessionError(self.failed)
+        if self.started:
+            return
+        self.started = True
+        if not self.real:
+            return
+        link = self._new_link()
+        with self.guard.own_frames():
+            self._probe_checksums(link)
+            for name, body in (("version", "?"), ("processor_id", "Q")):
+                r = link.send(body)
+                if r is not None and r.code == 0:
+                    self.identity[name] = ",".join(r.values)
+            self.report.identity = self.identity
+            for n in range(6):
+                r = link.send(f"SR{n}")
+                if _hex_ok(r):
+                    self.status[n] = r.hex()
+            self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
+            self.report.found["checksums"] = "on" if self.checksums else "off"
+            r = link.send("SR6")
+            if _hex_ok(r):
+                st6 = r.hex()
+                self.report.found["ST6"] = "%02X" % st6
+                if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
+                    self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
+                                   f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
+                                   "mode; stop it before running the suite")
+                    raise SessionError(self.failed)
+            counters = self._position(link)
+            if counters:
+                self.guard.envelope.origin(counters)
+            if self.target.info.allow_destructive and "ER" in self.profile.commands:
+                self._backup_eeprom(link)
+        self.report.wire_log += link.transcript_lines()
+
+    def _probe_checksums(self, link: Link) -> None:
+        """The checksum mode as found: `?` without a checksum is refused (4) in the mode."""
+        r = link.send("?", checksum=False)
+        if r is not None and r.code == 4:
+            summed = link.send("?", checksum=True)
+            if summed is not None and summed.code == 0:
+                link.checksums = True
+        self.checksums = link.checksums
+
+    def _position(self, link: Link) -> dict[int, int]:
+        r = link.send("PF")
+        if r is None or r.code != 0 or len(r.values) < 3:
+            return {}
+        try:
+            return {i: r.dec(i) for i in range(min(3, len(self.profile.axes)))}
+        except AssertionError:
+            return {}
+
+    def _backup_eeprom(self, link: Link) -> None:
+        """Every byte the run can write, before its first EEPROM write: all of them."""
+        for address in range(self.profile.eeprom.size):
+            r = link.send("ER%02X" % address)
+            if _hex_ok(r):
+                self.eeprom[address] = r.hex()
+        self.guard.eeprom_backed = set(self.eeprom)
+        missing = self.profile.eeprom.size - len(self.eeprom)
+        if missing:
+            self.report.problems.append(f"EEPROM: {missing} bytes could not be read, so "
+                                        "they are not written")
+
+    # -- the known state --------------------------------------------------------------------------
+    def _halt(self, link: Link, timeout: float | None = None) -> Response | None:
+        """`H` in the mode the unit is in: refused (4) or unanswered in the mode the link
+        believes, it is sent in the other."""
+        r = link.send("H", timeout=timeout)
+        if r is None or r.code == 4:
+            other = link.send("H", checksum=not link.checksums, timeout=timeout)
+            if other is not None and other.code == 0:
+                link.checksums = not link.checksums
+                return other
+        return r
+
+    def _reset_frames(self) -> list[str]:
+        """What cannot be read, set to the reset state (spec 9)."""
+        p, r = self.profile, self.profile.reset
+        table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
+                 "VL": "VL" + ",".join(str(v) for v in r.VL)}
+        frames = [body for name, body in table.items() if name in p.commands]
+        frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
+        if p.microstep:
+            frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
+        return frames
+
+    def _stop(self, link: Link) -> None:
+        """`H`, checksums off, interrupts off (ST0..ST5 = 00), then `D`: the queue empty
+        and ST6 clear (an input still enabled would set INTA again at once)."""
+        self._halt(link)
+        if link.checksums:
+            link.send("%-", checksum=True)
+        for n in range(6):
+            link.send(f"SW{n},00")
+        link.send("D")
+
+    def _known_state(self, link: Link) -> None:
+        self._stop(link)
+        for body in self._reset_frames():
+            link.send(body)
+        self._go_back(link)
+        link.send("N")
+
+    def _go_back(self, link: Link) -> None:
+        """Move the axes back to where the run began (known exactly only at rest)."""
+        self._position(link)
+        here = self.guard.envelope.position()
+        back = [0 if h is None else -int(h) for h in here]
+        if not any(back):
+            return
+        speed = self.profile.reset.V
+        r = link.send("L" + ",".join(str(b) for b in back))
+        if r is None or r.code != 0:
+            raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
+        seconds = max(abs(b) for b in back) / speed * 2 + 2 * self.guard.stop_seconds() + 2
+        if link.poll("L0,0,0", lambda r: r.code == 0, seconds) is None:
+            raise CouldNotTest("the return to where the run began did not end in time")
+        self._position(link)
+
+    # -- Ctrl-C and the end --------------------------------------------------------------------
+    def emergency_stop(self) -> None:
+        """Ctrl-C: `H`, then `D`, before anything else (real units)."""
+        if self.real and self._link is not None:
+            self.report.interrupted = True
+            wait = None if self.guard.responding else MARGIN
+            with self.guard.emergency():
+                self._halt(self._link, timeout=wait)
+                self._link.send("D", timeout=wait)
+        self.interrupts.handle()
+
+    def finish(self) -> SessionReport:
+        """Put back what the run changed and say what could not be (once)."""
+        if self.finished:
+            return self.report
+        self.finished = True
+        if self.real and self.started and not self.failed:     # found moving: untouched
+            if self.interrupts.pending:
+                self.emergency_stop()
+            link = self._new_link()
+            try:
+                with self.guard.own_frames():
+                    self._restore(link)
+            except Interrupted:
+                self.emergency_stop()
+                self.report.problems.append("restorations stopped by Ctrl-C: what follows "
+                                            "was not put back")
+                self._unrestored()
+            except (TargetNotResponding, SafetyStop, CouldNotTest) as err:
+                self.report.problems.append(f"restorations stopped: {err}")
+                self._unrestored()
+            self.report.wire_log += link.transcript_lines()
+        self.report.interrupted = self.report.interrupted or self.interrupts.stopped
+        if self.real:
+            self.report.excursion = [list(e) for e in self.guard.excursion()]
+        return self.report
+
+    def _restore(self, link: Link) -> None:
+        if not self.guard.responding:
+            self.report.not_responding = "the target stopped responding"
+            with self.guard.emergency():              # once, without waiting long
+                self._halt(link, timeout=MARGIN)
+                link.send("D")
+            raise TargetNotResponding("the target is not responding")
+        self._stop(link)
+        for body in self._reset_frames():
+            link.send(body)
+        self.report.reset.append("set to the reset state (they cannot be read): "
+                                 + ", ".join(self._reset_frames()))
+        if self.profile.microstep:
+            self.report.reset.append("GVE54 micro-step mode and current set to "
+                                     f"M{self.profile.microstep.reset_mode}, "
+                                     f"M{self.profile.microstep.reset_current} (the reset state)")
+        if not self.interrupts.stopped:
+            self._go_back(link)
+            here = self.guard.envelope.position()
+            self.report.restored.append(
+                "axes back where the run began" if all(h == 0 for h in here) else
+                "axes: the way back is not known exactly for "
+                + ", ".join(a for a, h in zip(self.profile.axes, here, strict=True) if h is None))
+        self._restore_eeprom(link)
+        self._restore_status(link)
+        if self.checksums:
+            r = link.send("%+", checksum=False)
+            if r is None or r.code != 0:
+                self.report.problems.append(f"checksum mode not turned back on: %+ answered {r}")
+            else:
+                self.report.restored.append("checksum mode back on")
+
+    def _restore_eeprom(self, link: Link) -> None:
+        if not self.guard.eeprom_written:
+            return
+        changed = []
+        for address, value in sorted(self.eeprom.items()):
+            r = link.send("ER%02X" % address)
+            if _hex_ok(r) and r.hex() == value:
+                continue
+            link.send("EW%02X,%02X" % (address, value))
+            r = link.send("ER%02X" % address)
+            if _hex_ok(r) and r.hex() == value:
+                changed.append("%02X" % address)
+            else:
+                self.report.problems.append(f"EEPROM {address:02X} not restored to {value:02X} "
+                                            f"(reads {r})")
+        self.report.restored.append(f"EEPROM: {len(self.eeprom)} bytes verified"
+                                    + (f", {' '.join(changed)} written back" if changed else ""))
+        self.guard.eeprom_written.clear()
+
+    def _restore_status(self, link: Link) -> None:
+        for n in RESTORE_ORDER:
+            if n in self.status:
+                link.send("SW%d,%02X" % (n, self.status[n]))
+        wrong = []
+        for n, value in sorted(self.status.items()):
+            r = link.send(f"SR{n}")
+            if not (_hex_ok(r) and r.hex() == value):
+                wrong.append(f"ST{n} reads {r}, found {value:02X}")
+        if wrong:
+            self.report.problems.append("status words not restored: " + "; ".join(wrong))
+        elif self.status:
+            self.report.restored.append("ST0..ST5 as found: " + " ".join(
+                "%02X" % v for _, v in sorted(self.status.items())))
+
+    def _unrestored(self) -> None:
+        if self.guard.eeprom_written:
+            written = sorted(self.guard.eeprom_written)
+            self.report.problems.append("EEPROM not verified: bytes written by the run: "
+                                        + " ".join("%02X" % a for a in written))
+        if self.status:
+            self.report.problems.append("status words not verified as found: " + " ".join(
+                f"ST{n}={v:02X}" for n, v in sorted(self.status.items())))
+
+
+def _hex_ok(r: Response | None) -> bool:
+    return r is not None and r.code == 0 and len(r.values) >= 1 and \
+        len(r.values[0]) == 2 and all(c in "0123456789ABCDEF" for c in r.values[0])
+
+

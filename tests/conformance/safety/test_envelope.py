@@ -1,0 +1,155 @@
+"""The run's envelope, bookkeeping alone (conformance/link/envelope.py through the guard):
+what a unit may do with what it accepted, from spec 5, 7, 10.1, 10.4, 10.5, 10.7. The
+envelope is ±500 full steps here; every expected figure is worked out from the spec."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.link.framing import parse_response
+from conformance.link.safety import Guard, SafetyStop
+from gve_fixtures.profile import load_profile
+
+
+def guard(profile: str = "GVE84-100", travel: int = 500) -> Guard:
+    g = Guard(load_profile(profile), 0, enforce=True, max_travel=travel, allow_destructive=True)
+    g.envelope.origin({0: 0, 1: 0, 2: 0})       # the run begins at counters 0
+    return g
+
+
+def answer(text: str):
+    return None if text is None else parse_response(text.encode() + b"\r", summed=False)
+
+
+def sent(g: Guard, body: str, reply: str | None = "0") -> None:
+    """The frame passes the guard, goes out, and is answered ``reply``."""
+    g.check(body)
+    g.accepted(body, answer(reply))
+
+
+def refused(g: Guard, body: str) -> str:
+    with pytest.raises(SafetyStop) as err:
+        g.check(body)
+    return str(err.value)
+
+
+def x(g: Guard) -> tuple[float, float]:
+    s = g.envelope.reach()[0]
+    return s.lo, s.hi
+
+
+def test_a_vector_counts_whole_until_the_unit_shows_it_ended():
+    g = guard()
+    sent(g, "C300,0,0")
+    assert "X could reach 0..600" in refused(g, "C300,0,0")    # 300 + 300 > 500
+    sent(g, "SR6", "0,40")                                    # RUN: still on its way
+    assert x(g) == (0, 300)
+    sent(g, "SR6", "0,00")                                    # RUN = 0: it ended at 300
+    assert x(g) == (300, 300)
+    sent(g, "C-800,0,0")                                      # to -500: inside
+    assert x(g) == (-500, 300)
+
+
+def test_back_and_forth_costs_only_the_widest_swing():
+    g = guard(travel=2)
+    sent(g, "H", "8")
+    for i in range(2048):
+        sent(g, "C1,0,0" if i % 2 == 0 else "C-1,0,0")
+    assert x(g) == (0, 1)
+
+
+def test_counter_resets_do_not_reset_the_odometer():
+    g = guard()
+    sent(g, "L400,0,0")
+    sent(g, "L0,0,0")                      # accepted: the L before it has ended (spec 10.1)
+    sent(g, "N")                           # counters 0, the axis still 400 from the start
+    sent(g, "NX-1000")
+    assert "X could reach 400..600" in refused(g, "L200,0,0")
+    sent(g, "L-900,0,0")                   # to -500: inside
+    sent(g, "SR6", "0,00")
+    sent(g, "PF", "0,-1900,0,0")           # counter -1900 = -1000 + (-900): physical -500
+    assert x(g) == (-500, -500)
+
+
+def test_a_halted_and_deleted_vector_leaves_the_axis_anywhere_on_it_until_read():
+    g = guard()
+    sent(g, "C400,0,0")
+    sent(g, "H", "8")
+    sent(g, "D")
+    assert x(g) == (0, 400)
+    assert "X could reach 0..600" in refused(g, "L200,0,0")   # from anywhere on 0..400
+    sent(g, "PF", "0,123,0,0")             # nothing can move after D: it rests at 123
+    assert x(g) == (123, 123)
+    sent(g, "L377,0,0")                    # to 500 exactly
+
+
+def test_a_kept_remainder_counts_whole_when_restored():
+    g = guard()
+    sent(g, "C450,0,0")
+    sent(g, "H", "8")
+    sent(g, "K")                           # the remainder saved: up to 450 more
+    sent(g, "PF", "0,100,0,0")
+    sent(g, "L0,0,-300")
+    sent(g, "L0,0,300")
+    sent(g, "SR6", "0,00")
+    assert "X could reach 100..550" in refused(g, "R")
+    sent(g, "L-100,0,0")
+    sent(g, "SR6", "0,00")
+    sent(g, "R", "8")                      # now from 0: up to 450
+    sent(g, "G")
+    assert x(g) == (0, 450)
+
+
+def test_a_packet_is_judged_whole_before_its_end_is_sent():
+    g = guard()
+    sent(g, "*S", None)
+    for _ in range(4):
+        sent(g, "C100,0,0", None)          # members: no answer, not yet committed
+    assert x(g) == (0, 0)
+    refused(g, "C200,0,0")                 # a member that would make the packet 600
+    sent(g, "*E4", "0,4")
+    assert x(g) == (0, 400)
+    sent(g, "*S", None)
+    sent(g, "C100,0,0", None)
+    assert "X could reach 0..600" in refused(g, "C100,0,0")
+    sent(g, "*E1", "2,1")                  # refused: nothing committed
+    assert x(g) == (0, 400)
+
+
+def test_gve54_vectors_are_in_the_micro_step_mode_and_positions_in_sixteenths():
+    g = guard("GVE54", travel=100)         # 1600 sixteenths either side
+    # the mode is not known yet: up to 8 sixteenths a step (M2)
+    assert "X could reach 0..100.5 " in refused(g, "L201,0,0")
+    sent(g, "MF")
+    sent(g, "L1600,0,0")                   # 1600 sixteenths = 100 full steps
+    sent(g, "L0,0,0")
+    sent(g, "M4")
+    assert "X could reach 100..100.25" in refused(g, "L1,0,0")
+    sent(g, "L-400,0,0")                   # 400 quarter steps: back to 0
+    assert g.excursion()[0] == (0, 100)
+
+
+def test_a_reference_run_counts_its_whole_travel():
+    g = guard()
+    assert "Y could reach -600..50 " in refused(g, "WY,-600,1000,50,500")
+    sent(g, "WY,-450,1000,50,500")         # to the switch within 450, back within 50
+    assert g.envelope.reach()[1].lo == -450 and g.envelope.reach()[1].hi == 50
+
+
+def test_an_unclear_answer_is_whichever_reaches_farther():
+    g = guard()
+    sent(g, "C300,0,0")
+    sent(g, "D", None)                     # deleted or not: the vector may still run
+    sent(g, "PF", "0,10,0,0")              # so a read tells nothing
+    assert x(g) == (0, 300)
+    sent(g, "L150,0,0", None)              # maybe accepted: counted from anywhere on 0..300
+    assert x(g) == (0, 450)
+
+
+def test_unreadable_numbers_in_a_motion_frame_are_unbounded():
+    g = guard()
+    refused(g, "L9999999999999,0,0")
+    refused(g, "L1x,0,0")
+    refused(g, "l600,0,0")                 # lower case: a lenient unit may take it
+    sent(g, "L+5, 5,")                     # lenient readings stay bounded
+    assert x(g) == (0, 5)

@@ -1,0 +1,124 @@
+"""The guard's other duties: destructive frames, other addresses, raw bytes framed as a
+unit frames them (spec 3), Ctrl-C, silence, the operator's confirmation, timeouts."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.link.framing import HostFramer, parse_response
+from conformance.link.interrupts import Interrupted, Interrupts
+from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
+from gve_fixtures.profile import load_profile
+
+
+def guard(profile: str = "GVE84-100", *, destructive: bool = False, travel: int = 500,
+          interrupts: Interrupts | None = None) -> Guard:
+    return Guard(load_profile(profile), 0, enforce=True, max_travel=travel,
+                 allow_destructive=destructive, interrupts=interrupts)
+
+
+@pytest.mark.parametrize("body", ["J", "WX,-100,100,10,100", "WX-100,100,10,100", "EW01,00",
+                                  "EFW30,1.5", "EUW40,7", "ew01,00"])
+def test_destructive_frames_need_permission(body):
+    with pytest.raises(SafetyStop, match="--allow-destructive"):
+        guard().check(body)
+
+
+def test_eeprom_writes_go_only_to_bytes_backed_up():
+    g = guard(destructive=True)
+    g.eeprom_backed = {0x30, 0x31, 0x32}
+    with pytest.raises(SafetyStop, match="EEPROM 33 not backed up"):
+        g.check("EFW30,1.5")                # four bytes: 30..33
+    g.check("EW31,00")
+    with pytest.raises(SafetyStop, match="not backed up"):
+        g.check("EWzz,00")                  # which byte? not written
+    assert g.eeprom_written == {0x31}
+
+
+def test_motion_and_writes_for_another_address_are_refused():
+    g = guard(destructive=True)
+    g.eeprom_backed = set(range(256))
+    for body in ("L1,0,0", "G", "EW01,00"):
+        with pytest.raises(SafetyStop, match="address 3"):
+            g.check(body, 3)
+    g.check("V2000", 3)                     # harmless elsewhere
+    spindle = guard("GVE114-500", destructive=True)
+    spindle.eeprom_backed = {1}
+    spindle.check("EW01,00", 7)             # the GVE114's own EEPROM, through address 7
+
+
+def test_raw_bytes_are_framed_as_a_unit_frames_them():
+    g = guard()
+    framer = HostFramer()
+    assert framer.frames(b"noise!0L1") == []
+    frames = framer.frames(b"00,0,0\r!0V1!0L601,0,0\r\n")   # a '!' restarts the frame
+    assert [f.text for f in frames] == ["L100,0,0", "L601,0,0"]
+    with pytest.raises(SafetyStop):
+        g.check_frames(frames, summed=False)
+    # with the checksum mode unknown, "L400,0,10" may be z = 10 or a checksum: both judged
+    (f,) = HostFramer().frames(b"!0L400,0,10\r")
+    assert f.bodies(None) == ["L400,0,10", "L400,0"]
+    g.check_frames([f], summed=None)
+    with pytest.raises(SafetyStop):
+        g.check_frames(HostFramer().frames(b"!0L400,0,600\r"), summed=None)
+
+
+def test_after_ctrl_c_only_the_sessions_own_frames_go_and_never_motion():
+    interrupts = Interrupts()
+    g = guard(interrupts=interrupts)
+    interrupts.signal()
+    with pytest.raises(Interrupted):
+        g.check("SR0")
+    with g.emergency():
+        g.check("H")                        # the emergency stop goes first
+    interrupts.handle()
+    with pytest.raises(Interrupted):
+        g.check("SR0")                      # still no case frame
+    with g.own_frames():
+        g.check("SW0,00")
+        with pytest.raises(SafetyStop, match="no motion after Ctrl-C"):
+            g.check("L0,0,1")
+    interrupts.signal()
+    with g.own_frames(), pytest.raises(Interrupted):
+        g.check("SW1,00")                   # a new signal stops the restorations too
+
+
+def test_consecutive_silences_give_the_target_up():
+    g = guard()
+    garbage = parse_response(b"\x00zz\r", summed=False)
+    for r in (None, garbage, None):
+        g.answered(r)
+    g.answered(parse_response(b"0\r", summed=False))     # an answer: the count starts again
+    for r in (None, None, garbage):
+        g.answered(r)
+    with pytest.raises(TargetNotResponding, match="4 frames unanswered"):
+        g.answered(None)
+    with pytest.raises(TargetNotResponding):
+        g.check("SR0")                      # nothing more goes out
+
+
+def test_the_operator_confirms_the_first_motion_once():
+    asked = []
+    g = guard()
+    g.before_motion = lambda: asked.append(1)
+    g.check("SR0")
+    g.check("L0,0,0")                       # moves nothing
+    assert asked == []
+    g.check("L10,0,0")
+    g.check("L20,0,0")
+    assert asked == [1]
+    no = guard()
+    no.before_motion = lambda: False
+    with pytest.raises(SafetyStop, match="not confirmed"):
+        no.check("C1,0,0")
+    with pytest.raises(SafetyStop, match="not confirmed"):
+        no.check("G")
+
+
+def test_halt_waits_for_the_longest_stop_the_envelope_allows():
+    g = guard(travel=2000)
+    # braking over the whole width (4000 steps) at A1 (1000 steps/s²): sqrt(2·4000/1000)
+    assert g.stop_seconds() == pytest.approx(8 ** 0.5)
+    assert g.answer_seconds("H") == pytest.approx(2 * 8 ** 0.5)
+    assert g.answer_seconds("WY,-2000,1000,200,100") == pytest.approx(2 + 2 + 4 * 8 ** 0.5)
+    assert g.answer_seconds("V100") is None

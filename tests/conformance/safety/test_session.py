@@ -1,0 +1,151 @@
+"""The session on a real unit, end to end, with the emulator in process on the wall
+clock behind a serial-like target (tests/conformance/safety/units.py): the unit is left
+as found, EEPROM byte for byte, and Ctrl-C sends H, then D, before anything else."""
+
+from __future__ import annotations
+
+import os
+import random
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.runner import run
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL
+from tests.conformance.safety.units import in_process_unit
+
+MOTION = (b"L", b"C", b"G", b"R", b"W", b"*E", b"SW6")
+
+
+def body(frame: bytes) -> bytes:
+    return frame[2:].split(b",")[0] if frame[2:3] != b"S" else frame[2:]
+
+
+def moves(frame: bytes) -> bool:
+    text = frame[2:-1]
+    return text.startswith(MOTION) and not text.startswith((b"L0,0,0", b"C0,0,0"))
+
+
+def random_eeprom(seed: str) -> bytes:
+    """Random bytes, but 06 = FF: other values may turn the GVE114's hand-wheel (MPG)
+    mode on, and a unit in that mode reports RUN (spec 9), which the suite refuses."""
+    data = bytearray(random.Random(seed).randbytes(256))
+    data[6] = 0xFF
+    return bytes(data)
+
+
+def test_a_unit_found_moving_is_not_taken_over(tmp_path):
+    image = tmp_path / "unit.eeprom"
+    image.write_bytes(b"\xff" * 6 + b"\x01" + b"\xff" * 249)   # MPG enabled: RUN = 1
+    unit = in_process_unit("GVE114-500", eeprom=str(image))
+    result = run([unit], select(["5.errors.*"]))
+    assert {r.verdict for r in result.results} == {COULD_NOT_TEST}
+    assert result.problems and "ST6 = 40" in result.problems[0]
+    assert not [f for f in unit.frames if moves(f) or f.startswith(b"!0H")]
+
+
+def test_the_unit_is_left_as_found():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    for frame in (b"!0SW2,05\r", b"!0SW1,03\r", b"!0SW0,1A\r", b"!0%+\r"):
+        unit.recorder.write(frame)          # the machine's own settings, before the run
+        unit.recorder.read_until(b"\r")
+    before = unit.state()
+    result = run([unit], select(["10.3.status.*", "6.checksum.*", "5.errors.busy"]))
+    after = unit.state()
+    assert not any(r.verdict in (FAIL, ERROR) for r in result.results)
+    assert after["status"][:6] == before["status"][:6] == ["1A", "03", "05", "00", "00", "00"]
+    assert after["checksums"] is True
+    assert after["physical"] == [0, 0, 0]    # back where the run began
+    report = result.sessions[unit.info.spec]
+    assert report["problems"] == [] and report["identity"]["version"] == "IP84 v3 27.1.2010"
+    assert any("1A 03 05 00 00 00" in line for line in report["restored"])
+
+
+def test_gve54_micro_steps_are_reset_before_every_case_and_at_the_end():
+    unit = in_process_unit("GVE54", max_travel=500)
+    result = run([unit], select(["10.7.*", "11.golden.g5b*", "1.profile.*"]))
+    assert unit.state()["microstep"] in ("F", 1)  # the reset mode, MF
+    assert [f for f in unit.frames if f.startswith(b"!0MF")]
+    assert any("micro-step" in line for line in result.sessions[unit.info.spec]["reset"])
+
+
+@pytest.mark.parametrize(("profile", "globs"), [
+    ("GVE114-500", ["10.6.*", "10.machine.queue-status-eeprom"]),
+    ("GVE84-100", ["11.golden.g9*", "10.6.eeprom.round-trip"]),
+])
+def test_a_destructive_run_leaves_random_eeprom_byte_for_byte(tmp_path, profile, globs):
+    image = tmp_path / "unit.eeprom"
+    image.write_bytes(random_eeprom(profile))
+    found = image.read_bytes()
+    unit = in_process_unit(profile, allow_destructive=True, eeprom=str(image))
+    result = run([unit], select(globs))
+    assert any(f.startswith((b"!0EW", b"!0EFW", b"!0EUW")) for f in unit.frames)
+    assert image.read_bytes() == found
+    assert result.problems == []
+    assert any("EEPROM: 256 bytes verified" in line
+               for line in result.sessions[unit.info.spec]["restored"])
+
+
+def _ctrl_c_at(unit, trigger) -> int:
+    """Press Ctrl-C while the first frame ``trigger(index, frame)`` picks is in flight."""
+    pressed = []
+
+    def hook(i: int, frame: bytes) -> None:
+        if not pressed and trigger(i, frame):
+            pressed.append(i)
+            unit.session.interrupts.signal()
+    unit.on_frame = hook
+    return pressed
+
+
+def _after_ctrl_c(unit, pressed) -> list[bytes]:
+    assert pressed, "the trigger never fired"
+    after = unit.frames[pressed[0] + 1:]
+    assert [f[2:3] for f in after[:2]] == [b"H", b"D"], after[:4]
+    assert not [f for f in after if moves(f)], "motion after Ctrl-C"
+    return after
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_ctrl_c_inside_a_hypothesis_machine_halts_first(tmp_path, seed):
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    pick = random.Random(seed).randrange(1, 40)
+    seen: list[bytes] = []                 # frames since the machine's first @
+
+    def trigger(i: int, frame: bytes) -> bool:
+        if seen or frame == b"!0@\r":
+            seen.append(frame)
+        return len(seen) >= pick
+    pressed = _ctrl_c_at(unit, trigger)
+    result = run([unit], select(["7.machine.packets", "8.index.*"]))
+    _after_ctrl_c(unit, pressed)
+    assert result.interrupted and result.results[-1].interrupted
+    assert result.results[-1].id == "7.machine.packets"
+    assert unit.state()["status"][:6] == ["00"] * 6
+
+
+@pytest.mark.parametrize("when", ["backup", "case", "restore"])
+def test_ctrl_c_during_eeprom_work_halts_first_and_restores(tmp_path, when):
+    image = tmp_path / "unit.eeprom"
+    image.write_bytes(random_eeprom(when))
+    found = image.read_bytes()
+    unit = in_process_unit("GVE114-500", allow_destructive=True, eeprom=str(image))
+    seen = {"EW": 0}
+
+    def trigger(i: int, frame: bytes) -> bool:
+        if frame.startswith((b"!0EW", b"!0EFW", b"!0EUW")):
+            seen["EW"] += 1
+        return {"backup": frame.startswith(b"!0ER7F"),
+                "case": seen["EW"] == 2,
+                "restore": seen["EW"] >= 2 and frame.startswith(b"!0ER80")
+                and i > 600}[when]
+    pressed = _ctrl_c_at(unit, trigger)
+    result = run([unit], select(["10.6.*", "10.machine.queue-status-eeprom"]))
+    _after_ctrl_c(unit, pressed)
+    assert result.interrupted
+    if when == "restore":               # a signal during the restorations stops them
+        assert any("stopped by Ctrl-C" in p for p in result.problems)
+    else:
+        assert image.read_bytes() == found
+        assert result.problems == []
+    assert os.path.exists(image)
