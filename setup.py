@@ -12,7 +12,7 @@ from setuptools.command.build_ext import build_ext
 
 # fixtures/ installs as gve_fixtures; its data folders (profiles/, transcripts/) are named
 # as packages too, as setuptools asks of every folder that carries package data
-packages = [*find_packages(include=["emulator*", "conformance*"]), "gve_fixtures",
+packages = [*find_packages(include=["emulator*", "conformance*", "gve_host*"]), "gve_fixtures",
             *(f"gve_fixtures.{name}" for name in
               find_namespace_packages(where="fixtures", exclude=["*__pycache__*"]))]
 

@@ -25,7 +25,8 @@ pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
 #: the packages and the folders they install from
-PACKAGES = {"conformance": "conformance", "emulator": "emulator", "fixtures": "gve_fixtures"}
+PACKAGES = {"conformance": "conformance", "emulator": "emulator", "fixtures": "gve_fixtures",
+            "gve_host": "gve_host"}
 SMOKE = ["gve-conformance", "--target", "emu:GVE84-100", "--cases", "6.*"]
 
 
