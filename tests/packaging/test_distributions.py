@@ -24,10 +24,13 @@ from tests.conformance.fleet.services import free_port
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
-#: the packages and the folders they install from
+#: a folder of the tree -> the package it installs as
 PACKAGES = {"conformance": "conformance", "emulator": "emulator", "fixtures": "gve_fixtures",
             "gve_host": "gve_host"}
 SMOKE = ["gve-conformance", "--target", "emu:GVE84-100", "--cases", "6.*"]
+#: exits 0 only where the compiled C stepper core loads
+C_CORE = ("import sys; from emulator.motion.factory import c_available; "
+          "sys.exit(not c_available())")
 
 
 def run(argv: list[str], cwd: Path, timeout: float = 900) -> subprocess.CompletedProcess:
@@ -80,9 +83,7 @@ def test_the_wheel_carries_every_file_of_the_packages(dists):
 def test_the_sdist_installs_builds_the_c_core_and_runs(dists, tmp_path):
     bin_dir = fresh_env(tmp_path / "env")
     run([str(bin_dir / "python"), "-m", "pip", "install", "-q", str(dists["sdist"])], tmp_path)
-    run([str(bin_dir / "python"), "-c",
-         "import sys; from emulator.motion import c_available; sys.exit(not c_available())"],
-        tmp_path)
+    run([str(bin_dir / "python"), "-c", C_CORE], tmp_path)
     done = run([str(bin_dir / SMOKE[0]), *SMOKE[1:]], tmp_path)
     assert "PASSED" in done.stdout
 
@@ -103,9 +104,7 @@ def test_the_ci_job_installs_the_wheel_runs_and_fails_a_broken_clone(dists, tmp_
     assert junit.findall(".//testcase/failure")
     assert (tmp_path / "artifacts" / "gve-report" / "report.html").is_file()
     bin_dir = tmp_path / ".gve-venv" / "bin"
-    run([str(bin_dir / "python"), "-c",
-         "import sys; from emulator.motion import c_available; sys.exit(not c_available())"],
-        tmp_path)
+    run([str(bin_dir / "python"), "-c", C_CORE], tmp_path)
     assert "PASSED" in run([str(bin_dir / SMOKE[0]), *SMOKE[1:]], tmp_path).stdout
 
 
