@@ -5,9 +5,9 @@ cannot be used is a usage error before anything runs."""
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
@@ -23,12 +23,12 @@ MUTANT_TARGET = "emu:GVE84-100?mutant=checksum-lower-case"
 pytest_plugins = ["pytester"]
 
 
-def examples(report: Path) -> list[list[str]]:
-    """The host's frames of each example (each link) the machine ran, in order."""
-    data = json.loads((report / "results.json").read_text())
-    (result,) = [r for r in data["results"] if r["id"] == CASE]
+def examples(junit: Path) -> list[list[str]]:
+    """The host's frames of each example (each link) the machine ran, in order: the
+    failing case's whole wire log, as its JUnit failure carries it."""
+    (failure,) = ET.parse(junit).getroot().iter("failure")
     out: list[list[str]] = []
-    for line in result["wire_log"]:
+    for line in failure.text.splitlines():
         if line == "# link":
             out.append([])
         elif " > " in line:
@@ -37,9 +37,12 @@ def examples(report: Path) -> list[list[str]]:
 
 
 def run_cli(folder: Path, run_id: str, *options: str) -> tuple[int, list[list[str]]]:
+    """A run of the machine against the mutant (reports only as JUnit unless the
+    options say otherwise): its status and its examples."""
+    junit = folder / f"{run_id}.xml"
     status = main(["--target", MUTANT_TARGET, "--cases", CASE, "--report-dir", str(folder),
-                   "--run-id", run_id, "-q", *options])
-    return status, examples(folder / run_id)
+                   "--run-id", run_id, "--junitxml", str(junit), "-q", *options])
+    return status, examples(junit)
 
 
 def test_the_next_run_tries_the_failing_example_first(tmp_path):
@@ -54,7 +57,7 @@ def test_the_next_run_tries_the_failing_example_first(tmp_path):
 
 
 def test_without_a_database_each_run_searches_again(tmp_path):
-    _, first = run_cli(tmp_path, "first", "--hypothesis-db", "none")
+    _, first = run_cli(tmp_path, "first", "--no-reports")
     _, second = run_cli(tmp_path, "second", "--hypothesis-db", "none")
     assert second == first and len(second) > 2      # derandomized: the same search
     assert not (tmp_path / DEFAULT_DATABASE).exists()
@@ -97,19 +100,20 @@ def test_benches_sharing_redis_try_each_others_failing_examples_first(tmp_path, 
     runs it first; the same run as B without the database does not."""
 
     def bench(name: str, seed: str, database: str) -> list[list[str]]:
+        junit = tmp_path / f"{name}.xml"
         done = subprocess.run(
             [sys.executable, "-m", "conformance", "--target", MUTANT_TARGET, "--cases", CASE,
              "--settings", "dev", "--seed", seed, "--hypothesis-db", database,
-             "--report-dir", str(tmp_path), "--run-id", name, "-q"],
+             "--no-reports", "--junitxml", str(junit), "-q"],
             capture_output=True, text=True, timeout=120, check=False)
         assert done.returncode == 1, done.stdout + done.stderr
-        return examples(tmp_path / name)
+        return examples(junit)
 
     a = bench("bench-a", "1", redis_url)
     from redis import Redis
     assert Redis.from_url(redis_url).keys("gve-example:GVE84-100:*")
     b = bench("bench-b", "2", redis_url)
     _, alone = run_cli(tmp_path, "bench-b-alone", "--settings", "dev", "--seed", "2",
-                       "--hypothesis-db", "none")
+                       "--no-reports")
     assert b[0] == a[-1] and len(b) == 2
     assert alone[0] != a[-1] and len(alone) > len(b)

@@ -16,7 +16,7 @@ from conformance.targets import parse_target
 pytest.importorskip("xdist", reason="pytest-xdist (the dev extra) runs the fleets")
 
 #: quick cases that need no motion beyond the real-unit envelope
-CASES = ["5.errors.*", "8.index.*"]
+CASES = ["5.errors.*"]
 
 
 def test_two_tcp_units_run_in_parallel_on_two_workers(tcp_units, tmp_path):
