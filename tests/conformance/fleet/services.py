@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+from tests.processes import stop
+
 
 class Service:
     """A process started for a test, stopped (terminate, then kill) by :meth:`stop`."""
@@ -27,13 +29,7 @@ class Service:
         return self.proc.stdout.readline().strip()
 
     def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(10)
+        stop(self.proc)
         self.proc.stdout.close()
 
 
