@@ -12,7 +12,9 @@ move, and the steps only a hand on the machine can do.
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TextIO
@@ -20,6 +22,7 @@ from typing import TextIO
 from tqdm import tqdm
 
 from conformance.case import CouldNotTest
+from conformance.link.interrupts import Interrupted
 from conformance.link.link import Link
 
 #: input ports read FF with nothing connected (spec 10.3: inputs are grounded to act)
@@ -43,7 +46,7 @@ class Console:
     def _answer(self, prompt: str) -> str | None:
         if not self.interactive:
             return None
-        with tqdm.external_write_mode(file=self.stdout):
+        with tqdm.external_write_mode(file=self.stdout), _interruptible():
             self.stdout.write(prompt)
             self.stdout.flush()
             line = self.stdin.readline()
@@ -67,6 +70,27 @@ class Console:
         skipped (or nobody can answer)."""
         answer = self._answer(f"{instruction} now, then press Enter; s to skip: ")
         return answer is not None and answer.lower() not in ("s", "skip")
+
+
+@contextmanager
+def _interruptible() -> Iterator[None]:
+    """Ctrl-C at a question ends the wait at once: the run counts it as it counts any
+    Ctrl-C (then H and D go out), and the question raises Interrupted."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+
+    def stop(signum: int, frame: object) -> None:
+        if callable(previous):
+            previous(signum, frame)
+        raise Interrupted("Ctrl-C at a question")
+
+    signal.signal(signal.SIGINT, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def confirm_motion(console: Console, lines: list[str]) -> bool:
@@ -122,21 +146,20 @@ class Hands:
                                f"(IN{bit} should read {want})")
         self.console.say(f"  verified: I{port} = {level:02X}")
 
+    def _set(self, port: int, bit: int, what: str, grounded: bool) -> bool:
+        if self._link().rig is not None:
+            self._rig(port, bit, grounded)
+        else:
+            self._by_hand(port, bit, what, grounded)
+        return True
+
     def ground(self, port: int, bit: int, what: str) -> bool:
         """Make input IN<bit> of port I<port> active (grounded); True once verified."""
-        if self._link().rig is not None:
-            self._rig(port, bit, grounded=True)
-        else:
-            self._by_hand(port, bit, what, grounded=True)
-        return True
+        return self._set(port, bit, what, grounded=True)
 
     def release(self, port: int, bit: int, what: str) -> bool:
         """Disconnect input IN<bit> again (reads 1); True once verified."""
-        if self._link().rig is not None:
-            self._rig(port, bit, grounded=False)
-        else:
-            self._by_hand(port, bit, what, grounded=False)
-        return True
+        return self._set(port, bit, what, grounded=False)
 
     @contextmanager
     def grounded(self, port: int, bit: int, what: str) -> Iterator[None]:

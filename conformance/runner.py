@@ -59,12 +59,12 @@ class RunResult:
     seconds: float = 0.0
     frames: int = 0
     interrupted: bool = False
-    meta: RunMeta = field(default_factory=RunMeta)
     #: per target: its session's report (identity, envelope and largest excursion per
     #: axis, what was restored, what could not be) — SessionReport.to_dict()
     sessions: dict[str, dict] = field(default_factory=dict)
     #: what could not be restored or verified: the top of every report, exit status 1
     problems: list[str] = field(default_factory=list)
+    meta: RunMeta = field(default_factory=RunMeta)
 
     def counts(self) -> dict[str, int]:
         out: dict[str, int] = {}

@@ -51,13 +51,14 @@ def get(name: str) -> settings:
         raise ValueError(f"unknown settings profile {name!r}: {', '.join(PROFILES)}") from None
 
 
-def run_seed(name: str | None, seed: int | None = None) -> int | None:
+def run_seed(names: list[str], seed: int | None = None) -> int | None:
     """The seed a run records and gives the machines: ``seed`` when given (it overrides
-    derandomization), else None for derandomized settings (every run draws the same
-    examples) and a fresh random one for the others, so that any run can be replayed."""
+    derandomization), else None when every settings profile ``names`` is derandomized
+    (every run draws the same examples), else a fresh random one, so that any run can be
+    replayed."""
     if seed is not None:
         return seed
-    if name is None or get(name).derandomize:     # None: ci and hardware, both exact
+    if all(get(name).derandomize for name in names):
         return None
     return secrets.randbits(32)
 

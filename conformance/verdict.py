@@ -44,12 +44,16 @@ FAILED = "FAILED"
 JUDGED = (PASS, NON_STRICT, INFO)
 
 
-def overall(verdicts: list[str], interrupted: bool = False) -> tuple[str, str]:
+def overall(verdicts: list[str], interrupted: bool = False, problems: list[str] = ()
+            ) -> tuple[str, str]:
     """PASSED or FAILED for a run's case verdicts, with the reason in a few words. A run
-    that judged nothing has not passed: a broken or silent target never earns a PASS."""
+    that judged nothing has not passed: a broken or silent target never earns a PASS;
+    nor has one that left something of a unit unrestored (``problems``)."""
     bad = [v for v in ORDER if failing(v) and v in verdicts]
     if bad:
         return FAILED, " and ".join(f"{verdicts.count(v)} {v}" for v in bad)
+    if problems:
+        return FAILED, f"{len(problems)} problem(s) restoring the unit: {problems[0]}"
     if interrupted:
         return FAILED, "interrupted before every case had run"
     if not any(v in JUDGED for v in verdicts):

@@ -47,6 +47,14 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 1500) -> 
     ctx.require(r is not None and r.code == 0 and r.inta, f"H answered {show(r)}")
 
 
+def halted_line(ctx: CaseContext, steps: int, seconds: float) -> None:
+    """Setup: an L of ``steps`` along X halted after ``seconds`` (INTA = 1, RUN = 1)."""
+    setup(ctx, "L" + vector(ctx, steps))
+    ctx.link.wait(seconds)
+    r = ctx.link.send("H")
+    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+
+
 def fresh_reset(ctx: CaseContext) -> None:
     """Cases about the state right after a reset: the emulator gives a fresh unit; a real
     unit is restarted with J, which needs --allow-destructive."""

@@ -6,7 +6,7 @@ fixtures/rules.toml and replays the exchange the spec writes for it."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, position, setup, show, vector
+from conformance.cases._kit import answers, code, halted_line, position, setup, show, vector
 
 IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 10.3)
 
@@ -67,10 +67,7 @@ def sw6(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "the vector waits for G", observed=position(ctx),
                expected=[0, 0, 0], rule="10.3.sw6.acts")
     link = ctx.fresh_link()
-    setup(ctx, "L" + vector(ctx, 300))
-    link.wait(0.1)
-    r = link.send("H")
-    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+    halted_line(ctx, 300, 0.1)
     code(ctx, link.send("SW6,00"), 0, "SW6,00 clears INTA", inta=False, rule="10.3.sw6.acts")
     r = link.poll("SR6", lambda r: r.values == ["00"], 10)
     ctx.expect(r is not None, "RUN clears when the resumed vector ends", observed=show(r),
@@ -84,10 +81,7 @@ def sw6(ctx: CaseContext) -> None:
 @case("10.5.restore.save-emptied", rules=("10.5.restore.pops",))
 def save_emptied(ctx: CaseContext) -> None:
     link = ctx.link
-    setup(ctx, "L" + vector(ctx, 1000))
-    link.wait(0.3)
-    r = link.send("H")
-    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+    halted_line(ctx, 1000, 0.3)
     setup(ctx, "K")
     setup(ctx, "R", expect="8")
     setup(ctx, "G")
@@ -136,12 +130,9 @@ def go_empty(ctx: CaseContext) -> None:
 @case("5.code.busy-while-halted", rules=("5.code.busy-run-decided",), requires=("NX",))
 def busy_halted(ctx: CaseContext) -> None:
     link = ctx.link
-    setup(ctx, "L" + vector(ctx, 1000))
-    link.wait(0.2)
-    r = link.send("H")
-    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+    halted_line(ctx, 1000, 0.2)
     answers(ctx, link.send("NX0"), "F", "N<axis> while the halted vector holds RUN → 7")
-    if ctx.target.allow_destructive and "W" in ctx.profile.commands:
+    if ctx.target.kind == "emu" and "W" in ctx.profile.commands:   # W: never on real units
         answers(ctx, link.send("WX,-10,1000,10,1000"), "F", "W while RUN = 1 → 7")
     here = position(ctx)
     ctx.expect(here is not None and 0 < here[0] < 1000, "the refused commands moved nothing",

@@ -4,8 +4,8 @@ spec 10.2 (conformance/motion), with the tolerance printed in each check: zero o
 embedded emulator's virtual clock; on serial and TCP targets the window in which the unit
 processed each frame (from the baud rate and the observed latency) and one step.
 
-A scenario is a list: a frame to send, seconds to sample ``PF`` for, or a position (in
-commanded steps) to poll ``PF`` until.
+A scenario is a list: a frame to send, seconds to sample ``PF`` for (every 50 ms, or a
+pair: seconds and how often), or a position (in commanded steps) to poll ``PF`` until.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     # T: a vector from rest starts T after the previous one ended at rest (10.2)
     "10.2.measured.dwell": (
         ("10.2.motion.dwell", "10.cmd.modal"), (), (),
-        ["T24", "A10000", "V5000", "L100,0,0", [100, 0, 0], "L100,0,0", 0.06]),
+        ["T24", "A10000", "V5000", "L100,0,0", [100, 0, 0], "L100,0,0", (0.06, 0.005)]),
     # no dwell between continuous vectors (10.2; M84 12.5.2)
     "10.2.measured.no-dwell-continuous": (
         ("10.2.motion.no-dwell-continuous",), (), (),

@@ -20,6 +20,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 from conformance.verdict import ERROR, FAIL
+from gve_fixtures.rules import load_rules
 
 #: profiles tried first, one per family; the others follow
 FIRST = ("GVE84-100", "GVE114-500", "GVE54")
@@ -49,9 +50,14 @@ def profiles_in_order(chosen: list[str] | None = None) -> list[str]:
     return [p for p in FIRST if p in every] + [p for p in every if p not in FIRST]
 
 
-def in_area(case_id: str, section: str, area: str) -> bool:
-    """Whether a case checks the rule area ``area`` (its section, or one below it)."""
-    return section == area or section.startswith(area + ".")
+def closeness(case, area: str) -> int:
+    """How closely a case checks the rule area ``area`` (a spec section: 10 is the command
+    table, 10.2 the motion model, each an area of its own): 0 filed there, 1 naming a rule
+    of it, 2 neither."""
+    if case.section == area:
+        return 0
+    rules = load_rules()
+    return 1 if any(rules[r].section == area for r in case.rules) else 2
 
 
 def hunt(mutant: str, profiles: list[str] | None = None,
@@ -63,29 +69,36 @@ def hunt(mutant: str, profiles: list[str] | None = None,
     area, description = emu.mutants()[mutant]
     result = Hunt(mutant, area, description)
     cases = select(include or None)
-    ordered = ([c for c in cases if in_area(c.id, c.section, area)]
-               + [c for c in cases if not in_area(c.id, c.section, area)])
+    ordered = sorted(cases, key=lambda c: closeness(c, area))      # stable: spec order
+    area_cases = [c for c in ordered if closeness(c, area) < 2]
     names = profiles_in_order(profiles)
-    targets = [(parse_target(f"emu:{p}", mutant=mutant), parse_target(f"emu:{p}"))
-               for p in names]
+    targets = {p: (parse_target(f"emu:{p}", mutant=mutant), parse_target(f"emu:{p}"))
+               for p in names}
+    first = [p for p in names if p in FIRST] or names[:1]
+    rest = [p for p in names if p not in first]
+    # the area's cases on one profile per family, then the other cases there, then the
+    # whole catalogue on the remaining profiles
+    pairs = ([(c, p) for c in ordered[:len(area_cases)] for p in first]
+             + [(c, p) for c in ordered[len(area_cases):] for p in first]
+             + [(c, p) for c in ordered for p in rest])
     start = time.perf_counter()
-    for c in ordered:
-        for target, clean in targets:
-            if c.missing_for(target.profile):
-                continue
-            r = run_case(c, target, "mutation")
-            result.runs += 1
-            where = f"{c.id} [{target.profile.name}]"
-            if r.verdict == ERROR:
-                result.errors.append(where)
-            if r.verdict != FAIL:
-                continue
-            if run_case(c, clean, "mutation").verdict in (FAIL, ERROR):
-                result.clean_fails.append(where)
-                continue
-            result.caught_by = where
-            result.seconds = time.perf_counter() - start
-            return result
+    for c, p in pairs:
+        target, clean = targets[p]
+        if c.missing_for(target.profile):
+            continue
+        r = run_case(c, target, "mutation")
+        result.runs += 1
+        where = f"{c.id} [{p}]"
+        if r.verdict == ERROR:
+            result.errors.append(where)
+        if r.verdict != FAIL:
+            continue
+        if run_case(c, clean, "mutation").verdict in (FAIL, ERROR):
+            result.clean_fails.append(where)
+            continue
+        result.caught_by = where
+        result.seconds = time.perf_counter() - start
+        return result
     result.seconds = time.perf_counter() - start
     return result
 

@@ -21,7 +21,7 @@ from serial import SerialException
 
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
-from conformance.cli.unit import confirmed, record_identities, resolve
+from conformance.cli.unit import ask_before_motion, confirmed, record_identities, resolve
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
@@ -49,9 +49,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT; repeatable")
-    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target; 'auto': "
-                    "ask the unit (? and Q) and choose (with no --target: run the emulator "
-                    "as this profile)")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target "
+                                      "(with no --target: run the emulator as this profile); "
+                                      "'auto': ask the unit (? and Q) and choose")
     ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
                     "say it: the variant (e.g. 100 for a GVE84-100)")
     ap.add_argument("--yes", action="store_true",
@@ -99,61 +99,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return ap.parse_args(argv)
 
 
-class Refused(Exception):
-    """The run cannot start; the message says why (exit status 2)."""
-
-
-def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], cases: list,
-          seed: int | None) -> RunMeta:
-    meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
-                   settings=args.settings, seed=seed, mutant=args.mutant,
-                   destructive=args.allow_destructive, max_travel=args.max_travel,
-                   cases=args.cases, exclude=args.exclude, full_logs=args.full_logs)
-    for target in targets:
-        t = meta.target(target.info.spec)
-        t.kind, t.profile = target.info.kind, target.profile.name
-        t.envelope = None if target.info.kind == "emu" else target.info.max_travel
-    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
-                                        for s in d["sections"]]}
-                     for d in (pc.as_dict() for pc in coverage(
-                         sorted({t.profile.name for t in targets}), cases=cases))]
-    return meta
-
-
-def prepare(args: argparse.Namespace, argv: list[str], cases: list, console: Console
-            ) -> tuple[list[Target], RunMeta]:
-    """The targets and the run's metadata: profiles chosen (``--profile auto`` asks the
-    units), identities recorded, motion confirmed on real units. Refused when not."""
-    every = [f"emu:{name}" for name in available_profiles()]
-    if args.profile and args.profile != "auto" and not args.target:
-        every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
-    # no --target, or emu:all: the embedded emulator on every profile
-    specs = [s for t in args.target or ["emu:all"]
-             for s in (every if t.split("?")[0] == "emu:all" else [t])]
-    try:
-        chosen = [resolve(s, None if s in every else args.profile, args.variant, console)
-                  for s in specs]
-        targets = [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
-                                max_travel=args.max_travel, mutant=args.mutant)
-                   for s, p, _ in chosen]
-        meta = _meta(args, argv, targets, cases, run_seed(args.settings, args.seed))
-        meta.settings = _settings_line(targets, args.settings)
-        record_identities(targets, meta)
-    except (ValueError, LookupError, OSError, SerialException) as err:
-        raise Refused(str(err)) from err
-    for (_, _, how), target in zip(chosen, targets, strict=True):
-        meta.target(target.info.spec).profile_chosen = how
-    real = any(t.info.kind != "emu" for t in targets)
-    meta.operator_steps = (real and console.interactive if args.operator is None
-                           else args.operator)
-    if real:
-        meta.confirmed = "--yes" if args.yes else "asked"
-        if not args.yes and not confirmed(targets, meta, console):
-            raise Refused("motion not confirmed, nothing that moves was sent (answer y, or "
-                          "give --yes on an unattended bench)")
-    return targets, meta
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
@@ -162,6 +107,19 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     return execute(args, argv)
+
+
+def execute(args: argparse.Namespace, argv: list[str]) -> int:
+    """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
+    fleet runs for its one target (cli/fleet.py)."""
+    try:
+        return _main(args, argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:
+        _quiet_stdout()          # `gve-conformance --list | head -1`: end quietly
+        return 0
 
 
 def _quiet_stdout() -> None:
@@ -186,20 +144,7 @@ def example_database_of(args: argparse.Namespace) -> str | None:
     return None if args.no_reports else str(Path(args.report_dir, DEFAULT_DATABASE))
 
 
-def execute(args: argparse.Namespace, argv: list[str]) -> int:
-    """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
-    fleet runs for its one target. A usage error is one line and exit status 2."""
-    try:
-        return _execute(args, argv)
-    except UsageError as err:
-        print(f"{PROG}: {err}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        _quiet_stdout()          # `gve-conformance --list | head -1`: end quietly
-        return 0
-
-
-def _execute(args: argparse.Namespace, argv: list[str]) -> int:
+def _main(args: argparse.Namespace, argv: list[str]) -> int:
     cases = select(args.cases or None, args.exclude or None)
     if not cases:
         raise UsageError("no case matches " + " ".join(
@@ -213,46 +158,41 @@ def _execute(args: argparse.Namespace, argv: list[str]) -> int:
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
         except LookupError as err:
-            raise UsageError(str(err)) from None
+            raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
         return 0
     if args.jobs < 1:
         raise UsageError("--jobs must be 1 or more")
     if not args.no_reports:
         _check_writable(Path(args.report_dir))
-    database = example_database_of(args)
     with ExitStack() as run_scope:
         try:
-            run_scope.enter_context(example_database(database))
+            run_scope.enter_context(example_database(example_database_of(args)))
         except ValueError as err:
             raise UsageError(f"--hypothesis-db: {err}") from None
-        console = Console()
-        try:
-            targets, meta = prepare(args, argv, cases, console)
-        except Refused as err:
-            raise UsageError(str(err)) from None
-        except KeyboardInterrupt:
-            print("\ngve-conformance: interrupted before the run, nothing that moves was sent",
-                  file=sys.stderr)
-            return 130
-        run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-        if args.jobs > 1 and len(targets) > 1:
-            from conformance.cli.fleet import run_fleet
-            for target in targets:
-                target.close()          # each member opens its own port
-            return run_fleet(args, argv, targets, run_id, meta.seed, database)
-        _preflight(targets)
-        return _run(args, targets, cases, meta, console, run_id)
+        return _run(args, argv, cases)
 
 
-def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: RunMeta,
-         console: Console, run_id: str) -> int:
-    seed = meta.seed
-    _say(f"Hypothesis settings: {meta.settings}")
-    exact = args.settings or " and ".join(sorted({settings_for(t, None) for t in targets}))
+def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
+    console = Console()
+    try:
+        targets, how = _targets(args, console)
+    except KeyboardInterrupt:
+        raise UsageError("interrupted before the run, nothing was sent") from None
+    _preflight(targets)
+    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+    seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
+    meta = _meta(args, argv, targets, how, cases, seed, console)
+    if args.jobs > 1 and len(targets) > 1:
+        return _fleet(args, argv, targets, meta, console, run_id)
+    if meta.confirmed == "asked":
+        for target in targets:
+            if target.info.kind != "emu":
+                target.session.before_motion = ask_before_motion(target, console, meta)
+    _say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
     _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
-         f"seed: none (--settings {exact} is derandomized: every run draws the same "
-         "examples; --seed N for others)")
+         "seed: none (derandomized settings draw the same examples every run; --seed N for "
+         "others)")
     progress = Progress(len(targets) * len(cases), quiet=args.quiet)
     try:
         result = run(targets, cases, settings_name=args.settings, run_id=run_id,
@@ -261,10 +201,10 @@ def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: Run
     finally:
         progress.close()
     meta.finished = now_iso()
+    _from_sessions(result, meta)
     result.meta = meta
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    verdict, reason = overall([r.verdict for r in result.results], result.interrupted)
     _say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
     _say(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
          f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
@@ -275,8 +215,82 @@ def _run(args: argparse.Namespace, targets: list[Target], cases: list, meta: Run
         _say(f"reports: {folder}/report.html, results.json, junit.xml")
     if args.junitxml:
         _say(f"JUnit XML: {write_junit(result, args.junitxml)}")
+    verdict, reason = overall([r.verdict for r in result.results], result.interrupted,
+                              result.problems)
     _say(f"{verdict}: {reason}")
-    return 1 if verdict == FAILED or result.problems else 0
+    return 1 if verdict == FAILED else 0
+
+
+def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], meta: RunMeta,
+           console: Console, run_id: str) -> int:
+    """The targets in processes of their own (cli/fleet.py), asked about once here: the
+    members have no terminal."""
+    from conformance.cli.fleet import run_fleet
+    if meta.confirmed == "asked" and not confirmed(targets, meta, console):
+        raise UsageError("motion not confirmed, nothing that moves was sent (answer y, or "
+                         "give --yes on an unattended bench)")
+    for target in targets:
+        target.close()              # each member opens its own port
+    return run_fleet(args, argv, targets, run_id, meta.seed, example_database_of(args))
+
+
+def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how: list[str],
+          cases: list, seed: int | None, console: Console) -> RunMeta:
+    """What the reports say about the run before it starts."""
+    meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
+                   settings=_settings_line(targets, args.settings), seed=seed,
+                   mutant=args.mutant, destructive=args.allow_destructive,
+                   max_travel=args.max_travel, cases=args.cases, exclude=args.exclude,
+                   full_logs=args.full_logs)
+    for target, chosen in zip(targets, how, strict=True):
+        t = meta.target(target.info.spec)
+        t.kind, t.profile, t.profile_chosen = target.info.kind, target.profile.name, chosen
+        t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
+                                        for s in d["sections"]]}
+                     for d in (pc.as_dict() for pc in coverage(
+                         sorted({t.profile.name for t in targets}), cases=cases))]
+    real = any(t.info.kind != "emu" for t in targets)
+    meta.operator_steps = (real and console.interactive if args.operator is None
+                           else args.operator)
+    if real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+    try:
+        record_identities([t for t in targets if t.info.kind == "emu"], meta)
+    except (OSError, SerialException, ValueError) as err:
+        raise UsageError(str(err)) from None
+    return meta
+
+
+def _from_sessions(result: RunResult, meta: RunMeta) -> None:
+    """What each real unit's session found (its identity) and saw (the largest
+    excursion per axis), into the run's metadata."""
+    for spec, s in result.sessions.items():
+        t = meta.target(spec)
+        if s["identity"]:
+            t.version = s["identity"].get("version", t.version)
+            t.processor_id = s["identity"].get("processor_id", t.processor_id)
+        if s["excursion"]:
+            t.excursion = [max(abs(lo), abs(hi)) for lo, hi in s["excursion"]]
+
+
+def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], list[str]]:
+    """The targets, and how each one's profile was chosen (``--profile auto`` asks)."""
+    every = [f"emu:{name}" for name in available_profiles()]
+    if args.profile and args.profile != "auto" and not args.target:
+        every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
+    # no --target, or emu:all: the embedded emulator on every profile (--profile is for
+    # the targets named)
+    specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
+             for s in (every if t.split("?")[0] == "emu:all" else [t])]
+    try:
+        chosen = [resolve(s, args.profile if named else None, args.variant, console)
+                  for s, named in specs]
+        return [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
+                             max_travel=args.max_travel, mutant=args.mutant)
+                for s, p, _ in chosen], [how for _, _, how in chosen]
+    except (ValueError, LookupError, OSError, SerialException) as err:
+        raise UsageError(str(err).strip("'\"")) from None
 
 
 def _check_writable(folder: Path) -> None:

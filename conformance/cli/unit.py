@@ -4,6 +4,8 @@ move on a real unit."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from conformance.metadata import RunMeta
 from conformance.operator import Console, confirm_motion
 from conformance.targets import Target
@@ -45,7 +47,8 @@ def resolve(spec: str, profile: str | None, variant: str | None, console: Consol
 
 
 def record_identities(targets: list[Target], meta: RunMeta) -> None:
-    """Each unit's answers to `?` and `Q` into the run's metadata."""
+    """Each unit's answers to `?` and `Q` into the run's metadata (a real unit's session
+    reads them itself, before its first case)."""
     for target in targets:
         identity = of_target(target)
         if identity is not None:
@@ -53,18 +56,34 @@ def record_identities(targets: list[Target], meta: RunMeta) -> None:
             t.version, t.processor_id = identity.version, identity.processor_id
 
 
+def _what_moves(target: Target, version: str, processor_id: str) -> list[str]:
+    axes = ", ".join(f"{a} ±{target.info.max_travel}" for a in target.profile.axes)
+    return [f"{target.info.spec}: {version or '(no answer to ?)'}, Q {processor_id}, "
+            f"judged as {target.profile.name}",
+            f"  envelope (full steps either side of where the run began): {axes}",
+            "  destructive tests (J, W, EEPROM writes; EEPROM backed up and restored): "
+            + ("ON" if target.info.allow_destructive else "off")]
+
+
+def ask_before_motion(target: Target, console: Console, meta: RunMeta
+                      ) -> Callable[[], bool]:
+    """The question the target's session asks before the run's first frame that can move
+    an axis (its guard then refuses every motion frame unless the answer was yes)."""
+    def ask() -> bool:
+        found = target.session.identity
+        yes = confirm_motion(console, _what_moves(target, found.get("version", ""),
+                                                  found.get("processor_id", "")))
+        meta.confirmed = "asked: yes" if yes else "asked: refused, nothing moved"
+        if not yes:
+            console.say("  motion refused: cases that move will be COULD-NOT-TEST")
+        return yes
+    return ask
+
+
 def confirmed(targets: list[Target], meta: RunMeta, console: Console) -> bool:
-    """Ask before moving a real unit (every target on the embedded emulator: no need)."""
+    """The same question once for several targets before any of them runs (a fleet,
+    whose members have no terminal); the identities are those known so far."""
     real = [t for t in targets if t.info.kind != "emu"]
-    if not real:
-        return True
-    lines = []
-    for target in real:
-        t = meta.target(target.info.spec)
-        axes = ", ".join(f"{a} ±{target.info.max_travel}" for a in target.profile.axes)
-        lines += [f"{target.info.spec}: {t.version or '(no answer to ?)'}, Q {t.processor_id}, "
-                  f"judged as {target.profile.name}",
-                  f"  envelope (steps from where the run begins): {axes}",
-                  "  destructive tests (J, EEPROM writes, backed up and restored): "
-                  + ("ON" if target.info.allow_destructive else "off")]
-    return confirm_motion(console, lines)
+    lines = [line for t in real for line in _what_moves(
+        t, meta.target(t.info.spec).version, meta.target(t.info.spec).processor_id)]
+    return not real or confirm_motion(console, lines)

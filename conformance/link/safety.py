@@ -128,6 +128,7 @@ class Guard:
         self.before_motion: Callable[[], bool | None] | None = None
         self.motion_confirmed: bool | None = None
         self.silences = 0
+        self.garbage = ""                         # the last bytes that were not an answer
         self.dead = False
         self._own = 0                             # inside the session's own frames
         self._emergency = 0
@@ -160,9 +161,8 @@ class Guard:
             return
         if self.interrupts.pending or (self.interrupts.stopped and not self._own):
             raise Interrupted
-        if self.dead and not self._own:
-            raise TargetNotResponding(f"target not responding: {self.silences} frames "
-                                      "unanswered")
+        if self.dead:
+            raise TargetNotResponding(self._not_responding())
 
     def check(self, body: str, address: int | None = None) -> None:
         """Raise if the frame ``body`` for ``address`` may not be sent now."""
@@ -348,10 +348,15 @@ class Guard:
             self.silences = 0
             return
         self.silences += 1
-        if self.silences >= SILENCE_LIMIT and not self._own and not self._emergency:
+        if response is not None:
+            self.garbage = response.text
+        if self.silences >= SILENCE_LIMIT and not self._emergency:
             self.dead = True
-            raise TargetNotResponding(f"target not responding: {self.silences} frames "
-                                      "unanswered")
+            self.check_idle()
+
+    def _not_responding(self) -> str:
+        last = f" (the last bytes were not an answer: {self.garbage})" if self.garbage else ""
+        return f"target not responding: {self.silences} frames unanswered{last}"
 
     @property
     def responding(self) -> bool:

@@ -7,12 +7,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from conformance.reports.banner import run_verdict
 from conformance.reports.html import render_html
 from conformance.reports.junit import render_junit, write_junit
 from conformance.reports.logs import compact, compact_checks, compact_traces
 from conformance.reports.sections import section_key, section_name
 from conformance.runner import RunResult
-from conformance.verdict import overall
 
 __all__ = ["render_html", "render_junit", "to_json", "write_junit", "write_reports"]
 
@@ -32,7 +32,7 @@ def to_json(run: RunResult) -> dict:
     ``checks_total``: how many there were); a check names its rule only where it is not
     the case's own. What a case is (rule, source, section name) is said once, in
     ``cases``, not in each of its runs."""
-    verdict, reason = overall([r.verdict for r in run.results], run.interrupted)
+    verdict, reason = run_verdict(run)
     results = []
     for r in run.results:
         d = r.to_dict()
@@ -49,7 +49,8 @@ def to_json(run: RunResult) -> dict:
     return {"verdict": verdict, "reason": reason, "run_id": run.run_id,
             "meta": run.meta.to_dict(), "targets": run.targets, "settings": run.settings,
             "seconds": round(run.seconds, 3), "frames": run.frames,
-            "interrupted": run.interrupted, "counts": run.counts(),
+            "interrupted": run.interrupted, "problems": run.problems,
+            "sessions": run.sessions, "counts": run.counts(),
             "sections": {s: section_name(s) for s in sorted({r.section for r in run.results},
                                                             key=section_key)},
             "cases": {r.id: {"rule": r.rule, "tag": r.tag, "source": r.source,

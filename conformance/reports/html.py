@@ -10,11 +10,12 @@ from collections import Counter
 from importlib import resources
 
 import conformance.reports.plots as plots
+from conformance.reports.banner import run_verdict
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import html_text as h
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS, overall
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS
 
 #: verdicts whose case opens by itself
 _OPEN = (FAIL, ERROR)
@@ -35,11 +36,13 @@ def _rows(items: list[tuple[str, object]]) -> str:
 
 
 def _header(run: RunResult) -> list[str]:
-    verdict, reason = overall([r.verdict for r in run.results], run.interrupted)
+    verdict, reason = run_verdict(run)
     m = run.meta
     counts = run.counts()
     out = [f"<div class='banner {verdict}'>{verdict}</div> <span class='why'>{h(reason)}"
            f"{' (interrupted by Ctrl-C)' if run.interrupted else ''}</span>",
+           *([f"<ul class='FAIL'>{''.join(f'<li>PROBLEM: {h(p)}</li>' for p in run.problems)}"
+              "</ul>"] if run.problems else []),
            f"<h1>gve-conformance run {h(run.run_id)}</h1>",
            "<p>" + " ".join(f"<span class='{h(v)}'>{h(v)}: {counts[v]}</span>"
                             for v in ORDER if v in counts)
@@ -56,8 +59,7 @@ def _header(run: RunResult) -> list[str]:
            "<th>largest excursion</th><th>verdict</th></tr>"]
     for target in run.targets:
         t = m.target(target)
-        mine = [r.verdict for r in run.results if r.target == target]
-        v, why = overall(mine, run.interrupted)
+        v, why = run_verdict(run, target)
         out.append(
             f"<tr><td>{h(target)}</td><td>{h(t.profile)}"
             f"{' (' + h(t.profile_chosen) + ')' if t.profile_chosen else ''}</td>"
@@ -66,6 +68,15 @@ def _header(run: RunResult) -> list[str]:
             f"<td>{h(t.excursion if t.excursion is not None else '')}</td>"
             f"<td class='{v}'>{v}: {h(why)}</td></tr>")
     out.append("</table>")
+    for target, s in run.sessions.items():
+        done = [*(f"found {k} {v}" for k, v in s.get("found", {}).items()),
+                *(f"restored: {r}" for r in s.get("restored", [])),
+                *(f"reset: {r}" for r in s.get("reset", [])),
+                *(f"PROBLEM: {p}" for p in s.get("problems", []))]
+        if done:
+            out.append(f"<details><summary>{h(target)}: the unit as found and as left "
+                       f"({len(done)})</summary><ul>"
+                       + "".join(f"<li>{h(d)}</li>" for d in done) + "</ul></details>")
     return out
 
 
@@ -182,7 +193,7 @@ def _case(r: CaseResult, full_logs: bool, also: tuple[str, ...] = ()) -> list[st
 
 def render_html(run: RunResult, full_logs: bool | None = None) -> str:
     full = run.meta.full_logs if full_logs is None else full_logs
-    verdict, _ = overall([r.verdict for r in run.results], run.interrupted)
+    verdict, _ = run_verdict(run)
     sections = sorted({r.section for r in run.results}, key=section_key)
     out = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
            f"<title>{verdict} — gve-conformance {h(run.run_id)}</title>",

@@ -10,11 +10,12 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from conformance.reports.banner import run_verdict
 from conformance.reports.logs import compact
 from conformance.reports.sections import section_title
 from conformance.reports.text import clean
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, overall
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS
 
 
 def _message(r: CaseResult) -> str:
@@ -41,7 +42,7 @@ def _properties(parent: ET.Element, items: dict[str, object]) -> None:
 
 def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
     full = run.meta.full_logs if full_logs is None else full_logs
-    verdict, reason = overall([r.verdict for r in run.results], run.interrupted)
+    verdict, reason = run_verdict(run)
     root = _element(ET.Element("dummy"), "testsuites", name="gve-conformance",
                     tests=len(run.results), time=f"{run.seconds:.3f}")
     for target in run.targets:
@@ -56,6 +57,7 @@ def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
             timestamp=run.meta.started, hostname=run.meta.host)
         _properties(suite, {
             "run verdict": f"{verdict} ({reason})", "target": target,
+            **{f"problem {i + 1}": p for i, p in enumerate(run.problems)},
             "profiles": " ".join(sorted({r.profile for r in results})),
             "unit version (?)": t.version, "unit processor id (Q)": t.processor_id,
             "operator": run.meta.operator, "suite version": run.meta.suite_version,

@@ -14,7 +14,7 @@ _UNSAFE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uf
 
 def _shown(m: re.Match) -> str:
     code = ord(m.group(0))
-    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+    return f"\\x{code:02X}" if code < 0x100 else f"\\u{code:04X}"
 
 
 def clean(text: object) -> str:

@@ -41,8 +41,12 @@ class Target:
         return self._session
 
     def begin(self, interrupts: Interrupts | None = None) -> Session:
-        """A new session for a run (Ctrl-C shared through ``interrupts``)."""
-        self._session = Session(self, interrupts)
+        """The session for a run, Ctrl-C shared through ``interrupts``: the one prepared
+        before the run (an operator's prompt set, the identity read), else a new one."""
+        if self._session is None or self._session.finished:
+            self._session = Session(self, interrupts)
+        elif interrupts is not None:
+            self._session.share(interrupts)
         return self._session
 
     def open_link(self, address: int | None = None) -> Link:

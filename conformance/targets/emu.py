@@ -1,6 +1,6 @@
 """``emu:PROFILE[?mutant=NAME]``: the embedded emulator in virtual time, a fresh unit per
-link. The only place the suite imports the emulator: to open its ``gve://`` URL, and to
-list the deliberate bugs it can plant (:func:`mutants`)."""
+link. The only place the suite imports the emulator, and only to open its ``gve://`` URL
+and to read its registry of mutants."""
 
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ from gve_fixtures.profile import load_profile
 
 
 def mutants() -> dict[str, tuple[str, str]]:
-    """Every mutant the emulator can plant: name -> (the rule area a case must check to
-    catch it, what it gets wrong), from the emulator's registry."""
+    """The emulator's deliberate bugs: name -> (the rule area a case must check to catch
+    it, what it gets wrong), from its registry."""
     from emulator.mutants import MUTANTS
     # an entry is (sections, description[, area]); the area defaults to the first section
     return {name: (spec[2] if len(spec) > 2 else spec[0].split(",")[0].strip(), spec[1])

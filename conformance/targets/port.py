@@ -1,6 +1,6 @@
 """``serial:PATH?baud=&address=`` and ``tcp:HOST:PORT``: a real unit or a clone's
-simulator in real time, one port shared by every link of the run. ``serial:`` also
-takes any pyserial URL (``serial:rfc2217://host:port``, ``serial:socket://host:port``,
+simulator in real time, one port shared by every link of the run. ``serial:`` also takes
+any pyserial URL (``serial:rfc2217://host:port``, ``serial:socket://host:port``,
 ``serial:loop://``), its own options kept."""
 
 from __future__ import annotations

@@ -50,6 +50,15 @@ class Reachable(Protocol):
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
 
 
+def known_axis_limits(profile: Profile) -> tuple[int, ...]:
+    """The VL a unit is put back to: the reset VL (the variant's maximum) where VL's range
+    reaches it, else the top of the range (only J restores more, spec 9, 10)."""
+    if "VL" not in profile.ranges:
+        return tuple(profile.reset.VL)
+    top = profile.range("VL").hi
+    return tuple(min(v, top) for v in profile.reset.VL)
+
+
 class SessionError(Exception):
     """The session cannot begin on this target (one line for the user)."""
 
@@ -71,6 +80,7 @@ class SessionReport:
     problems: list[str] = field(default_factory=list)
     interrupted: bool = False
     not_responding: str = ""
+    violations: list[str] = field(default_factory=list)   # answers outside the cases
     wire_log: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
@@ -91,12 +101,17 @@ class Session:
         self.status: dict[int, int] = {}           # ST0..ST5 as found
         self.checksums: bool | None = None         # the checksum mode as found
         self.eeprom: dict[int, int] = {}           # EEPROM bytes as found
+        self.counters: dict[int, int] = {}         # position counters as found (PF)
         self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
                                     self.real, max_travel=info.max_travel if self.real else None)
         self.started = False
         self.failed = ""                           # why the session could not begin
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
+
+    def share(self, interrupts: Interrupts) -> None:
+        """Take Ctrl-C from the run's ``interrupts``."""
+        self.interrupts = self.guard.interrupts = interrupts
 
     # -- the guard's interface, for frames sent by other means ---------------------------------
     @property
@@ -153,34 +168,44 @@ class Session:
         if not self.real:
             return
         link = self._new_link()
-        with self.guard.own_frames():
-            self._probe_checksums(link)
-            for name, body in (("version", "?"), ("processor_id", "Q")):
-                r = link.send(body)
-                if r is not None and r.code == 0:
-                    self.identity[name] = ",".join(r.values)
-            self.report.identity = self.identity
-            for n in range(6):
-                r = link.send(f"SR{n}")
-                if _hex_ok(r):
-                    self.status[n] = r.hex()
-            self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
-            self.report.found["checksums"] = "on" if self.checksums else "off"
-            r = link.send("SR6")
+        try:
+            with self.guard.own_frames():
+                self._read_as_found(link)
+        finally:
+            self._keep_log(link)
+
+    def _read_as_found(self, link: Link) -> None:
+        """Identity, checksum mode, status words, where the axes are, EEPROM."""
+        self._probe_checksums(link)
+        for name, body in (("version", "?"), ("processor_id", "Q")):
+            r = link.send(body)
+            if r is not None and r.code == 0:
+                self.identity[name] = ",".join(r.values)
+        self.report.identity = self.identity
+        for n in range(6):
+            r = link.send(f"SR{n}")
             if _hex_ok(r):
-                st6 = r.hex()
-                self.report.found["ST6"] = "%02X" % st6
-                if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
-                    self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
-                                   f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
-                                   "mode; stop it before running the suite")
-                    raise SessionError(self.failed)
-            counters = self._position(link)
-            if counters:
-                self.guard.envelope.origin(counters)
-            if self.target.info.allow_destructive and "ER" in self.profile.commands:
-                self._backup_eeprom(link)
+                self.status[n] = r.hex()
+        self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
+        self.report.found["checksums"] = "on" if self.checksums else "off"
+        r = link.send("SR6")
+        if _hex_ok(r):
+            st6 = r.hex()
+            self.report.found["ST6"] = "%02X" % st6
+            if st6 & St6.STOP or (st6 & St6.RUN and not st6 & St6.INTA):
+                self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
+                               f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
+                               "mode; stop it before running the suite")
+                raise SessionError(self.failed)
+        self.counters = self._position(link)
+        self.guard.envelope.origin(self.counters)
+        if self.target.info.allow_destructive and "ER" in self.profile.commands:
+            self._backup_eeprom(link)
+
+    def _keep_log(self, link: Link) -> None:
+        """The session's own frames and what went wrong there, for the report."""
         self.report.wire_log += link.transcript_lines()
+        self.report.violations += link.violations
 
     def _probe_checksums(self, link: Link) -> None:
         """The checksum mode as found: `?` without a checksum is refused (4) in the mode."""
@@ -228,7 +253,7 @@ class Session:
         """What cannot be read, set to the reset state (spec 9)."""
         p, r = self.profile, self.profile.reset
         table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
-                 "VL": "VL" + ",".join(str(v) for v in r.VL)}
+                 "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
         if p.microstep:
@@ -249,6 +274,10 @@ class Session:
         self._stop(link)
         for body in self._reset_frames():
             link.send(body)
+        # a KEEP left by the last case leaves a queue that takes only L (spec 10.5): R
+        # empties the save; D then clears what R and a still active input set again
+        link.send("R")
+        link.send("D")
         self._go_back(link)
         link.send("N")
 
@@ -299,7 +328,7 @@ class Session:
             except (TargetNotResponding, SafetyStop, CouldNotTest) as err:
                 self.report.problems.append(f"restorations stopped: {err}")
                 self._unrestored()
-            self.report.wire_log += link.transcript_lines()
+            self._keep_log(link)
         self.report.interrupted = self.report.interrupted or self.interrupts.stopped
         if self.real:
             self.report.excursion = [list(e) for e in self.guard.excursion()]
@@ -328,6 +357,7 @@ class Session:
                 "axes back where the run began" if all(h == 0 for h in here) else
                 "axes: the way back is not known exactly for "
                 + ", ".join(a for a, h in zip(self.profile.axes, here, strict=True) if h is None))
+        self._restore_counters(link)
         self._restore_eeprom(link)
         self._restore_status(link)
         if self.checksums:
@@ -336,6 +366,30 @@ class Session:
                 self.report.problems.append(f"checksum mode not turned back on: %+ answered {r}")
             else:
                 self.report.restored.append("checksum mode back on")
+
+    def _restore_counters(self, link: Link) -> None:
+        """The position counters read as they would had the run never zeroed them: as
+        found plus how far each axis now is from where the run began (N<axis>)."""
+        names = self.profile.axes
+        self._position(link)
+        here = self.guard.envelope.position()
+        wanted = {i: c + int(here[i]) for i, c in self.counters.items() if here[i] is not None}
+        settable = {i: v for i, v in wanted.items() if f"N{names[i]}" in self.profile.commands}
+        if not settable:
+            if self.counters:
+                self.report.reset.append(
+                    "position counters not restored (the unit cannot set them): they read "
+                    + ",".join(str(c) for c in self.counters.values()) + " when found")
+            return
+        for i, value in settable.items():
+            link.send(f"N{names[i]}{value}")
+        read = self._position(link)
+        if all(read.get(i) == v for i, v in settable.items()):
+            self.report.restored.append("position counters as found: " + ", ".join(
+                f"{names[i]} {v}" for i, v in settable.items()))
+        else:
+            self.report.problems.append(f"position counters not restored: PF reads {read}, "
+                                        f"expected {settable}")
 
     def _restore_eeprom(self, link: Link) -> None:
         if not self.guard.eeprom_written:
@@ -365,6 +419,8 @@ class Session:
             r = link.send(f"SR{n}")
             if not (_hex_ok(r) and r.hex() == value):
                 wrong.append(f"ST{n} reads {r}, found {value:02X}")
+        wrong += [f"ST{n} could not be read before the run, left 00" for n in range(6)
+                  if n not in self.status]
         if wrong:
             self.report.problems.append("status words not restored: " + "; ".join(wrong))
         elif self.status:

@@ -10,7 +10,7 @@ import time
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
 from emulator.link.clock import RealClock
-from emulator.link.line import SECOND, Line
+from emulator.link.line import SECOND, Line, byte_time
 from emulator.link.url import parse_url
 
 
@@ -44,8 +44,10 @@ class Serial(SerialBase):
 
     def _reconfigure_port(self) -> None:
         if self.line is not None and self._baudrate != self.line.baud:
+            if self._baudrate <= 0:
+                raise ValueError(f"not a baud rate: {self._baudrate}")
             self.line.baud = self._baudrate
-            self.line.byte_ns = round(10 * 1_000_000_000 / self._baudrate)
+            self.line.byte_ns = byte_time(self._baudrate)
 
     @property
     def in_waiting(self) -> int:

@@ -66,6 +66,16 @@ class Outbox:
         self.dropped = 0
 
     def put(self, data: bytes, send: Callable[[bytes], int]) -> None:
+        if not self.pending:                  # the usual case: the host takes it at once
+            try:
+                n = send(data)
+            except (BlockingIOError, InterruptedError):
+                n = 0
+            except OSError:
+                return                        # the host is gone: nobody to read it
+            data = data[n:]
+            if not data:
+                return
         if len(self.pending) + len(data) > OUTPUT_LIMIT:
             self.dropped += len(data)
             return
@@ -117,17 +127,20 @@ class PtyHost(Host):
 
     def on_event(self, fd: int, events: int, line: Line, poll: select.poll) -> None:
         if events & select.POLLIN:
-            with contextlib.suppress(BlockingIOError, InterruptedError, OSError):
+            try:
                 data = os.read(self.master, READ_SIZE)
-                if data:
-                    line.write(data)
+            except OSError:                   # EAGAIN, EINTR, EIO: nothing to take
+                data = b""
+            if data:
+                line.write(data)
         if events & select.POLLOUT:
             self.out.flush(self._write)
-        poll.modify(self.master, self._events())
+            poll.modify(self.master, self._events())
 
     def send(self, data: bytes, poll: select.poll) -> None:
         self.out.put(data, self._write)
-        poll.modify(self.master, self._events())
+        if self.out.pending:
+            poll.modify(self.master, self._events())
 
     def close(self) -> None:
         os.close(self.master)
@@ -186,13 +199,14 @@ class TcpHost(Host):
                 line.write(data)
         if events & select.POLLOUT:
             self.out.flush(conn.send)
-        poll.modify(conn, self._events())
+            poll.modify(conn, self._events())
 
     def send(self, data: bytes, poll: select.poll) -> None:
         if self.conn is None:
             return
         self.out.put(data, self.conn.send)
-        poll.modify(self.conn, self._events())
+        if self.out.pending:
+            poll.modify(self.conn, self._events())
 
     def close(self) -> None:
         if self.conn is not None:
@@ -253,10 +267,11 @@ def serve(line: Line, host: Host, control: int | None) -> None:
     stdout = sys.stdout.fileno()
     poll.register(stdout, 0)                  # only errors: the reader went away
     host.register(poll)
+    ms = SECOND // 1000
     try:
         while not stop:
             due = line.wake_instant()
-            timeout = None if due is None else max(0, -(-(due - line.now) // (SECOND // 1000)))
+            timeout = None if due is None else max(0, -(-(due - line.now) // ms))
             for fd, events in poll.poll(timeout):
                 if fd == wake_r:
                     with contextlib.suppress(OSError):

@@ -15,7 +15,8 @@ from emulator.protocol.device import Device
 from emulator.protocol.params import CommandError, dec, decfloat, fields, hexa, within
 from emulator.protocol.reply import Reply
 from emulator.protocol.session import Session
-from gve_fixtures.protocol import ErrorCode, St6
+from emulator.protocol.state import QUEUE_FULL
+from gve_fixtures.protocol import ErrorCode
 
 Handler = Callable[[Device, Session, str, int], Reply]
 
@@ -112,7 +113,7 @@ def cmd_status_write(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 def cmd_flags(dev: Device, ses: Session, p: str, t: int) -> Reply:
     full = dev.motion.queued(t) >= dev.capacity()
-    return ["%02X" % (dev.st6(t) | (St6.QUEUE_FULL if full else 0))]
+    return ["%02X" % (dev.st6(t) | (QUEUE_FULL if full else 0))]
 
 
 # -- the GVE114's spindle at address 7 (spec 12) ----------------------------------------------

@@ -15,8 +15,8 @@ from emulator.protocol.device import Device
 from emulator.protocol.params import CommandError, dec, fields, within
 from emulator.protocol.reply import Deferred, Reply
 from emulator.protocol.session import Session
-from emulator.protocol.state import Saved
-from gve_fixtures.protocol import ErrorCode, St6
+from emulator.protocol.state import INTA, INTCOM, Saved
+from gve_fixtures.protocol import ErrorCode
 
 Handler = Callable[[Device, Session, str, int], Reply]
 
@@ -189,7 +189,7 @@ def _reference_run(dev: Device, t: int, duration: int, moves: list[tuple[int, in
 
 def cmd_halt(dev: Device, ses: Session, p: str, t: int) -> Reply:
     rest = dev.motion.halt(t)
-    dev.state.status[6] |= St6.INTA | St6.INTCOM
+    dev.state.status[6] |= INTA | INTCOM
     if rest > t and not dev.mutant.active("halt-answers-early"):
         return Deferred(rest, lambda at: (ErrorCode.OK, []))
     return []
@@ -201,7 +201,7 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
         if dev.mutant.active("go-without-inta"):
             return []
         raise CommandError(ErrorCode.NOTHING_TO_GO, "G with INTA = 0")
-    s.status[6] &= ~(St6.INTA | St6.INTCOM)
+    s.status[6] &= ~(INTA | INTCOM)
     s.status[4] = s.status[5] = 0
     dev.motion.resume(t)
     if dev.mutant.active("go-loses-step") and dev.motion.queued(t):

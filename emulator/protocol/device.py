@@ -17,9 +17,9 @@ from emulator.motion.interface import Vector
 from emulator.mutants import Mutant
 from emulator.protocol.eeprom import Eeprom
 from emulator.protocol.params import CommandError
-from emulator.protocol.state import DeviceState, reset_state
+from emulator.protocol.state import FREE, INTA, RUN, STOP, DeviceState, reset_state
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode, St6
+from gve_fixtures.protocol import ErrorCode
 
 MS = 1_000_000
 #: input ports read FF with nothing connected (spec 10.3)
@@ -69,11 +69,11 @@ class Device:
 
     def st6(self, t: int) -> int:
         flags = self.motion.flags(t)
-        value = self.state.status[6] & ~(St6.RUN | St6.STOP)
+        value = self.state.status[6] & ~(RUN | STOP)
         if flags.busy or self.mpg_active() or self.state.reference_until > t:
-            value |= St6.RUN
+            value |= RUN
         if flags.stopping:
-            value |= St6.STOP
+            value |= STOP
         return value
 
     def moving(self, t: int) -> bool:
@@ -86,7 +86,7 @@ class Device:
             raise CommandError(ErrorCode.BUSY, "not possible while moving")
 
     def refuse_while_running(self, t: int) -> None:
-        if self.st6(t) & St6.RUN:
+        if self.st6(t) & RUN:
             raise CommandError(ErrorCode.BUSY, "not possible while RUN = 1")
 
     def refuse_vectors_to_mpg(self) -> None:
@@ -175,7 +175,7 @@ class Device:
     def stop(self, t: int) -> None:
         """INTA set by an event: a stop on the ramp; later vectors wait for G."""
         if not self.state.inta:
-            self.state.status[6] |= St6.INTA
+            self.state.status[6] |= INTA
             self.motion.halt(t)
 
     def set_input(self, port: int, value: int, t: int) -> None:
@@ -190,11 +190,11 @@ class Device:
                 value &= self.profile.low_mask if n % 2 == 0 else self.profile.high_mask
             s.status[n] = value
         elif self.mutant.active("sw6-inert"):
-            s.status[6] = value & ~(St6.RUN | St6.STOP)
+            s.status[6] = value & ~(RUN | STOP)
         else:
             was = s.inta
             # RUN, STOP and FREE describe the stepper: writing them changes nothing
-            s.status[6] = value & ~(St6.RUN | St6.STOP | St6.FREE)
+            s.status[6] = value & ~(RUN | STOP | FREE)
             if s.inta and not was:
                 self.motion.halt(t)               # a stop ramp; no cause bit
             elif was and not s.inta:

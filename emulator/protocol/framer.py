@@ -99,6 +99,16 @@ class Framer:
         Returns (the frame or None, the index after it, the CR's instant). Byte ``k``
         of ``data`` is complete at ``t + k * byte_ns``."""
         n = len(data)
+        if self.buf is None:
+            # the common case first: a whole frame of ordinary length in this chunk
+            j = data.find(b"!", i)
+            if j < 0:
+                return None, n, 0
+            found = _NEXT.search(data, j + 1)
+            if found is not None and data[found.start()] == 0x0D \
+                    and found.start() - j <= MAX_FRAME:
+                cr = found.start()
+                return Frame(data[j:cr], cr - j, 0, b""), cr + 1, t + cr * byte_ns
         while i < n:
             if self.buf is None:
                 j = data.find(b"!", i)

@@ -12,6 +12,10 @@ from emulator.motion.interface import KeepSave
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
+# plain ints of the St6 bits for the per-frame path (IntFlag's operators are slow)
+INTA, INTCOM, RUN, STOP, FREE, QUEUE_FULL = (
+    b.value for b in (St6.INTA, St6.INTCOM, St6.RUN, St6.STOP, St6.FREE, St6.QUEUE_FULL))
+
 
 @dataclass
 class Modal:
@@ -52,7 +56,7 @@ class DeviceState:
 
     @property
     def inta(self) -> bool:
-        return bool(self.status[6] & St6.INTA)
+        return bool(self.status[6] & INTA)
 
 
 def reset_state(profile: Profile) -> DeviceState:

@@ -8,9 +8,7 @@ the spindle (spec 12). A name outside the table answers 3.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from types import MappingProxyType
 
 from emulator.protocol import cmd_io as io
 from emulator.protocol import cmd_motion as mo
@@ -38,7 +36,7 @@ def _bare(run: Handler, **flags: object) -> Command:
 
 
 #: every command by the name it has on the wire
-COMMANDS: Mapping[str, Command] = MappingProxyType({
+COMMANDS: dict[str, Command] = {
     "?": _bare(io.cmd_version), "Q": _bare(io.cmd_processor),
     "L": Command(mo.cmd_line), "C": Command(mo.cmd_cont),
     "T": Command(mo.modal("T", "T")), "$": Command(mo.modal("$", "dollar")),
@@ -68,7 +66,7 @@ COMMANDS: Mapping[str, Command] = MappingProxyType({
     "%": Command(se.cmd_checksum_mode),
     "*S": _bare(se.cmd_packet_start, remembered=False, packet=DISCARD),
     "*E": Command(se.cmd_packet_end, packet=CLOSE),
-})
+}
 
 #: the spindle's V at the GVE114's address 7 (spec 12)
 SPINDLE_V = Command(io.cmd_spindle)
@@ -90,13 +88,11 @@ def spindle_table(profile: Profile) -> dict[str, Command]:
     return table
 
 
-_BY_LENGTH = tuple(frozenset(n for n in COMMANDS if len(n) == k) for k in (3, 2, 1))
-
-
 def split(body: str) -> tuple[str | None, str]:
     """The command name at the start of ``body`` (the longest of the protocol's names
     that matches) and its parameter text."""
-    for k, names in zip((3, 2, 1), _BY_LENGTH, strict=True):
-        if body[:k] in names:
-            return body[:k], body[k:]
+    for k in (3, 2, 1):
+        name = body[:k]
+        if len(name) == k and name in COMMANDS:
+            return name, body[k:]
     return None, body

@@ -92,7 +92,7 @@ class Unit:
         return best
 
     def advance(self, t: int) -> None:
-        if self._pending or self.framer.open:
+        if self._pending or self.framer.buf is not None:
             while True:
                 expiry = self.framer.deadline()
                 answer = min((d.instant for _, d, _ in self._pending), default=None)

@@ -42,7 +42,7 @@ def test_the_default_run_writes_at_most_2_mb(default_run):
 def test_the_default_run_reports_passed_with_its_metadata(default_run):
     _, out, run_dir, junit = default_run
     assert out.rstrip().endswith("PASSED: no case failed")
-    assert "seed: none (--settings ci is derandomized" in out
+    assert "seed: none (derandomized settings draw the same examples every run" in out
     page = (run_dir / "report.html").read_text()
     assert "class='banner PASSED'>PASSED<" in page and "Technician T." in page
     data = json.loads((run_dir / "results.json").read_text())
@@ -57,7 +57,8 @@ def test_the_default_run_reports_passed_with_its_metadata(default_run):
 
 def _frames(tmp_path, seed: int) -> list[str]:
     folder = tmp_path / str(seed)
-    assert main(["--target", "emu:GVE84-100", "--cases", "6.machine.*", "--settings", "dev",
+    # ci settings are derandomized; a seed overrides that, so they show it cheaply
+    assert main(["--target", "emu:GVE84-100", "--cases", "6.machine.*", "--settings", "ci",
                  "--seed", str(seed), "--full-logs", "--report-dir", str(folder)]) == 0
     (run_dir,) = folder.iterdir()
     (r,) = json.loads((run_dir / "results.json").read_text())["results"]
@@ -66,13 +67,13 @@ def _frames(tmp_path, seed: int) -> list[str]:
 
 def test_the_same_seed_sends_the_same_frames(tmp_path, capsys):
     first, again = _frames(tmp_path / "a", 2026), _frames(tmp_path / "b", 2026)
-    assert len(first) > 100 and first == again
+    assert len(first) > 50 and first == again
     assert _frames(tmp_path / "c", 2027) != first        # the seed is what decides
     assert "seed 2026 (the same examples again: --seed 2026)" in capsys.readouterr().out
 
 
 def test_a_random_seed_is_printed_and_recorded(tmp_path, capsys):
-    main(["--target", "emu:GVE54", "--cases", "6.machine.*", "--settings", "dev",
+    main(["--target", "emu:GVE54", "--cases", "1.profile.version", "--settings", "dev",
           "--report-dir", str(tmp_path)])
     out = capsys.readouterr().out
     seed = int(out.split("seed ", 1)[1].split()[0])

@@ -53,6 +53,22 @@ def test_each_ending_has_its_verdict(target, body, tag, verdict):
     assert run_case(_toy(body, tag), target).verdict == verdict
 
 
+def _reads_garbage(index):
+    def body(ctx):
+        ctx.link.inject("unit", "corrupt", at=2, xor=0x40)   # 0,00 -> 0,p0
+        r = ctx.link.send("SR0")
+        r.hex(index)                                         # the unit's fault, not ours
+    return body
+
+
+@pytest.mark.parametrize("index", [0, 3])
+def test_unit_bytes_that_cannot_be_read_fail_the_case_never_error(target, index):
+    r = run_case(_toy(_reads_garbage(index), "D-info"), target)
+    assert r.verdict == FAIL
+    assert "cannot be read" in r.failed_checks[0]["what"] and "0,p0" in \
+        r.failed_checks[0]["what"]
+
+
 def test_d_is_non_strict_on_a_unit_that_does_not_implement_the_decisions(target):
     target.profile = dataclasses.replace(target.profile, implements_decisions=False)
     assert run_case(_toy(_fails, "D"), target).verdict == NON_STRICT

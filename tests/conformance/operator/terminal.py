@@ -25,22 +25,36 @@ class Terminal:
         self.seen = ""
         self.pos = 0             # where the next expect looks from
 
+    def _read(self, end: float, what: str) -> None:
+        """Whatever the program writes next, waiting up to the instant ``end``."""
+        left = end - time.monotonic()
+        assert left > 0, f"waited for {what}; seen:\n{self.seen[-2000:]}"
+        ready, _, _ = select.select([self.master], [], [], left)
+        if ready:
+            try:
+                data = os.read(self.master, 4096)
+            except OSError:                     # the program ended: EIO on Linux
+                data = b""
+            assert data, f"ended before {what}; seen:\n{self.seen[-2000:]}"
+            self.seen += data.decode("utf-8", "replace")
+
     def expect(self, text: str, deadline: float = DEADLINE) -> str:
         """Read until ``text`` appears after the last text expected; what came between."""
         end = time.monotonic() + deadline
         while text not in self.seen[self.pos:]:
-            left = end - time.monotonic()
-            assert left > 0, f"waited {deadline} s for {text!r}; seen:\n{self.seen[-2000:]}"
-            ready, _, _ = select.select([self.master], [], [], left)
-            if ready:
-                try:
-                    data = os.read(self.master, 4096)
-                except OSError:                     # the program ended: EIO on Linux
-                    data = b""
-                assert data, f"ended before {text!r}; seen:\n{self.seen[-2000:]}"
-                self.seen += data.decode("utf-8", "replace")
+            self._read(end, repr(text))
         start, self.pos = self.pos, self.seen.index(text, self.pos) + len(text)
         return self.seen[start:self.pos]
+
+    def expect_any(self, *texts: str, deadline: float = DEADLINE) -> str:
+        """Read until one of ``texts`` appears; the one that appeared first."""
+        end = time.monotonic() + deadline
+        while True:
+            found = sorted((i, t) for t in texts if (i := self.seen.find(t, self.pos)) >= 0)
+            if found:
+                self.expect(found[0][1])
+                return found[0][1]
+            self._read(end, " or ".join(map(repr, texts)))
 
     def answer(self, line: str) -> None:
         os.write(self.master, line.encode() + b"\n")
@@ -80,11 +94,11 @@ class EmulatedUnit:
             self._path = self.proc.stdout.readline().strip()
         return self._path
 
-    def rig(self, command: str) -> None:
-        """A control-channel command (``in 1 FE``: IN0 grounded); waits for its answer."""
+    def rig(self, command: str) -> str:
+        """A control-channel command (``in 1 FE``: IN0 grounded); its answer."""
         self.proc.stdin.write(command + "\n")
         self.proc.stdin.flush()
-        self.proc.stdout.readline()
+        return self.proc.stdout.readline()
 
     def close(self) -> None:
         self.proc.terminate()

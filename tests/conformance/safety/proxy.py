@@ -98,6 +98,22 @@ class Proxy:
         except OSError:
             return b""
 
+    def ask(self, frame: bytes) -> bytes:
+        """Send one frame as another host would (before the suite opens the port) and
+        read its answer."""
+        fd = os.open(self.path, os.O_RDWR | os.O_NOCTTY)
+        try:
+            os.write(fd, frame)
+            answer = b""
+            while not answer.endswith(b"\r"):
+                ready, _, _ = select.select([fd], [], [], 5)
+                if not ready:
+                    break
+                answer += os.read(fd, 64)
+            return answer
+        finally:
+            os.close(fd)
+
     def sent(self) -> list[bytes]:
         return [f for _, f in self.frames]
 

@@ -46,7 +46,8 @@ def test_a_unit_found_moving_is_not_taken_over(tmp_path):
 
 def test_the_unit_is_left_as_found():
     unit = in_process_unit("GVE84-100", max_travel=500)
-    for frame in (b"!0SW2,05\r", b"!0SW1,03\r", b"!0SW0,1A\r", b"!0%+\r"):
+    for frame in (b"!0NX1234\r", b"!0NY-5\r", b"!0SW2,05\r", b"!0SW1,03\r", b"!0SW0,1A\r",
+                  b"!0%+\r"):
         unit.recorder.write(frame)          # the machine's own settings, before the run
         unit.recorder.read_until(b"\r")
     before = unit.state()
@@ -56,6 +57,7 @@ def test_the_unit_is_left_as_found():
     assert after["status"][:6] == before["status"][:6] == ["1A", "03", "05", "00", "00", "00"]
     assert after["checksums"] is True
     assert after["physical"] == [0, 0, 0]    # back where the run began
+    assert after["position"] == [1234, -5, 0]  # counters as found
     report = result.sessions[unit.info.spec]
     assert report["problems"] == [] and report["identity"]["version"] == "IP84 v3 27.1.2010"
     assert any("1A 03 05 00 00 00" in line for line in report["restored"])
@@ -149,3 +151,13 @@ def test_ctrl_c_during_eeprom_work_halts_first_and_restores(tmp_path, when):
         assert image.read_bytes() == found
         assert result.problems == []
     assert os.path.exists(image)
+
+
+def test_the_operator_is_asked_once_before_the_first_motion_with_the_identity_known():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    asked = []
+    unit.session.before_motion = lambda: asked.append(
+        (unit.session.identity["version"], [f for f in unit.frames if moves(f)]))
+    run([unit], select(["1.profile.*", "5.errors.ok", "10.1.*"]))
+    assert asked == [("IP84 v3 27.1.2010", [])]       # before any frame that moves
+    assert [f for f in unit.frames if moves(f)]

@@ -1,0 +1,41 @@
+"""What a technician sees on a real unit (a pty here): the Hypothesis settings chosen for
+real units, the largest excursion per axis, what was restored; the same run through the
+pytest plugin leaves the unit as found."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.cli import main
+from tests.conformance.safety.proxy import unit_behind_proxy
+
+pytestmark = pytest.mark.pty
+pytest_plugins = ["pytester"]
+
+
+def test_the_console_says_what_the_session_did(tmp_path, capsys):
+    with unit_behind_proxy("--model", "GVE84-100") as (_, proxy):
+        status = main(["--target", f"serial:{proxy.path}", "--profile", "GVE84-100",
+                       "--cases", "5.errors.ok", "--cases", "10.3.status.run-bit",
+                       "--max-travel", "800", "--report-dir", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "Hypothesis settings: hardware on real units" in out
+    assert "largest excursion (full steps, envelope ±800): X +0..+500, Y +0..+0, Z +0..+0" \
+        in out
+    assert "restored: axes back where the run began" in out
+    assert "restored: ST0..ST5 as found: 00 00 00 00 00 00" in out
+
+
+def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
+    with unit_behind_proxy("--model", "GVE84-100") as (emu, proxy):
+        assert proxy.ask(b"!0SW0,05\r") == b"0\r"      # the machine's interrupt enables
+        result = pytester.runpytest("--gve-target", f"serial:{proxy.path}", "--gve-profile",
+                                    "GVE84-100", "--gve-cases", "5.errors.ok",
+                                    "--gve-cases", "10.3.status.all-bits-stored", "-q")
+        state = emu.state()
+    result.assert_outcomes(passed=2)
+    assert state["status"][0] == "05" and state["physical"] == [0, 0, 0]
+    # one session for the whole pytest run: the unit as found is read once (the checksum
+    # probe and the identity ask ? once each)
+    assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 2
