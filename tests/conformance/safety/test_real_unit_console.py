@@ -17,7 +17,7 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
     with unit_behind_proxy("--model", "GVE84-100") as (_, proxy):
         status = main(["--target", f"serial:{proxy.path}", "--profile", "GVE84-100",
                        "--cases", "5.errors.ok", "--cases", "10.3.status.run-bit",
-                       "--max-travel", "800", "--report-dir", str(tmp_path)])
+                       "--max-travel", "800", "--yes", "--report-dir", str(tmp_path)])
     out = capsys.readouterr().out
     assert status == 0
     assert "Hypothesis settings: hardware on real units" in out
