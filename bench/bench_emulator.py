@@ -1,8 +1,16 @@
-"""Commands per second in process (virtual time) and round trips per second over the pty.
+"""The emulator's speed as its share of a bare baseline, measured in one run:
+
+- in process (virtual time): the frame mix against ``gve://`` and the same loop against
+  pyserial's ``loop://`` (which only hands the bytes back);
+- over a pty (real time): ``!0V1000`` round trips against ``python -m emulator --pty``
+  and against a bare pty echo server (bench/pty_echo.py: the frame comes back as it
+  went, 8 bytes for the emulator's 2); for reference also against a bare server that
+  answers ``0`` to every frame with no work behind it.
 
     python -m bench.bench_emulator [--seconds 3] [--no-profile]
 
-Prints its figures; the machine is shared and noisy, so compare ratios from one run.
+The machine is shared and noisy, so only the ratios of one run mean anything; the goals
+are in the printout. The profile at the end lists where the in-process time goes.
 """
 
 from __future__ import annotations
@@ -11,9 +19,11 @@ import argparse
 import cProfile
 import io
 import pstats
+import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 
 import serial
 
@@ -21,10 +31,12 @@ import emulator  # noqa: F401  (registers gve://)
 
 MIX = [b"!0V1000\r", b"!0SR6\r", b"!0PF\r", b"!0@\r", b"!0A100\r", b"!0F\r", b"!0C10,0,0\r",
        b"!0T5\r"]
+GOAL_IN_PROCESS = 0.50      # of loop://
+GOAL_PTY = 0.80             # of the bare pty round trip
 
 
-def in_process(seconds: float) -> tuple[int, float]:
-    port = serial.serial_for_url("gve://?model=GVE84-100", timeout=1)
+def frames_per_second(port: serial.SerialBase, seconds: float,
+                      between: Callable[[], None] = lambda: None) -> float:
     n, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
         for frame in MIX:
@@ -32,26 +44,51 @@ def in_process(seconds: float) -> tuple[int, float]:
             port.read_until(b"\r")
         n += len(MIX)
         if n % 4000 < len(MIX):
-            port.line.run_until_idle(3600)
-    return n, time.perf_counter() - start
+            between()
+    return n / (time.perf_counter() - start)
 
 
-def over_pty(seconds: float) -> tuple[int, float]:
-    proc = subprocess.Popen([sys.executable, "-m", "emulator", "--model", "GVE84-100", "--pty"],
-                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+def in_process(seconds: float, windows: int = 6) -> tuple[float, float]:
+    """The mix per second through ``gve://`` and through ``loop://``, in alternating
+    windows; the median window of each."""
+    emu = serial.serial_for_url("gve://?model=GVE84-100", timeout=1)
+    loop = serial.serial_for_url("loop://", timeout=1)
+    rates: tuple[list[float], list[float]] = ([], [])
+    for _ in range(windows):
+        rates[0].append(frames_per_second(emu, seconds / windows,
+                                          lambda: emu.line.run_until_idle(3600)))
+        rates[1].append(frames_per_second(loop, seconds / windows))
+    return statistics.median(rates[0]), statistics.median(rates[1])
+
+
+def round_trips(commands: dict[str, list[str]], seconds: float,
+                windows: int = 6) -> dict[str, float]:
+    """``!0V1000`` round trips per second against each server, measured in alternating
+    windows (so that a change of the machine's load falls on all of them alike); the
+    median window of each."""
+    procs: dict[str, subprocess.Popen] = {}
+    ports: dict[str, serial.Serial] = {}
+    rates: dict[str, list[float]] = {name: [] for name in commands}
     try:
-        path = proc.stdout.readline().strip()
-        port = serial.Serial(path, 115200, timeout=2)
-        n, start = 0, time.perf_counter()
-        while time.perf_counter() - start < seconds:
-            port.write(b"!0V1000\r")
-            port.read_until(b"\r")
-            n += 1
-        port.close()
-        return n, time.perf_counter() - start
+        for name, command in commands.items():
+            procs[name] = proc = subprocess.Popen(command, stdin=subprocess.PIPE,
+                                                  stdout=subprocess.PIPE, text=True)
+            ports[name] = serial.Serial(proc.stdout.readline().split()[-1], 115200, timeout=2)
+        for _ in range(windows):
+            for name, port in ports.items():
+                n, start = 0, time.perf_counter()
+                while time.perf_counter() - start < seconds / windows:
+                    port.write(b"!0V1000\r")
+                    port.read_until(b"\r")
+                    n += 1
+                rates[name].append(n / (time.perf_counter() - start))
     finally:
-        proc.terminate()
-        proc.wait(10)
+        for port in ports.values():
+            port.close()
+        for proc in procs.values():
+            proc.terminate()
+            proc.wait(10)
+    return {name: statistics.median(r) for name, r in rates.items()}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -60,17 +97,27 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--no-profile", dest="profile", action="store_false",
                     help="skip the cProfile run of the in-process loop (top items by own time)")
     args = ap.parse_args(argv)
-    n, dt = in_process(args.seconds)
-    print(f"in process (virtual time): {n / dt:,.0f} commands/s  (goal 50,000)")
-    n, dt = over_pty(args.seconds)
-    print(f"over the pty (real time):  {n / dt:,.0f} round trips/s  (goal 5,000)")
+    s = args.seconds
+    emu, loop = in_process(2 * s)
+    print(f"in process (virtual time): {emu:,.0f} commands/s; loop:// {loop:,.0f}/s; "
+          f"share {emu / loop:.0%} (goal {GOAL_IN_PROCESS:.0%})")
+    here = [sys.executable, "-m"]
+    rt = round_trips({"emulator": [*here, "emulator", "--model", "GVE84-100", "--pty"],
+                      "echo": [*here, "bench.pty_echo"],
+                      "answer": [*here, "bench.pty_echo", "--answer"]}, 3 * s)
+    emu_pty, echo, answer = rt["emulator"], rt["echo"], rt["answer"]
+    print(f"over a pty (real time):    {emu_pty:,.0f} round trips/s; bare pty echo server "
+          f"{echo:,.0f}/s; share {emu_pty / echo:.0%} (goal {GOAL_PTY:.0%})")
+    print(f"                           bare server answering 0 {answer:,.0f}/s; "
+          f"share {emu_pty / answer:.0%} (the emulator's own work, for reference)")
     if args.profile:
         prof = cProfile.Profile()
+        port = serial.serial_for_url("gve://?model=GVE84-100", timeout=1)
         prof.enable()
-        in_process(args.seconds / 2)
+        frames_per_second(port, s / 2, lambda: port.line.run_until_idle(3600))
         prof.disable()
         out = io.StringIO()
-        pstats.Stats(prof, stream=out).sort_stats("tottime").print_stats(12)
+        pstats.Stats(prof, stream=out).sort_stats("tottime").print_stats(15)
         print(out.getvalue())
 
 

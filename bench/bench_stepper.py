@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import time
 
-from emulator.motion import Vector, c_available, create
+from emulator.motion.factory import c_available, create
+from emulator.motion.interface import Vector
 
 
 def vectors(n: int, steps: int) -> list[Vector]:

@@ -62,16 +62,25 @@ class Case:
 REGISTRY: dict[str, Case] = {}
 
 
-def case(id: str, *, rule: str, tag: str, source: str, requires: tuple[str, ...] = (),
-         absent: tuple[str, ...] = (), applies: Callable[[Profile], bool] | None = None,
-         rig: bool = False, destructive: bool = False, timing: bool = False,
-         rules: tuple[str, ...] = ()):
-    """Register a case (see docs/suite.md)."""
-    if tag not in TAGS:
-        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
-    unknown = [r for r in rules if r not in load_rules()]
+def case(id: str, *, rule: str | None = None, tag: str | None = None, source: str | None = None,
+         requires: tuple[str, ...] = (), absent: tuple[str, ...] = (),
+         applies: Callable[[Profile], bool] | None = None, rig: bool = False,
+         destructive: bool = False, timing: bool = False, rules: tuple[str, ...] = ()):
+    """Register a case (see docs/suite.md). ``rule``, ``tag`` and ``source`` default to
+    those of the first rule the case names, so that a case quotes its requirement from
+    fixtures/rules.toml rather than writing it again."""
+    known = load_rules()
+    unknown = [r for r in rules if r not in known]
     if unknown:
         raise ValueError(f"{id}: unknown rule(s) {unknown} (see fixtures/rules.toml)")
+    if (rule is None or tag is None or source is None) and not rules:
+        raise ValueError(f"{id}: name its rules, or give rule, tag and source")
+    first = known[rules[0]] if rules else None
+    rule = first.text if rule is None else rule
+    tag = first.tag if tag is None else tag
+    source = first.source if source is None else source
+    if tag not in TAGS:
+        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)
@@ -103,7 +112,7 @@ class Check:
     observed: str = ""
     expected: str = ""
     tag: str = ""
-    rule: str = ""
+    rule: str = ""           # the rule ID of fixtures/rules.toml it judges, if named
 
 
 @dataclass
@@ -116,6 +125,7 @@ class CaseContext:
     checks: list[Check] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     artifacts: dict[str, str] = field(default_factory=dict)
+    traces: list[dict] = field(default_factory=list)
     links: list[Link] = field(default_factory=list)
     _link: Link | None = None
 
@@ -135,10 +145,20 @@ class CaseContext:
 
     def expect(self, ok: bool, what: str, *, observed: Any = None, expected: Any = None,
                tag: str | None = None, rule: str | None = None) -> bool:
+        """Record one check. ``rule`` names the rule it judges (one of the case's
+        ``rules``): a failed check is graded by that rule's tag. ``tag`` overrides both
+        (``"always"``: a crash-class failure whatever the rule). Without either, the
+        case's tag grades it."""
+        if rule is not None and rule not in self.case.rules:
+            raise ValueError(f"{self.case.id}: a check names {rule!r}, which the case does "
+                             f"not list in its rules")
+        if rule is None and len(self.case.rules) == 1:
+            rule = self.case.rules[0]
+        graded = tag or (load_rules()[rule].tag if rule else self.case.tag)
         self.checks.append(Check(bool(ok), what,
                                  "" if observed is None else str(observed),
                                  "" if expected is None else str(expected),
-                                 tag or self.case.tag, rule or self.case.rule))
+                                 graded, rule or ""))
         return bool(ok)
 
     def require(self, ok: bool, why: str) -> None:
@@ -150,3 +170,15 @@ class CaseContext:
 
     def artifact(self, name: str, text: str) -> None:
         self.artifacts[name] = text
+
+    def trace(self, name: str, *, samples: list[tuple[float, list[int]]],
+              model: list[tuple[float, list[int]]], tolerance: dict[str, float],
+              params: dict[str, Any]) -> None:
+        """Record a motion trace for the reports: ``samples`` as read from the target
+        (seconds since the motion's origin, positions per axis), ``model`` the spec
+        model's positions at those or denser instants, ``tolerance`` the band the check
+        used (``seconds``, ``steps``), ``params`` the parameters (A, V, B, T, XM...)."""
+        self.traces.append({"name": name,
+                            "samples": [[float(t), [int(p) for p in ps]] for t, ps in samples],
+                            "model": [[float(t), [int(p) for p in ps]] for t, ps in model],
+                            "tolerance": dict(tolerance), "params": dict(params)})

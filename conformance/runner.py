@@ -34,6 +34,7 @@ class CaseResult:
     notes: list[str] = field(default_factory=list)
     wire_log: list[str] = field(default_factory=list)
     artifacts: dict[str, str] = field(default_factory=dict)
+    traces: list[dict] = field(default_factory=list)      # CaseContext.trace
     seconds: float = 0.0
     frames: int = 0
     interrupted: bool = False       # Ctrl-C ended it
@@ -147,7 +148,7 @@ def run_case(case: Case, target: Target, settings_name: str | None = None) -> Ca
     result.verdict = worst(verdicts)
     result.checks = [asdict(c) for c in ctx.checks]
     result.notes = ctx.notes
-    result.artifacts = ctx.artifacts
+    result.artifacts, result.traces = ctx.artifacts, ctx.traces
     result.wire_log = [line for link in ctx.links for line in
                        ["# link", *link.transcript_lines()]]
     result.frames = sum(link.frames for link in ctx.links)

@@ -14,6 +14,9 @@ PROFILES = {
     # real time is dear: no shrinking (a failing example is reported as it ran)
     "hardware": settings(max_examples=3, stateful_step_count=10, derandomize=True,
                          phases=[Phase.explicit, Phase.generate], **_COMMON),
+    # the mutation score: ci's examples, a failure counts as it is found (no shrinking)
+    "mutation": settings(max_examples=8, stateful_step_count=12, derandomize=True,
+                         phases=[Phase.explicit, Phase.generate], **_COMMON),
 }
 
 

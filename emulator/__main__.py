@@ -4,62 +4,128 @@
     python -m emulator --unit GVE54@1 --unit GVE84-100@0 --tcp 127.0.0.1:5114
 
 Serves in real time until SIGINT/SIGTERM (or `quit` on the control channel: standard
-input, one command a line: `in 1 7F`, `switch Y -1500`, `power-on`, `state`, `quit`).
+input, one command a line: `in 1 7F`, `switch Y -1500`, `power-on`, `state`, `quit`;
+docs/rig.md). A usage error is one line on stderr and exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from typing import NoReturn
 
 from emulator.link.clock import RealClock
 from emulator.link.line import Line
-from emulator.link.server import serve_pty, serve_tcp, stdin_or_none
-from emulator.link.url import DEFAULT_MODEL, LineSpec, parse_unit
+from emulator.link.server import (
+    PtyHost,
+    StdoutGone,
+    TcpHost,
+    control_fd,
+    say,
+    serve,
+    silence_stdout,
+)
+from emulator.link.url import DEFAULT_MODEL, LineSpec, parse_address, parse_unit, positive
 from emulator.mutants import MUTANTS
+
+PROG = "gve-emulator"
+
+
+class UsageError(Exception):
+    pass
+
+
+class Parser(argparse.ArgumentParser):
+    """Usage errors in one line (and exit status 2), like every other error here."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def _address(text: str) -> int:
+    try:
+        return parse_address(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _positive(text: str) -> int:
+    try:
+        return positive("the value", text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def tcp_address(text: str) -> tuple[str, int]:
+    """HOST:PORT (HOST defaults to 127.0.0.1; PORT 0 picks a free one)."""
+    host, colon, port = text.rpartition(":")
+    if not colon or not port.isdigit() or int(port) > 65535:
+        raise UsageError(f"--tcp takes HOST:PORT with PORT 0..65535, not {text!r}")
+    return host or "127.0.0.1", int(port)
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(prog="gve-emulator", description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=(__doc__ or "").splitlines()[0])
     ap.add_argument("--model", default=None, help=f"unit profile (default {DEFAULT_MODEL})")
-    ap.add_argument("--address", type=int, default=None, help="the unit's address 0..7")
+    ap.add_argument("--address", type=_address, default=None, help="the unit's address 0..7")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable)")
     where = ap.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", action="store_true", help="serve on a new pseudo-terminal")
     where.add_argument("--tcp", metavar="HOST:PORT", help="serve raw bytes on a TCP port")
-    ap.add_argument("--baud", type=int, default=None,
+    ap.add_argument("--baud", type=_positive, default=None,
                     help="pace bytes at this rate (default: delivered at once)")
     ap.add_argument("--eeprom", metavar="FILE", help="EEPROM image (kept across restarts)")
     ap.add_argument("--log", metavar="FILE", help="write a transcript of the wire")
-    ap.add_argument("--watchdog-ms", type=int, default=None)
-    ap.add_argument("--mutant", choices=sorted(MUTANTS), help="plant one deliberate bug")
+    ap.add_argument("--watchdog-ms", type=_positive, default=None)
+    ap.add_argument("--mutant", choices=sorted(MUTANTS), metavar="NAME",
+                    help="plant one deliberate bug (emulator/mutants.py)")
     ap.add_argument("--stepper", choices=["c", "python"], default=None)
     return ap.parse_args(argv)
 
 
-def main(argv: list[str] | None = None) -> int:
+def build(argv: list[str] | None) -> tuple[Line, PtyHost | TcpHost]:
+    """The line and where it is served; every usage problem raises UsageError."""
     args = parse_args(argv)
-    units = [parse_unit(u) for u in args.unit]
-    if not units:
-        units = [(args.model or DEFAULT_MODEL, args.address)]
-    spec = LineSpec(units=units, baud=args.baud, watchdog_ms=args.watchdog_ms,
-                    eeprom=args.eeprom, mutant=args.mutant, stepper=args.stepper, log=args.log)
     try:
+        units = [parse_unit(u) for u in args.unit]
+        if not units:
+            units = [(args.model or DEFAULT_MODEL, args.address)]
+        spec = LineSpec(units=units, baud=args.baud, watchdog_ms=args.watchdog_ms,
+                        eeprom=args.eeprom, mutant=args.mutant, stepper=args.stepper,
+                        log=args.log)
         built = spec.build_units()
-    except (ValueError, OSError) as err:
-        print(f"gve-emulator: {err}", file=sys.stderr)
+        place = tcp_address(args.tcp) if args.tcp else None
+        line = Line(built, spec.line_baud(built), clock=RealClock(), log=args.log,
+                    paced=args.baud is not None)
+        host = PtyHost() if place is None else TcpHost(*place)
+    except (ValueError, LookupError, ImportError) as err:
+        raise UsageError(str(err)) from None
+    except OSError as err:
+        raise UsageError(f"{err.strerror or err}"
+                         f"{f' ({err.filename})' if err.filename else ''}") from None
+    return line, host
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        line, host = build(argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
         return 2
-    line = Line(built, spec.line_baud(built), clock=RealClock(), log=args.log,
-                paced=args.baud is not None)
-    control = stdin_or_none()
-    if args.pty:
-        serve_pty(line, control)
-    else:
-        host, _, port = args.tcp.rpartition(":")
-        serve_tcp(line, host or "127.0.0.1", int(port), control)
-    if line.log is not None:
-        line.log.close()
+    try:
+        say(host.name)
+    except StdoutGone:
+        host.close()
+        silence_stdout()
+        return 0
+    try:
+        serve(line, host, control_fd())
+    except StdoutGone:
+        silence_stdout()                  # the reader went away: end quietly
+    finally:
+        if line.log is not None:
+            line.log.close()
     return 0
 
 

@@ -2,13 +2,19 @@
 
 from conformance.cases import (  # noqa: F401
     checksum,
+    eeprom,
     errors,
+    families,
     frame,
     golden,
     index,
+    interactions,
     keep,
+    measured,
     motion,
     packet,
+    params,
+    reference,
     status,
     units,
 )

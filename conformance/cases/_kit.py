@@ -11,17 +11,17 @@ def show(r: Response | None) -> str:
 
 
 def answers(ctx: CaseContext, r: Response | None, text: str, what: str, *,
-            tag: str | None = None) -> bool:
+            tag: str | None = None, rule: str | None = None) -> bool:
     """Expect the answer's exact bytes (``text`` without the final CR)."""
     return ctx.expect(r is not None and r.raw == text.encode() + b"\r", what,
-                      observed=show(r), expected=text, tag=tag)
+                      observed=show(r), expected=text, tag=tag, rule=rule)
 
 
 def code(ctx: CaseContext, r: Response | None, value: int, what: str, *,
-         tag: str | None = None, inta: bool | None = None) -> bool:
+         tag: str | None = None, inta: bool | None = None, rule: str | None = None) -> bool:
     ok = r is not None and r.code == value and (inta is None or r.inta == inta)
     shown = f"{value + (8 if inta else 0):X}" if inta is not None else str(value)
-    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag)
+    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag, rule=rule)
 
 
 def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
@@ -47,6 +47,14 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 1500) -> 
     ctx.require(r is not None and r.code == 0 and r.inta, f"H answered {show(r)}")
 
 
+def halted_line(ctx: CaseContext, steps: int, seconds: float) -> None:
+    """Setup: an L of ``steps`` along X halted after ``seconds`` (INTA = 1, RUN = 1)."""
+    setup(ctx, "L" + vector(ctx, steps))
+    ctx.link.wait(seconds)
+    r = ctx.link.send("H")
+    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+
+
 def fresh_reset(ctx: CaseContext) -> None:
     """Cases about the state right after a reset: the emulator gives a fresh unit; a real
     unit is restarted with J, which needs --allow-destructive."""
@@ -66,12 +74,12 @@ def index(ctx: CaseContext) -> int | None:
 
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
-                tag: str | None = None) -> bool:
+                tag: str | None = None, rule: str | None = None) -> bool:
     """Expect the index to have advanced by ``frames`` since ``before`` (spec 8)."""
     after = index(ctx)
     expected = None if before is None else (before + frames) % 256
     return ctx.expect(after is not None and after == expected, what, observed=after,
-                      expected=expected, tag=tag)
+                      expected=expected, tag=tag, rule=rule)
 
 
 def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:

@@ -7,14 +7,18 @@ from conformance.cases._kit import answers, code, setup
 from conformance.link.framing import byte_sum
 
 
-@case("6.checksum.mode-on-off", tag="M-ex", source="M84 12.3.2; M114 13.3.2 (G1)",
+@case("6.checksum.mode-on-off",
+      rules=("6.checksum.mode-answers",),
+      tag="M-ex", source="M84 12.3.2; M114 13.3.2 (G1)",
       requires=("%",), rule="!0%+ answers 0,5C (already summed); !0%-,CF answers 0")
 def on_off(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("%+", checksum=False), "0,5C", "%+ → 0,5C")
     answers(ctx, ctx.link.send("%-", checksum=True), "0", "%-,CF → 0 without a checksum")
 
 
-@case("6.checksum.command-summed", tag="M-ex", source="M84 12.3.2 (G2)", requires=("%",),
+@case("6.checksum.command-summed",
+      rules=("6.checksum.sum",),
+      tag="M-ex", source="M84 12.3.2 (G2)", requires=("%",),
       rule="The checksum sums every byte from '!' through the comma: !0A100, → 4F")
 def command_summed(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
@@ -22,7 +26,9 @@ def command_summed(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("A100", checksum="4F"), "0,5C", "!0A100,4F is accepted")
 
 
-@case("6.checksum.bad-sum-rejected", tag="D", source="spec 6 [D]; M84 12.3.2",
+@case("6.checksum.bad-sum-rejected",
+      rules=("6.checksum.bad-refused", "4.response.failed-not-executed"),
+      tag="D", source="spec 6 [D]; M84 12.3.2",
       requires=("%",), rule="In checksum mode a wrong checksum is not executed and answers 4")
 def bad_sum(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
@@ -35,21 +41,27 @@ def bad_sum(ctx: CaseContext) -> None:
                observed=r, expected="0,00,XX", tag="M")
 
 
-@case("6.checksum.missing-sum-rejected", tag="D", source="spec 6 [D]", requires=("%",),
+@case("6.checksum.missing-sum-rejected",
+      rules=("6.checksum.bad-refused",),
+      tag="D", source="spec 6 [D]", requires=("%",),
       rule="In checksum mode a frame without a checksum answers 4")
 def missing(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
     code(ctx, ctx.link.send("A100", checksum=False), 4, "no checksum → 4")
 
 
-@case("6.checksum.lower-case-accepted", tag="D", source="spec 3 [D]", requires=("%",),
+@case("6.checksum.lower-case-accepted",
+      rules=("3.frame.checksum-case",),
+      tag="D", source="spec 3 [D]", requires=("%",),
       rule="Checksum hex digits are accepted in either case")
 def lower(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
     answers(ctx, ctx.link.send("A100", checksum="4f"), "0,5C", "!0A100,4f is accepted")
 
 
-@case("6.checksum.responses-summed", tag="M", source="M84 12.3.2", requires=("%",),
+@case("6.checksum.responses-summed",
+      rules=("6.checksum.response-sum",),
+      tag="M", source="M84 12.3.2", requires=("%",),
       rule="Responses are summed the same way from their first byte, in upper-case hex")
 def responses(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
@@ -59,7 +71,9 @@ def responses(ctx: CaseContext) -> None:
                    observed=r, expected="a valid upper-case checksum")
 
 
-@case("6.checksum.absent-on-gve54", tag="M", source="spec 1; M54", absent=("%",),
+@case("6.checksum.absent-on-gve54",
+      rules=("1.profile.gve54-no-checksums", "1.profile.command-set"),
+      tag="M", source="spec 1; M54", absent=("%",),
       rule="A unit without checksums answers % with 3")
 def absent(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("%+"), 3, "%+ → 3")

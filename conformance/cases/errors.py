@@ -6,12 +6,16 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, fill_queue, halted_with_queue, setup, vector
 
 
-@case("5.errors.ok", tag="M-ex", source="M84 12.6 (G4a)", rule="An accepted command answers 0")
+@case("5.errors.ok",
+      rules=("5.code.ok", "10.cmd.vector", "3.params.commas"),
+      tag="M-ex", source="M84 12.6 (G4a)", rule="An accepted command answers 0")
 def ok(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("L" + vector(ctx, 100)), "0", "L100,0,0 on an idle unit")
 
 
-@case("5.errors.queue-full", tag="M", source="M84 12.5.2, 12.6 code 1",
+@case("5.errors.queue-full",
+      rules=("5.code.queue-full", "1.profile.buffer", "10.1.queue.cont-buffer"),
+      tag="M", source="M84 12.5.2, 12.6 code 1",
       rule="C with no room in the CONT buffer answers 1; the buffer holds the profile's size")
 def queue_full(ctx: CaseContext) -> None:
     n = ctx.profile.buffer
@@ -20,27 +24,35 @@ def queue_full(ctx: CaseContext) -> None:
     ctx.link.send("D")
 
 
-@case("5.errors.unknown", tag="M", source="M84 12.6 code 3",
+@case("5.errors.unknown",
+      rules=("5.code.unknown",),
+      tag="M", source="M84 12.6 code 3",
       rule="An unknown command answers 3")
 def unknown(ctx: CaseContext) -> None:
     for body in ("Z", "E", "XQ"):
         code(ctx, ctx.link.send(body), 3, f"{body} → 3")
 
 
-@case("5.errors.out-of-range", tag="M-ex", source="M84 12.6 (G4e)",
+@case("5.errors.out-of-range",
+      rules=("5.code.range", "10.cmd.status-words", "10.cmd.modal", "10.cmd.accel-range"),
+      tag="M-ex", source="M84 12.6 (G4e)",
       rule="A parameter out of range answers 5 (!0SW8,F1 → 5)")
 def out_of_range(ctx: CaseContext) -> None:
     for body in ("SW8,F1", "T25", "A0", "SR7"):
         code(ctx, ctx.link.send(body), 5, f"{body} → 5")
 
 
-@case("5.errors.go-without-inta", tag="M", source="M84 12.6 code 6",
+@case("5.errors.go-without-inta",
+      rules=("5.code.nothing-to-go", "10.4.go.without-inta"),
+      tag="M", source="M84 12.6 code 6",
       rule="G while INTA = 0 answers 6 and does nothing")
 def go_idle(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("G"), 6, "G on an idle unit → 6")
 
 
-@case("5.errors.busy", tag="M", source="M84 12.5.6, 12.5.8: 'nelze použít za chodu'",
+@case("5.errors.busy",
+      rules=("5.code.busy-moving", "5.code.busy-run", "5.moving.definition"),
+      tag="M", source="M84 12.5.6, 12.5.8: 'nelze použít za chodu'",
       rule="D, K, R, N while a vector runs answer 7")
 def busy(ctx: CaseContext) -> None:
     setup(ctx, "V1000")
@@ -51,14 +63,18 @@ def busy(ctx: CaseContext) -> None:
     ctx.link.send("H")
 
 
-@case("5.errors.n-while-run", tag="M", source="M84 12.5.6: 'pri RUN=1'",
+@case("5.errors.n-while-run",
+      rules=("5.code.busy-run", "5.moving.after-halt"),
+      tag="M", source="M84 12.5.6: 'pri RUN=1'",
       rule="N is refused (7) while interrupted vectors still hold RUN = 1")
 def n_run(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True)
 
 
-@case("5.errors.refused-not-executed", tag="M", source="spec 4; M84 12.6",
+@case("5.errors.refused-not-executed",
+      rules=("4.response.failed-not-executed", "10.1.queue.line-alone"),
+      tag="M", source="spec 4; M84 12.6",
       rule="A command answered with an error is not executed")
 def refused_not_executed(ctx: CaseContext) -> None:
     ctx.link.send("V1000,5")

@@ -4,9 +4,14 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, show
+from conformance.link.framing import frame
+from conformance.link.link import MARGIN
+from conformance.motion.tolerance import byte_ns
 
 
-@case("2.link.other-address-ignored", tag="M", source="M114 1, 9.5; spec 2-3",
+@case("2.link.other-address-ignored",
+      rules=("2.link.addressed-only", "3.frame.other-address-whole", "8.index.uncounted"),
+      tag="M", source="M114 1, 9.5; spec 2-3",
       rule="Only the addressed unit answers; a frame for another address is ignored whole")
 def other_address(ctx: CaseContext) -> None:
     link = ctx.link
@@ -21,14 +26,18 @@ def other_address(ctx: CaseContext) -> None:
     index_moved(ctx, before, 0, "the ignored frame did not count in the index", tag="D")
 
 
-@case("3.frame.noise-before-bang", tag="D", source="spec 3 [D]",
+@case("3.frame.noise-before-bang",
+      rules=("3.frame.noise-ignored",),
+      tag="D", source="spec 3 [D]",
       rule="Bytes before '!' are ignored")
 def noise(ctx: CaseContext) -> None:
     ctx.link.send_raw(b"\x00xyz 12\n")
     answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "a frame after noise")
 
 
-@case("3.frame.bang-restarts", tag="D", source="spec 3 [D]",
+@case("3.frame.bang-restarts",
+      rules=("3.frame.bang-restarts", "2.link.simplex"),
+      tag="D", source="spec 3 [D]",
       rule="A '!' inside an unfinished frame starts a new frame; the old one gets no answer")
 def restart(ctx: CaseContext) -> None:
     before = index(ctx)
@@ -37,7 +46,9 @@ def restart(ctx: CaseContext) -> None:
     ctx.expect(ctx.link.wait(0.3) == b"", "no second answer", tag="always")
 
 
-@case("3.frame.lf-after-cr", tag="D", source="spec 3 [D]",
+@case("3.frame.lf-after-cr",
+      rules=("3.frame.lf-ignored", "2.link.simplex"),
+      tag="D", source="spec 3 [D]",
       rule="A LF after CR is ignored")
 def lf(ctx: CaseContext) -> None:
     before = index(ctx)
@@ -47,27 +58,35 @@ def lf(ctx: CaseContext) -> None:
     index_moved(ctx, before, 1, "the LF made no frame")
 
 
-@case("3.frame.lower-case-unknown", tag="D", source="spec 3 [D]",
+@case("3.frame.lower-case-unknown",
+      rules=("3.frame.upper-case", "5.code.unknown"),
+      tag="D", source="spec 3 [D]",
       rule="Command letters are upper case: a lower-case command is unknown (3)")
 def lower(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("v1000"), 3, "v1000 is an unknown command")
     answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "still answering")
 
 
-@case("3.frame.syntax-errors", tag="D", source="spec 3 [D]; M84 12.6 code 4",
+@case("3.frame.syntax-errors",
+      rules=("3.params.decimal", "5.code.syntax"),
+      tag="D", source="spec 3 [D]; M84 12.6 code 4",
       rule="A '+', a space, an empty field or a non-digit in a number is a syntax error (4)")
 def syntax(ctx: CaseContext) -> None:
     for body in ("V+100", "V 100", "V", "V1x", "T5,5", "L1,,2"):
         code(ctx, ctx.link.send(body), 4, f"{body} → 4")
 
 
-@case("3.frame.too-long", tag="D", source="spec 3 [D]",
+@case("3.frame.too-long",
+      rules=("3.frame.max-length",),
+      tag="D", source="spec 3 [D]",
       rule="A frame longer than 96 bytes is a syntax error (4) once its CR arrives")
 def too_long(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), 4, "a 106-byte frame → 4")
 
 
-@case("3.frame.watchdog", tag="M", source="M84 12.6 code 2; spec 3 [timing D]",
+@case("3.frame.watchdog",
+      rules=("3.frame.watchdog", "5.code.watchdog", "8.index.uncounted"),
+      tag="M", source="M84 12.6 code 2; spec 3 [timing D]",
       rule="A frame left unfinished longer than the watchdog time is dropped and answered 2",
       timing=True)
 def watchdog(ctx: CaseContext) -> None:
@@ -82,7 +101,9 @@ def watchdog(ctx: CaseContext) -> None:
     index_moved(ctx, before, 0, "a frame dropped by the watchdog does not count", tag="D")
 
 
-@case("3.frame.lone-bang-silent", tag="D", source="spec 3 [D]",
+@case("3.frame.lone-bang-silent",
+      rules=("3.frame.watchdog-lone-bang",),
+      tag="D", source="spec 3 [D]",
       rule="If only '!' arrived before the watchdog time, nothing is answered", timing=True)
 def lone_bang(ctx: CaseContext) -> None:
     ctx.link.send_raw(b"!")
@@ -90,7 +111,9 @@ def lone_bang(ctx: CaseContext) -> None:
     ctx.expect(got == b"", "no answer to a lone '!'", observed=got, expected=b"")
 
 
-@case("4.response.inta-bit", tag="M", source="M84 12.6",
+@case("4.response.inta-bit",
+      rules=("4.response.inta-bit",),
+      tag="M", source="M84 12.6",
       rule="While ST6.INTA = 1 every response carries bit 3 (8..F)")
 def inta_bit(ctx: CaseContext) -> None:
     from conformance.cases._kit import halted_with_queue
@@ -100,17 +123,37 @@ def inta_bit(ctx: CaseContext) -> None:
         code(ctx, r, value, f"{body} while interrupted", inta=True)
 
 
-@case("4.response.hex-values", tag="M", source="M-ex 12.6; M84 12.5.11",
+@case("4.response.hex-values",
+      rules=("4.response.value-format", "3.params.hex-digits"),
+      tag="M", source="M-ex 12.6; M84 12.5.11",
       rule="Status words and ports are two upper-case hex digits")
 def hex_values(ctx: CaseContext) -> None:
     ctx.link.send("SW2,ab")
     answers(ctx, ctx.link.send("SR2"), "0,AB", "SR2 in upper case after SW2,ab")
 
 
-@case("4.response.refused-has-no-values", tag="D", source="spec 4 [D]",
+@case("4.response.refused-has-no-values",
+      rules=("4.response.failed-no-values",),
+      tag="D", source="spec 4 [D]",
       rule="A failing command's response carries no values")
 def refused(ctx: CaseContext) -> None:
     for body in ("SR9", "ERXY", "PF1"):
         r = ctx.link.send(body)
         ctx.expect(r is not None and r.code and not r.values, f"{body} → code only",
                    observed=show(r), expected="an error code alone")
+
+
+@case("2.link.answers-at-once", rules=("2.link.answer-promptly",))
+def at_once(ctx: CaseContext) -> None:
+    link = ctx.link
+    for body in ("V1000", "PF", "SR6", "?", "Z"):
+        r = link.send(body)
+        wire = (len(frame(body, link.address, link.checksums)) + (len(r.raw) if r else 0)) \
+            * byte_ns(link.baud)
+        # a real unit may take the link's margin to process a frame (spec 2: "as soon as
+        # possible"; later is a timeout anyway); in virtual time the emulator takes none
+        limit = wire + (0 if link.virtual else round(MARGIN * 1e9))
+        took = None if r is None else r.received_at - r.sent_at
+        ctx.expect(took is not None and took <= limit, f"{body} is answered at once",
+                   observed=f"{took} ns", expected=f"at most {limit} ns (the bytes' time"
+                   f"{'' if link.virtual else f' and {MARGIN} s'})")

@@ -18,7 +18,9 @@ def _tag(kind: str | None, default: str) -> str:
     return kind if kind in TAGS else default
 
 
-def play(ctx: CaseContext, t: Transcript) -> None:
+def play(ctx: CaseContext, t: Transcript, rule: str | None = None) -> None:
+    """Replay ``t``; each expected answer is a check of ``rule`` graded by its record's
+    tag."""
     link = ctx.link
     default = _tag(t.tag.kind if t.tag else None, "M-ex")
     for rec in t.records:
@@ -35,18 +37,19 @@ def play(ctx: CaseContext, t: Transcript) -> None:
             if setup:
                 ctx.require(ok, f"setup answered {got!r} at {what}")
             else:
-                ctx.expect(ok, what, observed=got, expected=rec.data, tag=tag)
+                ctx.expect(ok, what, observed=got, expected=rec.data, tag=tag, rule=rule)
         elif rec.direction == ACTION:
-            _action(ctx, rec.action, what, tag)
+            _action(ctx, rec.action, what, tag, rule)
 
 
-def _action(ctx: CaseContext, words: list[str], what: str, tag: str) -> None:
+def _action(ctx: CaseContext, words: list[str], what: str, tag: str,
+            rule: str | None = None) -> None:
     link, verb, args = ctx.link, words[0], words[1:]
     if verb == "wait":
         link.wait(float(args[0]))
     elif verb == "silence":
         got = link.wait(float(args[0]))
-        ctx.expect(got == b"", what, observed=got, expected=b"", tag="always")
+        ctx.expect(got == b"", what, observed=got, expected=b"", tag="always", rule=rule)
     elif verb == "poll":
         frame, pattern = unescape(args[1]), re.compile(unescape(args[2]), re.DOTALL)
         limit = link.now + float(args[0]) * 1e9
@@ -68,7 +71,7 @@ def _action(ctx: CaseContext, words: list[str], what: str, tag: str) -> None:
         link.rig.set_input(int(args[0]), int(args[1], 16))
     elif verb == "expect":
         got = ("%02X" % link.rig.outputs()) if args[0] == "outputs" else str(link.rig.spindle())
-        ctx.expect(got == args[1], what, observed=got, expected=args[1], tag=tag)
+        ctx.expect(got == args[1], what, observed=got, expected=args[1], tag=tag, rule=rule)
     elif verb == "power-on":
         link.rig.power_on()
         link.wait(2.5)
@@ -82,17 +85,22 @@ def _register(path: Path) -> None:
     needs_rig = any(r.direction == ACTION and r.action[0] in RIG_ACTIONS for r in t.records)
     address = int(t.meta.get("address", "-1"))
     tag = _tag(t.tag.kind if t.tag else None, "M-ex")
+    # the golden exchange's own rule (spec "11 G4" -> 11.golden.g4), then those its
+    # records check (header "rules:")
+    golden = re.search(r"\b11 G(\d+)", t.meta.get("spec", ""))
+    rule = f"11.golden.g{golden.group(1)}" if golden else None
+    rules = tuple(r for r in (rule, *t.meta.get("rules", "").split()) if r)
 
     def applies(profile) -> bool:
         return not families or profile.family in families or profile.name in families
 
     @case(f"11.golden.{path.stem}", rule=t.meta.get("title", path.stem),
-          tag=tag, source=t.meta.get("source", ""),
+          tag=tag, source=t.meta.get("source", ""), rules=rules,
           applies=applies, rig=needs_rig, destructive=bool(t.meta.get("destructive")))
     def replay(ctx: CaseContext) -> None:
         if address >= 0 and address != ctx.link.address:
             ctx.fresh_link(address)
-        play(ctx, t)
+        play(ctx, t, rule)
 
 
 for _path in golden_transcripts():

@@ -12,11 +12,14 @@ from conformance.cases._kit import (
     setup,
     vector,
 )
+from conformance.link.framing import byte_sum
 
 SRC = "M84 12.5.12; spec 8 [D what counts]"
 
 
-@case("8.index.counts-every-frame", tag="M", source=SRC,
+@case("8.index.counts-every-frame",
+      rules=("8.index.counts",),
+      tag="M", source=SRC,
       rule="Every complete frame advances the index by one, refused ones too")
 def counts(ctx: CaseContext) -> None:
     link = ctx.link
@@ -27,7 +30,9 @@ def counts(ctx: CaseContext) -> None:
     index_moved(ctx, before, 3, "three frames, two refused, counted")
 
 
-@case("8.index.queries-not-counted", tag="D", source=SRC,
+@case("8.index.queries-not-counted",
+      rules=("8.index.counts",),
+      tag="D", source=SRC,
       rule="@ and > themselves do not advance the index")
 def queries(ctx: CaseContext) -> None:
     link = ctx.link
@@ -38,7 +43,9 @@ def queries(ctx: CaseContext) -> None:
     index_moved(ctx, before, 1, "only V1000 counted")
 
 
-@case("8.index.modulo-256", tag="M", source=SRC, rule="The index counts modulo 256")
+@case("8.index.modulo-256",
+      rules=("8.index.counts",),
+      tag="M", source=SRC, rule="The index counts modulo 256")
 def modulo(ctx: CaseContext) -> None:
     before = index(ctx)
     for _ in range(258):
@@ -46,7 +53,9 @@ def modulo(ctx: CaseContext) -> None:
     index_moved(ctx, before, 258, "258 frames later the index moved by 2 (mod 256)")
 
 
-@case("8.repeat.last-frame-and-answer", tag="D", source=SRC,
+@case("8.repeat.last-frame-and-answer",
+      rules=("8.repeat.answer", "8.repeat.remembered"),
+      tag="D", source=SRC,
       rule="> answers the last frame as received, then the response it got")
 def repeat(ctx: CaseContext) -> None:
     link = ctx.link
@@ -56,14 +65,18 @@ def repeat(ctx: CaseContext) -> None:
     answers(ctx, r, expected, "> repeats the refused frame and its answer")
 
 
-@case("8.repeat.no-history", tag="D", source=SRC,
+@case("8.repeat.no-history",
+      rules=("8.repeat.answer",),
+      tag="D", source=SRC,
       rule="With no history since reset, > answers a single line 0")
 def no_history(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     answers(ctx, ctx.link.send(">"), "0", "> right after reset")
 
 
-@case("8.repeat.not-reexecuted", tag="M", source="M84 12.5.12",
+@case("8.repeat.not-reexecuted",
+      rules=("8.repeat.no-reexecute",),
+      tag="M", source="M84 12.5.12",
       rule="> re-executes nothing")
 def not_again(ctx: CaseContext) -> None:
     link = ctx.link
@@ -81,7 +94,9 @@ def not_again(ctx: CaseContext) -> None:
     ctx.expect(here == want, "the vector ran once", observed=here, expected=want, tag="always")
 
 
-@case("8.recovery.lost-response", tag="M", source="M84 12.5.12: recovery with @ and >",
+@case("8.recovery.lost-response",
+      rules=("8.index.counts", "8.repeat.answer"),
+      tag="M", source="M84 12.5.12: recovery with @ and >",
       rule="A lost response is recovered with @ and > without executing the vector twice")
 def lost_response(ctx: CaseContext) -> None:
     link = ctx.link
@@ -98,3 +113,17 @@ def lost_response(ctx: CaseContext) -> None:
     link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
     ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
                expected=[9, 0, 0], tag="always")
+
+
+@case("8.repeat.queries-forgotten", requires=("%",), rules=("8.repeat.remembered",))
+def queries_forgotten(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "%+", checksum=False)
+    setup(ctx, "V1000")
+    link.send("@", checksum="00")                  # a bad checksum: answered 4, not kept
+    link.send(">", checksum="00", lines=1)
+    r = link.send(">", lines=2)
+    ctx.expect(r is not None and r.lines[:1] == [f"!{link.address}V1000,%02X".encode()
+                                                 % byte_sum(f"!{link.address}V1000,".encode())],
+               "> still shows V1000: @ and > are never remembered, even refused",
+               observed=r, expected=f"!{link.address}V1000,XX then 0,5C")

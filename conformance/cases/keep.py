@@ -17,7 +17,9 @@ from conformance.cases._kit import (
 SRC = "M84 12.5.8; M114 13.6.9; M54"
 
 
-@case("10.5.keep.saves-st6", tag="M", source=SRC,
+@case("10.5.keep.saves-st6",
+      rules=("10.5.keep.saves", "10.5.restore.exact", "4.response.inta-after-command"),
+      tag="M", source=SRC,
       rule="K saves the queue and ST4..ST6 and clears them; R brings them back")
 def saves(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
@@ -29,7 +31,9 @@ def saves(ctx: CaseContext) -> None:
                observed=show(r), expected="8,D0")
 
 
-@case("10.5.keep.partial-vector", tag="M", source=SRC,
+@case("10.5.keep.partial-vector",
+      rules=("10.5.keep.saves", "10.5.restore.exact"),
+      tag="M", source=SRC,
       rule="K keeps the rest of the interrupted vector: after R and G no step is lost")
 def partial(ctx: CaseContext) -> None:
     halted_with_queue(ctx, 2, 1500)
@@ -45,7 +49,9 @@ def partial(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[3000, 0, 0])
 
 
-@case("10.5.keep.single-l", tag="D", source="M84 12.5.8 [M]; C → 4 [D]",
+@case("10.5.keep.single-l",
+      rules=("10.5.keep.c-refused", "10.5.keep.single-l"),
+      tag="D", source="M84 12.5.8 [M]; C → 4 [D]",
       applies=lambda p: p.keep == "single-L",
       rule="After K the GVE84/GVE114 queue takes only L (a C answers 4)")
 def single_l(ctx: CaseContext) -> None:
@@ -55,7 +61,9 @@ def single_l(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("L" + vector(ctx, 10)), 0, "L after K → 0", tag="M")
 
 
-@case("10.5.keep.refused-while-moving", tag="M", source=SRC,
+@case("10.5.keep.refused-while-moving",
+      rules=("5.code.busy-moving", "10.5.keep.saves"),
+      tag="M", source=SRC,
       rule="K and R are not possible while moving (7)")
 def moving(ctx: CaseContext) -> None:
     setup(ctx, "C" + vector(ctx, 2000))
@@ -65,7 +73,9 @@ def moving(ctx: CaseContext) -> None:
     ctx.link.send("H")
 
 
-@case("10.5.restore.empty", tag="D", source="spec 10.5 [D]",
+@case("10.5.restore.empty",
+      rules=("10.5.restore.pops",),
+      tag="D", source="spec 10.5 [D]",
       rule="R with nothing saved restores an empty save and answers 0")
 def restore_empty(ctx: CaseContext) -> None:
     fresh_reset(ctx)
@@ -73,7 +83,9 @@ def restore_empty(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved")
 
 
-@case("10.5.keep.one-level", tag="M", source="M54 [M]; M84 12.5.8, M114 13.6.9 [INFO]",
+@case("10.5.keep.one-level",
+      rules=("10.5.keep.one-level", "10.5.keep.one-level-info"),
+      tag="M", source="M54 [M]; M84 12.5.8, M114 13.6.9 [INFO]",
       rule="The save has one level: a second K without R overwrites it")
 def one_level(ctx: CaseContext) -> None:
     halted_with_queue(ctx)

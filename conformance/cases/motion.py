@@ -15,7 +15,9 @@ from conformance.cases._kit import (
 )
 
 
-@case("10.1.line.refused-while-busy", tag="M", source="M84 12.5.2",
+@case("10.1.line.refused-while-busy",
+      rules=("10.1.queue.line-alone", "5.code.queue-full"),
+      tag="M", source="M84 12.5.2",
       rule="L is accepted only when nothing is queued or running; otherwise 1")
 def l_busy(ctx: CaseContext) -> None:
     setup(ctx, "C" + vector(ctx, 500))
@@ -25,7 +27,9 @@ def l_busy(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[500, 0, 0], tag="always")
 
 
-@case("10.1.line.wait-idiom", tag="M", source="M84 12.5.2",
+@case("10.1.line.wait-idiom",
+      rules=("10.1.queue.wait-idiom",),
+      tag="M", source="M84 12.5.2",
       rule="L0,0,0 answers 1 until everything before it has finished, then 0")
 def idiom(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 300))
@@ -36,7 +40,9 @@ def idiom(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[300, 0, 0])
 
 
-@case("10.1.queue.executing-counts", tag="M", source="M84 12.5.2: '1 je vykonáván'",
+@case("10.1.queue.executing-counts",
+      rules=("10.1.queue.cont-buffer", "10.cmd.flags", "1.profile.buffer"),
+      tag="M", source="M84 12.5.2: '1 je vykonáván'",
       rule="The CONT buffer's size includes the executing vector; F shows bit 5 when full")
 def queue_full_flag(ctx: CaseContext) -> None:
     if fill_queue(ctx):
@@ -46,7 +52,9 @@ def queue_full_flag(ctx: CaseContext) -> None:
     ctx.link.send("D")
 
 
-@case("10.2.motion.targets-reached", tag="M", source="M84 12.5.2: vectors are relative",
+@case("10.2.motion.targets-reached",
+      rules=("10.1.queue.relative", "10.2.motion.step-placement"),
+      tag="M", source="M84 12.5.2: vectors are relative",
       rule="Vectors are relative to the previous end point and end exactly on target")
 def targets(ctx: CaseContext) -> None:
     setup(ctx, "V5000")
@@ -59,7 +67,9 @@ def targets(ctx: CaseContext) -> None:
                observed=position(ctx), expected=expected)
 
 
-@case("10.4.halt.answers-when-stopped", tag="M", source="M84 12.5.8",
+@case("10.4.halt.answers-when-stopped",
+      rules=("10.4.halt.ramp", "10.cmd.halt-answer", "10.3.st6.inta-run", "10.3.st6.bits"),
+      tag="M", source="M84 12.5.8",
       rule="H brakes on the ramp and answers (8) only once the motion has stopped")
 def halt(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
@@ -72,7 +82,9 @@ def halt(ctx: CaseContext) -> None:
                observed=show(r), expected="8,D0")
 
 
-@case("10.4.go.resumes-exactly", tag="M", source="M84 12.5.8",
+@case("10.4.go.resumes-exactly",
+      rules=("10.4.go.resume",),
+      tag="M", source="M84 12.5.8",
       rule="G resumes the interrupted vector from the exact step: no step lost or gained")
 def go(ctx: CaseContext) -> None:
     halted_with_queue(ctx, 3, 1500)
@@ -82,7 +94,9 @@ def go(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[4500, 0, 0])
 
 
-@case("10.4.delete.clears", tag="M", source="M84 12.5.8",
+@case("10.4.delete.clears",
+      rules=("10.4.delete",),
+      tag="M", source="M84 12.5.8",
       rule="D empties the queue and clears ST4..ST6; the position is unchanged")
 def delete(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
@@ -94,7 +108,9 @@ def delete(ctx: CaseContext) -> None:
                expected=here)
 
 
-@case("10.4.delete.refused-while-moving", tag="M", source="M84 12.5.8",
+@case("10.4.delete.refused-while-moving",
+      rules=("10.4.delete", "5.code.busy-moving"),
+      tag="M", source="M84 12.5.8",
       rule="D while moving answers 7")
 def delete_moving(ctx: CaseContext) -> None:
     setup(ctx, "C" + vector(ctx, 2000))
@@ -103,7 +119,9 @@ def delete_moving(ctx: CaseContext) -> None:
     ctx.link.send("H")
 
 
-@case("10.commands.zero-axis", tag="M-ex", source="M84 12.5.6", requires=("NX",),
+@case("10.commands.zero-axis",
+      rules=("10.cmd.set-axis", "10.cmd.zero"),
+      tag="M-ex", source="M84 12.5.6", requires=("NX",),
       rule="!0NX100 sets the X counter; !0N zeroes every axis")
 def set_axis(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("NX100"), "0", "NX100")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, fill_queue, index, index_moved, position, setup, vector
+from conformance.link.framing import byte_sum
 
 RULE = "spec 7 [D]; M84 12.3.3"
 
@@ -16,7 +17,9 @@ def _packet(ctx: CaseContext, members: list[str], count: int):
     return link.send(f"*E{count}")
 
 
-@case("7.packet.commits-all", tag="M", source="M84 12.3.3", requires=("*S",),
+@case("7.packet.commits-all",
+      rules=("7.packet.exchange", "7.packet.members", "7.packet.all-or-nothing"),
+      tag="M", source="M84 12.3.3", requires=("*S",),
       rule="*E<n> commits every member in order and answers code,k")
 def commits(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
@@ -26,7 +29,9 @@ def commits(ctx: CaseContext) -> None:
                expected=[10, 20, 0])
 
 
-@case("7.packet.count-mismatch", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.count-mismatch",
+      rules=("7.packet.codes", "7.packet.all-or-nothing", "5.code.watchdog"),
+      tag="D", source=RULE, requires=("*S",),
       rule="k ≠ n: nothing is committed and *E answers 2,k")
 def count(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
@@ -35,7 +40,9 @@ def count(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", tag="always")
 
 
-@case("7.packet.invalid-member", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.invalid-member",
+      rules=("7.packet.other-member", "7.packet.codes", "7.packet.all-or-nothing"),
+      tag="D", source=RULE, requires=("*S",),
       rule="A member other than C or B fails the packet with 4; nothing is committed")
 def invalid(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
@@ -45,14 +52,18 @@ def invalid(ctx: CaseContext) -> None:
                expected=[0, 0, 0], tag="always")
 
 
-@case("7.packet.out-of-range-member", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.out-of-range-member",
+      rules=("7.packet.codes",),
+      tag="D", source=RULE, requires=("*S",),
       rule="A member out of range fails the packet with its code (5)")
 def out_of_range(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B1", "C" + vector(ctx, 10)], 2)
     answers(ctx, r, "5,2", "B1 (below range) → 5,2")
 
 
-@case("7.packet.no-room", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.no-room",
+      rules=("7.packet.codes", "5.code.queue-full", "7.packet.all-or-nothing"),
+      tag="D", source=RULE, requires=("*S",),
       rule="A packet that does not fit the queue answers 1 and commits nothing")
 def no_room(ctx: CaseContext) -> None:
     if not fill_queue(ctx, ctx.profile.buffer - 1):
@@ -67,13 +78,17 @@ def no_room(ctx: CaseContext) -> None:
     ctx.link.send("D")
 
 
-@case("7.packet.end-without-start", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.end-without-start",
+      rules=("7.packet.breakers",),
+      tag="D", source=RULE, requires=("*S",),
       rule="*E with no open packet answers 4,0")
 def end_alone(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("*E1"), "4,0", "*E1 alone → 4,0")
 
 
-@case("7.packet.halt-inside", tag="D", source=RULE, requires=("*S",),
+@case("7.packet.halt-inside",
+      rules=("7.packet.breakers", "8.index.counts"),
+      tag="D", source=RULE, requires=("*S",),
       rule="H, @, > inside an open packet are answered at once and discard the packet")
 def breakers(ctx: CaseContext) -> None:
     link = ctx.link
@@ -84,10 +99,33 @@ def breakers(ctx: CaseContext) -> None:
     answers(ctx, link.send("*E1"), "4,0", "the packet was discarded")
 
 
-@case("7.packet.with-checksums", tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
+@case("7.packet.with-checksums",
+      rules=("7.packet.checksums",),
+      tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
       rule="Packets work in checksum mode, each member with its own checksum")
 def summed(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 2)
     ctx.expect(r is not None and r.code == 0 and r.values == ["2"] and r.checksum_ok,
                "a summed packet → 0,2 with its checksum", observed=r, expected="0,2,XX")
+
+
+@case("7.packet.bad-checksum-member.corrupted-end", requires=("*S",),
+      rules=("7.packet.bad-checksum-member", "8.index.uncounted"))
+def corrupted_end(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "%+", checksum=False)
+    before = index(ctx)
+    link.send("*S", answer=False)
+    link.send("C" + vector(ctx, 1), answer=False)
+    r = link.send("*E1", checksum="00", timeout=0.5)
+    ctx.expect(r is None, "a corrupted *E is a failing member: no answer", observed=r,
+               expected="nothing", rule="7.packet.bad-checksum-member")
+    answers(ctx, link.send("*E1"), "2,2,%02X" % byte_sum(b"2,2,"),
+            "the packet stayed open with two members",
+            rule="7.packet.bad-checksum-member")
+    index_moved(ctx, before, 3, "*S, the member and *E counted; the corrupted frame not",
+                rule="8.index.uncounted")
+    ctx.link.wait(0.5)
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing was committed", observed=position(ctx),
+               expected=[0, 0, 0], rule="7.packet.bad-checksum-member")

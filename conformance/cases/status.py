@@ -6,7 +6,9 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, position, setup, show, vector
 
 
-@case("10.3.status.all-bits-stored", tag="D", source="spec 10.3 [D]; M84 12.5.8 SW1,3F",
+@case("10.3.status.all-bits-stored",
+      rules=("10.3.status.all-bits", "10.cmd.status-words"),
+      tag="D", source="spec 10.3 [D]; M84 12.5.8 SW1,3F",
       rule="Every status word stores all 8 bits as written")
 def all_bits(ctx: CaseContext) -> None:
     for n, value in ((2, "2B"), (3, "FF"), (5, "80"), (1, "3F"), (0, "A2")):
@@ -17,7 +19,9 @@ def all_bits(ctx: CaseContext) -> None:
                    observed=show(r), expected=value)
 
 
-@case("10.3.status.run-bit", tag="M", source="M84 12.5.11",
+@case("10.3.status.run-bit",
+      rules=("10.3.st6.bits", "10.3.st6.inta-run"),
+      tag="M", source="M84 12.5.11",
       rule="ST6 bit 6 (RUN) is set while a vector is processed and clear when idle")
 def run_bit(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 500))
@@ -28,13 +32,17 @@ def run_bit(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("SR6"), "0,00", "idle again")
 
 
-@case("10.3.status.inputs-read-ff", tag="D", source="spec 10.3 [D]",
+@case("10.3.status.inputs-read-ff",
+      rules=("10.3.inputs.idle-level", "10.cmd.inputs"),
+      tag="D", source="spec 10.3 [D]",
       rule="Input ports read FF with nothing connected")
 def inputs(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected")
 
 
-@case("10.3.interrupt.stops-motion", tag="M", source="M84 12.5.11", rig=True,
+@case("10.3.interrupt.stops-motion",
+      rules=("10.3.inputs.interrupt", "10.3.status.meaning"),
+      tag="M", source="M84 12.5.11", rig=True,
       rule="An enabled active input stops the motion, sets its cause bit and INTA")
 def interrupt(ctx: CaseContext) -> None:
     link = ctx.link
@@ -51,7 +59,9 @@ def interrupt(ctx: CaseContext) -> None:
                observed=show(r), expected="8,01")
 
 
-@case("10.3.interrupt.polarity", tag="M", source="M84 12.5.11", rig=True,
+@case("10.3.interrupt.polarity",
+      rules=("10.3.inputs.polarity", "4.response.inta-level"),
+      tag="M", source="M84 12.5.11", rig=True,
       rule="An input is active when its level equals its polarity bit")
 def polarity(ctx: CaseContext) -> None:
     link = ctx.link
@@ -65,7 +75,9 @@ def polarity(ctx: CaseContext) -> None:
                expected="8,01")
 
 
-@case("10.3.flags.f-command", tag="M", source="M84 12.5.11",
+@case("10.3.flags.f-command",
+      rules=("10.cmd.flags", "3.params.none-expected"),
+      tag="M", source="M84 12.5.11",
       rule="F answers ST6 with bit 5 = queue full")
 def f_idle(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("F"), "0,00", "F when idle")

@@ -18,18 +18,29 @@ from conformance.cases._kit import (
     vector,
 )
 
-# command -> (a valid frame on an idle unit after reset, a regex of its answer) [spec 10]
+# command -> (a valid frame on an idle unit after reset, a regex of its answer, the rule
+# of spec 10 it checks)
 FORMATS = {
-    "?": ("?", r"0,.+"), "Q": ("Q", r"0,\d{8}"), "T": ("T10", "0"), "$": ("$100", "0"),
-    "A": ("A100", "0"), "V": ("V1000", "0"), "B": ("B1000", "0"),
-    "VL": ("VL1000,1000,1000", "0"), "VK": ("VK", "0"), "VN": ("VN", "0"), "XA": ("XA", "0"),
-    "XU": ("XU", "0"), "XD": ("XD", "0"), "XM": ("XM100", "0"), "P": ("P", r"0,-?\d+,-?\d+"),
-    "PF": ("PF", r"0(,-?\d+){3}"), "N": ("N", "0"), "NX": ("NX0", "0"), "NY": ("NY0", "0"),
-    "NZ": ("NZ0", "0"), "NA": ("NA0", "0"), "ER": ("ER05", r"0,[0-9A-F]{2}"),
-    "EFR": ("EFR30", r"0,\S+"), "EUR": ("EUR4C", r"0,\d+"), "O0": ("O0,FF", "0"),
-    "I0": ("I0", r"0,[0-9A-F]{2}"), "I1": ("I1", r"0,[0-9A-F]{2}"),
-    "I2": ("I2", r"0,[0-9A-F]{2}"), "SR": ("SR0", r"0,[0-9A-F]{2}"), "SW": ("SW0,00", "0"),
-    "F": ("F", r"0,[0-9A-F]{2}"), "@": ("@", r"0,\d+"), "H": ("H", "8"),
+    "?": ("?", r"0,.+", "1.profile.version"), "Q": ("Q", r"0,\d{8}", "10.cmd.processor"),
+    "T": ("T10", "0", "10.cmd.modal"), "$": ("$100", "0", "10.cmd.modal"),
+    "A": ("A100", "0", "10.cmd.accel-range"), "V": ("V1000", "0", "10.cmd.modal"),
+    "B": ("B1000", "0", "10.cmd.modal"), "VL": ("VL1000,1000,1000", "0", "10.cmd.axis-limits"),
+    "VK": ("VK", "0", "10.cmd.vk-vn"), "VN": ("VN", "0", "10.cmd.vk-vn"),
+    "XA": ("XA", "0", "10.cmd.exchange-velocity"), "XU": ("XU", "0", "10.cmd.exchange-velocity"),
+    "XD": ("XD", "0", "10.cmd.exchange-velocity"), "XM": ("XM100", "0", "10.cmd.override"),
+    "P": ("P", r"0,-?\d+,-?\d+", "10.cmd.positions"),
+    "PF": ("PF", r"0(,-?\d+){3}", "10.cmd.positions"), "N": ("N", "0", "10.cmd.zero"),
+    "NX": ("NX0", "0", "10.cmd.set-axis"), "NY": ("NY0", "0", "10.cmd.set-axis"),
+    "NZ": ("NZ0", "0", "10.cmd.set-axis"), "NA": ("NA0", "0", "10.cmd.set-axis"),
+    "ER": ("ER05", r"0,[0-9A-F]{2}", "10.cmd.eeprom-bytes"),
+    "EFR": ("EFR30", r"0,\S+", "10.cmd.eeprom-words"),
+    "EUR": ("EUR4C", r"0,\d+", "10.cmd.eeprom-words"), "O0": ("O0,FF", "0", "10.cmd.output"),
+    "I0": ("I0", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
+    "I1": ("I1", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
+    "I2": ("I2", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
+    "SR": ("SR0", r"0,[0-9A-F]{2}", "10.cmd.status-words"),
+    "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", r"0,[0-9A-F]{2}", "10.cmd.flags"),
+    "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 # commands of spec 10 a profile may lack (the refusal is 3)
 OPTIONAL = ["VL", "VK", "VN", "XM", "NX", "NY", "NZ", "NA", "W", "EFR", "EFW", "EUR", "EUW",
@@ -42,18 +53,23 @@ REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100
 
 
 @case("10.commands.formats", tag="M", source="M84 12.5; M114 13.6; M54; spec 10",
+      rules=("4.response.grammar", *sorted({rule for _, _, rule in FORMATS.values()})),
       rule="Every command of the profile answers in the format of spec 10")
 def formats(ctx: CaseContext) -> None:
-    for name, (body, pattern) in FORMATS.items():
+    for name, (body, pattern, rule) in FORMATS.items():
         if name not in ctx.profile.commands:
             continue
         link = ctx.fresh_link()
         r = link.send(body)
+        ctx.expect(r is not None and r.well_formed, f"{body}: a well-formed response",
+                   observed=show(r), expected="code *(,value) CR", rule="4.response.grammar")
         ok = r is not None and re.fullmatch(pattern, r.raw.decode("latin-1").rstrip("\r"))
-        ctx.expect(bool(ok), f"{body}", observed=show(r), expected=pattern)
+        ctx.expect(bool(ok), f"{body}", observed=show(r), expected=pattern, rule=rule)
 
 
-@case("10.commands.absent-refused", tag="M", source="spec 1, 5: code 3",
+@case("10.commands.absent-refused",
+      rules=("1.profile.command-set", "5.code.unknown"),
+      tag="M", source="spec 1, 5: code 3",
       rule="A command the profile lacks answers 3")
 def absent(ctx: CaseContext) -> None:
     lacking = [c for c in OPTIONAL if c not in ctx.profile.commands]
@@ -63,13 +79,17 @@ def absent(ctx: CaseContext) -> None:
         code(ctx, ctx.link.send(REFUSAL_FRAMES[name]), 3, f"{name} → 3")
 
 
-@case("1.profile.version", tag="D", source="spec 1 [D]",
+@case("1.profile.version",
+      rules=("1.profile.version", "2.link.serial-8n1", "3.frame.grammar"),
+      tag="D", source="spec 1 [D]",
       rule="? answers 0,<the profile's firmware string>")
 def version(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string")
 
 
-@case("9.reset.state", tag="M", source="M84 12.4; M114 13.5; M54",
+@case("9.reset.state",
+      rules=("9.reset.state", "8.index.counts"),
+      tag="M", source="M84 12.4; M114 13.5; M54",
       rule="After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off")
 def reset_state(ctx: CaseContext) -> None:
     fresh_reset(ctx)
@@ -81,7 +101,9 @@ def reset_state(ctx: CaseContext) -> None:
     index_moved(ctx, before, 8, "the index counted the SR and PF frames", tag="D")
 
 
-@case("9.reset.after-j", tag="D", source="M84 12.4; spec 9, 10 J [D]", destructive=True,
+@case("9.reset.after-j",
+      rules=("10.cmd.restart", "9.reset.state", "8.index.answer", "2.link.ready-after-restart"),
+      tag="D", source="M84 12.4; spec 9, 10 J [D]", destructive=True,
       rule="J answers a plain 0 and restores the reset state after about 2 s", timing=True)
 def after_j(ctx: CaseContext) -> None:
     link = ctx.link
@@ -95,7 +117,9 @@ def after_j(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", tag="M")
 
 
-@case("10.6.eeprom.round-trip", tag="M", source="M84 11; M114 11-12", destructive=True,
+@case("10.6.eeprom.round-trip",
+      rules=("10.cmd.eeprom-bytes",),
+      tag="M", source="M84 11; M114 11-12", destructive=True,
       rule="EW writes a byte that ER reads back (kept, then restored by the suite)")
 def eeprom(ctx: CaseContext) -> None:
     link = ctx.link
@@ -107,7 +131,9 @@ def eeprom(ctx: CaseContext) -> None:
     answers(ctx, link.send("ER40"), "0,%02X" % new, "ER40 reads the new byte")
 
 
-@case("10.6.eeprom.words", tag="D", source="spec 10 EFR/EUR [D]", destructive=True,
+@case("10.6.eeprom.words",
+      rules=("10.cmd.eeprom-words", "3.params.word-values-decimal"),
+      tag="D", source="spec 10 EFR/EUR [D]", destructive=True,
       requires=("EFW", "EUW"), rule="EFW/EFR store float32 and EUW/EUR uint32 little-endian")
 def words(ctx: CaseContext) -> None:
     link = ctx.link
@@ -119,7 +145,9 @@ def words(ctx: CaseContext) -> None:
     code(ctx, link.send("EFRFD"), 5, "a word past FF → 5")
 
 
-@case("10.7.microstep.positions-in-sixteenths", tag="M-ex", source="M54 (G5)",
+@case("10.7.microstep.positions-in-sixteenths",
+      rules=("10.2.motion.gve54-units", "10.7.motor.modes"),
+      tag="M-ex", source="M54 (G5)",
       requires=("M",), rule="GVE54 positions are in 1/16 steps: M4, L100,100,100 → 400")
 def microstep(ctx: CaseContext) -> None:
     link = ctx.link
@@ -130,7 +158,9 @@ def microstep(ctx: CaseContext) -> None:
     code(ctx, link.send("MQ"), 4, "an unknown mode → 4", tag="D")
 
 
-@case("12.spindle.address-7", tag="M-ex", source="M114 13.7 (G8)", rig=True,
+@case("12.spindle.address-7",
+      rules=("12.spindle.speed", "12.spindle.commands"),
+      tag="M-ex", source="M114 13.7 (G8)", rig=True,
       applies=lambda p: p.spindle is not None,
       rule="!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate")
 def spindle(ctx: CaseContext) -> None:

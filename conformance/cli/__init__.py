@@ -13,7 +13,10 @@ import importlib
 import sys
 
 #: subcommand -> (module, one line for the help)
-SUBCOMMANDS: dict[str, tuple[str, str]] = {}
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
+                 "with the catalogue until a case FAILs it"),
+}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -59,6 +59,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
+    ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
+                    help="print which rules of the spec the (selected) cases can fail, per "
+                         "section and profile, and the rules without one; exit 0")
     ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
     return ap.parse_args(argv)
 
@@ -97,6 +100,15 @@ def _main(argv: list[str] | None) -> int:
     if args.list:
         for c in cases:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
+        return 0
+    if args.coverage:
+        from conformance.coverage import coverage, format_coverage
+        profiles = [args.profile] if args.profile else None
+        try:
+            report = coverage(profiles, role=args.coverage, cases=cases)
+        except LookupError as err:
+            raise UsageError(str(err).strip("'\"")) from None
+        print(format_coverage(report, args.coverage))
         return 0
     targets = _targets(args)
     if not args.no_reports:

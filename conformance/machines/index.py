@@ -56,7 +56,9 @@ class RecoveryMachine(UnitMachine):
         pass
 
 
-@case("8.machine.recovery", tag="M", source="M84 12.5.12: recovery with @ and >",
+@case("8.machine.recovery",
+      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"),
+      tag="M", source="M84 12.5.12: recovery with @ and >",
       rule="Lost commands and lost/corrupted responses are recovered with @ and > exactly once")
 def recovery_machine(ctx: CaseContext) -> None:
     run_machine(ctx, RecoveryMachine)

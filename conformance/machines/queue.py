@@ -79,7 +79,10 @@ class QueueMachine(UnitMachine):
             assert r is not None and r.values == ["%02X" % value], f"SR{n}: {r}"
 
 
-@case("10.machine.queue-status-eeprom", tag="M", source="M84 12.5.2, 12.5.11, 11",
+@case("10.machine.queue-status-eeprom",
+      rules=("10.1.queue.cont-buffer", "10.1.queue.wait-idiom", "10.cmd.flags",
+             "10.cmd.status-words", "10.cmd.eeprom-bytes", "10.1.queue.wait-for-go"),
+      tag="M", source="M84 12.5.2, 12.5.11, 11",
       destructive=True,
       rule="The queue's room, L0,0,0, F, status words and EEPROM bytes keep their rules")
 def queue_machine(ctx: CaseContext) -> None:

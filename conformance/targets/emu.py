@@ -14,9 +14,12 @@ from gve_fixtures.profile import load_profile
 
 
 def mutants() -> dict[str, tuple[str, str]]:
-    """The emulator's deliberate bugs: name -> (spec section, what it gets wrong)."""
+    """The emulator's deliberate bugs: name -> (the rule area a case must check to catch
+    it, what it gets wrong), from its registry."""
     from emulator.mutants import MUTANTS
-    return dict(MUTANTS)
+    # an entry is (sections, description[, area]); the area defaults to the first section
+    return {name: (spec[2] if len(spec) > 2 else spec[0].split(",")[0].strip(), spec[1])
+            for name, spec in MUTANTS.items()}
 
 
 class EmuTarget(Target):

@@ -50,6 +50,15 @@ class Reachable(Protocol):
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
 
 
+def known_axis_limits(profile: Profile) -> tuple[int, ...]:
+    """The VL a unit is put back to: the reset VL (the variant's maximum) where VL's range
+    reaches it, else the top of the range (only J restores more, spec 9, 10)."""
+    if "VL" not in profile.ranges:
+        return tuple(profile.reset.VL)
+    top = profile.range("VL").hi
+    return tuple(min(v, top) for v in profile.reset.VL)
+
+
 class SessionError(Exception):
     """The session cannot begin on this target (one line for the user)."""
 
@@ -244,7 +253,7 @@ class Session:
         """What cannot be read, set to the reset state (spec 9)."""
         p, r = self.profile, self.profile.reset
         table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
-                 "VL": "VL" + ",".join(str(v) for v in r.VL)}
+                 "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
         if p.microstep:
@@ -261,10 +270,18 @@ class Session:
             link.send(f"SW{n},00")
         link.send("D")
 
-    def _known_state(self, link: Link) -> None:
+    def _settle(self, link: Link) -> None:
+        """Stopped, interrupts off, queue and save empty, the reset values of what cannot
+        be read. A KEEP left by the last case leaves a queue that takes only L (spec
+        10.5): K saves the empty queue over it and R restores that, which moves nothing."""
         self._stop(link)
         for body in self._reset_frames():
             link.send(body)
+        link.send("K")
+        link.send("R")
+
+    def _known_state(self, link: Link) -> None:
+        self._settle(link)
         self._go_back(link)
         link.send("N")
 
@@ -328,9 +345,7 @@ class Session:
                 self._halt(link, timeout=MARGIN)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._stop(link)
-        for body in self._reset_frames():
-            link.send(body)
+        self._settle(link)
         self.report.reset.append("set to the reset state (they cannot be read): "
                                  + ", ".join(self._reset_frames()))
         if self.profile.microstep:

@@ -1,4 +1,5 @@
-"""The control channel: one command a line, for what a test rig's hands would do.
+"""The control channel: one command a line, for what a test rig's hands would do
+(the protocol is documented for clones' simulators in docs/rig.md).
 
     in PORT HEX        set an input port's byte (in 1 7F)
     switch AXIS POS    place a virtual reference switch (switch Y -1500; switch Y none)
@@ -7,58 +8,81 @@
     quit | exit        stop the emulator
     help               list these
 
-Unknown or malformed lines answer ``error: ...``; nothing here can crash the server.
+``@ADDRESS`` at the end of a line picks one unit. Every line gets one reply: ``ok``,
+one JSON line, or ``error: ...``; nothing here can crash the server.
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 
 from emulator.link.line import Line
+from emulator.link.url import parse_address
 
-HELP = "commands: in PORT HEX | switch AXIS POS|none [@ADDR] | power-on | state | quit"
+HELP = "commands: in PORT HEX | switch AXIS POS|none | power-on | state | quit  [@ADDRESS]"
 
 
 class Quit(Exception):
     pass
 
 
-def _address(words: list[str]) -> tuple[list[str], int | None]:
-    if words and words[-1].startswith("@"):
-        return words[:-1], int(words[-1][1:])
-    return words, None
+def _input(line: Line, args: list[str], address: int | None) -> str:
+    port, value = int(args[0]), int(args[1], 16)
+    if port not in (0, 1, 2) or not 0 <= value <= 0xFF:
+        return "error: in PORT HEX with PORT 0..2 and HEX 00..FF"
+    line.set_input(port, value, address)
+    return "ok"
+
+
+def _switch(line: Line, args: list[str], address: int | None) -> str:
+    position = None if args[1].lower() == "none" else int(args[1])
+    line.set_switch(args[0].upper(), position, address)
+    return "ok"
+
+
+def _power_on(line: Line, args: list[str], address: int | None) -> str:
+    line.power_on(address)
+    return "ok"
+
+
+def _state(line: Line, args: list[str], address: int | None) -> str:
+    if address is None and len(line.units) > 1:
+        return json.dumps({str(u.address): u.snapshot(line.now) for u in line.units})
+    return json.dumps(line.state(address))
+
+
+def _quit(line: Line, args: list[str], address: int | None) -> str:
+    if address is not None:
+        return "error: quit takes no arguments"
+    raise Quit
+
+
+def _help(line: Line, args: list[str], address: int | None) -> str:
+    return HELP
+
+
+#: command -> (number of arguments, what it does)
+COMMANDS: dict[str, tuple[int, Callable[[Line, list[str], int | None], str]]] = {
+    "in": (2, _input), "switch": (2, _switch), "power-on": (0, _power_on),
+    "state": (0, _state), "quit": (0, _quit), "exit": (0, _quit), "help": (0, _help),
+}
 
 
 def handle(line: Line, text: str) -> str | None:
-    """Run one control line; returns the text to print (or None)."""
+    """Run one control line; returns its reply (None for an empty line)."""
+    words = text.split()
+    if not words:
+        return None
+    address = None
     try:
-        words, address = _address(text.split())
+        if words[-1].startswith("@"):
+            address = parse_address(words.pop()[1:])
         if not words:
-            return None
-        cmd, args = words[0].lower(), words[1:]
-        if cmd in ("quit", "exit"):
-            raise Quit
-        if cmd == "help":
-            return HELP
-        if cmd == "in" and len(args) == 2:
-            port, value = int(args[0]), int(args[1], 16)
-            if port not in (0, 1, 2) or not 0 <= value <= 0xFF:
-                return "error: in PORT HEX with PORT 0..2 and HEX 00..FF"
-            line.set_input(port, value, address)
-            return "ok"
-        if cmd == "switch" and len(args) == 2:
-            pos = None if args[1].lower() == "none" else int(args[1])
-            line.set_switch(args[0].upper(), pos, address)
-            return "ok"
-        if cmd == "power-on" and not args:
-            line.power_on(address)
-            return "ok"
-        if cmd == "state" and not args:
-            if address is None and len(line.units) > 1:
-                return json.dumps({str(u.address): u.snapshot(line.now) for u in line.units})
-            return json.dumps(line.state(address))
-    except Quit:
-        raise
-    except (ValueError, KeyError) as err:
+            raise ValueError("no command before the address")
+        arity, run = COMMANDS.get(words[0].lower(), (-1, _help))
+        if arity != len(words) - 1:
+            raise ValueError(f"unknown control command {text.strip()!r} ({HELP})")
+        return run(line, words[1:], address)
+    except (ValueError, KeyError, IndexError) as err:
         return f"error: {err}"
-    return f"error: unknown control command {text.strip()!r} ({HELP})"

@@ -15,10 +15,23 @@ from pathlib import Path
 from typing import IO
 
 from emulator.link.clock import RealClock, VirtualClock
+from emulator.motion.arith import NEVER
 from emulator.protocol.unit import Unit
 from gve_fixtures.transcript import TranscriptWriter
 
 SECOND = 1_000_000_000
+
+
+class TimeRangeError(ValueError):
+    """An instant beyond what the emulator's clock can reach."""
+
+
+def _reachable(t: int) -> int:
+    if t >= NEVER:
+        raise TimeRangeError(
+            f"the emulator's time ends {NEVER // SECOND:,} s (about 73 years) after its "
+            f"start; {t // SECOND:,} s is beyond it")
+    return t
 
 
 def byte_time(baud: int) -> int:
@@ -34,7 +47,9 @@ class Line:
         self.clock = clock or VirtualClock()
         # unpaced (a real-time pty without --baud): bytes take no time either way
         self.byte_ns = byte_time(baud) if paced or self.clock.virtual else 0
-        self._rx: deque[tuple[int, bytes]] = deque()     # (instant complete, byte) to host
+        # answers to the host, owned here alone: [instant its first byte is complete,
+        # bytes, bytes taken]; byte i of a chunk is complete byte_ns after byte i-1
+        self._rx: deque[list] = deque()
         self._unit_free = 0          # when the unit->host direction is free again
         self._host_free = 0          # when the host->unit direction is free again
         self.log: TranscriptWriter | None = None
@@ -65,6 +80,7 @@ class Line:
         self.advance_to(self.now + round(seconds * SECOND))
 
     def advance_to(self, t: int) -> None:
+        _reachable(t)
         while True:
             d = self.next_deadline()
             if d is None or d > t:
@@ -90,6 +106,7 @@ class Line:
     def write(self, data: bytes) -> int:
         start = max(self.now, self._host_free)
         first = start + self.byte_ns
+        _reachable(start + len(data) * self.byte_ns)
         if self.log is not None:
             self.log.host(data, first)
         for unit in self.units:
@@ -100,8 +117,6 @@ class Line:
         return len(data)
 
     # -- units -> host -------------------------------------------------------------------------
-    # _rx holds answers as [instant its first byte is complete, bytes, bytes taken];
-    # byte i of a chunk is complete byte_ns after byte i-1.
     def _emit(self, data: bytes, t: int) -> None:
         start = max(t, self._unit_free)
         b = self.byte_ns
@@ -177,7 +192,7 @@ class Line:
         if not self.clock.virtual:
             self._settle(self.now)
             return self._take(size, terminator)
-        deadline = None if timeout is None else self.now + round(timeout * SECOND)
+        deadline = None if timeout is None else _reachable(self.now + round(timeout * SECOND))
         out = bytearray()
         while True:
             out += self._take(size - len(out), terminator)
@@ -201,6 +216,23 @@ class Line:
     def read_until(self, terminator: bytes = b"\r", size: int = 4096,
                    timeout: float | None = 0.0) -> bytes:
         return self.read(size, timeout, terminator)
+
+    def next_arrival(self) -> int | None:
+        """The instant the next unread byte is complete, or None when none is coming."""
+        if not self._rx:
+            return None
+        first, _, taken = self._rx[0]
+        return first + taken * self.byte_ns
+
+    def discard_received(self) -> None:
+        """Forget every answer not yet read (pyserial's reset_input_buffer)."""
+        self._rx.clear()
+
+    def wake_instant(self) -> int | None:
+        """The next instant anything happens on the line: a byte for the host or a
+        unit's event."""
+        due = [x for x in (self.next_arrival(), self.next_deadline()) if x is not None]
+        return min(due) if due else None
 
     # -- the rig -------------------------------------------------------------------------------
     def unit(self, address: int | None = None) -> Unit:
@@ -226,7 +258,7 @@ class Line:
         return self.unit(address).snapshot(self.now)
 
     def outputs(self, address: int | None = None) -> int:
-        return self.unit(address).state.outputs
+        return int(self.state(address)["outputs"], 16)
 
     def spindle(self, address: int | None = None) -> int:
-        return self.unit(address).state.spindle
+        return int(self.state(address)["spindle"])

@@ -10,7 +10,7 @@ import time
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
 from emulator.link.clock import RealClock
-from emulator.link.line import SECOND, Line
+from emulator.link.line import SECOND, Line, byte_time
 from emulator.link.url import parse_url
 
 
@@ -29,7 +29,7 @@ class Serial(SerialBase):
         try:
             spec = parse_url(self._port)
             units = spec.build_units()
-        except (ValueError, OSError) as err:
+        except (ValueError, LookupError, ImportError, OSError) as err:
             raise SerialException(f"gve://: {err}") from err
         baud = spec.line_baud(units)
         self._baudrate = baud
@@ -44,8 +44,10 @@ class Serial(SerialBase):
 
     def _reconfigure_port(self) -> None:
         if self.line is not None and self._baudrate != self.line.baud:
+            if self._baudrate <= 0:
+                raise ValueError(f"not a baud rate: {self._baudrate}")
             self.line.baud = self._baudrate
-            self.line.byte_ns = round(10 * 1_000_000_000 / self._baudrate)
+            self.line.byte_ns = byte_time(self._baudrate)
 
     @property
     def in_waiting(self) -> int:
@@ -75,8 +77,7 @@ class Serial(SerialBase):
             if len(out) >= size or (terminator and out.endswith(terminator)):
                 return bytes(out)
             now = line.now
-            nxt = [x for x in (line._rx[0][0] if line._rx else None, line.next_deadline(),
-                               deadline) if x is not None]
+            nxt = [x for x in (line.wake_instant(), deadline) if x is not None]
             if deadline is not None and now >= deadline:
                 return bytes(out)
             wait = (min(nxt) - now) / SECOND if nxt else 0.05
@@ -89,7 +90,7 @@ class Serial(SerialBase):
 
     def reset_input_buffer(self) -> None:
         if self.line is not None:
-            self.line._rx.clear()
+            self.line.discard_received()
 
     def reset_output_buffer(self) -> None:
         pass

@@ -28,21 +28,44 @@ class LineSpec:
     realtime: bool = False
 
     def build_units(self) -> list[Unit]:
-        units = []
+        """The units of the line; two units that would answer one address are refused."""
+        units: list[Unit] = []
+        taken: dict[int, str] = {}
         for model, address in self.units or [(DEFAULT_MODEL, None)]:
-            units.append(Unit(load_profile(model), address, eeprom_path=self.eeprom,
-                              mutant=self.mutant, watchdog_ms=self.watchdog_ms,
-                              stepper=self.stepper))
+            unit = Unit(load_profile(model), address, eeprom_path=self.eeprom,
+                        mutant=self.mutant, watchdog_ms=self.watchdog_ms, stepper=self.stepper)
+            for a in sorted(unit.addresses):
+                if a in taken:
+                    raise ValueError(f"two units answer address {a}: {taken[a]} and "
+                                     f"{unit.profile.name}@{unit.address}")
+                taken[a] = f"{unit.profile.name}@{unit.address}"
+            units.append(unit)
         return units
 
     def line_baud(self, units: list[Unit]) -> int:
         return self.baud or units[0].profile.default_baud
 
 
+def positive(name: str, text: str) -> int:
+    """A whole number above 0 (a baud rate, a watchdog time)."""
+    if not text.isdigit() or int(text) <= 0:
+        raise ValueError(f"{name} must be a whole number above 0, not {text!r}")
+    return int(text)
+
+
+def parse_address(text: str) -> int:
+    """A unit's address: one digit 0..7."""
+    if len(text) != 1 or text not in "01234567":
+        raise ValueError(f"an address is 0..7, not {text!r}")
+    return int(text)
+
+
 def parse_unit(text: str) -> tuple[str, int | None]:
     """``MODEL@ADDRESS`` (or just ``MODEL``)."""
-    model, _, address = text.partition("@")
-    return model, (int(address) if address else None)
+    model, at, address = text.partition("@")
+    if not model:
+        raise ValueError(f"a unit is MODEL@ADDRESS, not {text!r}")
+    return model, (parse_address(address) if at else None)
 
 
 def parse_url(url: str) -> LineSpec:
@@ -62,11 +85,11 @@ def parse_url(url: str) -> LineSpec:
     if not spec.units:
         model = one("model") or parts.netloc or DEFAULT_MODEL
         address = one("address")
-        spec.units = [(model, int(address) if address is not None else None)]
+        spec.units = [(model, parse_address(address) if address is not None else None)]
     for key in ("baud", "watchdog_ms"):
         value = one(key)
         if value is not None:
-            setattr(spec, key, int(value))
+            setattr(spec, key, positive(key, value))
     for key in ("eeprom", "mutant", "stepper", "log"):
         setattr(spec, key, one(key))
     spec.realtime = one("realtime") in ("1", "true", "yes")

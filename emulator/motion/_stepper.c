@@ -21,6 +21,13 @@ typedef int64_t i64;
 #define HISTORY 65536
 #define FWD 0
 #define REV 1
+/* deviations (interface.py Deviation) */
+#define DEV_ZERO_LENGTH_JUNCTION 1
+#define DEV_CONTINUOUS_DWELL 2
+#define DEV_HALT_SHORT 4
+#define DEV_JUNCTION_STOPS 8
+#define DEV_HALT_DEAD 16
+#define DEV_GO_AT_SPEED 32
 
 /* ---- arithmetic (arith.py) ------------------------------------------------------ */
 
@@ -210,6 +217,8 @@ struct stepper {
     int axes;
     i64 max_rate, now, rest, stop_end, xm;
     int halted;
+    int after_c;              /* the last stop ended a C of non-zero length, no more */
+    int dev;                  /* deviations */
     i64 base[ST_AXES];
     i64 offset[ST_AXES];      /* physical position minus counter */
     i64 lo[ST_AXES], hi[ST_AXES];   /* the physical extremes visited so far */
@@ -241,6 +250,8 @@ stepper *st_new(int axes, int64_t max_rate) {
     m->keep_history = 1;
     return m;
 }
+
+void st_set_deviations(stepper *m, int flags) { m->dev = flags; }
 
 void st_free(stepper *m) {
     if (!m) return;
@@ -342,6 +353,8 @@ static i64 cruise(const stepper *m, const entry_t *e) {
 
 static i64 junction(const stepper *m, const entry_t *e, const entry_t *nxt, i64 vc) {
     if (!nxt || !(e->vec.continuous && nxt->vec.continuous) || nxt->n == 0) return 0;
+    if (e->n == 0 && !(m->dev & DEV_ZERO_LENGTH_JUNCTION)) return 0;
+    if (m->dev & DEV_JUNCTION_STOPS) return 0;
     i128 v = min128(min128(e->vec.brake, vc), cruise(m, nxt));
     v = min128(v, isqrt((i128)2 * nxt->vec.accel * nxt->n));
     return (i64)max128(0, v);
@@ -359,14 +372,17 @@ static void plan_entry(stepper *m, entry_t *e, i64 t, i64 vin, int join) {
     e->decision = -1;
     if (vx == 0 && e->vec.continuous) {
         const seg_t *last = e->nseg ? &e->plan[e->nseg - 1] : NULL;
-        e->decision = (last && last->kind == REV) ? last->start : t;
+        if (!last) e->decision = t;
+        else if (last->kind == REV) e->decision = last->start;
+        else e->decision = (m->dev & DEV_CONTINUOUS_DWELL) ? t : last->end;
     }
 }
 
 static void start_head(stepper *m, i64 t, i64 vin) {
     entry_t *e = head(m);
     if (e->has_plan) return;
-    i64 start = (vin > 0 || e->done == e->n) ? t : max64(t, sat((i128)m->rest + e->vec.dwell));
+    int at_once = vin > 0 || e->done == e->n || (e->vec.continuous && m->after_c);
+    i64 start = at_once ? t : max64(t, sat((i128)m->rest + e->vec.dwell));
     plan_entry(m, e, start, vin, 1);
 }
 
@@ -410,6 +426,7 @@ void st_advance(stepper *m, int64_t t) {
             e->has_plan = 0;
             e->nseg = 0;
             m->rest = e->end;
+            m->after_c = 0;
             i64 here[ST_AXES];
             position_now(m, here);
             visit(m, here);
@@ -418,10 +435,16 @@ void st_advance(stepper *m, int64_t t) {
             continue;
         }
         i64 end = e->end, exit_rate = e->exit_rate, n = e->n;
+        int continuous = e->vec.continuous;
         for (int i = 0; i < m->axes; i++) m->base[i] += e->vec.steps[i];
         visit(m, m->base);
         pop_head(m);
-        if (exit_rate == 0 && n) m->rest = end;
+        if (!n) {
+            m->after_c = 0;
+        } else if (exit_rate == 0) {
+            m->rest = end;
+            m->after_c = continuous && !m->halted && !(m->dev & DEV_CONTINUOUS_DWELL);
+        }
         if (m->qlen && (!m->halted || head(m)->has_plan)) start_head(m, end, exit_rate);
     }
     m->now = t;
@@ -606,6 +629,7 @@ int64_t st_halt(stepper *m, int64_t t) {
     visit(m, here);
     if (m->halted) return max64(m->stop_end, t);
     m->halted = 1;
+    m->after_c = 0;
     m->stop_end = t;
     if (!m->qlen || !head(m)->has_plan) return t;
     entry_t *h = head(m);
@@ -614,10 +638,19 @@ int64_t st_halt(stepper *m, int64_t t) {
         h->nseg = 0;
         return t;
     }
+    if (h->nseg) {
+        const seg_t *last = &h->plan[h->nseg - 1];
+        if (h->exit_rate == 0 && last->kind == REV && t >= last->start
+                && !(m->dev & (DEV_HALT_SHORT | DEV_HALT_DEAD))) {
+            /* already braking to rest on its target: that ramp is the stop */
+            m->stop_end = h->end;
+            return h->end;
+        }
+    }
     i64 k = entry_steps(h, t);
     i64 v = entry_rate(h, t);
     i64 a = h->vec.accel;
-    i64 distance = (i64)fdiv((i128)v * v, (i128)2 * a);
+    i64 distance = (m->dev & DEV_HALT_DEAD) ? 0 : (i64)fdiv((i128)v * v, (i128)2 * a);
     record(m, h, k);
     h->done = k;
     i64 covered = 0, start = t;
@@ -650,7 +683,11 @@ void st_resume(stepper *m, int64_t t) {
     st_advance(m, t);
     if (!m->halted) return;
     m->halted = 0;
-    if (m->qlen && !head(m)->has_plan) start_head(m, t, 0);
+    if (m->qlen && !head(m)->has_plan) {
+        entry_t *h = head(m);
+        int at_speed = (m->dev & DEV_GO_AT_SPEED) && h->done < h->n;
+        start_head(m, t, at_speed ? cruise(m, h) : 0);
+    }
 }
 
 void st_clear(stepper *m, int64_t t) {
@@ -660,6 +697,7 @@ void st_clear(stepper *m, int64_t t) {
     m->qlen = 0;
     m->qhead = 0;
     m->halted = 0;
+    m->after_c = 0;
 }
 
 int64_t st_entries(stepper *m) { return (i64)m->qlen; }
@@ -684,6 +722,7 @@ int st_restore_add(stepper *m, const st_vector *v, int64_t done) { return append
 
 void st_restore_end(stepper *m, const int64_t *here, int halted, int64_t t) {
     m->halted = halted;
+    m->after_c = 0;
     if (m->qlen) {
         entry_t *h = head(m);
         for (int i = 0; i < m->axes; i++)

@@ -22,6 +22,8 @@ typedef struct stepper stepper;
 
 stepper *st_new(int axes, int64_t max_rate);
 void st_free(stepper *m);
+/* deliberate deviations from the model (interface.py Deviation), for mutants */
+void st_set_deviations(stepper *m, int flags);
 int64_t st_acc_time(int64_t v, int64_t a, int64_t m);
 int64_t st_acc_count(int64_t v, int64_t a, int64_t tau);
 /* floor(sqrt(hi·2^64 + lo)), exact */

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from emulator.motion._stepper_c import ffi, lib  # ImportError when not built
-from emulator.motion.interface import MotionFlags, Vector
+from emulator.motion.interface import Deviation, KeepSave, MotionFlags, Vector
 
 AXES = 4
 
@@ -18,14 +18,16 @@ AXES = 4
 class CMotion:
     kind = "c"
 
-    def __init__(self, axes: int, max_rate: int) -> None:
+    def __init__(self, axes: int, max_rate: int, deviations: Deviation = Deviation.NONE) -> None:
         if not 1 <= axes <= AXES:
             raise ValueError(f"the C core handles 1..{AXES} axes")
         self.axes = axes
         self.max_rate = max_rate
+        self.deviations = Deviation(deviations)
         self._m = ffi.gc(lib.st_new(axes, max_rate), lib.st_free)
         if self._m == ffi.NULL:
             raise MemoryError("st_new")
+        lib.st_set_deviations(self._m, int(self.deviations))
         self._out = ffi.new("int64_t[4]")
         self._vec = ffi.new("st_vector *")
 
@@ -119,7 +121,7 @@ class CMotion:
     def clear(self, t: int) -> None:
         lib.st_clear(self._m, t)
 
-    def keep(self, t: int) -> object:
+    def keep(self, t: int) -> KeepSave:
         lib.st_advance(self._m, t)
         done = ffi.new("int64_t *")
         c = ffi.new("st_vector *")
@@ -127,18 +129,17 @@ class CMotion:
         for i in range(lib.st_entries(self._m)):
             lib.st_entry(self._m, i, c, done)
             entries.append((self._py_vector(c), done[0]))
-        saved = (tuple(entries), bool(lib.st_halted(self._m)))
+        saved = KeepSave(tuple(entries), bool(lib.st_halted(self._m)))
         lib.st_clear(self._m, t)
         return saved
 
-    def restore(self, saved: object, t: int) -> None:
-        entries, halted = saved  # type: ignore[misc]
+    def restore(self, saved: KeepSave, t: int) -> None:
         here = ffi.new("int64_t[4]")
         lib.st_restore_begin(self._m, t, here)
-        for vector, done in entries:
+        for vector, done in saved.entries:
             if lib.st_restore_add(self._m, self._c_vector(vector), done):
                 raise MemoryError("st_restore_add")
-        lib.st_restore_end(self._m, here, int(halted), t)
+        lib.st_restore_end(self._m, here, int(saved.halted), t)
 
     def set_position(self, axis: int, value: int, t: int) -> None:
         lib.st_set_position(self._m, axis, value, t)

@@ -13,6 +13,7 @@ vectors of 2**31 steps costs nothing per step to advance through.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntFlag
 from typing import Protocol, runtime_checkable
 
 #: One second in clock units.
@@ -55,9 +56,37 @@ class MotionFlags:
     halted: bool
 
 
+@dataclass(frozen=True)
+class KeepSave:
+    """What KEEP takes from the queue (spec 10.5): every held vector with the dominant
+    steps it has done (the interrupted one first), and whether the queue was halted."""
+
+    entries: tuple[tuple[Vector, int], ...] = ()
+    halted: bool = False
+
+
+#: RESTORE with nothing saved restores this: an empty queue (spec 10.5 [D])
+EMPTY_SAVE = KeepSave()
+
+
+class Deviation(IntFlag):
+    """Deliberate deviations from the motion model a core can be built with: the
+    mutants of ``emulator/mutants.py`` whose behaviour lives in the stepper core. Both
+    cores implement every flag alike; a clean core has none."""
+
+    NONE = 0
+    ZERO_LENGTH_JUNCTION = 1   # a zero-length C passes a junction rate on to the next C
+    CONTINUOUS_DWELL = 2       # a C whose braking takes no whole step cannot be joined
+                               # after it is planned, and T also separates C vectors
+    HALT_SHORT = 4             # H in the final deceleration lays a ramp of its own
+    JUNCTION_STOPS = 8         # B ignored: every C brakes to rest at its end
+    HALT_DEAD = 16             # H stops at once, without a ramp
+    GO_AT_SPEED = 32           # G resumes at the cruise rate instead of from rest
+
+
 @runtime_checkable
 class Motion(Protocol):
-    """A stepper core for one unit. Created by :func:`emulator.motion.create`.
+    """A stepper core for one unit. Created by :func:`emulator.motion.factory.create`.
 
     All mutating calls take the instant ``t`` at which they happen; ``t`` never goes
     backwards. Every call first advances the model to ``t``.
@@ -116,8 +145,9 @@ class Motion(Protocol):
         While halted it waits in the queue until :meth:`resume`."""
 
     def halt(self, t: int) -> int:
-        """Begin a stop on the ramp at ``t`` (it may run into following vectors).
-        Returns the instant the motion is at rest. Idempotent while stopping."""
+        """Begin a stop on the ramp at ``t`` (it may run into following vectors; a
+        vector already braking to rest at its end keeps that ramp and ends on its
+        target). Returns the instant the motion is at rest. Idempotent while stopping."""
 
     def resume(self, t: int) -> None:
         """GO: continue the interrupted vector from the exact step it stopped at,
@@ -126,12 +156,12 @@ class Motion(Protocol):
     def clear(self, t: int) -> None:
         """DELETE: drop every held vector (position unchanged). Only while at rest."""
 
-    def keep(self, t: int) -> object:
-        """KEEP: return an opaque save of the held vectors (an interrupted vector with
-        the step it reached) and leave the queue empty. Only while at rest."""
+    def keep(self, t: int) -> KeepSave:
+        """KEEP: save the held vectors (an interrupted vector with the step it reached)
+        and leave the queue empty. Only while at rest."""
 
-    def restore(self, saved: object, t: int) -> None:
-        """RESTORE: put a save from :meth:`keep` back (replacing what is held)."""
+    def restore(self, saved: KeepSave, t: int) -> None:
+        """RESTORE: put a save back (replacing what is held); the axes do not move."""
 
     def set_position(self, axis: int, value: int, t: int) -> None:
         """N / N<axis>: set a counter (the axis does not move). Only while nothing is

@@ -19,9 +19,9 @@ from math import isqrt
 
 import numpy as np
 
-from emulator.motion import segment as seg
+import emulator.motion.segment as seg
 from emulator.motion.arith import NEVER, axis_count, first_step_reaching, stop_distance
-from emulator.motion.interface import MotionFlags, Vector
+from emulator.motion.interface import Deviation, KeepSave, MotionFlags, Vector
 
 #: executed plan pieces kept for pulses() of the past
 HISTORY = 65536
@@ -72,14 +72,16 @@ class PythonMotion:
 
     kind = "python"
 
-    def __init__(self, axes: int, max_rate: int) -> None:
+    def __init__(self, axes: int, max_rate: int, deviations: Deviation = Deviation.NONE) -> None:
         self.axes = axes
         self.max_rate = max_rate
+        self.deviations = Deviation(deviations)
         self._now = 0
         self._queue: deque[Entry] = deque()
         self._base = [0] * axes          # position at the head vector's start
         self._halted = False
         self._rest = 0                   # when the last stop ended (dwell reference)
+        self._after_c = False            # that stop ended a C of non-zero length, no more
         self._stop_end = 0               # the end of a HALT ramp
         self._xm = 100
         self._history: deque[Piece] = deque(maxlen=HISTORY)
@@ -104,8 +106,13 @@ class PythonMotion:
         return max(v, 1)
 
     def _junction(self, e: Entry, nxt: Entry | None, vc: int) -> int:
-        """The exit rate into a following C (0 when there is none)."""
+        """The exit rate into a following C (0 when there is none). A zero-length C
+        carries no speed: the C after it starts from rest."""
         if nxt is None or not (e.vector.continuous and nxt.vector.continuous) or nxt.n == 0:
+            return 0
+        if e.n == 0 and not self.deviations & Deviation.ZERO_LENGTH_JUNCTION:
+            return 0
+        if self.deviations & Deviation.JUNCTION_STOPS:
             return 0
         return max(0, min(e.vector.brake, vc, self._cruise(nxt),
                           isqrt(2 * nxt.vector.accel * nxt.n)))
@@ -120,17 +127,25 @@ class PythonMotion:
         e.exit_rate = vx
         e.final = True
         # a C that will stop may still join a C pushed before its final braking begins
+        # (or, when braking takes no whole step, before its last step)
         e.decision = -1
         if vx == 0 and e.vector.continuous:
             last = e.plan[-1] if e.plan else None
-            e.decision = last.start if last is not None and last.kind == seg.REV else t
+            if last is None:
+                e.decision = t
+            elif last.kind == seg.REV:
+                e.decision = last.start
+            else:
+                e.decision = t if self.deviations & Deviation.CONTINUOUS_DWELL else last.end
 
     def _start_head(self, t: int, vin: int) -> None:
         e = self._queue[0]
         if e.plan is not None:        # a piece of a HALT ramp already planned
             return
-        # a junction, or L0,0,0, starts at once; a start from rest waits out the dwell
-        start = t if vin > 0 or e.done == e.n else max(t, self._rest + e.vector.dwell)
+        # a junction, L0,0,0, or a C right after a C that stopped starts at once; any
+        # other start from rest waits out the dwell
+        at_once = vin > 0 or e.done == e.n or (e.vector.continuous and self._after_c)
+        start = t if at_once else max(t, self._rest + e.vector.dwell)
         self._plan(e, start, vin, join=True)
 
     def _replan(self, t: int, join: bool) -> None:
@@ -186,6 +201,7 @@ class PythonMotion:
                 e.done = e.steps(e.end)
                 e.plan = None
                 self._rest = e.end
+                self._after_c = False
                 self._visit(self._position_at(e))
                 if self._halted:
                     break
@@ -195,8 +211,12 @@ class PythonMotion:
             for i, d in enumerate(e.vector.steps):
                 self._base[i] += d
             self._visit(self._base)
-            if e.exit_rate == 0 and e.n:
+            if not e.n:
+                self._after_c = False
+            elif e.exit_rate == 0:
                 self._rest = e.end
+                self._after_c = (e.vector.continuous and not self._halted
+                                 and not self.deviations & Deviation.CONTINUOUS_DWELL)
             if q and (not self._halted or q[0].plan is not None):
                 self._start_head(e.end, e.exit_rate)
         self._now = t
@@ -320,6 +340,7 @@ class PythonMotion:
         if self._halted:
             return max(self._stop_end, t)
         self._halted = True
+        self._after_c = False
         self._stop_end = t
         q = self._queue
         if not q or q[0].plan is None:
@@ -328,10 +349,16 @@ class PythonMotion:
         if t < head.plan[0].start:            # still dwelling: not started after all
             head.plan = None
             return t
+        last = head.plan[-1]
+        if (head.exit_rate == 0 and last.kind == seg.REV and t >= last.start
+                and not self.deviations & (Deviation.HALT_SHORT | Deviation.HALT_DEAD)):
+            # already braking to rest on its target: that ramp is the stop
+            self._stop_end = head.end
+            return head.end
         k = head.steps(t)
         v = head.rate(t)
         a = head.vector.accel
-        distance = stop_distance(v, a)
+        distance = 0 if self.deviations & Deviation.HALT_DEAD else stop_distance(v, a)
         self._record(head, k)
         head.done = k
         # one braking curve from t, run on through as many vectors as it needs
@@ -362,7 +389,9 @@ class PythonMotion:
             return
         self._halted = False
         if self._queue and self._queue[0].plan is None:
-            self._start_head(t, 0)
+            head = self._queue[0]
+            at_speed = self.deviations & Deviation.GO_AT_SPEED and head.done < head.n
+            self._start_head(t, self._cruise(head) if at_speed else 0)
 
     def clear(self, t: int) -> None:
         self.advance(t)
@@ -370,23 +399,25 @@ class PythonMotion:
         self._visit(self._base)
         self._queue.clear()
         self._halted = False
+        self._after_c = False
 
-    def keep(self, t: int) -> object:
+    def keep(self, t: int) -> KeepSave:
         self.advance(t)
-        saved = (tuple((e.vector, e.done) for e in self._queue), self._halted)
+        saved = KeepSave(tuple((e.vector, e.done) for e in self._queue), self._halted)
         self._base = list(self._position_now())
         self._visit(self._base)
         self._queue.clear()
         self._halted = False
+        self._after_c = False
         return saved
 
-    def restore(self, saved: object, t: int) -> None:
+    def restore(self, saved: KeepSave, t: int) -> None:
         self.advance(t)
         here = self._position_now()
         self._visit(here)
-        entries, halted = saved  # type: ignore[misc]
-        self._queue = deque(Entry(v, _length(v.steps), done) for v, done in entries)
-        self._halted = halted
+        self._queue = deque(Entry(v, _length(v.steps), done) for v, done in saved.entries)
+        self._halted = halted = saved.halted
+        self._after_c = False
         if self._queue:
             head = self._queue[0]
             self._base = [p - axis_count(head.done, d, head.n)

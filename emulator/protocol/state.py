@@ -1,17 +1,20 @@
-"""The unit's protocol state that a reset (power-on, `J`) restores (spec 9)."""
+"""The device's protocol state that a reset (power-on, `J`) restores (spec 9).
+
+The session's state (index, `>` history, checksum mode, packet) is in session.py; the
+input levels are physical and survive a reset (they belong to the device, not here).
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from emulator.motion.interface import KeepSave
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import St6
 
-# ST6 bits (spec 10.3)
-STOP = 0x01
-INTCOM = 0x10
-QUEUE_FULL = 0x20   # only in the answer to F
-RUN = 0x40
-INTA = 0x80
+# plain ints of the St6 bits for the per-frame path (IntFlag's operators are slow)
+INTA, INTCOM, RUN, STOP, FREE, QUEUE_FULL = (
+    b.value for b in (St6.INTA, St6.INTCOM, St6.RUN, St6.STOP, St6.FREE, St6.QUEUE_FULL))
 
 
 @dataclass
@@ -28,17 +31,22 @@ class Modal:
 
 
 @dataclass
-class UnitState:
+class Saved:
+    """The KEEP save (spec 10.5): the motion's queue and ST4, ST5, ST6."""
+
+    motion: KeepSave
+    st4: int
+    st5: int
+    st6: int
+
+
+@dataclass
+class DeviceState:
     modal: Modal
     xm: int
     status: list[int]                 # ST0..ST5 as written; ST6's stored bits (INTA, INTCOM, ...)
     outputs: int
-    inputs: dict[int, int]
-    checksums: bool = False
-    index: int = 0
-    history: tuple[bytes, bytes] | None = None   # last answered frame and its response
-    packet: list | None = None        # members of an open packet
-    saved: tuple | None = None        # KEEP save: (motion save, ST4, ST5, ST6 bits)
+    saved: Saved | None = None        # the KEEP save (one level)
     kept_single: bool = False         # after K on GVE84/GVE114: the queue takes one L only
     microstep: str = "F"
     current: str = "D"
@@ -51,17 +59,15 @@ class UnitState:
         return bool(self.status[6] & INTA)
 
 
-def reset_state(profile: Profile) -> UnitState:
+def reset_state(profile: Profile) -> DeviceState:
     r = profile.reset
     axes = len(profile.axes)
     vl = list(r.VL) if r.VL else [profile.max_rate] * axes
-    state = UnitState(
+    state = DeviceState(
         modal=Modal(V=r.V, A=r.A, B=r.B, dollar=r.dollar, T=r.T, VK=r.VK, VL=vl),
         xm=r.XM,
         status=list(r.status),
         outputs=r.outputs,
-        inputs={0: 0xFF, 1: 0xFF, 2: 0xFF},
-        checksums=r.checksums,
     )
     if profile.microstep is not None:
         state.microstep = profile.microstep.reset_mode

@@ -1,34 +1,53 @@
 """The suite's power: it FAILs every deliberately broken emulator (naming the case that
-caught it) and PASSes the clean one on every profile (issue 4 item 9)."""
+caught it) and PASSes the clean one on every profile. The hunt is the one of
+`gve-conformance mutation`: a mutant is stopped at the first case that FAILs it and
+PASSes the clean emulator, cases of its rule area first."""
 
 from __future__ import annotations
 
 import pytest
 
 from conformance.catalogue import select
+from conformance.cli.mutation import hunt, main
 from conformance.runner import run
-from conformance.targets import parse_target
+from conformance.targets import emu, parse_target
 from conformance.verdict import ERROR, FAIL
-from emulator.mutants import MUTANTS
 from gve_fixtures.profile import available_profiles
 
-# where each mutant's deviation can show: micro-stepping exists on the GVE54 only
-PROFILE_OF = {"position-ignores-microstep": "GVE54"}
-
-
-def failures(profile: str, mutant: str | None = None) -> list[str]:
-    result = run([parse_target(f"emu:{profile}", mutant=mutant)], select())
-    return [f"{r.id}: {r.verdict}" for r in result.results if r.verdict in (FAIL, ERROR)]
+MUTANTS = emu.mutants()
 
 
 @pytest.mark.parametrize("mutant", sorted(MUTANTS))
 def test_the_suite_fails_every_mutant(mutant: str) -> None:
-    profile = PROFILE_OF.get(mutant, "GVE84-100")
-    caught = failures(profile, mutant)
-    assert caught, f"no case caught the mutant {mutant} ({MUTANTS[mutant][1]}) on {profile}"
-    print(f"{mutant} caught by {caught[0]}")
+    h = hunt(mutant)
+    assert h.caught, f"no case caught the mutant {mutant} ({h.description})"
+    assert not h.errors, f"suite defects met while hunting {mutant}: {h.errors}"
+    print(f"{mutant} caught by {h.caught_by} in {h.seconds:.2f} s")
 
 
 @pytest.mark.parametrize("profile", available_profiles())
 def test_the_clean_emulator_passes(profile: str) -> None:
-    assert failures(profile) == []
+    result = run([parse_target(f"emu:{profile}")], select())
+    bad = [f"{r.id}: {r.verdict}" for r in result.results if r.verdict in (FAIL, ERROR)]
+    assert bad == []
+
+
+def test_the_command_prints_the_score(capsys) -> None:
+    mutant = sorted(MUTANTS)[0]
+    assert main(["--mutant", mutant, "--profile", "GVE84-100"]) == 0
+    out = capsys.readouterr().out
+    assert f"caught  {mutant}" in out and "mutation score: 1/1 = 100.0 %" in out
+
+
+def test_a_mutant_no_case_checks_is_missed_and_the_score_says_so(capsys) -> None:
+    # only the firmware-string case: it cannot see a broken watchdog
+    assert main(["--mutant", "watchdog-never", "--cases", "1.profile.version"]) == 1
+    out = capsys.readouterr().out
+    assert "MISSED  watchdog-never" in out and "0/1 = 0.0 %" in out
+
+
+@pytest.mark.parametrize("argv", [["--mutant", "no-such-bug"], ["--profile", "GVE99"],
+                                  ["--jobs", "0"]])
+def test_bad_arguments_are_one_line_and_exit_2(argv, capsys) -> None:
+    assert main(argv) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1

@@ -30,14 +30,17 @@ def _compare(globs: list[str] | None, exclude: list[str] | None, settings_name: 
         cases = select(globs, exclude)
         serial_target = parse_target(f"serial:{path}?baud=115200", profile="GVE84-100",
                                      allow_destructive=True, max_travel=100_000)
-        over_pty = {r.id: r.verdict for r in run([serial_target], cases,
-                                                  settings_name=settings_name).results}
+        pty_results = run([serial_target], cases, settings_name=settings_name).results
+        over_pty = {r.id: r.verdict for r in pty_results}
+        # frames the guard does not send to a real unit (beyond the envelope): by design
+        guarded = {r.id for r in pty_results if any(n.startswith("safety stop")
+                                                    for n in r.notes)}
         in_process = {r.id: r.verdict for r in run([parse_target("emu:GVE84-100")], cases,
                                                    settings_name=settings_name).results}
     finally:
         proc.terminate()
         proc.wait(10)
-    rig = {c.id for c in cases if c.rig}
+    rig = {c.id for c in cases if c.rig} | guarded
     return {i: (in_process[i], over_pty[i]) for i in in_process
             if in_process[i] != over_pty[i] and not (i in rig and over_pty[i] == COULD_NOT_TEST)}
 
@@ -48,12 +51,12 @@ LONG_MOVES = ["*machine*", "10.1.*", "10.2.*", "10.4.*", "10.5.*", "11.golden.g4
 
 
 def test_serial_run_matches_the_in_process_run():
-    assert _compare(None, LONG_MOVES, "ci") == {}
+    assert _compare(None, [*LONG_MOVES, "*measured*"], "ci") == {}
 
 
 @pytest.mark.slow
 def test_long_moves_over_serial_match_the_in_process_run():
-    assert _compare(LONG_MOVES[1:], None, "ci") == {}
+    assert _compare(LONG_MOVES[1:], ["*measured*"], "ci") == {}
 
 
 @pytest.mark.slow

@@ -4,13 +4,31 @@ own, independent one): plays host records, checks unit records, performs actions
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Iterator
+from pathlib import Path
 
+import pytest
 import serial
 
 import emulator  # noqa: F401  (registers gve://)
-from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, unescape
+from gve_fixtures.profile import available_profiles, load_profile
+from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 ANSWER_TIMEOUT = 30.0     # virtual seconds: H waits for the stop
+#: the emulator's own transcripts: the interactions of the spec revision of 2026-11-25
+TRANSCRIPTS = Path(__file__).parent / "transcripts"
+
+
+def transcript_cases(paths: Iterable[Path]) -> Iterator:
+    """pytest params (path, profile) for every profile a transcript names (its
+    ``profiles`` header: families or profile names; none: every profile)."""
+    for path in paths:
+        names = load(path).meta.get("profiles", "").split()
+        for profile in available_profiles():
+            p = load_profile(profile)
+            if names and p.family not in names and p.name not in names:
+                continue
+            yield pytest.param(Path(path), profile, id=f"{Path(path).stem}-{profile}")
 
 
 def open_line(profile: str, address: int = 0, **params: str) -> serial.SerialBase:

@@ -14,7 +14,8 @@ from tests.emulator.replay import open_line
 
 FRAMES = ["V1000", "V5", "L5,0,0", "L-3,2,1", "C7,0,0", "C1,1,1", "T99", "SW8,F1", "SR6",
           "P", "PF", "H", "G", "D", "K", "R", "F", "?", "Q", "@", "N", "XA", "A100", "B50",
-          "*S", "*E1", "*E0", "%+", "%-", "ER01", "EW40,12", "Q5", "v1", "Z", "SR", "O0,FE"]
+          "*S", "*E1", "*E0", "%+", "%-", "ER01", "EW40,12", "Q5", "v1", "Z", "SR", "O0,FE",
+          "O1,FE", "O"]
 
 noise = st.binary(max_size=12).map(lambda b: b.replace(b"!", b"?"))
 item = st.one_of(
@@ -48,20 +49,20 @@ def test_bad_input_never_breaks_the_unit(model, items):
             line.advance(value)
         else:
             _drain(port)
-            if unit.state.checksums or unit.state.packet is not None:
+            if unit.session.checksums or unit.session.packet is not None:
                 continue                        # the model below speaks plain frames only
             port.write(f"!{address}@\r".encode())
             before = int(port.read_until(b"\r").split(b",")[1])
             port.write(f"!{address}{value}\r".encode())
             answer = port.read_until(b"\r")
             extra = _drain(port)
-            if unit.state.packet is not None:
+            if unit.session.packet is not None:
                 assert answer == b"", "*S and members are not answered"
                 continue
             if value != "H":
                 assert extra == b"", f"{value}: a second answer {extra!r}"
             assert answer.endswith(b"\r") and answer[:1] in b"0123456789ABCDEF", answer
-            if unit.state.checksums:
+            if unit.session.checksums:
                 continue                        # %+ just switched checksums on
             port.write(f"!{address}@\r".encode())
             after = port.read_until(b"\r")
@@ -72,18 +73,18 @@ def test_bad_input_never_breaks_the_unit(model, items):
             if value[0] in "LC" and code == 0:
                 steps = [int(x) for x in value[1:].split(",")]
                 for i, s in enumerate(steps):
-                    accepted[i] += s * unit.factor()
-            assert unit.motion.queued(line.now) <= unit.profile.buffer
+                    accepted[i] += s * unit.device.factor()
+            assert unit.device.motion.queued(line.now) <= unit.profile.buffer
     _drain(port)
     # the position is the sum of executed steps: let everything run out and compare
-    port.write(f"!{address}%-,CF\r".encode() if unit.state.checksums else b"")
+    port.write(f"!{address}%-,CF\r".encode() if unit.session.checksums else b"")
     _drain(port)
-    unit.state.packet = None
+    unit.session.packet = None
     port.write(f"!{address}G\r".encode())
     line.run_until_idle(600)
     _drain(port)
-    if not unit.motion.flags(line.now).busy and not _had_reset(items):
-        assert list(unit.motion.position(line.now)) == accepted, "position = executed steps"
+    if not unit.device.motion.flags(line.now).busy and not _had_reset(items):
+        assert list(unit.device.motion.position(line.now)) == accepted, "position = executed steps"
 
 
 def _had_reset(items) -> bool:

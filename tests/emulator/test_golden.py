@@ -8,23 +8,11 @@ from pathlib import Path
 import pytest
 
 from gve_fixtures import golden_transcripts
-from gve_fixtures.profile import available_profiles, load_profile
 from gve_fixtures.transcript import load
-from tests.emulator.replay import open_line, play
+from tests.emulator.replay import open_line, play, transcript_cases
 
 
-def cases():
-    for path in golden_transcripts():
-        t = load(path)
-        families = t.meta.get("profiles", "").split()
-        for name in available_profiles():
-            p = load_profile(name)
-            if families and p.family not in families and p.name not in families:
-                continue
-            yield pytest.param(Path(path), name, id=f"{Path(path).stem}-{name}")
-
-
-@pytest.mark.parametrize(("path", "profile"), list(cases()))
+@pytest.mark.parametrize(("path", "profile"), list(transcript_cases(golden_transcripts())))
 def test_golden_transcript(path: Path, profile: str, tmp_path: Path) -> None:
     t = load(path)
     address = int(t.meta.get("address", "0"))

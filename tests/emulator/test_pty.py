@@ -1,13 +1,11 @@
 """`python -m emulator --pty` as a separate process, driven with pyserial exactly as a
 third-party program would: the golden KEEP/RESTORE scenario and packet example, the
-watchdog, the control channel, and the TCP server."""
+watchdog, the control channel, the TCP server, and the transcripts of the emulator issue
+(those that wait more than 1 s are marked slow)."""
 
 from __future__ import annotations
 
 import json
-import selectors
-import subprocess
-import sys
 import time
 
 import pytest
@@ -15,66 +13,10 @@ import serial
 
 from gve_fixtures import TRANSCRIPTS_DIR
 from gve_fixtures.transcript import load
-from tests.emulator.replay import play
+from tests.emulator.process import Emulator, RealRig
+from tests.emulator.replay import TRANSCRIPTS, play, transcript_cases
 
 pytestmark = pytest.mark.pty
-
-
-class Emulator:
-    """The emulator process, its first stdout line, and its control channel."""
-
-    def __init__(self, *args: str) -> None:
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "emulator", *args], stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
-        self.first = self.readline(20.0)
-
-    def readline(self, timeout: float) -> str:
-        sel = selectors.DefaultSelector()
-        sel.register(self.proc.stdout, selectors.EVENT_READ)
-        assert sel.select(timeout), "the emulator printed nothing"
-        return self.proc.stdout.readline().strip()
-
-    def control(self, text: str) -> str:
-        self.proc.stdin.write(text + "\n")
-        self.proc.stdin.flush()
-        return self.readline(10.0)
-
-    def stop(self) -> int:
-        self.proc.terminate()
-        return self.proc.wait(10)
-
-
-class RealRig:
-    """Time passes for real; the rig's hands are the control channel."""
-
-    def __init__(self, emu: Emulator, port: serial.Serial) -> None:
-        self.emu, self.port = emu, port
-
-    @property
-    def now(self) -> int:
-        return time.monotonic_ns()
-
-    def advance(self, seconds: float) -> None:
-        # wait on the port itself: anything arriving meanwhile stays readable
-        deadline = time.monotonic() + seconds
-        while time.monotonic() < deadline:
-            sel = selectors.DefaultSelector()
-            sel.register(self.port.fileno(), selectors.EVENT_READ)
-            if sel.select(deadline - time.monotonic()):
-                return
-
-    def set_input(self, port: int, value: int) -> None:
-        assert self.emu.control(f"in {port} {value:02X}") == "ok"
-
-    def outputs(self) -> int:
-        return int(json.loads(self.emu.control("state"))["outputs"], 16)
-
-    def spindle(self) -> int:
-        return json.loads(self.emu.control("state"))["spindle"]
-
-    def power_on(self) -> None:
-        assert self.emu.control("power-on") == "ok"
 
 
 @pytest.fixture
@@ -143,3 +85,41 @@ def test_log_is_written_line_by_line(tmp_path):
     emu.proc.wait(10)
     records = [(r.direction, r.data) for r in load(log).records]
     assert records == [(">", b"!0?\r"), ("<", b"0,IP84 v3 27.1.2010\r")]
+
+
+def _waits(path) -> float:
+    """The seconds a transcript waits for (restarts count 2.5 s)."""
+    total = 0.0
+    for rec in load(path).records:
+        if rec.direction == "=" and rec.action[0] in ("wait", "silence"):
+            total += float(rec.action[1])
+        elif (rec.direction == "=" and rec.action[0] == "power-on") or b"!0J" in rec.data:
+            total += 2.5
+    return total
+
+
+def _over_the_pty():
+    """The issue's transcripts (errors e*, decisions d*) on one profile each; those that
+    wait long are slow."""
+    chosen: dict[str, tuple] = {}
+    issue = sorted([*TRANSCRIPTS.glob("e*.gvt"), *TRANSCRIPTS.glob("d*.gvt")])
+    for param in transcript_cases(issue):
+        path, profile = param.values
+        if path.stem not in chosen or profile in ("GVE84-100", "GVE114-500"):
+            chosen.setdefault(path.stem, (path, profile))
+            if profile == "GVE84-100":
+                chosen[path.stem] = (path, profile)
+    for name, (path, profile) in sorted(chosen.items()):
+        marks = [pytest.mark.slow] if _waits(path) > 1 else []
+        yield pytest.param(path, profile, id=f"{name}-{profile}", marks=marks)
+
+
+@pytest.mark.parametrize(("path", "profile"), list(_over_the_pty()))
+def test_revised_transcript_over_the_pty(path, profile, tmp_path):
+    emu = Emulator("--model", profile, "--pty", "--eeprom", str(tmp_path / "eeprom.bin"))
+    port = serial.Serial(emu.first, 115200, timeout=30)
+    try:
+        assert play(port, load(path), RealRig(emu, port)) == []
+    finally:
+        port.close()
+        assert emu.stop() == 0

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import c_available
+from emulator.motion.factory import c_available
 
 pytestmark = pytest.mark.skipif(not c_available(), reason="the C stepper core is not built "
                                 "(the emulator falls back to the Python twin)")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-import emulator.motion as motion
+import emulator.motion.factory as motion
 from emulator.motion.python_twin import PythonMotion
 
 

@@ -12,8 +12,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import SECOND, Vector, c_available, create
 from emulator.motion.arith import acc_count, acc_time
+from emulator.motion.factory import c_available, create
+from emulator.motion.interface import SECOND, Vector
 
 MAX_RATE = 100_000
 AXES = 3
@@ -308,3 +309,54 @@ def test_accelerations_stay_within_a(core, length, rate, kilo):
     allowed = a * (gaps[:-1] + gaps[1:]) / 1e9 + 2e9 / np.minimum(gaps[:-1],
                                                                           gaps[1:]) ** 2 + 1
     assert np.all(change <= allowed), float(np.max(change - allowed))
+
+
+# -- the spec revision of 2026-11-25 (spec 10.2, 10.4) ----------------------------------
+
+def _first_step_after(m, t: int) -> int:
+    times, _ = m.pulses(t + 1, t + 10 * SECOND)
+    return int(times[0])
+
+
+def test_a_c_joins_although_braking_takes_no_whole_step(core):
+    """A C whose braking is shorter than a step can still be joined until its last step:
+    at A = 1e7 steps/s² V1000 brakes in 0.05 steps."""
+    m = make(core)
+    m.push(vector((100, 0, 0), v=1000, a=10_000_000), 0)
+    m.push(vector((100, 0, 0), v=1000, a=10_000_000), 50 * SECOND // 1000)
+    times, _ = m.pulses(0, m.drain_instant() + 1)
+    gap = int(np.diff(times).max())
+    assert gap <= SECOND // 1000 + 1, "no stop at the junction"
+
+
+def test_no_dwell_between_continuous_vectors_from_rest(core):
+    """'Mezi CONT.vektory tato prodleva není' (M84 12.5.2): a C that comes after a C
+    has stopped starts at once; an L waits out T."""
+    for continuous, waits in ((True, False), (False, True)):
+        m = make(core)
+        m.push(vector((10, 0, 0), continuous=continuous, dwell_ms=20), 0)
+        end = run_out(m)
+        m.push(vector((10, 0, 0), continuous=continuous, dwell_ms=20), end + 1)
+        start = _first_step_after(m, end)
+        assert (start - end >= 20_000_000) == waits
+
+
+def test_a_zero_length_c_between_two_c_makes_the_next_start_from_rest(core):
+    m = make(core)
+    m.push(vector((0, -92, 0), v=1000, a=10_000_000, dwell_ms=24), 0)
+    m.push(vector((0, 0, 0), v=1000, a=10_000_000, dwell_ms=24), 1)
+    m.push(vector((0, 46, 0), v=1000, a=10_000_000, dwell_ms=24), 2)
+    first_end = m.instant_of_position(1, -92)
+    start = _first_step_after(m, first_end)
+    assert start - first_end >= 24_000_000, "after T from rest"
+
+
+def test_halt_in_the_final_deceleration_ends_on_the_target(core):
+    m = make(core)
+    m.push(vector((0, 0, 245), continuous=False, v=1500, a=20_000), 0)
+    end = m.drain_instant()
+    rest = m.halt(end - 30_000_000)             # 30 ms before the end: braking already
+    assert rest == end
+    assert m.position(rest) == (0, 0, 245)
+    flags = m.flags(rest)
+    assert flags.halted and not flags.busy      # nothing is left: RUN = 0

@@ -9,8 +9,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from emulator.motion import Vector, c_available, create
 from emulator.motion.arith import acc_count, acc_time
+from emulator.motion.factory import c_available, create
+from emulator.motion.interface import Deviation, Vector
 
 pytestmark = pytest.mark.skipif(not c_available(), reason="the C stepper core is not built "
                                 "(the emulator falls back to the Python twin)")
@@ -70,7 +71,10 @@ def observe(m, t: int):
 @given(data=st.data())
 @SETTINGS
 def test_twins_agree_step_by_step(axes, max_rate, data):
-    py, c = create(axes, max_rate, stepper="python"), create(axes, max_rate, stepper="c")
+    # the deliberate deviations (mutants) too: both cores plant them alike
+    deviations = Deviation(data.draw(st.sampled_from([0, 0, 0, *(1 << i for i in range(6))])))
+    py = create(axes, max_rate, stepper="python", deviations=deviations)
+    c = create(axes, max_rate, stepper="c", deviations=deviations)
     t = 0
     saves = {}
     for op, arg in data.draw(ops(axes, max_rate)):

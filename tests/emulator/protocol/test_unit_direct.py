@@ -172,14 +172,14 @@ def test_frames_during_a_pending_halt_are_dropped():
     h.send(b"!0V1000\r!0L20000,0,0\r")
     h.now += 50_000_000                        # let the vector run for 50 ms
     unit.advance(h.now)
-    assert unit.motion.flags(h.now).moving
+    assert unit.device.motion.flags(h.now).moving
     h.answers.clear()
     h.send(b"!0H\r")
     h.send(b"!0?\r")                           # arrives while H waits for the stop
     h.settle()
     # spec 2/10.4 + project decision: only H's answer, 8 (INTA set by HALT), no '?' answer
     assert _codes(h) == [b"8\r"]
-    assert not unit.motion.flags(h.now).moving
+    assert not unit.device.motion.flags(h.now).moving
 
 
 def test_reference_run_without_a_switch_is_5():

@@ -1,0 +1,172 @@
+"""`gve-conformance mutation`: the suite's mutation score. Every deliberate bug the
+emulator can plant (its registry, through the ``emu`` target) is hunted with the case
+catalogue until a case FAILs it; the command prints, per mutant, the case that caught it
+and the time it took, then the score, and exits 1 below 100 %.
+
+A mutant is stopped at its first FAIL by a case that PASSes the clean emulator on the
+same profile (a case failing both proves nothing; it is reported). The cases of the
+mutant's rule area (the spec section it breaks) run first, then the rest of the
+catalogue; each on the profiles in turn (one per family first: a mutant of the GVE54's
+micro-stepping shows only there). Hypothesis machines run with the ``mutation`` settings
+(no shrinking).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+
+from conformance.verdict import ERROR, FAIL
+from gve_fixtures.rules import load_rules
+
+#: profiles tried first, one per family; the others follow
+FIRST = ("GVE84-100", "GVE114-500", "GVE54")
+
+
+@dataclass
+class Hunt:
+    mutant: str
+    area: str
+    description: str
+    caught_by: str | None = None     # "case [profile]"
+    runs: int = 0                    # case runs it took
+    seconds: float = 0.0
+    errors: list[str] = field(default_factory=list)   # suite defects met on the way
+    clean_fails: list[str] = field(default_factory=list)   # cases failing the clean unit
+
+    @property
+    def caught(self) -> bool:
+        return self.caught_by is not None
+
+
+def profiles_in_order(chosen: list[str] | None = None) -> list[str]:
+    from gve_fixtures.profile import available_profiles
+    every = available_profiles()
+    if chosen:
+        return chosen
+    return [p for p in FIRST if p in every] + [p for p in every if p not in FIRST]
+
+
+def closeness(case, area: str) -> int:
+    """How closely a case checks the rule area ``area`` (a spec section: 10 is the command
+    table, 10.2 the motion model, each an area of its own): 0 filed there, 1 naming a rule
+    of it, 2 neither."""
+    if case.section == area:
+        return 0
+    rules = load_rules()
+    return 1 if any(rules[r].section == area for r in case.rules) else 2
+
+
+def hunt(mutant: str, profiles: list[str] | None = None,
+         include: list[str] | None = None) -> Hunt:
+    """Run cases against ``mutant`` until one FAILs (see the module's text)."""
+    from conformance.catalogue import select
+    from conformance.runner import run_case
+    from conformance.targets import emu, parse_target
+    area, description = emu.mutants()[mutant]
+    result = Hunt(mutant, area, description)
+    cases = select(include or None)
+    ordered = sorted(cases, key=lambda c: closeness(c, area))      # stable: spec order
+    area_cases = [c for c in ordered if closeness(c, area) < 2]
+    names = profiles_in_order(profiles)
+    targets = {p: (parse_target(f"emu:{p}", mutant=mutant), parse_target(f"emu:{p}"))
+               for p in names}
+    first = [p for p in names if p in FIRST] or names[:1]
+    rest = [p for p in names if p not in first]
+    # the area's cases on one profile per family, then the other cases there, then the
+    # whole catalogue on the remaining profiles
+    pairs = ([(c, p) for c in ordered[:len(area_cases)] for p in first]
+             + [(c, p) for c in ordered[len(area_cases):] for p in first]
+             + [(c, p) for c in ordered for p in rest])
+    start = time.perf_counter()
+    for c, p in pairs:
+        target, clean = targets[p]
+        if c.missing_for(target.profile):
+            continue
+        r = run_case(c, target, "mutation")
+        result.runs += 1
+        where = f"{c.id} [{p}]"
+        if r.verdict == ERROR:
+            result.errors.append(where)
+        if r.verdict != FAIL:
+            continue
+        if run_case(c, clean, "mutation").verdict in (FAIL, ERROR):
+            result.clean_fails.append(where)
+            continue
+        result.caught_by = where
+        result.seconds = time.perf_counter() - start
+        return result
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _hunt(args: tuple[str, list[str] | None, list[str] | None]) -> Hunt:
+    return hunt(*args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="gve-conformance mutation",
+                                 description=__doc__.splitlines()[0])
+    ap.add_argument("--profile", action="append", default=[],
+                    help="hunt on this profile only (repeatable; default: every profile)")
+    ap.add_argument("--mutant", action="append", default=[], metavar="NAME",
+                    help="only this mutant (repeatable; default: every one)")
+    ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
+                    help="only cases whose ID matches (repeatable)")
+    ap.add_argument("--jobs", type=int, default=1, help="mutants hunted in parallel")
+    args = ap.parse_args(argv)
+    from conformance.targets import emu
+    from gve_fixtures.profile import available_profiles
+    known = emu.mutants()
+    wrong = [m for m in args.mutant if m not in known]
+    wrong += [p for p in args.profile if p not in available_profiles()]
+    if wrong or args.jobs < 1:
+        print(f"gve-conformance mutation: unknown {', '.join(wrong) or '--jobs'}",
+              file=sys.stderr)
+        return 2
+    names = args.mutant or sorted(known)
+    jobs = [(m, args.profile or None, args.cases or None) for m in names]
+    start = time.perf_counter()
+    results = []
+    with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else _Serial() as pool:
+        for h in pool.map(_hunt, jobs):
+            results.append(h)
+            _show(h)
+    caught = sum(h.caught for h in results)
+    score = 100.0 * caught / len(results) if results else 100.0
+    print(f"\nmutation score: {caught}/{len(results)} = {score:.1f} % "
+          f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s))")
+    return 0 if caught == len(results) else 1
+
+
+def _show(h: Hunt) -> None:
+    if h.caught:
+        line = f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s ({h.runs} runs)"
+    else:
+        line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {h.runs} runs "
+                f"in {h.seconds:.1f} s")
+    print(line, flush=True)
+    for e in h.errors:
+        print(f"        ERROR on the way (a defect of the suite): {e}", flush=True)
+    for e in h.clean_fails:
+        print(f"        not counted: {e} fails the clean emulator too", flush=True)
+
+
+class _Serial:
+    """One job: no worker processes."""
+
+    def __enter__(self) -> _Serial:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+    def map(self, fn, items):
+        return map(fn, items)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

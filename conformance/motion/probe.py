@@ -1,0 +1,290 @@
+"""A motion scenario on a link, measured: frames are sent with the window in which the
+unit processed them, the motion they cause is booked in the suite's model, positions are
+read with ``PF``, and at the end every reading is judged against the model at its
+instant, within the tolerance of :mod:`conformance.motion.tolerance` (printed with each
+check), and the whole is recorded as a trace for the reports.
+
+The probe interprets the frames it sends as the unit must (spec 10): modal parameters
+(``V A B $ T VK VN VL M``) are captured by the vectors accepted after them, ``XM XA XU
+XD`` act on the queue at once, ``H`` and ``G`` halt and resume. On the GVE54 vectors, ``V``,
+``B``, ``A``, ``$`` and the maximum rate are in commanded steps and scaled to the
+1/16-step counters by the micro-step factor (docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from conformance.case import CaseContext, CouldNotTest
+from conformance.link.framing import Response, frame
+from conformance.motion.arith import SECOND
+from conformance.motion.model import MotionModel
+from conformance.motion.plan import Params
+from conformance.motion.tolerance import (
+    Window,
+    answer_window,
+    late_window,
+    processing_window,
+    tolerance,
+)
+from conformance.targets.session import known_axis_limits
+
+#: dense model points per trace
+TRACE_POINTS = 60
+#: let the unit rest longer than any T (24 ms) before a scenario starts
+SETTLE = 0.03
+#: a scenario's moves take well under this
+UNTIL_SECONDS = 5.0
+
+
+@dataclass
+class Event:
+    window: Window
+    kind: str                 # push, override, halt, go
+    args: dict = field(default_factory=dict)
+    answer: Window | None = None    # H: when its answer left the unit
+
+
+@dataclass
+class Reading:
+    window: Window
+    positions: list[int]
+    label: str
+
+
+class Probe:
+    def __init__(self, ctx: CaseContext, name: str, rule: str) -> None:
+        self.ctx, self.name, self.rule = ctx, name, rule
+        self.link = ctx.link
+        p = ctx.profile
+        r = p.reset
+        self.scale = 1 if p.microstep is None else p.microstep.factors[p.microstep.reset_mode]
+        # the state a case starts from: a fresh emulated unit, or a real one put into the
+        # known state (docs/suite.md), whose VL cannot always be set back to the reset's
+        vl = r.VL if self.link.virtual or "VL" not in p.commands else known_axis_limits(p)
+        self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T, "VK": r.VK,
+                      "VL": tuple(vl)}
+        self.events: list[Event] = []
+        self.readings: list[Reading] = []
+        self.params: dict = {}
+        self.round_trip = 0
+        self.link.wait(SETTLE)
+        start = self.read("start")
+        if start is None:
+            raise CouldNotTest("PF did not answer with positions before the motion")
+        self.origin = start
+
+    # -- the link -----------------------------------------------------------------------
+    def _timing(self, body: str, r: Response) -> tuple[Window, Window]:
+        """When the unit took the frame, and when its answer left."""
+        n = len(frame(body, self.link.address, self.link.checksums))
+        # a serial: target may be a pseudo-terminal, whose bytes take no time: only the
+        # round trip is sure (a line known to be paced could leave the bytes' time out)
+        kw = {"virtual": self.link.virtual, "paced": False}
+        answered = answer_window(r.sent_at, r.received_at, n, len(r.raw), self.link.baud, **kw)
+        if body[:1] == "H":
+            return late_window(r.sent_at, n, self.link.baud, self.round_trip, **kw), answered
+        self.round_trip = max(self.round_trip, r.received_at - r.sent_at)
+        return processing_window(r.sent_at, r.received_at, n, len(r.raw), self.link.baud,
+                                 **kw), answered
+
+    def send(self, body: str) -> Response:
+        """Send a frame the scenario needs (the case cannot judge when it is refused) and
+        book what it does."""
+        r = self.link.send(body)
+        self.ctx.require(r is not None and r.code == 0, f"{body} answered "
+                         f"{'nothing' if r is None else r.text}, expected 0")
+        self._book(body, *self._timing(body, r))
+        return r
+
+    def read(self, label: str = "") -> list[int] | None:
+        """Read PF and keep the reading (None when the unit did not answer with positions;
+        bytes that are not decimals fail the case through the response's accessor)."""
+        r = self.link.send("PF")
+        if r is None or r.code != 0 or len(r.values) < 3:
+            return None
+        values = r.decs()
+        self.readings.append(Reading(self._timing("PF", r)[0], values, label))
+        return values
+
+    def sample(self, seconds: float, every: float, label: str = "") -> None:
+        """Read PF every ``every`` s for ``seconds``."""
+        end = self.link.now + round(seconds * SECOND)
+        while self.link.now < end:
+            self.link.wait(every)
+            self.read(label)
+
+    def until(self, target: list[int], max_seconds: float, every: float) -> None:
+        """Read PF every ``every`` s until the axes stand at ``target`` (counter units)."""
+        end = self.link.now + round(max_seconds * SECOND)
+        while self.link.now < end:
+            got = self.read()
+            if got is not None and got[:len(target)] == target:
+                return
+            self.link.wait(every)
+        raise CouldNotTest(f"the axes did not reach {target} within {max_seconds} s")
+
+    def script(self, steps: list, every: float = 0.05) -> bool:
+        """Run a scenario and judge it: a string is a frame to send, a number the seconds
+        to sample PF for (every ``every`` s; a pair: seconds and how often), a list the
+        position (in commanded steps) to poll PF until (every 2 ms)."""
+        for step in steps:
+            if isinstance(step, str):
+                self.send(step)
+            elif isinstance(step, tuple):
+                self.sample(*step)
+            elif isinstance(step, list):
+                self.until([o + x * self.scale for o, x in zip(self.origin, step, strict=False)],
+                           UNTIL_SECONDS, 0.002)
+            else:
+                self.sample(step, every)
+        return self.judge()
+
+    # -- the frames' meaning (spec 10) --------------------------------------------------
+    def _book(self, body: str, w: Window, answered: Window) -> None:
+        head, rest = _split(body)
+        if head in ("L", "C"):
+            d = tuple(int(x) * self.scale for x in rest.split(","))
+            self.events.append(Event(w, "push", {"d": d, "kind": head,
+                                                 "p": self._captured()}))
+        elif head in ("V", "A", "B", "$", "T"):
+            self.modal[head] = int(rest)
+            self.params[head] = int(rest)
+        elif head in ("VK", "VN"):
+            self.modal["VK"] = head == "VK"
+            self.params["VK" if head == "VK" else "VN"] = True
+        elif head == "VL":
+            values = [int(x) for x in rest.split(",")]
+            self.modal["VL"] = tuple(values) + self.modal["VL"][len(values):]
+            self.params["VL"] = values
+        elif head == "M":
+            self.scale = self.ctx.profile.microstep.factors[rest]
+            self.params["M"] = rest
+        elif head == "XM":
+            self.events.append(Event(w, "override", {"name": "XM", "value": int(rest)}))
+            self.params["XM"] = int(rest)
+        elif head in ("XA", "XU", "XD"):
+            p = self._captured()             # XA: the modal V (GVE54: and A) as it is now
+            self.events.append(Event(w, "override", {
+                "name": head, "modal_v": p.V, "modal_a": p.A,
+                "scales_accel": self.ctx.profile.microstep is not None}))
+            self.params[head] = True
+        elif head == "H":
+            self.events.append(Event(w, "halt", answer=answered))
+        elif head == "G":
+            self.events.append(Event(w, "go"))
+
+    def _captured(self) -> Params:
+        m, s = self.modal, self.scale
+        max_rate = self.ctx.profile.max_rate
+        vl = tuple(min(v, max_rate) for v in m["VL"])
+        return Params(V=m["V"] * s, A=m["A"] * 1000 * s, B=m["B"] * s, dollar=m["$"] * s,
+                      T=m["T"] * 1_000_000, max_rate=max_rate * s, VK=m["VK"], VL=vl)
+
+    # -- judging --------------------------------------------------------------------------
+    def model(self, shift: dict[int, int] | None = None) -> tuple[MotionModel, list[int]]:
+        """The model fed with every event at its instant: the middle of its window, or
+        for the events in ``shift`` (index -> instant) that instant; and the instant it
+        comes to rest after each H."""
+        model = MotionModel(self.origin)
+        rests = []
+        for i, e in enumerate(self.events):
+            t = (shift or {}).get(i, (e.window.lo + e.window.hi) // 2)
+            if e.kind == "push":
+                model.push(t, e.args["d"], e.args["kind"], e.args["p"])
+            elif e.kind == "override":
+                model.override(t, **e.args)
+            elif e.kind == "halt":
+                rests.append(model.halt(t))
+            elif e.kind == "go":
+                model.go(t)
+        last = max([r.window.hi for r in self.readings] + [e.window.hi for e in self.events])
+        model.advance(last)
+        return model, rests
+
+    def _variants(self) -> list[tuple[MotionModel, list[int]]]:
+        """The model with each event moved to either end of its window (the others in the
+        middle): how much not knowing when the unit took a frame can change the motion.
+        On the emulator's virtual clock every window is an instant: no variant."""
+        out = []
+        for i, e in enumerate(self.events):
+            if e.window.lo != e.window.hi:
+                out += [self.model({i: e.window.lo}), self.model({i: e.window.hi})]
+        return out
+
+    def judge(self) -> bool:
+        """Judge every reading taken after the first event, and the instant each H
+        answered; record the trace."""
+        (model, rests), variants = self.model(), self._variants()
+        virtual = self.link.virtual
+        t0 = self.events[0].window.lo if self.events else self.readings[0].window.lo
+        spread = sum(e.window.hi - e.window.lo for e in self.events)
+        ok_all = True
+        widest = tolerance(Window(0, spread), virtual=virtual)
+        halts = [e for e in self.events if e.kind == "halt"]
+        for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
+            # what each event's window can change, added up (as for positions)
+            lo = rest + sum(min(0, v[1][n] - rest) for v in variants)
+            hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
+            a = e.answer
+            tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual)
+            ok_all &= self.ctx.expect(
+                lo <= a.hi and a.lo <= hi,
+                f"{self.name}: H answered when the motion came to rest ({tol})",
+                observed=f"answer at {(a.lo - t0) / 1e6:.3f} ms",
+                expected=f"at rest at {(rest - t0) / 1e6:.3f} ms", rule=self.rule)
+        for reading in self.readings:
+            w = reading.window
+            if w.hi < t0:
+                continue
+            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual)
+            widest = max(widest, tol, key=lambda x: x.seconds)
+            band = _band(model, variants, w, tol.steps)
+            got = reading.positions[:len(band)]
+            ok = all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True))
+            expected = [b0 + tol.steps if b0 + tol.steps == b1 - tol.steps else f"{b0}..{b1}"
+                        for b0, b1 in band]
+            ok_all &= self.ctx.expect(
+                ok, f"{self.name}: PF at {(w.lo - t0) / 1e6:.3f} ms"
+                f"{' ' + reading.label if reading.label else ''} ({tol})",
+                observed=got, expected=expected, rule=self.rule)
+        self._trace(model, t0, widest)
+        return ok_all
+
+    def _trace(self, model: MotionModel, t0: int, tol) -> None:
+        end = max(r.window.hi for r in self.readings)
+        end = max(end, model.rest)
+        step = max(1, (end - t0) // TRACE_POINTS)
+        instants = sorted({*range(t0, end + 1, step), end,
+                           *((r.window.lo + r.window.hi) // 2 for r in self.readings
+                             if r.window.hi >= t0)})
+        self.ctx.trace(self.name,
+                       samples=[((r.window.lo + r.window.hi) / 2 / SECOND - t0 / SECOND,
+                                 r.positions) for r in self.readings if r.window.hi >= t0],
+                       model=[((t - t0) / SECOND, model.position(t)) for t in instants],
+                       tolerance=tol.as_dict(), params=dict(self.params))
+
+
+def _split(body: str) -> tuple[str, str]:
+    for head in ("VL", "VK", "VN", "XM", "XA", "XU", "XD"):
+        if body.startswith(head):
+            return head, body[len(head):]
+    return body[:1], body[1:]
+
+
+def _band(model: MotionModel, variants: list[tuple[MotionModel, list[int]]], w: Window,
+          steps: int) -> list[tuple[int, int]]:
+    """Per axis, the least and greatest position the model gives over the reading's
+    window, widened by what each event's own window can change (the variants, added up)
+    and by ``steps``."""
+    points = [model.position(t) for t in (w.lo, w.hi, *model.boundaries(w.lo, w.hi))]
+    mid = model.position((w.lo + w.hi) // 2)
+    out = []
+    for i in range(len(points[0])):
+        low = min(p[i] for p in points) - steps
+        high = max(p[i] for p in points) + steps
+        for v, _ in variants:
+            here = v.position((w.lo + w.hi) // 2)[i] - mid[i]
+            low, high = low + min(0, here), high + max(0, here)
+        out.append((low, high))
+    return out

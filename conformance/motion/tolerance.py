@@ -1,0 +1,142 @@
+"""When a frame was processed, and how far a position read from a moving unit may be
+from the model's.
+
+A unit answers ``P``/``PF`` with the step counts at the instant it processes the frame
+(spec 10.2). The host cannot see that instant; it knows when it began sending the frame
+(``sent_at``) and when the answer had arrived (``received_at``). Between them lie the
+frame's bytes on the wire, the unit's processing and the answer's bytes:
+
+    sent_at ── frame bytes ──▶ [processed] ── answer bytes ──▶ received_at
+
+- On the embedded emulator (virtual time) every byte takes exactly ``round(1e10/baud)`` ns
+  and nothing else takes time, so the instant is known exactly:
+  ``sent_at + len(frame)·byte = received_at − len(answer)·byte``. The window has width 0.
+- On a paced line (a serial port: the UART sends at the baud rate) the frame's and the
+  answer's bytes take at least their transmission time, so the window is
+  ``[sent_at + len(frame)·byte, received_at − len(answer)·byte]``; what is left is the
+  observed latency (driver, USB, the unit's processing).
+- On an unpaced line (a pty or TCP, where bytes may take no time) only
+  ``[sent_at, received_at]`` is sure.
+
+A position judged against the model is accepted within the model's positions over the
+whole window (the model is evaluated at both ends and at every vector boundary inside),
+widened by ``steps`` (one step of placement on real targets, none in virtual time):
+:class:`Tolerance` carries both figures, which every motion check prints.
+
+The differential fuzzer compares two targets' readings the same way:
+:func:`reading_band` is how many steps two readings taken in two windows may differ by
+while the axes run at up to ``rate`` steps per second.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+SECOND = 1_000_000_000
+#: bits per byte on an 8N1 line (spec 2): start, 8 data, stop
+BITS_PER_BYTE = 10
+#: steps a real target may differ by from the model at a known instant (step placement)
+PLACEMENT_STEPS = 1
+
+
+def byte_ns(baud: int) -> int:
+    """Nanoseconds one byte takes on the line at ``baud`` (8N1)."""
+    return round(BITS_PER_BYTE * SECOND / baud)
+
+
+@dataclass(frozen=True)
+class Window:
+    """The instants (ns, on the link's clock) between which a frame was processed."""
+
+    lo: int
+    hi: int
+
+    @property
+    def seconds(self) -> float:
+        return (self.hi - self.lo) / SECOND
+
+    def shifted(self, ns: int) -> Window:
+        return Window(self.lo + ns, self.hi + ns)
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """The band a check used: the width of the time window, and steps on top."""
+
+    seconds: float
+    steps: int
+
+    @property
+    def exact(self) -> bool:
+        return self.seconds == 0 and self.steps == 0
+
+    def as_dict(self) -> dict:
+        return {"seconds": self.seconds, "steps": self.steps}
+
+    def __str__(self) -> str:
+        return f"±{self.steps} step(s) over a window of {self.seconds * 1e3:.3f} ms"
+
+
+def processing_window(sent_at: int, received_at: int, frame_bytes: int, answer_bytes: int,
+                      baud: int, *, virtual: bool, paced: bool) -> Window:
+    """The window in which the unit processed a frame (see the module's text).
+
+    ``virtual``: the embedded emulator's clock (exact); ``paced``: a line whose bytes take
+    their transmission time (a serial port)."""
+    b = byte_ns(baud)
+    if virtual:
+        t = sent_at + frame_bytes * b
+        return Window(t, t)
+    if paced:
+        lo, hi = sent_at + frame_bytes * b, received_at - answer_bytes * b
+        if lo <= hi:
+            return Window(lo, hi)
+    return Window(sent_at, received_at)
+
+
+def answer_window(sent_at: int, received_at: int, frame_bytes: int, answer_bytes: int,
+                  baud: int, *, virtual: bool, paced: bool) -> Window:
+    """The window in which the unit sent its answer: the processing instant for most
+    frames; for ``H`` and ``W``, which answer when the motion has stopped, later."""
+    if virtual:
+        t = received_at - answer_bytes * byte_ns(baud)
+        return Window(t, t)
+    return processing_window(sent_at, received_at, frame_bytes, answer_bytes, baud,
+                             virtual=False, paced=paced)
+
+
+def late_window(sent_at: int, frame_bytes: int, baud: int, round_trip: int, *,
+                virtual: bool, paced: bool) -> Window:
+    """The processing window of a frame answered late (``H``): after its bytes arrived,
+    and no later than the longest round trip observed on the link for frames answered
+    at once."""
+    b = byte_ns(baud)
+    if virtual:
+        t = sent_at + frame_bytes * b
+        return Window(t, t)
+    lo = sent_at + (frame_bytes * b if paced else 0)
+    return Window(lo, max(lo, sent_at + round_trip))
+
+
+def tolerance(window: Window, *, virtual: bool) -> Tolerance:
+    """The tolerance a position read in ``window`` is judged with."""
+    return Tolerance(window.seconds, 0 if virtual else PLACEMENT_STEPS)
+
+
+def since(sample: Window, start: Window) -> Window:
+    """The window of the time elapsed from an event in ``start`` (a vector accepted) to
+    one in ``sample`` (a position read): both uncertainties add up."""
+    return Window(sample.lo - start.hi, sample.hi - start.lo)
+
+
+def reading_band(a: Window, b: Window, rate: int, *,
+                 placement: int = 2 * PLACEMENT_STEPS) -> int:
+    """Steps by which two readings of one axis may differ when they were taken in the
+    windows ``a`` and ``b`` (each measured from the same motion's start, see
+    :func:`since`) while the axis steps at up to ``rate`` per second: the rate times the
+    farthest apart the two instants can be, plus the placement step of each real target
+    (``placement=0`` when both are exact, e.g. the emulator in virtual time against
+    itself)."""
+    apart = max(a.hi - b.lo, b.hi - a.lo, 0)
+    return math.ceil(rate * apart / SECOND) + placement

@@ -1,0 +1,270 @@
+"""The motion commands of spec 10: vectors, modal parameters, overrides, positions, the
+reference run, HALT/GO/DELETE/KEEP/RESTORE, and the GVE54 motor and GVE114 MPG modes.
+
+Every handler takes the device, the session, the parameter text and the instant, and
+parses every field (syntax) before it checks any range or state (spec 3); a refusal
+raises :class:`CommandError` and changes nothing (spec 4).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from emulator.motion.interface import EMPTY_SAVE, SECOND, KeepSave
+from emulator.protocol.device import Device
+from emulator.protocol.params import CommandError, dec, fields, within
+from emulator.protocol.reply import Deferred, Reply
+from emulator.protocol.session import Session
+from emulator.protocol.state import INTA, INTCOM, Saved
+from gve_fixtures.protocol import ErrorCode
+
+Handler = Callable[[Device, Session, str, int], Reply]
+
+
+# -- vectors ---------------------------------------------------------------------------
+
+def parse_steps(dev: Device, p: str) -> tuple[int, ...]:
+    """The relative steps of L or C: one value per axis (the GVE114's A may be left out)."""
+    axes = len(dev.profile.axes)
+    values = [dec(x) for x in fields(p, (3, 4) if axes == 4 else (axes,))]
+    lim = dev.profile.vector_range
+    for v in values:
+        within(v, -lim, lim)
+    return tuple(values + [0] * (axes - len(values)))
+
+
+def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    steps = parse_steps(dev, p)
+    dev.refuse_vectors_to_mpg()
+    if dev.state.reference_until > t:
+        raise CommandError(ErrorCode.QUEUE_FULL, "a reference run is in progress")
+    if dev.motion.queued(t) and not dev.mutant.active("line-while-busy"):
+        raise CommandError(ErrorCode.QUEUE_FULL, "L waits until nothing is queued or running")
+    dev.push(steps, False, t)
+    return []
+
+
+def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    steps = parse_steps(dev, p)
+    if dev.state.kept_single:
+        raise CommandError(ErrorCode.SYNTAX, "after K the queue takes one L only")
+    dev.refuse_vectors_to_mpg()
+    room = dev.profile.buffer - (1 if dev.mutant.active("queue-one-short") else 0)
+    if dev.motion.queued(t) >= room:
+        raise CommandError(ErrorCode.QUEUE_FULL, "the CONT buffer is full")
+    dev.push(steps, True, t)
+    return []
+
+
+# -- modal parameters and overrides ---------------------------------------------------------
+
+def modal(key: str, attr: str) -> Handler:
+    """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
+    def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
+        r = dev.profile.ranges[key]
+        setattr(dev.state.modal, attr, within(dec(p), r.lo, r.hi))
+        return []
+    handler.__name__ = f"cmd_{attr}"
+    return handler
+
+
+def cmd_axis_limits(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    axes = len(dev.profile.axes)
+    values = [dec(x) for x in fields(p, (3, 4) if axes == 4 else (axes,))]
+    r = dev.profile.ranges["VL"]
+    limits = [min(within(v, r.lo, r.hi), dev.profile.max_rate) for v in values]
+    dev.state.modal.VL[: len(limits)] = limits
+    return []
+
+
+def path_speed(flag: bool) -> Handler:
+    def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
+        dev.state.modal.VK = flag
+        return []
+    handler.__name__ = "cmd_vk" if flag else "cmd_vn"
+    return handler
+
+
+def cmd_xa(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    dev.exchange_velocity(t)
+    return []
+
+
+def scale(num: int, den: int) -> Handler:
+    def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
+        dev.scale_velocity(num, den, t)
+        return []
+    handler.__name__ = f"cmd_scale_{num}_{den}"
+    return handler
+
+
+def cmd_xm(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    r = dev.profile.ranges["XM"]
+    dev.override(within(dec(p), r.lo, r.hi), t)
+    return []
+
+
+# -- positions ----------------------------------------------------------------------------
+
+def positions(count: int) -> Handler:
+    def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
+        return [str(x) for x in dev.positions(t)[:count]]
+    handler.__name__ = f"cmd_positions_{count}"
+    return handler
+
+
+def cmd_zero(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    dev.refuse_while_running(t)
+    for axis in range(len(dev.profile.axes)):
+        dev.motion.set_position(axis, 0, t)
+    return []
+
+
+def set_axis(axis: int) -> Handler:
+    def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
+        value = dec(p)
+        r = dev.profile.ranges.get("position")
+        if r is not None:
+            within(value, r.lo, r.hi)
+        dev.refuse_while_running(t)
+        dev.motion.set_position(axis, value * dev.factor(), t)
+        return []
+    handler.__name__ = f"cmd_set_axis_{axis}"
+    return handler
+
+
+def cmd_reference(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    """W<axis>[,]travel,speed,back,speed_back: run to the switch, back off until it
+    releases, and zero the counter there (spec 10 W [D]). The run is timed at constant
+    speeds; the axis moves (``jump``) when it ends."""
+    if not p or p[0] not in dev.profile.axes:
+        raise CommandError(ErrorCode.SYNTAX, "W needs an axis letter")
+    name, axis = p[0], dev.profile.axes.index(p[0])
+    travel, speed, back, speed_back = (
+        dec(x) for x in fields(p[2:] if p[1:2] == "," else p[1:], (4,)))
+    lim, vr = dev.profile.vector_range, dev.profile.ranges["V"]
+    if travel == 0:
+        raise CommandError(ErrorCode.RANGE, "no travel")
+    within(travel, -lim, lim)
+    within(speed, vr.lo, vr.hi)
+    within(back, 0, lim)
+    within(speed_back, vr.lo, vr.hi)
+    dev.refuse_vectors_to_mpg()
+    dev.refuse_while_running(t)
+    f = dev.factor()
+    here = dev.motion.physical(t)[axis]
+    direction = 1 if travel > 0 else -1
+    switch = dev.reference_switch(name, here)
+    to_switch = None if switch is None else switch[0] - here
+    if to_switch is None or not 0 <= to_switch * direction <= abs(travel) * f:
+        # not found within the travel: the whole travel, then 5
+        return _reference_run(dev, t, abs(travel) * SECOND // speed,
+                              [(axis, travel * f)], ErrorCode.RANGE)
+    time_to = abs(to_switch) // f * SECOND // speed
+    if switch[1] and back >= 1:               # a virtual switch releases one step back
+        return _reference_run(dev, t, time_to + SECOND // speed_back,
+                              [(axis, to_switch), (axis, -direction * f)], ErrorCode.OK,
+                              zero=axis)
+    # still active after n4 steps back: 5, the axis stays there
+    return _reference_run(dev, t, time_to + back * SECOND // speed_back,
+                          [(axis, to_switch), (axis, -direction * back * f)], ErrorCode.RANGE)
+
+
+def _reference_run(dev: Device, t: int, duration: int, moves: list[tuple[int, int]],
+                   code: ErrorCode, zero: int | None = None) -> Deferred:
+    end = t + duration
+    dev.state.reference_until = end
+
+    def finish(at: int) -> tuple[int, list[str]]:
+        for axis, delta in moves:
+            if delta:
+                dev.motion.jump(axis, delta, at)
+        if zero is not None:
+            dev.motion.set_position(zero, 0, at)
+        return code, []
+    return Deferred(end, finish)
+
+
+# -- HALT, GO, DELETE, KEEP, RESTORE (spec 10.4, 10.5) -------------------------------------
+
+def cmd_halt(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    rest = dev.motion.halt(t)
+    dev.state.status[6] |= INTA | INTCOM
+    if rest > t and not dev.mutant.active("halt-answers-early"):
+        return Deferred(rest, lambda at: (ErrorCode.OK, []))
+    return []
+
+
+def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    s = dev.state
+    if not s.inta:
+        if dev.mutant.active("go-without-inta"):
+            return []
+        raise CommandError(ErrorCode.NOTHING_TO_GO, "G with INTA = 0")
+    s.status[6] &= ~(INTA | INTCOM)
+    s.status[4] = s.status[5] = 0
+    dev.motion.resume(t)
+    if dev.mutant.active("go-loses-step") and dev.motion.queued(t):
+        dev.motion.set_position(0, dev.motion.position(t)[0] + 1, t)
+    dev.check_inputs(t)
+    return []
+
+
+def cmd_delete(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if not dev.mutant.active("delete-while-moving"):
+        dev.refuse_while_moving(t)
+    dev.motion.clear(t)
+    s = dev.state
+    s.status[4] = s.status[5] = s.status[6] = 0
+    dev.after_clearing(t)
+    return []
+
+
+def cmd_keep(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    dev.refuse_while_moving(t)
+    s = dev.state
+    st6 = 0 if dev.mutant.active("keep-forgets-st6") else s.status[6]
+    s.saved = Saved(dev.motion.keep(t), s.status[4], s.status[5], st6)
+    s.status[4] = s.status[5] = s.status[6] = 0
+    s.kept_single = dev.profile.keep == "single-L"
+    dev.after_clearing(t)
+    return []
+
+
+def cmd_restore(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    dev.refuse_while_moving(t)
+    s = dev.state
+    saved = s.saved or Saved(EMPTY_SAVE, 0, 0, 0)
+    if not dev.mutant.active("restore-keeps-save"):
+        s.saved = None                         # a stack of one level: R pops it
+    motion = saved.motion
+    if dev.mutant.active("restore-drops-partial") and motion.entries \
+            and motion.entries[0][1] > 0:
+        motion = KeepSave(motion.entries[1:], motion.halted)
+    dev.motion.restore(motion, t)
+    s.status[4], s.status[5], s.status[6] = saved.st4, saved.st5, saved.st6
+    s.kept_single = False
+    dev.after_clearing(t)
+    return []
+
+
+# -- GVE54 motor mode, GVE114 MPG ---------------------------------------------------------
+
+def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    ms = dev.profile.microstep
+    assert ms is not None
+    if p not in ms.currents and p not in ms.factors:
+        raise CommandError(ErrorCode.SYNTAX, f"unknown motor mode {p!r}")
+    dev.refuse_while_moving(t)
+    if p in ms.currents:
+        dev.state.current = p
+    else:
+        dev.state.microstep = p
+    return []
+
+
+def cmd_mpg(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if p not in ("+", "&", "-"):
+        raise CommandError(ErrorCode.SYNTAX, "Y takes +, & or -")
+    dev.state.mpg = p
+    return ["Y" + p]

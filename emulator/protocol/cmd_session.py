@@ -1,0 +1,94 @@
+"""The commands that act on the session (spec 6, 7, 8) and the restart `J`: the index
+`@`, the repeat `>`, the checksum mode `%`, packets `*S` / `*E` and their members."""
+
+from __future__ import annotations
+
+from emulator.protocol.cmd_motion import parse_steps
+from emulator.protocol.device import Device
+from emulator.protocol.params import CommandError, dec, within
+from emulator.protocol.reply import Answer, Plain, Reply
+from emulator.protocol.session import Member, Session
+from gve_fixtures.protocol import ErrorCode
+
+
+def cmd_index(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    return [str(ses.index)]
+
+
+def cmd_repeat(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    """The last answered frame as received, then its answer; a plain 0 with no history."""
+    if ses.history is None:
+        return []
+    last, answer = ses.history
+    return Plain(last + b"\r" + answer)
+
+
+def cmd_restart(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    """J: answers a plain 0 (formatted as after the reset [D]) and restarts."""
+    dev.reset(t)
+    ses.reset(dev.profile.reset.checksums)
+    return Plain(b"0\r")
+
+
+def cmd_checksum_mode(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if p not in ("+", "-"):
+        raise CommandError(ErrorCode.SYNTAX, "% takes + or -")
+    ses.checksums = p == "+"
+    return []
+
+
+def cmd_packet_start(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    ses.packet = []                            # no answer; a second *S restarts it
+    return None
+
+
+def member(dev: Device, name: str | None, params: str) -> Member:
+    """A frame inside an open packet (spec 7): only C and B may be members."""
+    if name is None:
+        return Member(None, None, ErrorCode.UNKNOWN)
+    if name not in ("C", "B"):
+        return Member(name, None, ErrorCode.SYNTAX)
+    try:
+        if name == "C":
+            return Member(name, parse_steps(dev, params), ErrorCode.OK)
+        r = dev.profile.ranges["B"]
+        return Member(name, within(dec(params), r.lo, r.hi), ErrorCode.OK)
+    except CommandError as err:
+        return Member(name, None, err.code)
+
+
+def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    """*E n: commit every member only if all k are valid, k = n and the queue has room
+    for the C members; the answer is always ``code,k`` (spec 7)."""
+    members, ses.packet = ses.packet, None
+    if members is None:
+        return Answer(ErrorCode.SYNTAX, ["0"])
+    k = len(members)
+    try:
+        n = dec(p)
+    except CommandError as err:
+        return Answer(err.code, [str(k)])
+    code = ErrorCode.OK
+    if k != n and not dev.mutant.active("packet-count-ignored"):
+        code = ErrorCode.COUNT_MISMATCH
+    if not code:
+        code = next((m.code for m in members if m.code), ErrorCode.OK)
+    vectors = sum(1 for m in members if m.name == "C" and not m.code)
+    if not code and vectors:
+        if dev.state.kept_single:
+            code = ErrorCode.SYNTAX
+        elif dev.mpg_active():
+            code = ErrorCode.BUSY
+        elif dev.motion.queued(t) + vectors > dev.profile.buffer:
+            code = ErrorCode.QUEUE_FULL
+    if code == ErrorCode.OK or dev.mutant.active("packet-partial-commit"):
+        room = dev.profile.buffer - dev.motion.queued(t)
+        for m in members:
+            if m.code:
+                continue
+            if m.name == "B":
+                dev.state.modal.B = m.value  # type: ignore[assignment]
+            elif room > 0:
+                dev.push(m.value, True, t)  # type: ignore[arg-type]
+                room -= 1
+    return Answer(code, [str(k)])

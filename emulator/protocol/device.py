@@ -1,0 +1,243 @@
+"""The device: the machine behind the serial protocol (docs/architecture.md).
+
+It owns the profile, the protocol state a reset restores (state.py), the stepper core,
+the EEPROM, and what the test rig's hands set: the input levels (physical: a reset does
+not change them, spec 10.3) and the virtual reference switches. The session (index,
+history, checksum mode, packets) is not here, and neither is the command table: the
+command handlers act on the device through the methods below.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from emulator.motion.factory import create
+from emulator.motion.interface import Vector
+from emulator.mutants import Mutant
+from emulator.protocol.eeprom import Eeprom
+from emulator.protocol.params import CommandError
+from emulator.protocol.state import FREE, INTA, RUN, STOP, DeviceState, reset_state
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
+
+MS = 1_000_000
+#: input ports read FF with nothing connected (spec 10.3)
+UNCONNECTED = {0: 0xFF, 1: 0xFF, 2: 0xFF}
+
+
+class Device:
+    def __init__(self, profile: Profile, *, mutant: Mutant, eeprom_path: str | Path | None = None,
+                 stepper: str | None = None, origin: int = 0) -> None:
+        self.profile = profile
+        self.mutant = mutant
+        self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
+        scale = profile.position_scale if profile.microstep is not None else 1
+        self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
+                             deviations=mutant.deviations)
+        self.motion.advance(origin)
+        self.inputs = dict(UNCONNECTED)
+        self.switches: dict[str, int | None] = {}
+        self.state: DeviceState = reset_state(profile)
+        self.deaf_until = origin          # restarting (power-on, J) until then
+
+    # -- power ------------------------------------------------------------------------
+    def reset(self, t: int) -> None:
+        """Power-on or J: the reset state of spec 9, deaf for the restart. The axes stay
+        where they are (the counters read 0) and so do the input levels."""
+        p = self.profile
+        self.state = reset_state(p)
+        self.motion.clear(t)
+        for axis in range(len(p.axes)):
+            self.motion.set_position(axis, 0, t)
+        self.motion.set_multiplier(self.state.xm, t)
+        if self.mutant.active("restart-resets-inputs"):
+            self.inputs = dict(UNCONNECTED)
+        self.deaf_until = t + p.restart_ms * MS
+
+    # -- derived state ----------------------------------------------------------------
+    def factor(self) -> int:
+        """Counter units per commanded step (GVE54 micro-stepping, spec 10.7)."""
+        ms = self.profile.microstep
+        return ms.factors[self.state.microstep] if ms is not None else 1
+
+    def mpg_active(self) -> bool:
+        """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""
+        mpg = self.profile.mpg
+        return (mpg is not None and self.state.mpg in ("+", "&")
+                and self.eeprom.read(mpg.enable_address)[0] in mpg.enabling_values)
+
+    def st6(self, t: int) -> int:
+        flags = self.motion.flags(t)
+        value = self.state.status[6] & ~(RUN | STOP)
+        if flags.busy or self.mpg_active() or self.state.reference_until > t:
+            value |= RUN
+        if flags.stopping:
+            value |= STOP
+        return value
+
+    def moving(self, t: int) -> bool:
+        """Executing, braking or dwelling, a reference run, or the MPG (spec 5)."""
+        mpg = self.mpg_active() and not self.mutant.active("mpg-not-moving")
+        return self.motion.flags(t).moving or self.state.reference_until > t or mpg
+
+    def refuse_while_moving(self, t: int) -> None:
+        if self.moving(t):
+            raise CommandError(ErrorCode.BUSY, "not possible while moving")
+
+    def refuse_while_running(self, t: int) -> None:
+        if self.st6(t) & RUN:
+            raise CommandError(ErrorCode.BUSY, "not possible while RUN = 1")
+
+    def refuse_vectors_to_mpg(self) -> None:
+        if self.mpg_active():
+            raise CommandError(ErrorCode.BUSY, "the MPG holds the axes")
+
+    def capacity(self) -> int:
+        """The queue's capacity now: one vector after K on GVE84/GVE114 (spec 10.5)."""
+        if self.state.kept_single and not self.mutant.active("flags-ignore-keep-capacity"):
+            return 1
+        return self.profile.buffer
+
+    def positions(self, t: int) -> tuple[int, ...]:
+        """The counters as P and PF report them."""
+        here = self.motion.position(t)
+        if self.mutant.active("position-ignores-microstep"):
+            f = self.factor()
+            return tuple(int(x / f) for x in here)
+        return here
+
+    # -- vectors ------------------------------------------------------------------------
+    def push(self, steps: tuple[int, ...], continuous: bool, t: int) -> None:
+        """Accept a vector with the modal parameters it captures (spec 10.1)."""
+        m, p, act = self.state.modal, self.profile, self.mutant.active
+        mr, f = p.max_rate, self.factor()
+        v = p.reset.V if act("velocity-ignored") else m.V
+        if act("override-late"):                  # XM captured instead of an override
+            v = v * self.state.xm // 100
+        accel = p.reset.A if act("accel-ignored") else m.A
+        rate_f = 1 if act("microstep-rates-unscaled") else f
+        limits = (mr,) * len(m.VL) if act("axis-limit-ignored") else m.VL
+        self.motion.push(Vector(
+            steps=tuple(s * f for s in steps), continuous=continuous,
+            velocity=min(v, mr) * rate_f, accel=accel * 1000 * f,
+            brake=min(m.B, mr) * rate_f,
+            short=0 if act("short-vector-ignored") else m.dollar * f,
+            dwell=0 if act("dwell-ignored") else m.T * MS,
+            path_speed=m.VK and not act("path-speed-ignored"),
+            axis_limits=tuple(min(x, mr) * f for x in limits)), t)
+
+    def exchange_velocity(self, t: int) -> None:
+        """XA: the queue takes the modal V (the GVE54 also the modal A)."""
+        if self.mutant.active("xa-ignored"):
+            return
+        p, f = self.profile, self.factor()
+        v = p.reset.V if self.mutant.active("velocity-ignored") else self.state.modal.V
+        accel = self.state.modal.A * 1000 * f if p.microstep is not None else None
+        self.motion.set_velocity(min(v, p.max_rate) * f, t, accel)
+
+    def scale_velocity(self, num: int, den: int, t: int) -> None:
+        """XU / XD: the queue's speeds (the GVE54 also its accelerations) times num/den."""
+        if self.mutant.active("xu-xd-swapped"):
+            num = 2 * den - num                   # 17/16 <-> 15/16
+        self.motion.scale_velocity(num, den, t, accel=self.profile.microstep is not None)
+
+    def override(self, percent: int, t: int) -> None:
+        """XM: an override of every vector, held and later ones (spec 10 XM)."""
+        self.state.xm = percent
+        if not self.mutant.active("override-late"):
+            self.motion.set_multiplier(percent, t)
+
+    # -- interrupts (spec 10.3) ---------------------------------------------------------
+    def _hits(self) -> tuple[int, int]:
+        """The enabled inputs that are active now (level equals polarity), per word."""
+        s, i, p = self.state.status, self.inputs, self.profile
+        active1 = ~(i[1] ^ s[2]) & 0xFF
+        active2 = ~(i[2] ^ s[3]) & 0xFF
+        return s[0] & active1 & p.low_mask, s[1] & active2 & p.high_mask
+
+    def check_inputs(self, t: int) -> None:
+        """Level-triggered: an enabled active input sets its cause bit and INTA (and
+        stops the motion on a ramp) whenever it is looked at."""
+        hit1, hit2 = self._hits()
+        if not (hit1 or hit2) or self.mutant.active("interrupt-ignored"):
+            return
+        s = self.state.status
+        s[4] |= hit1
+        s[5] |= hit2
+        self.stop(t)
+
+    def after_clearing(self, t: int) -> None:
+        """D, K, R cleared the cause bits or INTA: an input still active sets them again."""
+        if not self.mutant.active("inputs-forgotten-after-delete"):
+            self.check_inputs(t)
+
+    def stop(self, t: int) -> None:
+        """INTA set by an event: a stop on the ramp; later vectors wait for G."""
+        if not self.state.inta:
+            self.state.status[6] |= INTA
+            self.motion.halt(t)
+
+    def set_input(self, port: int, value: int, t: int) -> None:
+        self.inputs[port] = value & 0xFF
+        self.check_inputs(t)
+
+    def write_status(self, n: int, value: int, t: int) -> None:
+        """SW: ST0..ST5 store every bit; ST6 acts like the events its bits stand for."""
+        s = self.state
+        if n < 6:
+            if self.mutant.active("status-word-masked"):
+                value &= self.profile.low_mask if n % 2 == 0 else self.profile.high_mask
+            s.status[n] = value
+        elif self.mutant.active("sw6-inert"):
+            s.status[6] = value & ~(RUN | STOP)
+        else:
+            was = s.inta
+            # RUN, STOP and FREE describe the stepper: writing them changes nothing
+            s.status[6] = value & ~(RUN | STOP | FREE)
+            if s.inta and not was:
+                self.motion.halt(t)               # a stop ramp; no cause bit
+            elif was and not s.inta:
+                self.motion.resume(t)             # like G, but ST4/ST5 stay
+        self.check_inputs(t)
+
+    # -- the reference run ------------------------------------------------------------------
+    def reference_switch(self, axis: str, here: int) -> tuple[int, bool] | None:
+        """The axis's reference switch for W (spec 10 W [D]): (physical position, whether
+        it releases when the axis backs off). A virtual switch placed by the rig releases
+        one step back; the axis's reference input, when it is active now, is a level the
+        rig holds: it is here and stays active however the axis moves."""
+        if self.switches.get(axis) is not None:
+            return self.switches[axis], True
+        bit = self.profile.reference_inputs.get(axis)
+        if bit is not None:
+            level = (self.inputs[1] >> bit) & 1
+            if level == (self.state.status[2] >> bit) & 1:
+                return here, False
+        return None
+
+    # -- EEPROM -----------------------------------------------------------------------------
+    def write_eeprom(self, address: int, data: bytes, t: int) -> None:
+        self.refuse_while_moving(t)
+        if not self.mutant.active("eeprom-write-lost"):
+            self.eeprom.write(address, data)
+
+    # -- the rig's view ---------------------------------------------------------------------
+    def snapshot(self, t: int) -> dict[str, Any]:
+        s, m = self.state, self.state.modal
+        return {
+            "position": list(self.motion.position(t)),
+            "physical": list(self.motion.physical(t)),
+            "excursion": [list(e) for e in self.motion.excursion(t)],
+            "status": ["%02X" % x for x in s.status[:6]] + ["%02X" % self.st6(t)],
+            "queue": self.motion.queued(t),
+            "outputs": "%02X" % s.outputs,
+            "inputs": {str(k): "%02X" % v for k, v in self.inputs.items()},
+            "spindle": s.spindle,
+            "modal": {"V": m.V, "A": m.A, "B": m.B, "$": m.dollar, "T": m.T,
+                      "VK": m.VK, "VL": list(m.VL), "XM": s.xm},
+            "microstep": s.microstep if self.profile.microstep else None,
+            "mpg": s.mpg or None,
+            "kept": s.saved is not None,
+            "eeprom": str(self.eeprom.path) if self.eeprom.path else None,
+        }

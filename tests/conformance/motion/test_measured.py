@@ -1,0 +1,57 @@
+"""The measured motion cases: exact on the emulator's virtual clock (zero tolerance,
+printed with every check, a trace per scenario), and within the printed tolerance in real
+time over a pseudo-terminal."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.runner import run
+from conformance.targets import parse_target
+from conformance.verdict import MISSING, PASS
+
+MEASURED = ["*measured*"]
+TOLERANCE = re.compile(r"\(±(\d+) step\(s\) over a window of ([\d.]+) ms\)")
+
+
+@pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
+def test_virtual_time_judges_every_reading_with_zero_tolerance(profile: str) -> None:
+    results = run([parse_target(f"emu:{profile}")], select(MEASURED)).results
+    assert {r.verdict for r in results} <= {PASS, MISSING}
+    ran = [r for r in results if r.verdict == PASS]
+    assert ran
+    for r in ran:
+        assert r.traces and all(t["tolerance"] == {"seconds": 0.0, "steps": 0} for t in r.traces)
+        for c in r.checks:
+            m = TOLERANCE.search(c["what"])
+            assert m and (m.group(1), m.group(2)) == ("0", "0.000"), c["what"]
+
+
+@pytest.mark.slow
+@pytest.mark.pty
+@pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
+def test_real_time_over_a_pty_within_the_printed_tolerance(profile: str) -> None:
+    proc = subprocess.Popen([sys.executable, "-m", "emulator", "--model", profile, "--pty"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+    try:
+        path = proc.stdout.readline().strip()
+        target = parse_target(f"serial:{path}?baud=115200", profile=profile,
+                              allow_destructive=True, max_travel=100_000)
+        result = run([target], select(MEASURED))
+    finally:
+        proc.terminate()
+        proc.wait(10)
+    bad = {r.id: [c["what"] for c in r.checks if not c["ok"]][:2] for r in result.results
+           if r.verdict not in (PASS, MISSING)}
+    assert not bad
+    widths = sorted(float(m.group(2)) for r in result.results for c in r.checks
+                    if ": PF at " in c["what"] and (m := TOLERANCE.search(c["what"])))
+    print(f"{profile}: {len(widths)} readings in {result.seconds:.1f} s; tolerance windows "
+          f"median {widths[len(widths) // 2]:.3f} ms, 90th percentile "
+          f"{widths[len(widths) * 9 // 10]:.3f} ms, widest {widths[-1]:.3f} ms, ±1 step")

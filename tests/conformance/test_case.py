@@ -1,0 +1,92 @@
+"""Cases name the rules they check; a check naming its rule is graded by that rule's tag
+(fixtures/rules.toml), and a motion trace is kept with the result."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from conformance.case import REGISTRY, Case, case
+from conformance.runner import run_case
+from conformance.targets import parse_target
+from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT, PASS
+from gve_fixtures.rules import load_rules
+
+
+def _toy(body, *, rules=("10.3.st6.free", "5.code.ok"), tag="M") -> Case:
+    return Case("99.toy.case", body, rule="toy", tag=tag, source="test", rules=rules)
+
+
+@pytest.fixture
+def target():
+    t = parse_target("emu:GVE84-100")
+    t.profile = t.profile.__class__(**{**t.profile.__dict__, "implements_decisions": False})
+    return t
+
+
+@pytest.mark.parametrize(("rule", "verdict"), [
+    ("10.3.st6.free", INFO),        # [D-info] in rules.toml
+    ("5.code.ok", FAIL),            # [M]
+])
+def test_a_failed_check_is_graded_by_its_rules_tag(target, rule, verdict):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x", rule=rule)), target)
+    assert r.verdict == verdict
+    assert r.checks[0]["rule"] == rule and r.checks[0]["tag"] == load_rules()[rule].tag
+
+
+def test_a_d_rule_is_non_strict_where_the_decisions_are_not_implemented(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x", rule="3.frame.upper-case"),
+                      rules=("3.frame.upper-case",)), target)
+    assert r.verdict == NON_STRICT
+
+
+def test_an_explicit_tag_outranks_the_rule(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x", rule="10.3.st6.free",
+                                             tag="always")), target)
+    assert r.verdict == FAIL
+
+
+def test_the_only_rule_of_a_case_is_the_rule_of_its_checks(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x"), rules=("10.3.st6.free",)), target)
+    assert r.verdict == INFO and r.checks[0]["rule"] == "10.3.st6.free"
+
+
+def test_a_check_naming_a_rule_its_case_does_not_list_is_a_defect(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(True, "x", rule="3.frame.upper-case")), target)
+    assert r.verdict == ERROR
+
+
+def test_a_case_quotes_its_first_rule_when_it_gives_no_text():
+    try:
+        case("99.toy.quoted", rules=("5.code.range",))(lambda ctx: None)
+        c = REGISTRY["99.toy.quoted"]
+        rule = load_rules()["5.code.range"]
+        assert (c.rule, c.tag, c.source) == (rule.text, rule.tag, rule.source)
+        with pytest.raises(ValueError, match="unknown rule"):
+            case("99.toy.unknown", rules=("5.code.nope",))(lambda ctx: None)
+        with pytest.raises(ValueError, match="name its rules"):
+            case("99.toy.bare", rule="r")(lambda ctx: None)
+    finally:
+        REGISTRY.pop("99.toy.quoted", None)
+
+
+def test_every_case_of_the_catalogue_names_known_rules():
+    from conformance.catalogue import select
+    rules = load_rules()
+    for c in select():
+        assert c.rules, f"{c.id} names no rule"
+        assert all(r in rules for r in c.rules)
+
+
+def test_a_trace_is_kept_with_the_result_as_json(target):
+    def body(ctx):
+        ctx.trace("toy", samples=[(0.5, [1, 2, 3])], model=[(0.0, [0, 0, 0]), (0.5, [1, 2, 3])],
+                  tolerance={"seconds": 0.0, "steps": 0}, params={"V": 1000})
+        ctx.expect(True, "traced")
+    r = run_case(_toy(body), target)
+    assert r.verdict == PASS
+    (trace,) = json.loads(json.dumps(r.to_dict()))["traces"]
+    assert trace == {"name": "toy", "samples": [[0.5, [1, 2, 3]]],
+                     "model": [[0.0, [0, 0, 0]], [0.5, [1, 2, 3]]],
+                     "tolerance": {"seconds": 0.0, "steps": 0}, "params": {"V": 1000}}

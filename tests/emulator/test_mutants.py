@@ -1,0 +1,107 @@
+"""Every mutant of emulator/mutants.py really deviates: on a transcript of the rule it
+breaks (tests/emulator/transcripts or a golden one), which the clean emulator passes
+(test_revised_spec.py, test_golden.py), the mutant answers differently. And every name
+the emulator asks ``active()`` about is a registered mutant."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from emulator.mutants import CORE_DEVIATIONS, MUTANTS, Mutant, UnknownMutant
+from gve_fixtures import TRANSCRIPTS_DIR
+from gve_fixtures.transcript import load
+from tests.emulator.replay import TRANSCRIPTS, open_line, play
+
+EMULATOR = Path(__file__).resolve().parents[2] / "emulator"
+
+#: mutant -> (the transcript of the rule it breaks, the profile it is played on)
+PROBES: dict[str, tuple[str, str]] = {
+    "checksum-no-comma": ("g1-checksum-mode", "GVE84-100"),
+    "checksum-unchecked": ("d4-checksum-in-packet", "GVE84-100"),
+    "checksum-lower-case": ("g1-checksum-mode", "GVE84-100"),
+    "wrong-address-answers": ("p01-framing", "GVE84-100"),
+    "lower-case-command": ("p01-framing", "GVE84-100"),
+    "watchdog-never": ("p01-framing", "GVE54"),
+    "inta-bit-missing": ("e04-sw6-acts", "GVE84-100"),
+    "range-error-code": ("d1-fields", "GVE54"),
+    "go-without-inta": ("e02-restore-empties-the-save", "GVE84-100"),
+    "line-while-busy": ("g6-keep-restore", "GVE84-100"),
+    "queue-one-short": ("p03-queue-size", "GVE84-15"),
+    "packet-partial-commit": ("p02-packet-all-or-nothing", "GVE114-500"),
+    "packet-count-ignored": ("d4-checksum-in-packet", "GVE114-500"),
+    "index-skips-refused": ("e10-bare-commands", "GVE84-100"),
+    "index-counts-queries": ("e10-bare-commands", "GVE54"),
+    "repeat-reexecutes": ("d4-checksum-in-packet", "GVE84-100"),
+    "halt-answers-early": ("m10-halt-ramp", "GVE84-100"),
+    "go-loses-step": ("g6-keep-restore", "GVE84-100"),
+    "delete-while-moving": ("e05-mpg-is-moving", "GVE114-500"),
+    "keep-forgets-st6": ("g6-keep-restore", "GVE114-500"),
+    "restore-drops-partial": ("g6-keep-restore", "GVE84-100"),
+    "status-word-masked": ("g4f-status-read", "GVE84-100"),
+    "interrupt-ignored": ("e01-inputs-after-d-k-r", "GVE84-100"),
+    "eeprom-write-lost": ("d1-fields", "GVE54"),
+    "position-ignores-microstep": ("g5b-gve54-microstep", "GVE54"),
+    "inputs-forgotten-after-delete": ("e01-inputs-after-d-k-r", "GVE84-100"),
+    "restore-keeps-save": ("e02-restore-empties-the-save", "GVE114-500"),
+    "zero-c-keeps-junction": ("e03-zero-length-c", "GVE84-100"),
+    "sw6-inert": ("e04-sw6-acts", "GVE114-500"),
+    "mpg-not-moving": ("e05-mpg-is-moving", "GVE114-500"),
+    "dwell-between-continuous": ("e06-no-dwell-between-c", "GVE84-100"),
+    "restart-resets-inputs": ("e07-j-keeps-inputs", "GVE54"),
+    "flags-ignore-keep-capacity": ("e08-f-after-k", "GVE84-100"),
+    "halt-short-of-target": ("e09-halt-in-final-ramp", "GVE114-500"),
+    "params-ignored-on-bare-commands": ("e10-bare-commands", "GVE84-100"),
+    "long-decimal-syntax-error": ("e11-long-decimals", "GVE84-100"),
+    "velocity-ignored": ("m01-velocity", "GVE84-100"),
+    "path-speed-ignored": ("m02-path-speed", "GVE114-500"),
+    "axis-limit-ignored": ("m03-axis-limit", "GVE84-100"),
+    "override-late": ("m04-override", "GVE84-100"),
+    "xa-ignored": ("m05-exchange", "GVE84-100"),
+    "xu-xd-swapped": ("m05-exchange", "GVE114-500"),
+    "accel-ignored": ("m06-acceleration", "GVE84-100"),
+    "dwell-ignored": ("m07-dwell", "GVE84-100"),
+    "junction-stops": ("m08-junction", "GVE84-100"),
+    "short-vector-ignored": ("m09-short-vector", "GVE84-100"),
+    "halt-without-ramp": ("m10-halt-ramp", "GVE84-100"),
+    "go-at-speed": ("m10-halt-ramp", "GVE114-500"),
+    "microstep-rates-unscaled": ("m11-microstep-rates", "GVE54"),
+}
+
+
+def _transcript(name: str) -> Path:
+    mine = TRANSCRIPTS / f"{name}.gvt"
+    return mine if mine.exists() else TRANSCRIPTS_DIR / f"{name}.gvt"
+
+
+def test_every_mutant_has_a_probe() -> None:
+    assert sorted(PROBES) == sorted(MUTANTS)
+
+
+@pytest.mark.parametrize("mutant", sorted(MUTANTS))
+def test_the_mutant_answers_its_probe_differently(mutant: str, tmp_path: Path) -> None:
+    name, profile = PROBES[mutant]
+    transcript = load(_transcript(name))
+    address = int(transcript.meta.get("address", "0"))
+    port = open_line(profile, address, eeprom=str(tmp_path / "eeprom.bin"), mutant=mutant)
+    problems = play(port, transcript)
+    assert problems, f"{mutant} ({MUTANTS[mutant].description}) passes {name} on {profile}"
+    print(f"{mutant}: {problems[0]}")
+
+
+def test_names_the_emulator_asks_about_are_registered() -> None:
+    asked = {m for path in EMULATOR.rglob("*.py")
+             for m in re.findall(r"""\bact(?:ive)?\(\s*["']([a-z0-9-]+)["']""", path.read_text())}
+    assert asked, "no active() calls found"
+    assert asked <= set(MUTANTS), asked - set(MUTANTS)
+    # every mutant is planted somewhere: asked by name, or a deviation of the core
+    assert set(MUTANTS) <= asked | set(CORE_DEVIATIONS), set(MUTANTS) - asked
+
+
+def test_an_unknown_name_is_refused() -> None:
+    with pytest.raises(UnknownMutant):
+        Mutant("no-such-bug")
+    with pytest.raises(UnknownMutant):
+        Mutant("sw6-inert").active("no-such-bug")
