@@ -55,16 +55,16 @@ def busy(ctx: CaseContext) -> None:
     link = ctx.link
     r = link.send("ER41")
     ctx.require(r is not None and r.code == 0 and r.values, "ER41 answered")
-    before = r.values[0]
+    before = r.hex()
     setup(ctx, "L" + vector(ctx, 1000))
     link.wait(0.1)
     words = (("EFW44,1.5", "EFW"), ("EUW48,7", "EUW"))
-    writes = ["EW41,%02X" % (int(before, 16) ^ 0xFF)]
+    writes = ["EW41,%02X" % (before ^ 0xFF)]
     writes += [body for body, name in words if name in ctx.profile.commands]
     for body in writes:
         code(ctx, link.send(body), 7, f"{body} while moving → 7")
     link.send("H")
-    answers(ctx, link.send("ER41"), f"8,{before}", "the refused write changed nothing")
+    answers(ctx, link.send("ER41"), f"8,{before:02X}", "the refused write changed nothing")
 
 
 @case("3.params.float-values", destructive=True, requires=("EFW",),

@@ -13,6 +13,7 @@ import sys
 import tempfile
 import time
 import uuid
+from contextlib import ExitStack
 from pathlib import Path
 from typing import NoReturn
 
@@ -20,13 +21,13 @@ from serial import SerialException
 
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
-from conformance.cli.unit import ask_before_motion, record_identities, resolve
+from conformance.cli.unit import ask_before_motion, confirmed, record_identities, resolve
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.reports import write_junit, write_reports
 from conformance.runner import RunResult, run, settings_for
-from conformance.settings import PROFILES, run_seed
+from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import FAILED, ORDER, overall
 from gve_fixtures.profile import available_profiles
@@ -75,6 +76,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                          "restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
+    ap.add_argument("--run-id", metavar="NAME",
+                    help="the report folder's name (default: date, time and a random tag)")
+    ap.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                    help="run the targets in N parallel processes: one report per target "
+                         "under reports/<run id>/ and a summary across them")
+    ap.add_argument("--hypothesis-db", metavar="DIR|redis://HOST:PORT/N|none",
+                    help="where the machines keep failing examples, tried first by the next "
+                         "run (redis: by every bench sharing it); default: "
+                         f"REPORT_DIR/{DEFAULT_DATABASE}, none with --no-reports")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
     ap.add_argument("--full-logs", action="store_true",
@@ -90,8 +100,20 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        return _main(argv)
+        args = parse_args(argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    return execute(args, argv)
+
+
+def execute(args: argparse.Namespace, argv: list[str]) -> int:
+    """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
+    fleet runs for its one target (cli/fleet.py)."""
+    try:
+        return _main(args, argv)
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
@@ -114,9 +136,15 @@ def _say(text: str = "") -> None:
         _quiet_stdout()
 
 
-def _main(argv: list[str] | None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
-    args = parse_args(argv)
+def example_database_of(args: argparse.Namespace) -> str | None:
+    """Where the run keeps failing examples (docs/ci.md): --hypothesis-db, else a folder
+    beside the reports (nowhere when the run writes no reports)."""
+    if args.hypothesis_db is not None:
+        return args.hypothesis_db
+    return None if args.no_reports else str(Path(args.report_dir, DEFAULT_DATABASE))
+
+
+def _main(args: argparse.Namespace, argv: list[str]) -> int:
     cases = select(args.cases or None, args.exclude or None)
     if not cases:
         raise UsageError("no case matches " + " ".join(
@@ -135,17 +163,30 @@ def _main(argv: list[str] | None) -> int:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
         return 0
+    if args.jobs < 1:
+        raise UsageError("--jobs must be 1 or more")
+    if not args.no_reports:
+        _check_writable(Path(args.report_dir))
+    with ExitStack() as run_scope:
+        try:
+            run_scope.enter_context(example_database(example_database_of(args)))
+        except ValueError as err:
+            raise UsageError(f"--hypothesis-db: {err}") from None
+        return _run(args, argv, cases)
+
+
+def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     console = Console()
     try:
         targets, how = _targets(args, console)
     except KeyboardInterrupt:
         raise UsageError("interrupted before the run, nothing was sent") from None
-    if not args.no_reports:
-        _check_writable(Path(args.report_dir))
     _preflight(targets)
-    run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
     seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
     meta = _meta(args, argv, targets, how, cases, seed, console)
+    if args.jobs > 1 and len(targets) > 1:
+        return _fleet(args, argv, targets, meta, console, run_id)
     if meta.confirmed == "asked":
         for target in targets:
             if target.info.kind != "emu":
@@ -180,6 +221,19 @@ def _main(argv: list[str] | None) -> int:
                               result.problems)
     _say(f"{verdict}: {reason}")
     return 1 if verdict == FAILED else 0
+
+
+def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], meta: RunMeta,
+           console: Console, run_id: str) -> int:
+    """The targets in processes of their own (cli/fleet.py), asked about once here: the
+    members have no terminal."""
+    from conformance.cli.fleet import run_fleet
+    if meta.confirmed == "asked" and not confirmed(targets, meta, console):
+        raise UsageError("motion not confirmed, nothing that moves was sent (answer y, or "
+                         "give --yes on an unattended bench)")
+    for target in targets:
+        target.close()              # each member opens its own port
+    return run_fleet(args, argv, targets, run_id, meta.seed, example_database_of(args))
 
 
 def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how: list[str],

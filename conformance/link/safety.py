@@ -27,7 +27,7 @@ import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from conformance.link.envelope import INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
+from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from gve_fixtures.profile import Profile
@@ -209,18 +209,22 @@ class Guard:
         return [(int(start.lo) + i) % size for i in range(width)]
 
     def _check_motion(self, body: str, command: Command) -> None:
-        if self.interrupts.stopped:
-            raise SafetyStop(f"{body}: no motion after Ctrl-C")
         event = self._event(command, Outcome.UNCLEAR, None)
-        reach = self.envelope.would_reach(event) if event else self.envelope.reach()
-        axis = self.envelope.outside(reach)
+        e = self.envelope
+        reach = e.would_reach(event) if event else e.reach()
+        axis = e.outside(reach)
         if axis is not None:
             span = reach[axis]
             raise SafetyStop(
                 f"{body}: axis {self.profile.axes[axis]} could reach "
                 f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
-        if reach != self.envelope.reach() or command.name in ("G", "R", "SW6"):
+        # G and SW6 resume the queue, R the save: they move only when something waits
+        waiting = e.saved if command.name == "R" else e.queue if command.name in ("G", "SW6") \
+            else None
+        if reach != e.reach() or (waiting and any(p != EMPTY for p in waiting)):
+            if self.interrupts.stopped:
+                raise SafetyStop(f"{body}: no motion after Ctrl-C")
             self._confirm_motion(body)
 
     def _confirm_motion(self, body: str) -> None:

@@ -270,14 +270,18 @@ class Session:
             link.send(f"SW{n},00")
         link.send("D")
 
-    def _known_state(self, link: Link) -> None:
+    def _settle(self, link: Link) -> None:
+        """Stopped, interrupts off, queue and save empty, the reset values of what cannot
+        be read. A KEEP left by the last case leaves a queue that takes only L (spec
+        10.5): K saves the empty queue over it and R restores that, which moves nothing."""
         self._stop(link)
         for body in self._reset_frames():
             link.send(body)
-        # a KEEP left by the last case leaves a queue that takes only L (spec 10.5): R
-        # empties the save; D then clears what R and a still active input set again
+        link.send("K")
         link.send("R")
-        link.send("D")
+
+    def _known_state(self, link: Link) -> None:
+        self._settle(link)
         self._go_back(link)
         link.send("N")
 
@@ -341,9 +345,7 @@ class Session:
                 self._halt(link, timeout=MARGIN)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._stop(link)
-        for body in self._reset_frames():
-            link.send(body)
+        self._settle(link)
         self.report.reset.append("set to the reset state (they cannot be read): "
                                  + ", ".join(self._reset_frames()))
         if self.profile.microstep:

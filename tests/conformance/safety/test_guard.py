@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
@@ -109,10 +110,14 @@ def test_the_operator_confirms_the_first_motion_once():
     assert asked == [1]
     no = guard()
     no.before_motion = lambda: False
+    no.check("G")                           # nothing queued: G moves nothing
+    no.check("R")                           # nothing saved: neither does R
     with pytest.raises(SafetyStop, match="not confirmed"):
         no.check("C1,0,0")
+    no.accepted("H", parse_response(b"8\r", summed=False))
+    no.envelope.vector([point(5), point(0), point(0)], Outcome.ACCEPTED, stand_alone=False)
     with pytest.raises(SafetyStop, match="not confirmed"):
-        no.check("G")
+        no.check("G")                       # now it would resume a vector
 
 
 def test_halt_waits_for_the_longest_stop_the_envelope_allows():

@@ -14,7 +14,9 @@ from conformance.runner import run
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL
 from tests.conformance.safety.units import in_process_unit
 
-MOTION = (b"L", b"C", b"G", b"R", b"W", b"*E", b"SW6")
+#: frames that can start motion (R after the session's K of an empty queue restores
+#: nothing: the physical check after Ctrl-C would see it if it did)
+MOTION = (b"L", b"C", b"G", b"W", b"*E", b"SW6")
 
 
 def body(frame: bytes) -> bytes:
@@ -96,6 +98,8 @@ def _ctrl_c_at(unit, trigger) -> int:
         if not pressed and trigger(i, frame):
             pressed.append(i)
             unit.session.interrupts.signal()
+        elif pressed and i == pressed[0] + 2:           # H has been answered: stopped
+            pressed.append(unit.state()["physical"])
     unit.on_frame = hook
     return pressed
 
@@ -105,6 +109,7 @@ def _after_ctrl_c(unit, pressed) -> list[bytes]:
     after = unit.frames[pressed[0] + 1:]
     assert [f[2:3] for f in after[:2]] == [b"H", b"D"], after[:4]
     assert not [f for f in after if moves(f)], "motion after Ctrl-C"
+    assert unit.state()["physical"] == pressed[1], "the axes moved after H"
     return after
 
 
