@@ -12,10 +12,14 @@ from conformance.machines.runner import run_machine
 
 
 class KeepMachine(UnitMachine):
-    @initialize()
-    def speed(self) -> None:
+    def __init__(self) -> None:
+        super().__init__()
+        # set before any rule runs: the teardown reads them even when a rule failed
         self.halted = False
         self.kept = False
+
+    @initialize()
+    def speed(self) -> None:
         r = self.link.send("V2000")
         assert r is not None and r.code == 0
 

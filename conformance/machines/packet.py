@@ -16,6 +16,10 @@ MEMBERS = {"C1,0,0": ("C", 0, (1, 0, 0)), "C0,2,0": ("C", 0, (0, 2, 0)),
 
 
 class PacketMachine(UnitMachine):
+    def __init__(self) -> None:
+        super().__init__()
+        self.pending: list[str] = []          # the members sent since *S
+
     @initialize(summed=st.booleans())
     def mode(self, summed: bool) -> None:
         if summed:
@@ -36,11 +40,11 @@ class PacketMachine(UnitMachine):
         kind, code, _ = MEMBERS[body]
         self.model.frame_arrived(kind)
         self.model.member(kind, code)
-        self.pending = [*getattr(self, "pending", []), body]
+        self.pending = [*self.pending, body]
 
     @rule(delta=st.sampled_from([0, 0, 0, 1, -1]))
     def end(self, delta: int) -> None:
-        members = list(getattr(self, "pending", [])) if self.model.packet is not None else []
+        members = list(self.pending) if self.model.packet is not None else []
         k = len(self.model.packet) if self.model.packet is not None else 0
         n = max(0, k + delta)
         expected = self.model.end_packet(n, self.model.buffer)

@@ -12,14 +12,18 @@ from conformance.machines.runner import run_machine
 
 
 class QueueMachine(UnitMachine):
+    def __init__(self) -> None:
+        super().__init__()
+        # set before any rule runs: the teardown reads them even when a rule failed
+        self.queued = 0
+        self.status: dict[int, int] = {}
+        self.eeprom: dict[int, int] = {}
+
     @initialize()
     def interrupted(self) -> None:
         # vectors wait in the queue while INTA = 1 [D 10.1]: the queue length is ours
         r = self.send("H")
         assert r is not None and r.inta, f"H answered {r}"
-        self.queued = 0
-        self.status: dict[int, int] = {}
-        self.eeprom: dict[int, int] = {}
 
     @rule(count=st.integers(1, 40))
     def queue(self, count: int) -> None:
