@@ -13,7 +13,7 @@ from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetySto
 from conformance.link.framing import UnitDataError
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
-from conformance.targets import SessionError, Target
+from conformance.targets import Session, SessionError, Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
 #: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
@@ -140,6 +140,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None) -> Ca
                 link.settle(final=True)
             for violation in link.violations:
                 ctx.expect(False, violation, tag=ALWAYS)
+        if ended:
+            _after_case(session, ctx)
     result.seconds = time.perf_counter() - start
     verdicts += [grade(c.tag, profile.implements_decisions) for c in ctx.checks if not c.ok]
     if not verdicts and not ctx.checks:
@@ -153,6 +155,14 @@ def run_case(case: Case, target: Target, settings_name: str | None = None) -> Ca
                        ["# link", *link.transcript_lines()]]
     result.frames = sum(link.frames for link in ctx.links)
     return result
+
+
+def _after_case(session: Session, ctx: CaseContext) -> None:
+    """The session's clean-up after a case (EEPROM bytes it wrote put back)."""
+    try:
+        session.after_case()
+    except (KeyboardInterrupt, TargetNotResponding, SafetyStop) as err:
+        ctx.note(f"after the case: {type(err).__name__} {err}")
 
 
 def run(targets: list[Target], cases: list[Case], *, settings_name: str | None = None,

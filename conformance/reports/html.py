@@ -24,6 +24,22 @@ def _cls(v: str) -> str:
     return escape(v)
 
 
+def _sessions(run: RunResult) -> list[str]:
+    """Per real unit: the envelope, the largest excursion, what was put back."""
+    out = []
+    for spec, s in run.sessions.items():
+        if not s.get("real"):
+            continue
+        axes = ", ".join(f"{a} {lo:+g}..{hi:+g}" for a, (lo, hi)
+                         in zip(s["axes"], s["excursion"] or [], strict=False))
+        lines = [f"largest excursion (full steps, envelope ±{s['max_travel']}): {axes}",
+                 *[f"restored: {r}" for r in s["restored"]],
+                 *[f"reset: {r}" for r in s["reset"]]]
+        out.append(f"<p><b>{escape(spec)}</b> {escape(str(s['identity']))}<br>"
+                   + "<br>".join(escape(line) for line in lines) + "</p>")
+    return out
+
+
 def render_html(run: RunResult) -> str:
     counts = run.counts()
     sections = sorted({r.section for r in run.results},
@@ -37,6 +53,7 @@ def render_html(run: RunResult) -> str:
            *[f"<p class='FAIL'><b>PROBLEM</b>: {escape(p)}</p>" for p in run.problems],
            "<p>" + " ".join(f"<span class='{_cls(v)}'>{escape(v)}: {counts[v]}</span>"
                             for v in ORDER if v in counts) + "</p>",
+           *_sessions(run),
            "<h2>Summary: spec section × verdict</h2><table><tr><th>section</th>"]
     out += [f"<th class='{_cls(v)}'>{escape(v)}</th>" for v in ORDER]
     out.append("</tr>")

@@ -4,6 +4,8 @@ pytest plugin leaves the unit as found."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from conformance.cli import main
@@ -25,6 +27,11 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
         in out
     assert "restored: axes back where the run began" in out
     assert "restored: ST0..ST5 as found: 00 00 00 00 00 00" in out
+    (folder,) = tmp_path.iterdir()
+    html = (folder / "report.html").read_text()
+    assert "envelope ±800): X +0..+500" in html and "restored: axes back" in html
+    session = json.loads((folder / "results.json").read_text())["sessions"]
+    assert next(iter(session.values()))["excursion"] == [[0, 500], [0, 0], [0, 0]]
 
 
 def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
