@@ -1,8 +1,10 @@
 """Run every benchmark: `python -m bench`."""
 
-from bench import bench_emulator, bench_stepper
+from bench import bench_emulator, bench_host, bench_stepper
 
 if __name__ == "__main__":
     bench_emulator.main()
     print()
     bench_stepper.main()
+    print()
+    bench_host.main([])

@@ -40,6 +40,7 @@ class Case:
     destructive: bool = False
     timing: bool = False
     rules: tuple[str, ...] = ()      # IDs of fixtures/rules.toml this case can fail
+    hands: bool = False              # needs a hand on the machine: the rig or an operator
 
     @property
     def section(self) -> str:
@@ -65,7 +66,8 @@ REGISTRY: dict[str, Case] = {}
 def case(id: str, *, rule: str | None = None, tag: str | None = None, source: str | None = None,
          requires: tuple[str, ...] = (), absent: tuple[str, ...] = (),
          applies: Callable[[Profile], bool] | None = None, rig: bool = False,
-         destructive: bool = False, timing: bool = False, rules: tuple[str, ...] = ()):
+         destructive: bool = False, timing: bool = False, rules: tuple[str, ...] = (),
+         hands: bool = False):
     """Register a case (see docs/suite.md). ``rule``, ``tag`` and ``source`` default to
     those of the first rule the case names, so that a case quotes its requirement from
     fixtures/rules.toml rather than writing it again."""
@@ -90,7 +92,7 @@ def case(id: str, *, rule: str | None = None, tag: str | None = None, source: st
                 func.__module__, func.__qualname__):
             raise ValueError(f"case {id} is registered twice")
         REGISTRY[id] = Case(id, func, rule, tag, source, tuple(requires), tuple(absent),
-                            applies, rig, destructive, timing, tuple(rules))
+                            applies, rig, destructive, timing, tuple(rules), hands)
         return func
     return register
 
@@ -128,6 +130,8 @@ class CaseContext:
     traces: list[dict] = field(default_factory=list)
     links: list[Link] = field(default_factory=list)
     _link: Link | None = None
+    seed: int | None = None      # the run's seed for the Hypothesis machines (None: settings)
+    operator: Any = None         # conformance.operator.Hands: hand steps (rig or technician)
 
     @property
     def link(self) -> Link:
@@ -170,6 +174,17 @@ class CaseContext:
 
     def artifact(self, name: str, text: str) -> None:
         self.artifacts[name] = text
+
+    def step_train(self, name: str) -> None:
+        """Record the pulses per axis the emulator's stepper core gave on the current link
+        so far, for the reports (through the test rig; nothing on a real unit)."""
+        rig = self.link.rig
+        if rig is None:
+            return
+        origin = rig.now - self.link.now            # the link's instant 0 on the rig's clock
+        pulses = [[(t - origin) / 1e9, mask] for t, mask in rig.pulses(origin)]
+        self.traces.append({"name": name, "pulses": pulses, "total": len(pulses),
+                            "axes": list(self.profile.axes)})
 
     def trace(self, name: str, *, samples: list[tuple[float, list[int]]],
               model: list[tuple[float, list[int]]], tolerance: dict[str, float],

@@ -5,12 +5,23 @@ Inert unless ``--gve-target`` is given (or ``pytest --pyargs conformance``, whic
 against the default emulator target), so it never changes other pytest runs. A mistake
 in the options is a usage error before anything is sent; one session per target lasts
 the whole pytest run and puts the unit back at its end (also after Ctrl-C).
+
+Fleets (pytest-xdist, ``-n N``): the items of a target that holds a port (serial, TCP)
+form one xdist group (``--dist loadgroup``, which the plugin sets), so that one worker has
+the port for the whole run; items of an ``emu:`` target (a fresh unit in process for
+every link) spread over the workers. The controller only checks that each port opens;
+a worker opens a target's port at its first item of that target.
 """
 
 from __future__ import annotations
 
+import re
+from contextlib import ExitStack
+from pathlib import Path
+
 import pytest
 
+from conformance import settings as settings_profiles
 from conformance.link.interrupts import Interrupts
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
@@ -32,6 +43,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      "serial/tcp targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
+    g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",
+                help="where the machines keep failing examples, tried first on the next run "
+                     f"(default: {settings_profiles.DEFAULT_DATABASE}/ in the rootdir)")
 
 
 class CaseFailed(Exception):
@@ -73,7 +87,37 @@ def _specs(config: pytest.Config) -> list[str]:
     specs = config.getoption("--gve-target")
     if not specs and config.getoption("pyargs") and "conformance" in config.args:
         specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
-    return specs
+    return list(dict.fromkeys(specs))       # a target named twice runs once
+
+
+def _on_xdist_worker(config: pytest.Config) -> bool:
+    return hasattr(config, "workerinput")
+
+
+def _xdist_controller(config: pytest.Config) -> bool:
+    return (getattr(config.option, "dist", "no") != "no" and bool(getattr(config.option, "tx",
+                                                                          None))
+            and not _on_xdist_worker(config))
+
+
+def worker_group(target: Target) -> str | None:
+    """The xdist group of a target's items: its port, or None (emu: nothing shared)."""
+    if target.info.kind == "emu":
+        return None
+    # loadgroup reads the group after a node ID's last '@', past its last ']'
+    return "gve-port:" + re.sub(r"[@\[\]]", "_", target.url)
+
+
+def _example_database(config: pytest.Config) -> None:
+    where = config.getoption("--gve-hypothesis-db")
+    if where is None:
+        where = str(Path(config.rootpath, settings_profiles.DEFAULT_DATABASE))
+    run = ExitStack()
+    try:
+        run.enter_context(settings_profiles.example_database(where))
+    except ValueError as err:
+        raise pytest.UsageError(f"--gve-hypothesis-db: {err}") from None
+    config.add_cleanup(run.close)
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -89,6 +133,10 @@ def pytest_configure(config: pytest.Config) -> None:
     globs = config.getoption("--gve-cases")
     if globs and not select(globs):
         raise pytest.UsageError(f"--gve-cases {' '.join(globs)}: no case matches")
+    _example_database(config)
+    controller, worker = _xdist_controller(config), _on_xdist_worker(config)
+    if controller and config.option.dist != "loadgroup":
+        config.option.dist = "loadgroup"    # only groups keep a port on one worker
     interrupts = Interrupts()
     targets = []
     try:
@@ -96,7 +144,11 @@ def pytest_configure(config: pytest.Config) -> None:
             target = parse_target(spec, profile=config.getoption("--gve-profile"),
                                   allow_destructive=config.getoption("--gve-allow-destructive"),
                                   max_travel=config.getoption("--gve-max-travel"))
-            target.preflight()
+            if not worker:
+                target.preflight()
+            if controller:
+                target.close()      # it runs nothing; the worker of the port opens it
+                continue
             target.begin(interrupts)
             targets.append(target)
     except (ValueError, LookupError) as err:
@@ -115,10 +167,13 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
     from conformance.catalogue import select
     globs = config.getoption("--gve-cases") or None
     for target in targets:
+        # on an xdist worker the node ID names the group, as xdist_group marks do
+        group = worker_group(target) if _on_xdist_worker(config) else None
         for case in select(globs):
+            name = f"{case.id}[{target.info.spec}]"
             items.append(GveItem.from_parent(
-                session, name=f"{case.id}[{target.profile.name}]", case=case, target=target,
-                settings_name=config.getoption("--gve-settings")))
+                session, name=name, nodeid=f"::{name}@{group}" if group else None, case=case,
+                target=target, settings_name=config.getoption("--gve-settings")))
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

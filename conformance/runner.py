@@ -13,6 +13,8 @@ from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetySto
 from conformance.link.framing import UnitDataError
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
+from conformance.metadata import RunMeta
+from conformance.operator import Console, Hands
 from conformance.targets import Session, SessionError, Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
@@ -62,6 +64,7 @@ class RunResult:
     sessions: dict[str, dict] = field(default_factory=dict)
     #: what could not be restored or verified: the top of every report, exit status 1
     problems: list[str] = field(default_factory=list)
+    meta: RunMeta = field(default_factory=RunMeta)
 
     def counts(self) -> dict[str, int]:
         out: dict[str, int] = {}
@@ -81,7 +84,8 @@ def _result(case: Case, target: Target, verdict: str = PASS) -> CaseResult:
                       target.profile.name, target.info.spec, verdict)
 
 
-def run_case(case: Case, target: Target, settings_name: str | None = None) -> CaseResult:
+def run_case(case: Case, target: Target, settings_name: str | None = None,
+             seed: int | None = None, console: Console | None = None) -> CaseResult:
     profile = target.profile
     result = _result(case, target)
     why = case.missing_for(profile)
@@ -97,7 +101,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None) -> Ca
     session = target.session
     ctx = CaseContext(case, profile, target.info,
                       settings_profiles.get(settings_for(target, settings_name)),
-                      session.open_link)
+                      session.open_link, seed=seed)
+    ctx.operator = Hands(lambda: ctx.link, console)
     start = time.perf_counter()
     verdicts: list[str] = []
     ended = True
@@ -166,7 +171,8 @@ def _after_case(session: Session, ctx: CaseContext) -> None:
 
 
 def run(targets: list[Target], cases: list[Case], *, settings_name: str | None = None,
-        run_id: str = "", on_result: Callable[[CaseResult], None] | None = None) -> RunResult:
+        run_id: str = "", on_result: Callable[[CaseResult], None] | None = None,
+        seed: int | None = None, console: Console | None = None) -> RunResult:
     """Every case on every target, one session per target; Ctrl-C stops the run after
     `H` and `D` and the restorations (docs/suite.md)."""
     chosen = sorted({settings_for(t, settings_name) for t in targets})
@@ -185,14 +191,16 @@ def run(targets: list[Target], cases: list[Case], *, settings_name: str | None =
         for target in targets:
             if interrupts.stopped:
                 break
-            _run_target(target, cases, interrupts, settings_for(target, settings_name), add, run)
+            _run_target(target, cases, interrupts, settings_for(target, settings_name), add, run,
+                        seed, console)
     run.interrupted = interrupts.stopped
     run.seconds = time.perf_counter() - start
     return run
 
 
 def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, settings: str,
-                add: Callable[[CaseResult], None], run: RunResult) -> None:
+                add: Callable[[CaseResult], None], run: RunResult, seed: int | None,
+                console: Console | None) -> None:
     session = target.begin(interrupts)
     stopped = ""
     try:
@@ -219,7 +227,7 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
                     r.notes = [f"not run: {stopped}"]
                     add(r)
                 continue
-            r = run_case(case, target, settings)
+            r = run_case(case, target, settings, seed, console)
             add(r)
             stopped = r.stopped
     finally:

@@ -35,3 +35,27 @@ def worst(verdicts: list[str]) -> str:
 def failing(verdict: str) -> bool:
     """Whether the run's exit status must be non-zero."""
     return verdict in (FAIL, ERROR)
+
+
+#: the run's overall verdict, the banner of its reports
+PASSED = "PASSED"
+FAILED = "FAILED"
+#: verdicts that judged the target (the others say why it could not be judged)
+JUDGED = (PASS, NON_STRICT, INFO)
+
+
+def overall(verdicts: list[str], interrupted: bool = False, problems: list[str] = ()
+            ) -> tuple[str, str]:
+    """PASSED or FAILED for a run's case verdicts, with the reason in a few words. A run
+    that judged nothing has not passed: a broken or silent target never earns a PASS;
+    nor has one that left something of a unit unrestored (``problems``)."""
+    bad = [v for v in ORDER if failing(v) and v in verdicts]
+    if bad:
+        return FAILED, " and ".join(f"{verdicts.count(v)} {v}" for v in bad)
+    if problems:
+        return FAILED, f"{len(problems)} problem(s) restoring the unit: {problems[0]}"
+    if interrupted:
+        return FAILED, "interrupted before every case had run"
+    if not any(v in JUDGED for v in verdicts):
+        return FAILED, "no case could judge the target"
+    return PASSED, "no case failed"

@@ -13,31 +13,35 @@ IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 
 
 def _interrupted_by_input(ctx: CaseContext) -> None:
     """Setup: IN0 enabled and active, so the unit is interrupted (INTA, ST4 bit 0)."""
-    ctx.link.rig.set_input(1, IN0_ACTIVE)
     r = ctx.link.send("SW0,01")
     ctx.require(r is not None and r.code == 0 and r.inta, f"SW0,01 answered {show(r)}")
 
 
-@case("10.3.inputs.level-after-clearing", rig=True,
+@case("10.3.inputs.level-after-clearing", hands=True,
       rules=("10.3.inputs.level-triggered", "4.response.inta-level"))
 def level_after_clearing(ctx: CaseContext) -> None:
     for body in ("G", "D", "K", "R"):
         ctx.fresh_link()
-        _interrupted_by_input(ctx)
-        code(ctx, ctx.link.send(body), 0, f"{body} with the input still active → 8", inta=True,
-             rule="4.response.inta-level")
-        for n, value in ((6, "80"), (4, "01")):
-            r = ctx.link.send(f"SR{n}")
-            ctx.expect(r is not None and r.inta and r.values == [value],
-                       f"after {body}: ST{n} set again at once", observed=show(r),
-                       expected=f"8,{value}", rule="10.3.inputs.level-triggered")
-        code(ctx, ctx.link.send("L" + vector(ctx, 300)), 0,
-             f"after {body}: L is accepted and waits", inta=True,
-             rule="10.3.inputs.level-triggered")
-        ctx.link.wait(0.5)
-        here = position(ctx)
-        ctx.expect(here == [0, 0, 0], f"after {body}: nothing moved while the input is active",
-                   observed=here, expected=[0, 0, 0], rule="10.3.inputs.level-triggered")
+        with ctx.operator.grounded(1, 0, "the X reference input"):
+            _after_clearing(ctx, body)
+
+
+def _after_clearing(ctx: CaseContext, body: str) -> None:
+    _interrupted_by_input(ctx)
+    code(ctx, ctx.link.send(body), 0, f"{body} with the input still active → 8", inta=True,
+         rule="4.response.inta-level")
+    for n, value in ((6, "80"), (4, "01")):
+        r = ctx.link.send(f"SR{n}")
+        ctx.expect(r is not None and r.inta and r.values == [value],
+                   f"after {body}: ST{n} set again at once", observed=show(r),
+                   expected=f"8,{value}", rule="10.3.inputs.level-triggered")
+    code(ctx, ctx.link.send("L" + vector(ctx, 300)), 0,
+         f"after {body}: L is accepted and waits", inta=True,
+         rule="10.3.inputs.level-triggered")
+    ctx.link.wait(0.5)
+    here = position(ctx)
+    ctx.expect(here == [0, 0, 0], f"after {body}: nothing moved while the input is active",
+               observed=here, expected=[0, 0, 0], rule="10.3.inputs.level-triggered")
 
 
 @case("10.3.inputs.physical-across-restart", rig=True, destructive=True,

@@ -65,6 +65,7 @@ def targets(ctx: CaseContext) -> None:
     expected = [sum(m[i] for m in moves) for i in range(3)]
     ctx.expect(position(ctx) == expected, "the sum of the vectors",
                observed=position(ctx), expected=expected)
+    ctx.step_train("the step train of the three vectors")
 
 
 @case("10.4.halt.answers-when-stopped",

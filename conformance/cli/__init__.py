@@ -14,8 +14,10 @@ import sys
 
 #: subcommand -> (module, one line for the help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "ports": ("conformance.cli.ports", "the serial ports of this machine, to find the unit's"),
     "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
                  "with the catalogue until a case FAILs it"),
+    "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
 }
 
 

@@ -1,4 +1,4 @@
-"""The default job of `gve-conformance`: run the suite, print verdicts, write reports.
+"""The default job of `gve-conformance`: run the suite, show progress, write reports.
 
 With no arguments: the whole suite against the embedded emulator, every profile.
 Everything a user can get wrong is refused before the first frame is sent, with one
@@ -13,15 +13,23 @@ import sys
 import tempfile
 import time
 import uuid
+from contextlib import ExitStack
 from pathlib import Path
 from typing import NoReturn
 
+from serial import SerialException
+
 from conformance.catalogue import select
-from conformance.reports import write_reports
-from conformance.runner import CaseResult, RunResult, run
-from conformance.settings import PROFILES
+from conformance.cli.progress import Progress
+from conformance.cli.unit import ask_before_motion, confirmed, record_identities, resolve
+from conformance.coverage import coverage, format_coverage
+from conformance.metadata import RunMeta, now_iso
+from conformance.operator import Console
+from conformance.reports import write_junit, write_reports
+from conformance.runner import RunResult, run, settings_for
+from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import ORDER, PASS, failing
+from conformance.verdict import FAILED, ORDER, overall
 from gve_fixtures.profile import available_profiles
 
 PROG = "gve-conformance"
@@ -42,13 +50,24 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT; repeatable")
     ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target "
-                                      "(with no --target: run the emulator as this profile)")
+                                      "(with no --target: run the emulator as this profile); "
+                                      "'auto': ask the unit (? and Q) and choose")
+    ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
+                    "say it: the variant (e.g. 100 for a GVE84-100)")
+    ap.add_argument("--yes", action="store_true",
+                    help="real units: move without asking first (unattended benches)")
+    ap.add_argument("--operator", action=argparse.BooleanOptionalAction, default=None,
+                    help="real units: ask a technician for hand steps (ground an input...); "
+                         "default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
     ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
                     help="Hypothesis settings profile (default: ci on the emulator, "
                          "hardware on serial/tcp targets)")
+    ap.add_argument("--seed", type=int, metavar="N",
+                    help="the Hypothesis machines' seed: the same N replays the same examples "
+                         "(default: a fresh one, printed; none for derandomized settings)")
     ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in full steps per axis either side "
                          "of where the run began (default %(default)s)")
@@ -57,7 +76,21 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                          "restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
+    ap.add_argument("--run-id", metavar="NAME",
+                    help="the report folder's name (default: date, time and a random tag)")
+    ap.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+                    help="run the targets in N parallel processes: one report per target "
+                         "under reports/<run id>/ and a summary across them")
+    ap.add_argument("--hypothesis-db", metavar="DIR|redis://HOST:PORT/N|none",
+                    help="where the machines keep failing examples, tried first by the next "
+                         "run (redis: by every bench sharing it); default: "
+                         f"REPORT_DIR/{DEFAULT_DATABASE}, none with --no-reports")
     ap.add_argument("--no-reports", action="store_true")
+    ap.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
+    ap.add_argument("--full-logs", action="store_true",
+                    help="whole wire logs in the reports for passing cases too")
+    ap.add_argument("--operator-name", default="", metavar="NAME",
+                    help="who ran the suite, for the report")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
@@ -67,8 +100,20 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        return _main(argv)
+        args = parse_args(argv)
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    return execute(args, argv)
+
+
+def execute(args: argparse.Namespace, argv: list[str]) -> int:
+    """The run that ``argv`` (parsed as ``args``) asks for; also what each process of a
+    fleet runs for its one target (cli/fleet.py)."""
+    try:
+        return _main(args, argv)
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
@@ -91,8 +136,15 @@ def _say(text: str = "") -> None:
         _quiet_stdout()
 
 
-def _main(argv: list[str] | None) -> int:
-    args = parse_args(argv)
+def example_database_of(args: argparse.Namespace) -> str | None:
+    """Where the run keeps failing examples (docs/ci.md): --hypothesis-db, else a folder
+    beside the reports (nowhere when the run writes no reports)."""
+    if args.hypothesis_db is not None:
+        return args.hypothesis_db
+    return None if args.no_reports else str(Path(args.report_dir, DEFAULT_DATABASE))
+
+
+def _main(args: argparse.Namespace, argv: list[str]) -> int:
     cases = select(args.cases or None, args.exclude or None)
     if not cases:
         raise UsageError("no case matches " + " ".join(
@@ -102,7 +154,8 @@ def _main(argv: list[str] | None) -> int:
             print(f"{c.id:48} {c.tag:6} {c.rule}")
         return 0
     if args.coverage:
-        from conformance.coverage import coverage, format_coverage
+        if args.coverage == "host":
+            import conformance.host.oracle  # noqa: F401  (registers the host checks)
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
@@ -110,25 +163,48 @@ def _main(argv: list[str] | None) -> int:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
         return 0
-    targets = _targets(args)
+    if args.jobs < 1:
+        raise UsageError("--jobs must be 1 or more")
     if not args.no_reports:
         _check_writable(Path(args.report_dir))
+    with ExitStack() as run_scope:
+        try:
+            run_scope.enter_context(example_database(example_database_of(args)))
+        except ValueError as err:
+            raise UsageError(f"--hypothesis-db: {err}") from None
+        return _run(args, argv, cases)
+
+
+def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
+    console = Console()
+    try:
+        targets, how = _targets(args, console)
+    except KeyboardInterrupt:
+        raise UsageError("interrupted before the run, nothing was sent") from None
     _preflight(targets)
-    run_id = time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
-
-    def show(r: CaseResult) -> None:
-        if args.quiet and r.verdict == PASS:
-            return
-        line = f"{r.verdict:15} {r.id} [{r.profile}]"
-        if r.failed_checks:
-            c = r.failed_checks[0]
-            line += f"  -- {c['what']}: observed {c['observed']!r}, expected {c['expected']!r}"
-        elif r.verdict != PASS and r.notes:
-            line += f"  -- {r.notes[0].splitlines()[0]}"
-        _say(line)
-
+    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+    seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
+    meta = _meta(args, argv, targets, how, cases, seed, console)
+    if args.jobs > 1 and len(targets) > 1:
+        return _fleet(args, argv, targets, meta, console, run_id)
+    if meta.confirmed == "asked":
+        for target in targets:
+            if target.info.kind != "emu":
+                target.session.before_motion = ask_before_motion(target, console, meta)
     _say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
-    result = run(targets, cases, settings_name=args.settings, run_id=run_id, on_result=show)
+    _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
+         "seed: none (derandomized settings draw the same examples every run; --seed N for "
+         "others)")
+    progress = Progress(len(targets) * len(cases), quiet=args.quiet)
+    try:
+        result = run(targets, cases, settings_name=args.settings, run_id=run_id,
+                     on_result=progress.result, seed=seed,
+                     console=console if meta.operator_steps else None)
+    finally:
+        progress.close()
+    meta.finished = now_iso()
+    _from_sessions(result, meta)
+    result.meta = meta
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
     _say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
@@ -138,25 +214,84 @@ def _main(argv: list[str] | None) -> int:
         _say(line)
     if not args.no_reports:
         folder = write_reports(result, args.report_dir)
-        _say(f"reports: {folder}/junit.xml, results.json, report.html")
-    bad = any(failing(r.verdict) for r in result.results)
-    return 1 if bad or result.interrupted or result.problems else 0
+        _say(f"reports: {folder}/report.html, results.json, junit.xml")
+    if args.junitxml:
+        _say(f"JUnit XML: {write_junit(result, args.junitxml)}")
+    verdict, reason = overall([r.verdict for r in result.results], result.interrupted,
+                              result.problems)
+    _say(f"{verdict}: {reason}")
+    return 1 if verdict == FAILED else 0
 
 
-def _targets(args: argparse.Namespace) -> list[Target]:
+def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], meta: RunMeta,
+           console: Console, run_id: str) -> int:
+    """The targets in processes of their own (cli/fleet.py), asked about once here: the
+    members have no terminal."""
+    from conformance.cli.fleet import run_fleet
+    if meta.confirmed == "asked" and not confirmed(targets, meta, console):
+        raise UsageError("motion not confirmed, nothing that moves was sent (answer y, or "
+                         "give --yes on an unattended bench)")
+    for target in targets:
+        target.close()              # each member opens its own port
+    return run_fleet(args, argv, targets, run_id, meta.seed, example_database_of(args))
+
+
+def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how: list[str],
+          cases: list, seed: int | None, console: Console) -> RunMeta:
+    """What the reports say about the run before it starts."""
+    meta = RunMeta(started=now_iso(), operator=args.operator_name, command=argv,
+                   settings=_settings_line(targets, args.settings), seed=seed,
+                   mutant=args.mutant, destructive=args.allow_destructive,
+                   max_travel=args.max_travel, cases=args.cases, exclude=args.exclude,
+                   full_logs=args.full_logs)
+    for target, chosen in zip(targets, how, strict=True):
+        t = meta.target(target.info.spec)
+        t.kind, t.profile, t.profile_chosen = target.info.kind, target.profile.name, chosen
+        t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+    meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
+                                        for s in d["sections"]]}
+                     for d in (pc.as_dict() for pc in coverage(
+                         sorted({t.profile.name for t in targets}), cases=cases))]
+    real = any(t.info.kind != "emu" for t in targets)
+    meta.operator_steps = (real and console.interactive if args.operator is None
+                           else args.operator)
+    if real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+    try:
+        record_identities([t for t in targets if t.info.kind == "emu"], meta)
+    except (OSError, SerialException, ValueError) as err:
+        raise UsageError(str(err)) from None
+    return meta
+
+
+def _from_sessions(result: RunResult, meta: RunMeta) -> None:
+    """What each real unit's session found (its identity) and saw (the largest
+    excursion per axis), into the run's metadata."""
+    for spec, s in result.sessions.items():
+        t = meta.target(spec)
+        if s["identity"]:
+            t.version = s["identity"].get("version", t.version)
+            t.processor_id = s["identity"].get("processor_id", t.processor_id)
+        if s["excursion"]:
+            t.excursion = [max(abs(lo), abs(hi)) for lo, hi in s["excursion"]]
+
+
+def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], list[str]]:
+    """The targets, and how each one's profile was chosen (``--profile auto`` asks)."""
     every = [f"emu:{name}" for name in available_profiles()]
-    if args.profile and not args.target:
+    if args.profile and args.profile != "auto" and not args.target:
         every = [f"emu:{args.profile}"]   # no target: the emulator behaving as --profile
     # no --target, or emu:all: the embedded emulator on every profile (--profile is for
     # the targets named)
     specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
              for s in (every if t.split("?")[0] == "emu:all" else [t])]
     try:
-        return [parse_target(s, profile=args.profile if named else None,
-                             allow_destructive=args.allow_destructive,
+        chosen = [resolve(s, args.profile if named else None, args.variant, console)
+                  for s, named in specs]
+        return [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
                              max_travel=args.max_travel, mutant=args.mutant)
-                for s, named in specs]
-    except (ValueError, LookupError) as err:
+                for s, p, _ in chosen], [how for _, _, how in chosen]
+    except (ValueError, LookupError, OSError, SerialException) as err:
         raise UsageError(str(err).strip("'\"")) from None
 
 

@@ -3,17 +3,24 @@ example starts from a fresh link, a failing example's wire log is saved as a tra
 
 from __future__ import annotations
 
+from hypothesis import seed
 from hypothesis.errors import Flaky
 from hypothesis.stateful import RuleBasedStateMachine, run_state_machine_as_test
 
+from conformance import settings as settings_profiles
 from conformance.case import CaseContext
 
 
 def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
-    """Run ``machine`` with ctx.settings; a failure becomes a failed check of the case."""
+    """Run ``machine`` with ctx.settings, the run's seed and its example database (the
+    failing examples found before are tried first); a failure becomes a failed check."""
     machine.ctx = ctx  # type: ignore[attr-defined]
+    run_settings, run_seed = settings_profiles.machine_run(ctx.settings, ctx.profile.name,
+                                                           ctx.seed)
+    # every run sets the seed: None lets Hypothesis draw one
+    seed(run_seed)(machine)
     try:
-        run_state_machine_as_test(machine, settings=ctx.settings)
+        run_state_machine_as_test(machine, settings=run_settings)
     except Flaky as err:
         # a real target answered differently when Hypothesis replayed an example
         ctx.expect(False, f"{machine.__name__}: the target is not deterministic on replay",

@@ -1,87 +1,218 @@
-"""One self-contained HTML page: summary matrix (section × verdict), target and profile,
-and per case its verdict, rule, section, checks and full wire log. No external assets."""
+"""One self-contained HTML page (issue 12 items 4-6): the banner PASSED/FAILED, the
+run's metadata and the units' identity, a chart and a matrix of verdicts by spec section
+(cells link to the cases), filters (a little inline script: works offline), and per case
+its checks, pictures of its motion, notes and wire log. No external assets; every text
+from a unit goes through :func:`html_text`."""
 
 from __future__ import annotations
 
-from html import escape
+from collections import Counter
+from importlib import resources
 
-from conformance.reports.clean import clean
-from conformance.runner import RunResult
-from conformance.verdict import ORDER
+import conformance.reports.plots as plots
+from conformance.reports.banner import run_verdict
+from conformance.reports.logs import compact, compact_checks
+from conformance.reports.sections import section_key, section_title
+from conformance.reports.text import html_text as h
+from conformance.runner import CaseResult, RunResult
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS
 
-STYLE = """
-body{font:14px system-ui,sans-serif;margin:1.5em;color:#222}
-table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:2px 8px}
-.PASS{background:#d8f5d0}.FAIL,.ERROR{background:#f8c9c4}.NON-STRICT{background:#fbe8b0}
-.INFO{background:#dde8fb}.MISSING,.COULD-NOT-TEST{background:#eee}
-details{margin:.3em 0;border-left:4px solid #ccc;padding-left:.5em}
-pre{background:#f6f6f6;padding:.5em;overflow:auto;max-height:30em}
-summary{cursor:pointer}
-"""
-
-
-def _cls(v: str) -> str:
-    return escape(v)
+#: verdicts whose case opens by itself
+_OPEN = (FAIL, ERROR)
+#: verdicts whose reason (the first note) shows on the case's line
+_WHY = (COULD_NOT_TEST, MISSING, ERROR)
 
 
-def _sessions(run: RunResult) -> list[str]:
-    """Per real unit: the envelope, the largest excursion, what was put back."""
-    out = []
-    for spec, s in run.sessions.items():
-        if not s.get("real"):
-            continue
-        axes = ", ".join(f"{a} {lo:+g}..{hi:+g}" for a, (lo, hi)
-                         in zip(s["axes"], s["excursion"] or [], strict=False))
-        lines = [f"largest excursion (full steps, envelope ±{s['max_travel']}): {axes}",
-                 *[f"restored: {r}" for r in s["restored"]],
-                 *[f"reset: {r}" for r in s["reset"]]]
-        out.append(f"<p><b>{escape(spec)}</b> {escape(str(s['identity']))}<br>"
-                   + "<br>".join(escape(line) for line in lines) + "</p>")
+def _asset(name: str) -> str:
+    return resources.files("conformance.reports").joinpath(name).read_text("utf-8")
+
+
+def _anchor(r: CaseResult) -> str:
+    return f"case-{r.id}-{r.profile}"
+
+
+def _rows(items: list[tuple[str, object]]) -> str:
+    return "".join(f"<tr><th>{h(k)}</th><td>{h(v)}</td></tr>" for k, v in items)
+
+
+def _header(run: RunResult) -> list[str]:
+    verdict, reason = run_verdict(run)
+    m = run.meta
+    counts = run.counts()
+    out = [f"<div class='banner {verdict}'>{verdict}</div> <span class='why'>{h(reason)}"
+           f"{' (interrupted by Ctrl-C)' if run.interrupted else ''}</span>",
+           *([f"<ul class='FAIL'>{''.join(f'<li>PROBLEM: {h(p)}</li>' for p in run.problems)}"
+              "</ul>"] if run.problems else []),
+           f"<h1>gve-conformance run {h(run.run_id)}</h1>",
+           "<p>" + " ".join(f"<span class='{h(v)}'>{h(v)}: {counts[v]}</span>"
+                            for v in ORDER if v in counts)
+           + f" — {len(run.results)} case runs in {run.seconds:.1f} s, {run.frames} frames</p>",
+           "<table class='meta'>" + _rows([
+               ("started", m.started), ("finished", m.finished),
+               ("operator", m.operator or "(not given: --operator-name)"),
+               ("suite version", m.suite_version),
+               ("host", f"{m.host} ({m.platform}, Python {m.python})"),
+               ("command", " ".join(["gve-conformance", *m.command])),
+               *((flag, value) for flag, value in m.flags().items())]) + "</table>",
+           "<h2>Units</h2><table><tr><th>target</th><th>profile</th><th>version (?)</th>"
+           "<th>processor id (Q)</th><th>envelope (steps per axis)</th>"
+           "<th>largest excursion</th><th>verdict</th></tr>"]
+    for target in run.targets:
+        t = m.target(target)
+        v, why = run_verdict(run, target)
+        out.append(
+            f"<tr><td>{h(target)}</td><td>{h(t.profile)}"
+            f"{' (' + h(t.profile_chosen) + ')' if t.profile_chosen else ''}</td>"
+            f"<td>{h(t.version)}</td><td>{h(t.processor_id)}</td>"
+            f"<td>{h('±' + str(t.envelope) if t.envelope is not None else 'not enforced')}</td>"
+            f"<td>{h(t.excursion if t.excursion is not None else '')}</td>"
+            f"<td class='{v}'>{v}: {h(why)}</td></tr>")
+    out.append("</table>")
+    for target, s in run.sessions.items():
+        done = [*(f"found {k} {v}" for k, v in s.get("found", {}).items()),
+                *(f"restored: {r}" for r in s.get("restored", [])),
+                *(f"reset: {r}" for r in s.get("reset", [])),
+                *(f"PROBLEM: {p}" for p in s.get("problems", []))]
+        if done:
+            out.append(f"<details><summary>{h(target)}: the unit as found and as left "
+                       f"({len(done)})</summary><ul>"
+                       + "".join(f"<li>{h(d)}</li>" for d in done) + "</ul></details>")
     return out
 
 
-def render_html(run: RunResult) -> str:
-    counts = run.counts()
-    sections = sorted({r.section for r in run.results},
-                      key=lambda s: tuple(int(x) for x in s.split(".") if x.isdigit()))
-    out = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-           f"<title>gve-conformance {escape(run.run_id)}</title><style>{STYLE}</style>",
-           "</head><body>", f"<h1>gve-conformance run {escape(run.run_id)}</h1>",
-           f"<p>Targets: {escape(', '.join(run.targets))}. Settings: {escape(run.settings)}. "
-           f"{len(run.results)} cases in {run.seconds:.1f} s, {run.frames} frames"
-           f"{' (interrupted)' if run.interrupted else ''}.</p>",
-           *[f"<p class='FAIL'><b>PROBLEM</b>: {escape(p)}</p>" for p in run.problems],
-           "<p>" + " ".join(f"<span class='{_cls(v)}'>{escape(v)}: {counts[v]}</span>"
-                            for v in ORDER if v in counts) + "</p>",
-           *_sessions(run),
-           "<h2>Summary: spec section × verdict</h2><table><tr><th>section</th>"]
-    out += [f"<th class='{_cls(v)}'>{escape(v)}</th>" for v in ORDER]
-    out.append("</tr>")
+def _matrix(run: RunResult, sections: list[str]) -> list[str]:
+    by_section = {s: Counter(r.verdict for r in run.results if r.section == s)
+                  for s in sections}
+    chart = plots.verdict_chart([(section_title(s), by_section[s]) for s in sections])
+    out = ["<h2>Verdicts by spec section</h2>",
+           f"<figure>{chart}</figure>" if chart else
+           "<p class='why'>Plots are off: install the plotting extra "
+           "(<code>pip install 'gve-conformance[plots]'</code>) to draw them.</p>",
+           "<table><tr><th>section</th>",
+           *(f"<th class='{h(v)}'>{h(v)}</th>" for v in ORDER), "</tr>"]
     for s in sections:
-        rs = [r for r in run.results if r.section == s]
-        out.append(f"<tr><td>{escape(s)}</td>")
-        out += [f"<td>{sum(r.verdict == v for r in rs) or ''}</td>" for v in ORDER]
+        out.append(f"<tr><td><a href='#sec-{h(s)}' data-section='{h(s)}' data-verdict=''>"
+                   f"{h(section_title(s))}</a></td>")
+        for v in ORDER:
+            n = by_section[s].get(v, 0)
+            out.append(f"<td class='n'><a href='#sec-{h(s)}' data-section='{h(s)}' "
+                       f"data-verdict='{h(v)}'>{n}</a></td>" if n else "<td></td>")
         out.append("</tr>")
-    out.append("</table><h2>Cases</h2>")
-    for r in sorted(run.results, key=lambda r: ORDER.index(r.verdict)):
-        out.append(f"<details class='{_cls(r.verdict)}'><summary><b>{escape(r.verdict)}</b> "
-                   f"{escape(r.id)} [{escape(r.profile)}] — {escape(r.rule)}</summary>")
-        out.append(f"<p>Section {escape(r.section)}, tag {escape(r.tag)}, source "
-                   f"{escape(r.source)}, target {escape(r.target)}, {r.seconds:.3f} s.</p>")
-        if r.checks:
-            out.append("<table><tr><th>ok</th><th>check</th><th>tag</th><th>observed</th>"
-                       "<th>expected</th></tr>")
-            for c in r.checks:
-                out.append(f"<tr class='{'PASS' if c['ok'] else 'FAIL'}'><td>"
-                           f"{'yes' if c['ok'] else 'NO'}</td><td>{escape(c['what'])}</td>"
-                           f"<td>{escape(c['tag'])}</td><td>{escape(c['observed'])}</td>"
-                           f"<td>{escape(c['expected'])}</td></tr>")
-            out.append("</table>")
-        for n in r.notes:
-            out.append(f"<pre>{escape(n)}</pre>")
-        out.append("<pre>" + escape("\n".join(r.wire_log)) + "</pre>")
-        for name, text in r.artifacts.items():
-            out.append(f"<p>{escape(name)}</p><pre>{escape(text)}</pre>")
-        out.append("</details>")
-    out.append("</body></html>")
-    return clean("\n".join(out))        # no raw control byte of a unit in the page
+    out.append("</table>")
+    return out
+
+
+def _coverage(run: RunResult) -> list[str]:
+    """Which rules of the spec the run's cases can fail, per section and profile."""
+    report = run.meta.coverage
+    if not report:
+        return []
+    cells: dict[str, dict[str, str]] = {}
+    uncovered: dict[str, list[str]] = {}
+    for pc in report:
+        for s in pc["sections"]:
+            total = s["covered"] + len(s["uncovered"])
+            cells.setdefault(s["section"], {})[pc["profile"]] = f"{s['covered']}/{total}"
+            for rule in s["uncovered"]:
+                uncovered.setdefault(rule, []).append(pc["profile"])
+    profiles = [pc["profile"] for pc in report]
+    out = ["<h2>Coverage: rules of the spec the cases can fail</h2><table><tr><th>section</th>",
+           *(f"<th>{h(p)}</th>" for p in profiles), "</tr>"]
+    for s in sorted(cells, key=section_key):
+        out.append(f"<tr><td>{h(section_title(s))}</td>"
+                   + "".join(f"<td class='n'>{h(cells[s].get(p, ''))}</td>" for p in profiles)
+                   + "</tr>")
+    out.append("<tr><th>all</th>" + "".join(f"<th class='n'>{pc['covered']}/{pc['total']}</th>"
+                                           for pc in report) + "</tr></table>")
+    if uncovered:
+        out.append("<details><summary>Rules no selected case can fail "
+                   f"({len(uncovered)})</summary><ul>"
+                   + "".join(f"<li>{h(rule)}: {h(', '.join(ps))}</li>"
+                             for rule, ps in sorted(uncovered.items())) + "</ul></details>")
+    return out
+
+
+def _filters(sections: list[str]) -> str:
+    boxes = "".join(f"<label class='{h(v)}'><input type='checkbox' value='{h(v)}' checked> "
+                    f"{h(v)}</label>" for v in ORDER)
+    options = "".join(f"<option value='{h(s)}'>{h(section_title(s))}</option>"
+                      for s in sections)
+    return (f"<div id='filters'>{boxes} <select id='f-section'><option value=''>"
+            f"every section</option>{options}</select> <input id='f-text' type='search' "
+            "placeholder='case ID contains'></div>")
+
+
+def _pictures(r: CaseResult, full_logs: bool) -> list[str]:
+    """The case's traces drawn (for a passing case the position only: the report must
+    stay small; --full-logs draws the rate too)."""
+    out = []
+    for i, trace in enumerate(r.traces):
+        key = f"{_anchor(r)}-{i}"
+        if "pulses" in trace:
+            svg = plots.step_train_chart(trace["pulses"], trace.get("axes", "XYZA"), key,
+                                         trace.get("total"))
+        else:
+            svg = plots.trace_chart(trace, key, rate=full_logs or r.verdict != PASS)
+        out.append(f"<figure>{svg}</figure>" if svg else
+                   f"<p class='why'>{h(trace.get('name', 'trace'))}: plots are off.</p>")
+    return out
+
+
+def _case(r: CaseResult, full_logs: bool, also: tuple[str, ...] = ()) -> list[str]:
+    """One case run; ``also``: the other profiles on which the same case passed too
+    (shown once, as its run on ``r.profile``)."""
+    why = f" <span class='why'>— {h(r.notes[0])}</span>" if r.verdict in _WHY and r.notes \
+        else ""
+    profiles = ", ".join((r.profile, *also))
+    out = [f"<details class='case {h(r.verdict)}' id='{h(_anchor(r))}' "
+           f"data-verdict='{h(r.verdict)}' data-section='{h(r.section)}'"
+           f"{' open' if r.verdict in _OPEN else ''}>"
+           f"<summary><b>{h(r.verdict)}</b> {h(r.id)} [{h(profiles)}] — {h(r.rule)}{why}"
+           "</summary>",
+           *([f"<p class='why'>Passed on {len(also) + 1} profiles; shown: its run on "
+              f"{h(r.profile)} (each run apart: --full-logs).</p>"] if also else []),
+           f"<p>Tag {h(r.tag)}, source {h(r.source)}, target {h(r.target)}, {r.seconds:.3f} s, "
+           f"{r.frames} frames.</p>"]
+    if r.checks:
+        out.append("<table><tr><th>ok</th><th>check</th><th>tag</th><th>observed</th>"
+                   "<th>expected</th></tr>")
+        out += [f"<tr class='{'PASS' if c['ok'] else 'FAIL'}'><td>{'yes' if c['ok'] else 'NO'}"
+                f"</td><td>{h(c['what'])}</td><td>{h(c['tag'])}</td><td>{h(c['observed'])}</td>"
+                f"<td>{h(c['expected'])}</td></tr>"
+                for c in compact_checks(r.checks, r.verdict, full_logs)]
+        out.append("</table>")
+    out += _pictures(r, full_logs)
+    out += [f"<pre>{h(n)}</pre>" for n in r.notes]
+    if r.wire_log:
+        out.append("<pre>" + h("\n".join(compact(r.wire_log, r.verdict, full_logs))) + "</pre>")
+    for name, text in r.artifacts.items():
+        out.append(f"<p>{h(name)}</p><pre>{h(text)}</pre>")
+    out.append("</details>")
+    return out
+
+
+def render_html(run: RunResult, full_logs: bool | None = None) -> str:
+    full = run.meta.full_logs if full_logs is None else full_logs
+    verdict, _ = run_verdict(run)
+    sections = sorted({r.section for r in run.results}, key=section_key)
+    out = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+           f"<title>{verdict} — gve-conformance {h(run.run_id)}</title>",
+           f"<style>{_asset('report.css')}</style></head><body>",
+           *_header(run), *_matrix(run, sections), *_coverage(run),
+           "<h2 id='cases'>Cases</h2>", _filters(sections)]
+    for s in sections:
+        out.append(f"<section class='cases' id='sec-{h(s)}'><h3>{h(section_title(s))}</h3>")
+        results = sorted((r for r in run.results if r.section == s),
+                         key=lambda r: (ORDER.index(r.verdict), r.id))
+        # the report must stay small: a case passing on several profiles shows once
+        passed: dict[str, list[CaseResult]] = {}
+        for r in results:
+            if r.verdict == PASS and not full:
+                passed.setdefault(r.id, []).append(r)
+            else:
+                out += _case(r, full)
+        for first, *others in passed.values():
+            out += _case(first, full, tuple(o.profile for o in others))
+        out.append("</section>")
+    out.append(f"<script>{_asset('report.js')}</script></body></html>")
+    return "\n".join(out)

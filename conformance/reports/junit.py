@@ -1,15 +1,21 @@
-"""JUnit XML in the common (Ant/Jenkins junit-10) schema: testsuites > testsuite (one per
-target, with its properties) > testcase (skipped | error | failure, then system-out).
-A testcase carries no properties there, so its verdict, tag, rule and source head its
-system-out, above the wire log."""
+"""JUnit XML (issue 12 item 5): testsuites > testsuite (one per target: timestamp,
+hostname, the run's flags and the unit's identity as properties) > testcase (its
+verdict, tag and section as properties, so that NON-STRICT and INFO are visible to CI
+tools that know only pass, fail, error and skip; then skipped | error | failure, then
+system-out with the case's head and wire log). Every text goes through
+:func:`clean`, so any bytes from a unit leave the file well-formed."""
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
-from conformance.reports.clean import clean
+from conformance.reports.banner import run_verdict
+from conformance.reports.logs import compact
+from conformance.reports.sections import section_title
+from conformance.reports.text import clean
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS
 
 
 def _message(r: CaseResult) -> str:
@@ -20,37 +26,68 @@ def _message(r: CaseResult) -> str:
     return "; ".join(r.notes)[:500] or r.verdict
 
 
-def render_junit(run: RunResult) -> str:
-    root = ET.Element("testsuites", name="gve-conformance", tests=str(len(run.results)),
-                      time=f"{run.seconds:.3f}")
+def _element(parent: ET.Element, tag: str, text: str | None = None, **attrs: object
+             ) -> ET.Element:
+    el = ET.SubElement(parent, tag, {k: clean(v) for k, v in attrs.items()})
+    if text is not None:
+        el.text = clean(text)
+    return el
+
+
+def _properties(parent: ET.Element, items: dict[str, object]) -> None:
+    props = _element(parent, "properties")
+    for key, value in items.items():
+        _element(props, "property", name=key, value=value)
+
+
+def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
+    full = run.meta.full_logs if full_logs is None else full_logs
+    verdict, reason = run_verdict(run)
+    root = _element(ET.Element("dummy"), "testsuites", name="gve-conformance",
+                    tests=len(run.results), time=f"{run.seconds:.3f}")
     for target in run.targets:
         results = [r for r in run.results if r.target == target]
-        suite = ET.SubElement(
-            root, "testsuite", name=target, tests=str(len(results)),
-            failures=str(sum(r.verdict == FAIL for r in results)),
-            errors=str(sum(r.verdict == ERROR for r in results)),
-            skipped=str(sum(r.verdict in (MISSING, COULD_NOT_TEST) for r in results)),
-            time=f"{sum(r.seconds for r in results):.3f}")
-        props = ET.SubElement(suite, "properties")
-        for key, value in (("target", target), ("settings", run.settings),
-                           ("profiles", " ".join(sorted({r.profile for r in results})))):
-            ET.SubElement(props, "property", name=key, value=value)
+        t = run.meta.target(target)
+        suite = _element(
+            root, "testsuite", name=target, tests=len(results),
+            failures=sum(r.verdict == FAIL for r in results),
+            errors=sum(r.verdict == ERROR for r in results),
+            skipped=sum(r.verdict in (MISSING, COULD_NOT_TEST) for r in results),
+            time=f"{sum(r.seconds for r in results):.3f}",
+            timestamp=run.meta.started, hostname=run.meta.host)
+        _properties(suite, {
+            "run verdict": f"{verdict} ({reason})", "target": target,
+            **{f"problem {i + 1}": p for i, p in enumerate(run.problems)},
+            "profiles": " ".join(sorted({r.profile for r in results})),
+            "unit version (?)": t.version, "unit processor id (Q)": t.processor_id,
+            "operator": run.meta.operator, "suite version": run.meta.suite_version,
+            **{flag: value for flag, value in run.meta.flags().items()}})
         for r in results:
-            tc = ET.SubElement(suite, "testcase", name=f"{r.id}[{r.profile}]",
-                               classname=f"gve.{r.profile}.section{r.section}",
-                               time=f"{r.seconds:.3f}")
+            tc = _element(suite, "testcase", name=f"{r.id}[{r.profile}]",
+                          classname=f"gve.{r.profile}.section{r.section}",
+                          time=f"{r.seconds:.3f}")
+            _properties(tc, {"verdict": r.verdict, "tag": r.tag,
+                             "section": section_title(r.section)})
+            log = "\n".join(compact(r.wire_log, r.verdict, full))
+            if r.verdict == FAIL:
+                _element(tc, "failure", log, message=_message(r), type=r.verdict)
+            elif r.verdict == ERROR:
+                _element(tc, "error", "\n".join(r.notes) + "\n" + log, message=_message(r),
+                         type=r.verdict)
+            elif r.verdict in (MISSING, COULD_NOT_TEST):
+                _element(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
+            if r.verdict == PASS and not full:
+                continue            # its properties say it all; the JSON keeps the rest
             head = (f"verdict {r.verdict}; tag {r.tag}; section {r.section}; "
                     f"source {r.source}\nrule: {r.rule}\n")
-            log = "\n".join(r.wire_log)
-            if r.verdict == FAIL:
-                ET.SubElement(tc, "failure", message=_message(r), type=r.verdict).text = log
-            elif r.verdict == ERROR:
-                ET.SubElement(tc, "error", message=_message(r), type=r.verdict).text = (
-                    "\n".join(r.notes) + "\n" + log)
-            elif r.verdict in (MISSING, COULD_NOT_TEST):
-                ET.SubElement(tc, "skipped", message=f"{r.verdict}: {_message(r)}")
-            ET.SubElement(tc, "system-out").text = head + log
-    for element in root.iter():         # any unit bytes: always well-formed XML
-        element.text = None if element.text is None else clean(element.text)
-        element.attrib = {k: clean(v) for k, v in element.attrib.items()}
+            # the log once: in the failure or error when there is one
+            _element(tc, "system-out", head + ("" if r.verdict in (FAIL, ERROR) else log))
     return ET.tostring(root, encoding="unicode", xml_declaration=True)
+
+
+def write_junit(run: RunResult, path: str | Path) -> Path:
+    """The JUnit file at ``path`` (``--junitxml``: where a CI expects it)."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(render_junit(run), encoding="utf-8")
+    return out

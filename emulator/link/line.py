@@ -257,6 +257,15 @@ class Line:
     def state(self, address: int | None = None) -> dict:
         return self.unit(address).snapshot(self.now)
 
+    def pulses(self, t0: int = 0, t1: int | None = None, address: int | None = None
+               ) -> list[tuple[int, int]]:
+        """The step train of a unit's stepper core in [t0, t1) (default: up to now), as
+        (instant in ns on this line's clock, mask): bit i = axis i stepped, bit 4+i = it
+        stepped backwards. For pictures of the motion; the suite judges positions."""
+        times, masks = self.unit(address).device.motion.pulses(t0, self.now if t1 is None
+                                                               else t1)
+        return list(zip(times.tolist(), masks.tolist(), strict=True))
+
     def outputs(self, address: int | None = None) -> int:
         return int(self.state(address)["outputs"], 16)
 

@@ -40,7 +40,7 @@ def _compare(globs: list[str] | None, exclude: list[str] | None, settings_name: 
     finally:
         proc.terminate()
         proc.wait(10)
-    rig = {c.id for c in cases if c.rig} | guarded
+    rig = {c.id for c in cases if c.rig or c.hands} | guarded  # hands: nobody at the pty
     return {i: (in_process[i], over_pty[i]) for i in in_process
             if in_process[i] != over_pty[i] and not (i in rig and over_pty[i] == COULD_NOT_TEST)}
 

@@ -20,6 +20,8 @@ import tty
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
+from tests.processes import stop
+
 #: a unit's answer (one line, CR included) -> (delay in seconds, bytes) to send instead
 Transform = Callable[[bytes], list[tuple[float, bytes]]]
 
@@ -143,12 +145,7 @@ class Emulator:
         return self.proc.stdout.readline().strip()
 
     def close(self) -> None:
-        self.proc.terminate()
-        try:
-            self.proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(10)
+        stop(self.proc)
 
 
 @contextlib.contextmanager

@@ -68,7 +68,7 @@ def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool]) -> tuple[list[by
         emu.control("in 1 FF")
         proc.append(subprocess.Popen(
             [sys.executable, "-m", "conformance", "--target", f"serial:{proxy.path}",
-             "--profile", "GVE84-100", "--allow-destructive", "--max-travel", "500",
+             "--profile", "GVE84-100", "--allow-destructive", "--max-travel", "500", "--yes",
              "--report-dir", str(tmp_path / "reports"), *CASES],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE))
         out, err = proc[0].communicate(timeout=120)

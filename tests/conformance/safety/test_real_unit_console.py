@@ -19,7 +19,7 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
     with unit_behind_proxy("--model", "GVE84-100") as (_, proxy):
         status = main(["--target", f"serial:{proxy.path}", "--profile", "GVE84-100",
                        "--cases", "5.errors.ok", "--cases", "10.3.status.run-bit",
-                       "--max-travel", "800", "--report-dir", str(tmp_path)])
+                       "--max-travel", "800", "--yes", "--report-dir", str(tmp_path)])
     out = capsys.readouterr().out
     assert status == 0
     assert "Hypothesis settings: hardware on real units" in out
@@ -29,7 +29,7 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
     assert "restored: ST0..ST5 as found: 00 00 00 00 00 00" in out
     (folder,) = tmp_path.iterdir()
     html = (folder / "report.html").read_text()
-    assert "envelope ±800): X +0..+500" in html and "restored: axes back" in html
+    assert "restored: axes back where the run began" in html and "±800" in html
     session = json.loads((folder / "results.json").read_text())["sessions"]
     assert next(iter(session.values()))["excursion"] == [[0, 500], [0, 0], [0, 0]]
 

@@ -1,0 +1,235 @@
+"""A fleet: ``gve-conformance --target A --target B ... --jobs N`` runs each target in a
+process of its own, at most N at once, and writes one report per target under
+``<report dir>/<run id>/<target>/`` and a summary across them: printed, ``summary.json``
+and ``index.html`` beside the targets' folders, and with ``--junitxml PATH`` one JUnit
+file with a testsuite per target.
+
+Each process is ``python -m conformance.cli.fleet_member JOB`` and runs the one target
+exactly as a single run would, with the fleet's seed and example database and the
+profile the fleet chose for it; the fleet has asked before moving (the members have no
+terminal: hand steps are COULD-NOT-TEST there). Its output comes back line by line
+behind the target's name. The processes live in process
+groups of their own: an interrupt (Ctrl-C or SIGTERM) reaches the fleet alone, which
+sends every running target one SIGINT, so that each halts its unit as a single run does,
+starts no other, waits for them and still reports.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import html
+import json
+import os
+import queue
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import xml.etree.ElementTree as ET
+from collections import deque
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from conformance.targets import Target
+from conformance.verdict import FAILED, ORDER, PASSED
+
+SUMMARY_JSON = "summary.json"
+INDEX_HTML = "index.html"
+
+
+@dataclass
+class Member:
+    """One target of the fleet and the process that runs it."""
+
+    spec: str
+    label: str                      # its report folder's name
+    process: subprocess.Popen | None = None
+    status: int | None = None       # the process's exit status
+    started: float = 0.0            # seconds since the fleet began, when it started
+    ended: float | None = None      # ... and when it ended
+    result: dict = field(default_factory=dict)   # its results.json, once written
+
+
+def labels(specs: list[str]) -> list[str]:
+    """A folder name for each target, from its spec (``tcp:127.0.0.1:5114`` ->
+    ``tcp-127.0.0.1-5114``), unique within the fleet."""
+    out: list[str] = []
+    for spec in specs:
+        base = re.sub(r"[^A-Za-z0-9._-]+", "-", spec).strip("-.") or "target"
+        name, n = base, 1
+        while name in out:
+            n += 1
+            name = f"{base}-{n}"
+        out.append(name)
+    return out
+
+
+def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], run_id: str,
+              seed: int | None, database: str | None) -> int:
+    """Run ``targets`` (chosen, confirmed, their ports closed) as a fleet with the options
+    of ``args``; the exit status."""
+    folder = (Path(tempfile.mkdtemp(prefix="gve-fleet-")) if args.no_reports
+              else Path(args.report_dir, run_id))
+    folder.mkdir(parents=True, exist_ok=True)
+    specs = [t.info.spec for t in targets]
+    members = [Member(spec, label) for spec, label in zip(specs, labels(specs), strict=True)]
+    # asked and answered here: the members neither ask nor identify again
+    child = dict(vars(args), jobs=1, report_dir=str(folder), no_reports=False, junitxml=None,
+                 seed=seed, hypothesis_db=database or "none", yes=True, operator=False,
+                 variant=None)
+    for m, target in zip(members, targets, strict=True):
+        job = {"args": dict(child, target=[m.spec], profile=target.profile.name,
+                            run_id=m.label), "argv": argv}
+        (folder / f"{m.label}.job.json").write_text(json.dumps(job), encoding="utf-8")
+    jobs = min(args.jobs, len(members))
+    print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
+    start = time.perf_counter()
+    interrupted = _run_members(members, folder, jobs, start)
+    seconds = time.perf_counter() - start
+    for m in members:
+        (folder / f"{m.label}.job.json").unlink(missing_ok=True)
+        path = folder / m.label / "results.json"
+        if path.is_file():
+            m.result = json.loads(path.read_text(encoding="utf-8"))
+    summary = _summary(members, run_id, seconds, interrupted)
+    _print_summary(summary)
+    if args.junitxml:
+        print(f"JUnit XML: {merge_junit(folder, members, args.junitxml, seconds)}")
+    if args.no_reports:
+        shutil.rmtree(folder, ignore_errors=True)
+    else:
+        (folder / SUMMARY_JSON).write_text(json.dumps(summary, indent=1), encoding="utf-8")
+        (folder / INDEX_HTML).write_text(_index_html(summary), encoding="utf-8")
+        print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
+    print(f"{summary['verdict']}: {summary['reason']}")
+    return 1 if summary["verdict"] != PASSED else 0
+
+
+def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -> bool:
+    """Run the members' processes, at most ``jobs`` at once; True when interrupted."""
+    pending, running = deque(members), []
+    wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
+    out_lock = threading.Lock()
+    interrupted = False
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    before = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        while pending or running:
+            try:
+                while pending and len(running) < jobs and not interrupted:
+                    m = pending.popleft()
+                    running.append(m)
+                    _start(m, folder, start, wake, out_lock)
+                with contextlib.suppress(queue.Empty):
+                    wake.get(timeout=0.5)
+                running = [m for m in running if m.status is None]
+            except KeyboardInterrupt:
+                interrupted = True
+                pending.clear()
+                print("fleet: interrupted; every running target halts its unit and reports",
+                      file=sys.stderr, flush=True)
+                for m in running:
+                    if m.process is not None and m.process.poll() is None:
+                        os.kill(m.process.pid, signal.SIGINT)
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+    return interrupted
+
+
+def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
+           out_lock: threading.Lock) -> None:
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    m.started = time.perf_counter() - start
+    m.process = subprocess.Popen(
+        [sys.executable, "-m", "conformance.cli.fleet_member",
+         str(folder / f"{m.label}.job.json")],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        text=True, errors="replace", env=env, process_group=0)
+
+    def relay() -> None:
+        assert m.process is not None and m.process.stdout is not None
+        for line in m.process.stdout:
+            with out_lock:
+                print(f"[{m.label}] {line}".rstrip(), flush=True)
+        status = m.process.wait()
+        m.ended = time.perf_counter() - start
+        m.status = status               # last: the member counts as done from here
+        wake.put(m)
+
+    threading.Thread(target=relay, name=f"fleet-{m.label}", daemon=True).start()
+
+
+def _summary(members: list[Member], run_id: str, seconds: float, interrupted: bool) -> dict:
+    rows, counts = [], {}
+    for m in members:
+        r = m.result
+        for verdict, n in r.get("counts", {}).items():
+            counts[verdict] = counts.get(verdict, 0) + n
+        rows.append({"target": m.spec, "folder": m.label, "exit_status": m.status,
+                     "verdict": r.get("verdict", FAILED),
+                     "reason": r.get("reason", "the target's process wrote no results"),
+                     "counts": r.get("counts", {}), "seconds": r.get("seconds"),
+                     "frames": r.get("frames", 0), "interrupted": r.get("interrupted", False),
+                     "started": round(m.started, 3),
+                     "ended": None if m.ended is None else round(m.ended, 3)})
+    failed = [row for row in rows if row["verdict"] != PASSED and not row["interrupted"]]
+    why = ([f"{len(failed)} of {len(rows)} targets failed"] if failed else []) + (
+        ["interrupted before every target had run"] if interrupted else [])
+    verdict, reason = (FAILED, "; ".join(why)) if why else (
+        PASSED, f"all {len(rows)} targets passed")
+    return {"run_id": run_id, "verdict": verdict, "reason": reason,
+            "seconds": round(seconds, 3), "interrupted": interrupted, "counts": counts,
+            "targets": rows}
+
+
+def _print_summary(summary: dict) -> None:
+    def text(counts: dict) -> str:
+        return ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts) or "nothing run"
+
+    width = max(len(row["target"]) for row in summary["targets"])
+    print(f"\nfleet of {len(summary['targets'])} targets in {summary['seconds']:.1f} s:")
+    for row in summary["targets"]:
+        print(f"  {row['target']:{width}}  {row['verdict']:6}  {text(row['counts'])}")
+    print(f"  {'all':{width}}  {summary['verdict']:6}  {text(summary['counts'])}")
+
+
+def merge_junit(folder: Path, members: list[Member], path: str, seconds: float) -> Path:
+    """One JUnit file: the testsuites of every target's junit.xml under one root."""
+    root = ET.Element("testsuites", name="gve-conformance", time=f"{seconds:.3f}")
+    tests = 0
+    for m in members:
+        source = folder / m.label / "junit.xml"
+        if not source.is_file():
+            continue
+        for suite in ET.parse(source).getroot().iter("testsuite"):
+            root.append(suite)
+            tests += int(suite.get("tests", "0"))
+    root.set("tests", str(tests))
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    ET.ElementTree(root).write(out, encoding="utf-8", xml_declaration=True)
+    return out
+
+
+def _index_html(summary: dict) -> str:
+    e = html.escape
+    rows = "".join(
+        f"<tr><td><a href=\"{e(row['folder'])}/report.html\">{e(row['target'])}</a></td>"
+        f"<td>{e(row['verdict'])}</td><td>{e(row['reason'])}</td>"
+        f"<td>{e(', '.join(f'{k} {v}' for k, v in row['counts'].items()))}</td></tr>"
+        for row in summary["targets"])
+    return (f"<!doctype html><meta charset=\"utf-8\"><title>gve-conformance fleet "
+            f"{e(summary['run_id'])}</title><h1>{e(summary['verdict'])}: "
+            f"{e(summary['reason'])}</h1><p>fleet {e(summary['run_id'])}, "
+            f"{summary['seconds']:.1f} s</p><table border=\"1\" cellpadding=\"4\">"
+            "<tr><th>target</th><th>verdict</th><th>why</th><th>cases</th></tr>"
+            f"{rows}</table>\n")

@@ -1,0 +1,126 @@
+"""`gve-conformance host`: certify a host program — the suite plays the unit.
+
+    gve-conformance host --profile GVE84-100 -- python -m gve_host {port} --job J
+    gve-conformance host --profile GVE84-100                     (attended)
+
+Launched: the command after `--` is started once per scenario, `{port}` replaced by the
+port to open (a pseudo-terminal path, or `socket://HOST:PORT` with --port tcp:...).
+Attended (no command): the port is printed first; the operator runs the host for each
+scenario and types `done`, `failed` or `hung` when its job has ended.
+Exit status: 0 when nothing FAILs, 1 otherwise, 2 for usage errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import fnmatch
+import sys
+
+from conformance.cli.ending import counted, end, new_run_id, progress
+from conformance.host.certify import HostStartError, Plan, certify
+from conformance.host.scenarios import SCENARIOS, select
+from conformance.host.units import load_units
+from conformance.runner import CaseResult
+from conformance.verdict import ORDER, PASS, grade
+from gve_fixtures.profile import ProfileError
+
+
+class Usage(Exception):
+    """A usage error: one line on stderr, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:     # one line, no usage dump, no traceback
+        raise Usage(message)
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    command: list[str] = []
+    if "--" in argv:
+        at = argv.index("--")
+        argv, command = argv[:at], argv[at + 1:]
+    ap = _Parser(prog="gve-conformance host", description=__doc__.splitlines()[0])
+    ap.add_argument("--profile", help="the unit played to the host, at its default address")
+    ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
+                    help="a unit on the line (repeatable; instead of --profile)")
+    ap.add_argument("--scenarios", action="append", default=[], metavar="GLOB",
+                    help="run only these scenarios (the clean run always runs)")
+    ap.add_argument("--baud", type=int, help="the line's baud rate (default: the profile's)")
+    ap.add_argument("--host-timeout", type=float, default=5.0, metavar="S",
+                    help="a host silent this long without exiting hangs (default 5)")
+    ap.add_argument("--port", default="pty",
+                    help="pty (default), tcp:HOST:PORT, or a serial device path")
+    ap.add_argument("--jobs", type=int, default=4,
+                    help="scenarios run side by side (launched, pty or tcp port 0)")
+    ap.add_argument("--strict", action="store_true",
+                    help="the host claims the project's decisions: [D] rules FAIL too")
+    ap.add_argument("--report-dir", default="reports")
+    ap.add_argument("--no-reports", action="store_true")
+    ap.add_argument("--list", action="store_true", help="list the scenarios and exit")
+    ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
+    args = ap.parse_args(argv)
+    args.command = command or None
+    return args
+
+
+def plan_of(args: argparse.Namespace) -> Plan:
+    if bool(args.profile) == bool(args.unit):
+        raise Usage("give --profile, or --unit MODEL@ADDRESS (repeatable)")
+    try:
+        units = load_units(args.unit or [args.profile])
+    except (ValueError, LookupError, ProfileError) as err:
+        raise Usage(str(err).splitlines()[0]) from None
+    baud = args.baud or units[0][0].default_baud
+    unsupported = [p.name for p, _ in units if baud not in p.bauds]
+    if unsupported:
+        raise Usage(f"--baud {baud}: the {', '.join(unsupported)} does not run at it "
+                    f"(it runs at {', '.join(map(str, units[0][0].bauds))})")
+    if args.host_timeout <= 0 or args.jobs < 1:
+        raise Usage("--host-timeout and --jobs take positive numbers")
+    if args.command and not any("{port}" in a for a in args.command):
+        raise Usage("the host command must name the port as {port}")
+    unmatched = [p for p in args.scenarios if not any(
+        fnmatch.fnmatchcase(s.name, p) or fnmatch.fnmatchcase(s.id, p) for s in SCENARIOS)]
+    if unmatched:
+        raise Usage(f"no scenario matches {' '.join(unmatched)} (see --list)")
+    scenarios = select(args.scenarios)
+    return Plan(units, baud, scenarios, args.command, args.port, args.host_timeout,
+                args.strict, args.jobs)
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = parse_args(list(sys.argv[1:] if argv is None else argv))
+        if args.list:
+            for sc in SCENARIOS:
+                print(f"{sc.id:32} {sc.title}")
+            return 0
+        plan = plan_of(args)
+    except Usage as err:
+        print(f"gve-conformance host: {err}", file=sys.stderr)
+        return 2
+    def worst(r: CaseResult) -> str | None:
+        """The check that graded the scenario worst, or why it did not run."""
+        failed = sorted((c for c in r.checks if not c["ok"]),
+                        key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
+        if failed:
+            return f"{failed[0]['what']} ({failed[0]['observed']})"
+        return r.notes[0] if r.verdict != PASS and r.notes else None
+
+    try:
+        result = certify(plan, new_run_id(), progress(args.quiet, worst), console=sys.stdout,
+                         operator=sys.stdin)
+    except (HostStartError, ValueError) as err:
+        print(f"gve-conformance host: {err}", file=sys.stderr)
+        return 2
+    print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
+          f"{' (interrupted by Ctrl-C: the hosts were stopped)' if result.interrupted else ''}")
+    clean = next((r for r in result.results if r.id.endswith(".clean")), None)
+    if clean is not None:
+        print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the clean "
+              f"line; {result.frames} frames")
+    return end(result, None if args.no_reports else args.report_dir)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,56 @@
+"""`gve-conformance ports`: the serial ports of this machine (pyserial's ``list_ports``:
+device, description, hardware id), so that a technician finds the unit's port. With
+``--probe`` each port is also asked ``?`` at the profiles' baud rates and the unit that
+answers is named; ``--glob`` adds ports the system does not list (a pty, a symlink)."""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import sys
+
+from serial.tools import list_ports
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(prog="gve-conformance ports", description=__doc__.split(".")[0])
+    ap.add_argument("--glob", action="append", default=[], metavar="PATTERN",
+                    help="also list devices matching PATTERN (e.g. '/dev/pts/*')")
+    ap.add_argument("--probe", action="store_true",
+                    help="ask each port `?` (only `?`: it moves nothing) and show who answers")
+    return ap.parse_args(argv)
+
+
+def found(patterns: list[str]) -> list[tuple[str, str, str]]:
+    """(device, description, hardware id) of every port, the system's first."""
+    ports = [(p.device, p.description, p.hwid)
+             for p in sorted(list_ports.comports(include_links=True))]
+    known = {device for device, _, _ in ports}
+    for pattern in patterns:
+        for device in sorted(glob.glob(pattern)):
+            if device not in known:
+                ports.append((device, "given by --glob", "n/a"))
+                known.add(device)
+    return ports
+
+
+def main(argv: list[str]) -> int:
+    args = parse_args(argv)
+    ports = found(args.glob)
+    if not ports:
+        print("no serial ports found (a USB adapter plugged in? try --glob)")
+        return 0
+    if args.probe:
+        from conformance.targets.identify import probe
+    width = max(len(device) for device, _, _ in ports)
+    for device, description, hwid in ports:
+        line = f"{device:{width}}  {description}  [{hwid}]"
+        if args.probe:
+            answer = probe(device)
+            line += f"  -> {answer}" if answer else "  -> no GVE unit answered"
+        print(line, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

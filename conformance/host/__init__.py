@@ -1,0 +1,17 @@
+"""The host role (issue 11): the suite plays GVE units to a host program and judges the
+host's traffic on the wire, under the faults a real line and unit bring.
+
+    ports/      where the host meets the relay (pty, TCP, serial device)
+    units.py    the emulated units behind the relay (gve://, its rig and its clock)
+    framer.py   the host's byte stream cut into frames, every byte timed
+    grammar.py  one frame judged against spec 3 and 10 (commands.toml: the parameters)
+    relay.py    host <-> units, answers paired with frames, faults applied
+    faults.py   lost, damaged, late and noisy answers, lost and cut frames, a full queue,
+                an interrupt, a restart
+    recording.py, unitview.py   what was seen both ways; what the units executed
+    checks.py   the host rules judged on the wire (WIRE_CHECKS: rule ID -> check)
+    scenarios.py, oracle.py     the scenarios; the executed motion against the clean run
+                (oracle.HOST_CHECKS: every host rule -> the check that judges it)
+    probe.py    where the motion ended, asked over the wire after the host left
+    certify.py  a whole certification, launched or attended
+"""

@@ -1,0 +1,347 @@
+"""The host rules, judged on the wire after each run (issue 11 item 2): one function per
+kind of evidence, each naming the rules of fixtures/rules.toml it judges.
+
+:data:`WIRE_CHECKS` maps every rule a host can fail here to the check that judges it
+(``oracle.HOST_CHECKS`` adds the rules the executed motion judges). Verdicts come from
+the rules' tags, as for units; a finding may carry its own tag where the spec's preamble
+says so (a hang is a FAIL whatever the tag).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+from conformance.host.recording import Exchange, Recording, Unsolicited, show
+from conformance.host.unitview import VECTORS, UnitView
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
+
+#: the least a host waits for an answer before it may treat it as lost (spec 8 [D])
+PATIENCE_MS = 100
+MS = 1_000_000
+#: `@` and `>`: asking, never resending (spec 8)
+ASKING = ("@", ">")
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A rule broken at instant ``t`` (ns since the run began), with the frame shown."""
+
+    rule: str
+    t: int
+    frame: str
+    what: str
+    tag: str | None = None          # overrides the rule's tag
+
+
+@dataclass
+class LineFacts:
+    """What the checks need to know about the line and the run."""
+
+    views: list[UnitView]
+    units: dict[int, Profile]       # address -> profile
+    baud: int
+    origin: int
+    exit_code: int | None = None
+
+    @property
+    def watchdog_ms(self) -> int:
+        return min(p.watchdog_ms for p in self.units.values())
+
+
+@dataclass
+class Judgement:
+    findings: list[Finding] = field(default_factory=list)
+    judged: set[str] = field(default_factory=set)
+    notes: list[str] = field(default_factory=list)
+
+    def add(self, rule: str, t: int, frame: str, what: str, tag: str | None = None) -> None:
+        self.findings.append(Finding(rule, t, frame, what, tag))
+
+
+Check = Callable[[Recording, LineFacts, Judgement], None]
+
+
+def _at(t: int, line: LineFacts) -> int:
+    return t - line.origin
+
+
+def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """Each frame on its own: grammar, address, command, parameters, checksum, length
+    (grammar.py), and a member of a packet carrying its own checksum (spec 7)."""
+    for ex in rec.exchanges:
+        out.judged |= ex.parsed.judged
+        for p in ex.parsed.problems:
+            out.add(p.rule, _at(ex.frame.start, line), ex.text, p.what)
+    for frag in rec.fragments:
+        out.judged.add("3.frame.grammar")
+        shown = show(frag.data)
+        if frag.kind == "cut":
+            out.add("3.frame.grammar", _at(frag.start, line), shown,
+                    "a frame that never ended with CR")
+        elif frag.kind == "stray":
+            out.add("3.frame.grammar", _at(frag.start, line), shown,
+                    "bytes outside any frame (units ignore them, spec 3 [D])", "D")
+        else:
+            out.add("3.frame.grammar", _at(frag.start, line), shown,
+                    "a LF after CR (units ignore it, spec 3 [D])", "D-info")
+
+
+def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """A frame the unit refused as unknown, for syntax or for range is the host's fault
+    (spec 5), unless a fault of ours made it so; so is one refused as "not while moving"
+    (7): the host did not wait for the motion to end, as `L0,0,0` lets it (spec 10.1)."""
+    rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
+             ErrorCode.RANGE: "5.code.range", ErrorCode.BUSY: "10.1.queue.wait-idiom"}
+    out.judged |= set(rules.values())
+    for ex in rec.exchanges:
+        if ex.fault is None and ex.code in rules:
+            answer = b"".join(ex.answer).decode("latin-1").strip()
+            out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
+                    f"the unit answered {answer}")
+
+
+def gaps(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """The pauses between a frame's bytes stay below the unit's watchdog (spec 3): the
+    slowest one is measured and shown; a pause while the relay itself was late is not
+    held against the host."""
+    out.judged.add("3.frame.watchdog")
+    limit = line.watchdog_ms * MS
+    slowest = max((ex.frame.slowest_gap for ex in rec.exchanges), default=0)
+    out.notes.append(f"slowest gap between the bytes of a frame: {slowest / MS:.1f} ms "
+                     f"(watchdog {line.watchdog_ms} ms)")
+    for ex in rec.exchanges:
+        long = [(a, b) for a, b in ex.frame.pauses if b - a >= limit]
+        ours = [(a, b) for a, b in long if any(s < b and e > a for s, e in rec.stalls)]
+        if ours:
+            out.notes.append(f"{len(ours)} long gap(s) in {ex.text} not judged: the relay "
+                             "was late itself")
+        theirs = [p for p in long if p not in ours]
+        if theirs:
+            a, b = max(theirs, key=lambda p: p[1] - p[0])
+            out.add("3.frame.watchdog", _at(a, line), ex.text,
+                    f"{(b - a) / MS:.1f} ms between two bytes (watchdog "
+                    f"{line.watchdog_ms} ms)")
+
+
+def simplex(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """No frame before the previous one is answered (spec 2), unless the host waited at
+    least PATIENCE_MS and gave the answer up for lost."""
+    out.judged.add("2.link.simplex")
+    previous: Exchange | None = None
+    for ex in rec.exchanges:
+        if previous is not None:
+            delivered = previous.delivered_at
+            waited = ex.frame.start - previous.frame.end
+            if ((delivered is None or delivered > ex.frame.start)
+                    and waited < PATIENCE_MS * MS):
+                out.add("2.link.simplex", _at(ex.frame.start, line), ex.text,
+                        f"sent {waited / MS:.2f} ms after {previous.text}, before its "
+                        "answer")
+        if ex.answer:
+            previous = ex
+
+
+def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """`*E n` gives the members sent since `*S`, and only `C` and `B` are members
+    (spec 7)."""
+    members: dict[int, int | None] = {}
+    for ex in rec.exchanges:
+        f = ex.parsed
+        if f.address is None or f.command is None:
+            continue
+        n = members.get(f.address)
+        if f.command == "*S":
+            out.judged |= {"7.packet.count", "7.packet.members", "7.packet.exchange"}
+            members[f.address] = 0
+        elif f.command == "*E":
+            out.judged.add("7.packet.exchange")
+            if n is None:
+                out.add("7.packet.exchange", _at(ex.frame.start, line), ex.text,
+                        "`*E` with no packet open")
+            elif f.params[:1] != [str(n)]:
+                out.add("7.packet.count", _at(ex.frame.start, line), ex.text,
+                        f"{n} member(s) sent since `*S`")
+            members[f.address] = None
+        elif n is not None:
+            if f.command in ("H", "@", ">", "J"):
+                members[f.address] = None          # breaks the packet (spec 7)
+                continue
+            members[f.address] = n + 1             # a member, failing or not
+            if f.command not in ("C", "B"):
+                out.add("7.packet.members", _at(ex.frame.start, line), ex.text,
+                        f"`{f.command}` inside a packet")
+            elif f.checksum is None and summed(ex):
+                out.judged.add("7.packet.checksums")
+                out.add("7.packet.checksums", _at(ex.frame.start, line), ex.text,
+                        "a member without its checksum in checksum mode")
+            elif summed(ex):
+                out.judged.add("7.packet.checksums")
+
+
+def summed(ex: Exchange) -> bool:
+    """Whether the unit was in checksum mode for this frame (spec 6)."""
+    return "6.checksum.sum" in ex.parsed.judged
+
+
+def restarts(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """After `J` the host sends nothing until the unit is ready again (spec 2)."""
+    for ex in rec.exchanges:
+        if ex.parsed.command != "J" or ex.code != 0 or ex.delivered_at is None:
+            continue
+        out.judged.add("2.link.ready-after-restart")
+        profile = line.units[ex.parsed.address or 0]
+        ready = ex.delivered_at + profile.restart_ms * MS
+        early = [e for e in rec.exchanges if ex.delivered_at < e.frame.start < ready]
+        if early:
+            e = early[0]
+            out.add("2.link.ready-after-restart", _at(e.frame.start, line), e.text,
+                    f"sent {(e.frame.start - ex.delivered_at) / MS:.0f} ms after `J` was "
+                    f"answered (the unit restarts for {profile.restart_ms} ms)")
+
+
+def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """After an answer the host did not get whole, it asks `@` (and `>`) before anything
+    else and never resends a vector blindly (spec 8); in checksum mode an answer whose
+    checksum fails is not trusted (spec 6)."""
+    for i, ex in enumerate(rec.exchanges):
+        if ex.fault is None or ex.fault in ("cut-frame", "queue-full", "interrupt",
+                                            "restart"):
+            continue
+        rest = rec.exchanges[i + 1:]
+        if not rest:
+            continue
+        nxt = rest[0]
+        asked = nxt.parsed.command in ASKING
+        shown = f"after {ex.text} ({ex.fault})"
+        out.judged |= {"8.recovery.no-blind-resend", "8.recovery.ask-index"}
+        if ex.fault == "corrupt-answer" and summed(ex):
+            out.judged.add("6.checksum.response-sum")
+            if not asked:
+                out.add("6.checksum.response-sum", _at(nxt.frame.start, line), nxt.text,
+                        f"trusted an answer whose checksum fails {shown}")
+                continue
+        if _got_answer(ex, nxt):
+            continue
+        if _resends(ex, nxt):
+            motion = ex.parsed.command in (*VECTORS, "*E")
+            rule = "8.recovery.no-blind-resend" if motion else "8.recovery.ask-index"
+            out.add(rule, _at(nxt.frame.start, line), nxt.text,
+                    f"resent {shown} without asking `@` first")
+        elif not asked:
+            out.add("8.recovery.ask-index", _at(nxt.frame.start, line), nxt.text,
+                    f"went on {shown} as if the answer had come")
+
+
+def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
+    """Whether the host had the unit's answer, whole, before its next frame (noise
+    before an answer leaves the answer whole)."""
+    whole = ex.fault in ("late-answer", "noise") and ex.delivered is not None
+    return whole and ex.delivered_at is not None and ex.delivered_at <= nxt.frame.start
+
+
+def _resends(ex: Exchange, nxt: Exchange) -> bool:
+    if ex.parsed.command == "*E":
+        return nxt.parsed.command in ("*S", "*E")
+    return nxt.frame.raw == ex.frame.raw
+
+
+def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """A vector or packet refused with 1 is sent again later (spec 5, 10.1). Not judged
+    when the host had to be stopped (it hung: that is its own finding)."""
+    if line.exit_code is None:
+        return
+    for i, ex in enumerate(rec.exchanges):
+        if ex.parsed.command not in (*VECTORS, "*E") or ex.delivered is None:
+            continue
+        told = ex.code == ErrorCode.QUEUE_FULL and ex.fault != "corrupt-answer"
+        if not (told or ex.fault == "queue-full"):
+            continue
+        out.judged.add("5.code.queue-full")
+        later = rec.exchanges[i + 1:]
+        again = (any(e.parsed.command == "*S" for e in later) if ex.parsed.command == "*E"
+                 else any(e.frame.raw == ex.frame.raw for e in later))
+        if not again:
+            out.add("5.code.queue-full", _at(ex.frame.start, line), ex.text,
+                    "refused with 1 (queue full) and never sent again")
+
+
+def port_settings(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """The host sets its port to 8N1 at the line's baud rate (spec 2), as far as the
+    port shows it (a pseudo-terminal does; TCP does not)."""
+    if not rec.settings:
+        return
+    out.judged.add("2.link.serial-8n1")
+    wanted = f"{line.baud} 8N1"
+    for t, seen in rec.settings:
+        if seen != wanted:
+            out.add("2.link.serial-8n1", _at(t, line), "(port settings)",
+                    f"the host set its port to {seen}, the line is {wanted}")
+            return
+
+
+def unsolicited(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """Answers that belong to no complete frame: the unit's watchdog dropped a frame the
+    host left unfinished (spec 3)."""
+    for u in rec.unsolicited:
+        if not _ours(u, rec):
+            out.notes.append(f"at {_at(u.t, line) / 1e9:.3f} s the unit answered "
+                             f"{b''.join(u.lines)!r} to no complete frame (its watchdog)")
+
+
+def _ours(u: Unsolicited, rec: Recording) -> bool:
+    return any(ex.fault == "cut-frame" and ex.frame.end <= u.t for ex in rec.exchanges)
+
+
+#: the checks run on every recording, in order
+CHECKS: tuple[Check, ...] = (frames, refusals, gaps, simplex, packets, restarts, recovery,
+                             queue_full, port_settings, unsolicited)
+
+#: every rule a host can fail on the wire -> the check that judges it
+WIRE_CHECKS: dict[str, Check] = {
+    **{rule: frames for rule in (
+        "3.frame.grammar", "3.frame.max-length", "3.frame.upper-case", "2.link.addressed-only",
+        "1.profile.command-set", "1.profile.gve54-no-checksums", "1.profile.axes",
+        "1.profile.vector-range", "1.profile.v-b-range", "1.profile.v-b-range-gve54",
+        "1.profile.dollar-range", "3.params.commas", "3.params.decimal", "3.params.hex-fields",
+        "3.params.word-values-decimal", "3.params.float-syntax", "3.params.none-expected",
+        "5.code.syntax", "5.code.range", "6.checksum.sum", "10.cmd.vector", "10.cmd.modal",
+        "10.cmd.accel-range", "10.cmd.axis-limits", "10.cmd.output", "12.spindle.speed")},
+    "5.code.unknown": refusals,
+    "10.1.queue.wait-idiom": refusals,
+    "3.frame.watchdog": gaps,
+    "2.link.simplex": simplex,
+    "7.packet.count": packets,
+    "7.packet.members": packets,
+    "7.packet.exchange": packets,
+    "7.packet.checksums": packets,
+    "2.link.ready-after-restart": restarts,
+    "8.recovery.no-blind-resend": recovery,
+    "8.recovery.ask-index": recovery,
+    "6.checksum.response-sum": recovery,
+    "5.code.queue-full": queue_full,
+    "2.link.serial-8n1": port_settings,
+}
+
+
+def judge(rec: Recording, line: LineFacts) -> Judgement:
+    out = Judgement()
+    for check in CHECKS:
+        check(rec, line, out)
+    seen: set[tuple[str, int, str | None]] = set()
+    unique = []
+    for f in out.findings:               # a frame's grammar and its refusal: said once
+        if (f.rule, f.t, f.tag) not in seen:
+            seen.add((f.rule, f.t, f.tag))
+            unique.append(f)
+    out.findings = unique
+    return out
+
+
+def findings_by_rule(j: Judgement) -> Iterator[tuple[str, list[Finding]]]:
+    """Every judged rule with its findings (none: the host kept it), in rule order."""
+    by: dict[str, list[Finding]] = {rule: [] for rule in sorted(j.judged)}
+    for f in j.findings:
+        by.setdefault(f.rule, []).append(f)
+    yield from by.items()

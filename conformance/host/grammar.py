@@ -1,0 +1,290 @@
+"""A host's command frame judged against spec 3 and 10: address, command, parameters,
+checksum and length, each problem naming the rule it breaks (fixtures/rules.toml).
+
+Written from the spec. The parameter table is data (``commands.toml`` next to this file);
+the ranges come from the addressed unit's profile.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import struct
+import tomllib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+
+from conformance.link.framing import byte_sum
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import MAX_FRAME
+from gve_fixtures.rules import load_rules
+
+COMMANDS_FILE = Path(__file__).with_name("commands.toml")
+
+_DEC = re.compile(r"-?[0-9]+\Z")
+_HEX = re.compile(r"[0-9A-Fa-f]+\Z")
+_FLOAT = re.compile(r"-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?\Z")
+_SUM = re.compile(rb",([0-9A-Fa-f]{2})\Z")
+_PRINTABLE = re.compile(rb"[\x20-\x7e]*")
+#: what a host might put between parameters instead of a comma (spec 3 [M] "commas")
+_SEPARATORS = re.compile(r"[ ;:\t]")
+#: commands only units with checksums and packets have (spec 1: the GVE54 lacks them)
+_CHECKSUM_COMMANDS = ("%", "*S", "*E")
+_SYNTAX_RULE = {"dec": "3.params.decimal", "hex": "3.params.hex-fields",
+                "float": "3.params.float-syntax", "word": "5.code.syntax"}
+
+
+@dataclass(frozen=True)
+class Field:
+    kind: str                                   # dec, hex, float, word
+    range: str | tuple[int, int] | None = None
+    choices: tuple[str, ...] = ()
+    syntax: str = ""                            # the rule its format breaks, if not the kind's
+
+
+@dataclass(frozen=True)
+class Command:
+    name: str
+    fields: tuple[Field, ...] = ()
+    repeat: str | None = None                   # "axes": the last field repeats
+    glued: bool = False
+    rules: tuple[str, ...] = ()
+    profile_name: str = ""
+    count_rule: str = "5.code.syntax"           # the rule a wrong number of parameters breaks
+
+    @property
+    def known_as(self) -> str:
+        """The name a profile's command set uses."""
+        return self.profile_name or self.name
+
+
+@cache
+def command_table(path: Path = COMMANDS_FILE) -> dict[str, Command]:
+    raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    table = {}
+    for name, entry in raw["command"].items():
+        fields = tuple(Field(f["kind"], _range(f.get("range")), tuple(f.get("choices", ())),
+                             f.get("syntax", "")) for f in entry.get("fields", ()))
+        table[name] = Command(name, fields, entry.get("repeat"), entry.get("glued", False),
+                              tuple(entry.get("rules", ())), entry.get("profile", ""),
+                              entry.get("count", "5.code.syntax"))
+    return table
+
+
+def _range(value: object) -> str | tuple[int, int] | None:
+    if isinstance(value, list):
+        return (int(value[0]), int(value[1]))
+    return value if isinstance(value, str) else None
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One rule a frame breaks, and how."""
+
+    rule: str
+    what: str
+
+
+@dataclass
+class ParsedFrame:
+    """A host's frame as the judge reads it (``raw`` from `!` to the byte before CR)."""
+
+    raw: bytes
+    address: int | None = None
+    body: str = ""                  # without the checksum
+    command: str | None = None      # a name of the command table
+    params: list[str] = field(default_factory=list)
+    checksum: str | None = None
+    problems: list[Problem] = field(default_factory=list)
+    judged: set[str] = field(default_factory=set)      # every rule this frame was held to
+
+    @property
+    def text(self) -> str:
+        return self.raw.decode("latin-1")
+
+    def problem(self, rule: str, what: str) -> None:
+        self.problems.append(Problem(rule, what))
+
+    def check(self, ok: bool, rule: str, what: str | Callable[[], str]) -> bool:
+        """Hold the frame to ``rule``; record ``what`` (text, or a function that writes
+        it, called only then) when it breaks it."""
+        self.judged.add(rule)
+        if not ok:
+            self.problem(rule, what if isinstance(what, str) else what())
+        return ok
+
+
+def parse_frame(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFrame:
+    """Judge one frame; ``units`` maps the addresses on the line to their profiles,
+    ``checksums`` is the checksum mode the addressed unit is in (spec 6)."""
+    return _parse(raw, units, checksums)
+
+
+class LineGrammar:
+    """:func:`parse_frame` for one line, remembering its answers: hosts repeat frames
+    (polls, retries). A parsed frame is shared between equal frames: do not change it."""
+
+    def __init__(self, units: dict[int, Profile], size: int = 4096) -> None:
+        self.units, self.size = units, size
+        self._seen: dict[tuple[bytes, bool], ParsedFrame] = {}
+
+    def parse(self, raw: bytes, checksums: bool) -> ParsedFrame:
+        found = self._seen.get((raw, checksums))
+        if found is None:
+            found = self._seen[raw, checksums] = _parse(raw, self.units, checksums)
+            if len(self._seen) > self.size:
+                self._seen.pop(next(iter(self._seen)))
+        return found
+
+
+def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFrame:
+    f = ParsedFrame(raw)
+    f.check(len(raw) <= MAX_FRAME, "3.frame.max-length",
+            lambda: f"{len(raw)} bytes, more than {MAX_FRAME}")
+    f.check(_PRINTABLE.fullmatch(raw) is not None, "3.frame.grammar",
+            "a byte that is not printable ASCII inside the frame")
+    digit = raw[1:2]
+    if not f.check(digit.isdigit() and int(digit) <= 7, "3.frame.grammar",
+                   "no address 0..7 after `!`"):
+        return f
+    f.address = int(digit)
+    profile = units.get(f.address)
+    if not f.check(profile is not None, "2.link.addressed-only",
+                   lambda: f"address {f.address}: no unit on the line has it"):
+        return f
+    assert profile is not None
+    body = raw[2:]
+    if checksums:
+        m = _SUM.search(body)
+        if f.check(m is not None, "6.checksum.sum",
+                   "checksum mode is on and the frame has no checksum"):
+            assert m is not None
+            f.checksum = m.group(1).decode()
+            expected = byte_sum(raw[: len(raw) - 2])
+            f.check(int(f.checksum, 16) == expected, "6.checksum.sum",
+                    lambda: f"checksum {f.checksum}, the bytes sum to {expected:02X}")
+            body = body[: m.start()]
+    f.body = body.decode("latin-1")
+    _command(f, profile)
+    return f
+
+
+def _command(f: ParsedFrame, profile: Profile) -> None:
+    table = command_table()
+    name = _longest_prefix(f.body, table)
+    upper = _longest_prefix(f.body.upper(), table)
+    lower = name is None and upper is not None
+    f.check(not lower, "3.frame.upper-case",
+            lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
+    if not f.check(name is not None or lower, "1.profile.command-set",
+                   lambda: f"`{f.body[:3]}…` is no command of spec 10") or name is None:
+        return
+    command = table[name]
+    f.command = name
+    spindle = profile.spindle is not None and f.address == profile.spindle.address
+    allowed = profile.spindle.commands if spindle else profile.commands
+    family_lacks = name in _CHECKSUM_COMMANDS and profile.family == "GVE54"
+    where = f"address {f.address} of the {profile.name}" if spindle else profile.name
+    if not f.check(command.known_as in allowed,
+                   "1.profile.gve54-no-checksums" if family_lacks else "1.profile.command-set",
+                   lambda: f"`{name}`: the {where} has no such command"):
+        return
+    _params(f, command, f.body[len(name):], profile, spindle)
+
+
+def _longest_prefix(body: str, table: dict[str, Command]) -> str | None:
+    for n in (3, 2, 1):
+        if body[:n] in table:
+            return body[:n]
+    return None
+
+
+def _params(f: ParsedFrame, command: Command, text: str, profile: Profile,
+            spindle: bool) -> None:
+    if not command.fields:
+        f.check(not text, "3.params.none-expected", f"`{command.name}` takes no parameters")
+        return
+    parts: list[str] = []
+    if command.glued:
+        parts, text = [text[:1]], text[1:]
+        if text.startswith(","):
+            text = text[1:]
+    if text or not command.glued:
+        parts += text.split(",")
+    f.params = parts
+    counts = _counts(command, profile)
+    rule = command.count_rule
+    if _SEPARATORS.search(text):
+        rule = "3.params.commas"
+    elif command.repeat == "axes" and len(parts) > len(profile.axes):
+        rule = "1.profile.axes"
+    if not f.check(len(parts) in counts, rule,
+                   lambda: f"`{command.name}` takes {' or '.join(map(str, counts))} "
+                           f"parameter(s), the frame has {len(parts)}"):
+        return
+    fields = [*command.fields, *[command.fields[-1]] * (len(parts) - len(command.fields))]
+    for spec, value in zip(fields, parts, strict=True):
+        rule, problem = _value(spec, value, command, profile, spindle)
+        f.check(problem is None, rule, problem or "")
+
+
+def _counts(command: Command, profile: Profile) -> tuple[int, ...]:
+    if command.repeat == "axes":
+        return tuple(range(3, len(profile.axes) + 1))
+    return (len(command.fields),)
+
+
+def _value(spec: Field, text: str, command: Command, profile: Profile,
+           spindle: bool) -> tuple[str, str | None]:
+    """The rule a parameter is held to, and what is wrong with it (None: nothing)."""
+    syntax = spec.syntax or _SYNTAX_RULE[spec.kind]
+    if spec.kind == "word":
+        ok = text in spec.choices
+        return syntax, None if ok else (f"`{command.name}`: `{text}` is not one of "
+                                        f"{' '.join(spec.choices)}")
+    if spec.kind == "float":
+        if not _FLOAT.match(text):
+            return syntax, f"`{text}` is not a decimal number"
+        return syntax, None if _float32(float(text)) else f"`{text}` is no finite float32"
+    pattern, base = (_DEC, 10) if spec.kind == "dec" else (_HEX, 16)
+    if not pattern.match(text):
+        what = "decimal integer" if base == 10 else "hexadecimal number"
+        return syntax, f"`{command.name}`: `{text}` is not a {what}"
+    value = int(text, base)
+    lo, hi = _bounds(spec, profile, spindle and command.name == "V")
+    rules = ("12.spindle.speed",) if spindle and command.name == "V" else command.rules
+    rule = _applicable(rules, profile.name, profile.family)
+    return rule, None if lo <= value <= hi else (f"`{command.name}`: {value} outside "
+                                                 f"{lo}..{hi}")
+
+
+def _bounds(spec: Field, profile: Profile, spindle: bool) -> tuple[int, int]:
+    if spindle and profile.spindle is not None:
+        return profile.spindle.range.lo, profile.spindle.range.hi
+    if isinstance(spec.range, tuple):
+        return spec.range
+    if spec.range == "vector":
+        return -profile.vector_range, profile.vector_range
+    r = profile.range(str(spec.range))
+    return r.lo, r.hi
+
+
+@cache
+def _applicable(rules: tuple[str, ...], name: str, family: str) -> str:
+    known = load_rules()
+    for rule in rules:
+        if rule in known and known[rule].applies_to(name, family):
+            return rule
+    return "5.code.range"
+
+
+def _float32(value: float) -> bool:
+    if not math.isfinite(value):
+        return False
+    try:
+        struct.pack("<f", value)
+    except OverflowError:
+        return False
+    return True

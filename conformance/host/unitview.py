@@ -1,0 +1,171 @@
+"""What each unit on the line did, read from the wire (spec 6, 7, 8, 9, 10.1): its checksum
+mode, its open packet, its modal settings, its status words as the host wrote them, and
+the motion it accepted — the oracle of the fault scenarios.
+
+A vector is executed when the unit answered it `0` (or `8`: OK while interrupted), a
+packet's members when its `*E` answered `0,k` (spec 7: all or nothing). Each executed
+vector is kept with the modal settings it was accepted under (spec 10.1), so that a lost
+setting shows as well as a lost vector. Zero-length vectors (the `L0,0,0` wait of 10.1)
+move nothing and are left out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from conformance.host.grammar import ParsedFrame, parse_frame
+from conformance.host.recording import Exchange
+from gve_fixtures.profile import Profile
+
+#: commands that set modal parameters captured with each vector (spec 10.1)
+MODAL = ("V", "A", "B", "$", "T", "VK", "VN", "VL", "XM")
+#: settings a fault scenario may target ("a setting", issue 11 item 3)
+SETTINGS = (*MODAL, "SW", "O", "M")
+#: commands that change the motion or the counters: kept in the executed sequence
+MARKERS = ("D", "N", "NX", "NY", "NZ", "NA", "K", "R", "W", "H", "M", "XA", "XU", "XD", "J")
+#: inside an open packet these are executed at once and discard it (spec 7)
+BREAKERS = ("H", "@", ">", "J")
+VECTORS = ("L", "C")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One thing the unit executed: a vector with the settings it runs under, or a
+    marker (``D``, ``N``, ``power-on``...)."""
+
+    kind: str
+    values: tuple[int | str, ...] = ()
+    modal: tuple = ()
+
+    def __str__(self) -> str:
+        body = f"{self.kind}{','.join(map(str, self.values))}"
+        if not self.modal:
+            return body
+        return f"{body} ({', '.join(f'{k}{v}' for k, v in self.modal)})"
+
+
+@dataclass
+class UnitView:
+    """One unit: its motion address and, on a GVE114 at address 0, the spindle address 7
+    that shares its checksum mode (spec 6 [D], 12)."""
+
+    profile: Profile
+    address: int
+    addresses: frozenset[int] = frozenset()
+    checksums: bool = False
+    packet: list[ParsedFrame] | None = None
+    modal: dict[str, object] = field(default_factory=dict)
+    status: list[int] = field(default_factory=lambda: [0] * 7)
+    executed: list[Step] = field(default_factory=list)
+    deaf_until: int = 0
+    vectors: int = 0                    # how many vectors the unit has accepted so far
+
+    def __post_init__(self) -> None:
+        spindle = self.profile.spindle
+        extra = {spindle.address} if spindle is not None and self.address == 0 else set()
+        self.addresses = frozenset({self.address, *extra})
+        self._reset()
+
+    def _reset(self) -> None:
+        r = self.profile.reset
+        self.checksums = r.checksums
+        self.packet = None
+        self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T,
+                      "VK": r.VK, "VL": tuple(r.VL), "XM": r.XM}
+        self.status = list(r.status)
+
+    def power_on(self, t: int) -> None:
+        """The unit restarted (the rig's power cycle): reset state, deaf for a while."""
+        self._reset()
+        self.executed.append(Step("power-on"))
+        self.deaf_until = t + self.profile.restart_ms * 1_000_000
+
+    def apply(self, ex: Exchange, units: dict[int, Profile]) -> None:
+        """Book one exchange for this unit: the frame as the unit got it, its answer."""
+        if ex.to_unit is None or not ex.to_unit.endswith(b"\r"):
+            return
+        f = (ex.parsed if ex.to_unit[:-1] == ex.parsed.raw
+             else parse_frame(ex.to_unit[:-1], units, self.checksums))
+        if f.address not in self.addresses or f.command is None:
+            return
+        name = f.command
+        if self.packet is not None and not ex.answer:
+            if name == "*S":
+                self.packet = []
+            else:
+                self.packet.append(f)
+            return
+        if name == "*S" and not ex.answer:
+            self.packet = []
+            return
+        if name in BREAKERS:
+            self.packet = None
+        code = ex.code
+        if code is None:
+            return
+        if name == "*E":
+            members, self.packet = self.packet or [], None
+            if code == 0:
+                for member in members:
+                    self._accept(member)
+            return
+        if code == 0:
+            self._accept(f)
+            if name == "J":
+                t = ex.answered_at or 0
+                self._reset()
+                self.deaf_until = t + self.profile.restart_ms * 1_000_000
+
+    def _accept(self, f: ParsedFrame) -> None:
+        name, params = f.command or "", f.params
+        if f.address != self.address:           # the spindle: V is its speed (spec 12)
+            if name == "%":
+                self.checksums = params[:1] == ["+"]
+            elif name == "V":
+                self.executed.append(Step("spindle", (int(params[0]),)))
+            return
+        if name == "%":
+            self.checksums = params[:1] == ["+"]
+        elif name in VECTORS:
+            values = tuple(int(p) for p in params)
+            values += (0,) * (len(self.profile.axes) - len(values))
+            if any(values):
+                modal = tuple((k, self.modal[k]) for k in sorted(self.modal))
+                self.executed.append(Step(name, values, modal))
+                self.vectors += 1
+        elif name in ("VK", "VN"):
+            self.modal["VK"] = name == "VK"
+        elif name == "VL":
+            values = tuple(int(p) for p in params)
+            self.modal["VL"] = values + tuple(self.modal["VL"])[len(values):]  # type: ignore[arg-type]
+        elif name in MODAL:
+            self.modal[name] = int(params[0])
+        elif name == "SW":
+            self.status[int(params[0])] = int(params[1], 16)
+        if name in MARKERS:
+            self.executed.append(Step(name, tuple(params)))
+
+    def interrupt_input(self) -> tuple[int, int, int] | None:
+        """The interrupt input the host enabled, as (port, bit, active level), or None
+        (spec 10.3: ST0/ST2 bit i is input I1 bit i, ST1/ST3 bit i is I2 bit i)."""
+        for port, enable, polarity, mask in ((1, 0, 2, self.profile.low_mask),
+                                             (2, 1, 3, self.profile.high_mask)):
+            bits = self.status[enable] & mask
+            if bits:
+                bit = (bits & -bits).bit_length() - 1
+                return port, bit, (self.status[polarity] >> bit) & 1
+        return None
+
+
+def line_views(units: list[tuple[Profile, int]]) -> list[UnitView]:
+    """One view per unit on the line (``units``: profile and address of each)."""
+    return [UnitView(profile, address) for profile, address in units]
+
+
+def by_address(views: list[UnitView]) -> dict[int, UnitView]:
+    """Every address on the line with the view of the unit that answers it."""
+    return {a: v for v in views for a in v.addresses}
+
+
+def profiles_by_address(views: list[UnitView]) -> dict[int, Profile]:
+    return {a: v.profile for v in views for a in v.addresses}

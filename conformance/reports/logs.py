@@ -1,0 +1,41 @@
+"""What the reports keep of a case (issue 12 item 6; the default run's three reports must
+stay under 2 MB): a case that did not PASS whole; of a passing case the head and tail of
+its wire log, its first check and how many more passed (a GVE114's full queue is 2048 of
+them) and no trace data (the page draws its traces). ``--full-logs`` keeps everything."""
+
+from __future__ import annotations
+
+from conformance.verdict import PASS
+
+#: lines kept at each end of a passing case's wire log
+LOG_ENDS = 2
+
+
+def _fold(items: list, ends: int, marker) -> list:
+    if len(items) <= 2 * ends + 1:
+        return list(items)
+    return [*items[:ends], marker(len(items) - 2 * ends), *items[-ends:]]
+
+
+def compact(lines: list[str], verdict: str, full: bool = False) -> list[str]:
+    """The lines of a wire log as a report shows them."""
+    if full or verdict != PASS:
+        return list(lines)
+    return _fold(lines, LOG_ENDS,
+                 lambda n: f"... {n} lines left out (the whole log: --full-logs) ...")
+
+
+def compact_checks(checks: list[dict], verdict: str, full: bool = False) -> list[dict]:
+    """A case's checks as a report shows them: all of them unless the case passed (then
+    every one passed); of a passing case's the first and one line saying how many more
+    passed."""
+    if full or verdict != PASS or len(checks) <= 1:
+        return list(checks)
+    return [checks[0], {"ok": True, "observed": "", "expected": "", "tag": "", "rule": "",
+                        "what": f"... and {len(checks) - 1} more passed checks (all of "
+                                "them: --full-logs) ..."}]
+
+def compact_traces(traces: list[dict], verdict: str, full: bool = False) -> list[dict]:
+    """A case's traces as the JSON keeps them: whole unless the case passed (the page
+    draws a passing case's once)."""
+    return list(traces) if full or verdict != PASS else []

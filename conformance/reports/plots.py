@@ -1,0 +1,203 @@
+"""Pictures for the HTML report (issue 12 item 4), as inline SVG drawn by matplotlib
+(the optional extra ``[plots]``; no pyplot, no display: figures are rendered straight
+to SVG text). Without matplotlib every function returns None and the report says that
+plots are off.
+
+- :func:`verdict_chart`: per spec section, a bar of its case verdicts.
+- :func:`trace_chart`: a motion trace (``CaseResult.traces``) — position and rate
+  against time as sampled from the target, over the spec's model, with the tolerance
+  band the check used.
+- :func:`step_train_chart`: the pulses per axis of the emulator's stepper core.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Sequence
+from functools import cache
+
+import numpy as np
+
+#: a line holds at most this many points (the report must stay small)
+MAX_POINTS = 40
+#: the step train shows at most this many pulses
+MAX_PULSES = 120
+#: verdict colours, the same as the page's (report.css)
+COLOURS = {"PASS": "#6cc35a", "NON-STRICT": "#e5b935", "FAIL": "#d9483b",
+           "ERROR": "#8b1e14", "INFO": "#6f93d8", "MISSING": "#bbbbbb",
+           "COULD-NOT-TEST": "#8d8d8d"}
+_AXIS_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
+
+
+@cache
+def available() -> bool:
+    """Whether matplotlib can be imported (the ``[plots]`` extra)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _figure(width: float, height: float, margins: dict[str, float] | None = None):
+    """A figure laid out by matplotlib, or with fixed ``margins`` (fractions of the
+    figure, as ``subplots_adjust`` takes them): much faster where the layout is known."""
+    from matplotlib.figure import Figure
+    if margins is None:
+        return Figure(figsize=(width, height), dpi=72, layout="constrained")
+    fig = Figure(figsize=(width, height), dpi=72)
+    fig.subplots_adjust(**margins)
+    return fig
+
+
+def _svg(fig, key: str) -> str:
+    """The figure as an SVG element for inline HTML: text as text (not glyph paths),
+    no date (the same run gives the same bytes), ids salted by ``key`` so that several
+    pictures on one page never share one."""
+    from matplotlib import rc_context
+    out = io.StringIO()
+    with rc_context({"svg.fonttype": "none", "svg.hashsalt": key, "path.simplify": True}):
+        fig.savefig(out, format="svg", metadata={"Date": None})
+    text = out.getvalue()
+    text = _METADATA.sub("", text[text.index("<svg"):])
+    return _BETWEEN_TAGS.sub("><", _PATH.sub(_shorter, text))
+
+
+_PATH = re.compile(r' d="([^"]*)"')
+_METADATA = re.compile(r"<metadata>.*?</metadata>", re.S)
+_BETWEEN_TAGS = re.compile(r">\s+<")
+_DECIMALS = re.compile(r"(\d\.\d)\d+")
+
+
+def _shorter(m: re.Match) -> str:
+    """A path's coordinates to 0.1 pt (a tenth of a pixel at 72 dpi), on one line."""
+    return ' d="' + _DECIMALS.sub(r"\1", m.group(1)).replace(" \n", " ").strip() + '"'
+
+
+def _thin(points: Sequence, limit: int = MAX_POINTS) -> list:
+    """At most ``limit`` points, evenly spread, the first and last kept."""
+    if len(points) <= limit:
+        return list(points)
+    idx = np.unique(np.linspace(0, len(points) - 1, limit).round().astype(int))
+    return [points[i] for i in idx]
+
+
+def verdict_chart(rows: list[tuple[str, dict[str, int]]], key: str = "verdicts") -> str | None:
+    """A horizontal bar per (label, {verdict: count}), stacked in the given verdict order."""
+    if not available() or not rows:
+        return None
+    fig = _figure(7.5, 0.9 + 0.24 * len(rows))
+    ax = fig.add_subplot()
+    labels = [label for label, _ in rows][::-1]
+    left = np.zeros(len(rows))
+    for verdict, colour in COLOURS.items():
+        counts = np.array([c.get(verdict, 0) for _, c in rows][::-1], dtype=float)
+        if counts.any():
+            ax.barh(labels, counts, left=left, color=colour, label=verdict, height=0.7)
+            left += counts
+    ax.set_xlabel("case runs")
+    ax.tick_params(labelsize=8)
+    fig.legend(fontsize=7, ncols=len(COLOURS), loc="outside upper center")
+    ax.spines[["top", "right"]].set_visible(False)
+    return _svg(fig, key)
+
+
+def _columns(series: Sequence) -> tuple[np.ndarray, np.ndarray]:
+    """(times, positions[point, axis]) of a trace's [(t_s, [pos...])]."""
+    if not series:
+        return np.zeros(0), np.zeros((0, 0))
+    return (np.array([float(t) for t, _ in series]),
+            np.array([[float(p) for p in pos] for _, pos in series]))
+
+
+def _rate(t: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rate (steps/s) between consecutive points, at their midpoints."""
+    if len(t) < 2:
+        return np.zeros(0), np.zeros((0, pos.shape[1] if pos.ndim == 2 else 0))
+    dt = np.diff(t)
+    dt[dt == 0] = np.nan
+    return (t[:-1] + t[1:]) / 2, np.diff(pos, axis=0) / dt[:, None]
+
+
+def _band(t: np.ndarray, model_t: np.ndarray, model: np.ndarray, seconds: float,
+          steps: float) -> tuple[np.ndarray, np.ndarray]:
+    """What the tolerance admits around the model: at each instant, anything the model
+    passes within ±seconds, widened by ±steps."""
+    shifted = np.stack([np.interp(t + d, model_t, model) for d in (-seconds, 0.0, seconds)])
+    return shifted.min(axis=0) - steps, shifted.max(axis=0) + steps
+
+
+def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
+    """Position (and ``rate``) against time: the target's samples over the model."""
+    if not available():
+        return None
+    st, sp = _columns(_thin(trace.get("samples") or []))
+    mt, mp = _columns(trace.get("model") or [])
+    tol = trace.get("tolerance") or {}
+    seconds, steps = float(tol.get("seconds", 0.0)), float(tol.get("steps", 0.0))
+    names = trace.get("axes") or ["X", "Y", "Z", "A"]
+    width = max(sp.shape[1] if sp.size else 0, mp.shape[1] if mp.size else 0)
+    moving = [i for i in range(width)
+              if (sp.size and np.ptp(sp[:, i]) > 0) or (mp.size and np.ptp(mp[:, i]) > 0)]
+    height = 4.4 if rate else 2.6
+    fig = _figure(7.5, height, {"left": 0.12, "right": 0.98, "top": 1 - 0.3 / height,
+                                "bottom": 0.5 / height, "hspace": 0.12})
+    pos_ax, rate_ax = fig.subplots(2, 1, sharex=True) if rate else (fig.add_subplot(), None)
+    for i in moving or range(min(width, 1)):
+        colour, name = _AXIS_COLOURS[i % 4], names[i] if i < len(names) else f"axis {i}"
+        if mp.size:
+            grid = np.linspace(mt[0], mt[-1], MAX_POINTS)
+            model_i = np.interp(grid, mt, mp[:, i])
+            lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
+            pos_ax.fill_between(grid, lo, hi, color=colour, alpha=0.15, linewidth=0)
+            pos_ax.plot(grid, model_i, "--", color=colour, linewidth=1, label=f"{name} model")
+            if rate_ax is not None:
+                rt, rv = _rate(grid, model_i[:, None])
+                rate_ax.plot(rt, rv[:, 0], "--", color=colour, linewidth=1)
+        if sp.size:
+            # samples are readings (PF) at instants: points, not a line between them
+            pos_ax.plot(st, sp[:, i], "o", color=colour, markersize=3.5, label=f"{name} read")
+            if rate_ax is not None:
+                rt, rv = _rate(st, sp[:, i:i + 1])
+                rate_ax.plot(rt, rv[:, 0], "o", color=colour, markersize=3.5)
+    title = trace.get("name", "motion")
+    params = trace.get("params") or {}
+    if params:
+        title += "  (" + ", ".join(f"{k} {v}" for k, v in params.items()) + ")"
+    pos_ax.set_title(title, fontsize=9)
+    pos_ax.set_ylabel("position (steps)")
+    if rate_ax is not None:
+        rate_ax.set_ylabel("rate (steps/s)")
+    (rate_ax or pos_ax).set_xlabel(f"time (s); band: ±{seconds:g} s, ±{steps:g} steps")
+    pos_ax.legend(fontsize=7, ncols=2)
+    for ax in (pos_ax, rate_ax or pos_ax):
+        ax.tick_params(labelsize=8)
+    return _svg(fig, key)
+
+
+def step_train_chart(pulses: Sequence[tuple[float, int]], axes: Sequence[str], key: str,
+                     total: int | None = None) -> str | None:
+    """Pulses per axis as ticks against time: ``pulses`` are (t_s, mask) with bit i =
+    axis i stepped and bit 4+i = it stepped backwards (the stepper core's own mask)."""
+    if not available():
+        return None
+    shown = list(pulses[:MAX_PULSES])
+    height = 0.9 + 0.35 * len(axes)
+    fig = _figure(7.5, height, {"left": 0.06, "right": 0.98, "top": 1 - 0.3 / height,
+                                "bottom": 0.5 / height})
+    ax = fig.add_subplot()
+    for i, name in enumerate(axes):
+        for negative, alpha in ((False, 1.0), (True, 0.45)):
+            times = [t for t, m in shown if m >> i & 1 and bool(m >> (4 + i) & 1) == negative]
+            if times:
+                ax.eventplot(times, lineoffsets=len(axes) - 1 - i, linelengths=0.7,
+                             linewidths=0.7, colors=_AXIS_COLOURS[i % 4], alpha=alpha)
+    ax.set_yticks(range(len(axes)), list(axes)[::-1])
+    count = total if total is not None else len(pulses)
+    ax.set_title(f"step train: the first {len(shown)} of {count} pulses "
+                 "(pale: backwards)", fontsize=9)
+    ax.set_xlabel("time (s)")
+    ax.tick_params(labelsize=8)
+    return _svg(fig, key)
+

@@ -1,0 +1,30 @@
+// Filters by verdict, section and text; the matrix's cells set them. Works offline.
+(function () {
+  var boxes = document.querySelectorAll('#filters input[type=checkbox]');
+  var section = document.getElementById('f-section');
+  var text = document.getElementById('f-text');
+  function apply() {
+    var shown = {};
+    boxes.forEach(function (b) { shown[b.value] = b.checked; });
+    var want = text.value.toLowerCase();
+    document.querySelectorAll('details.case').forEach(function (d) {
+      var ok = shown[d.dataset.verdict] &&
+        (!section.value || d.dataset.section === section.value) &&
+        (!want || d.id.toLowerCase().indexOf(want) >= 0);
+      d.classList.toggle('hidden', !ok);
+    });
+    document.querySelectorAll('section.cases').forEach(function (s) {
+      s.classList.toggle('hidden', !s.querySelector('details.case:not(.hidden)'));
+    });
+  }
+  boxes.forEach(function (b) { b.addEventListener('change', apply); });
+  section.addEventListener('change', apply);
+  text.addEventListener('input', apply);
+  document.querySelectorAll('a[data-verdict]').forEach(function (a) {
+    a.addEventListener('click', function () {
+      boxes.forEach(function (b) { b.checked = !a.dataset.verdict || b.value === a.dataset.verdict; });
+      section.value = a.dataset.section || '';
+      apply();
+    });
+  });
+})();

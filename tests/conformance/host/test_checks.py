@@ -1,0 +1,154 @@
+"""The host rules over hand-built recordings: each rule is broken where the spec says it
+is and kept where it is not."""
+
+from __future__ import annotations
+
+from conformance.host.checks import PATIENCE_MS
+from conformance.host.oracle import HOST_CHECKS
+from gve_fixtures.rules import load_rules
+from tests.conformance.host.records import Wire, broken
+
+
+def test_every_host_check_names_a_host_rule():
+    rules = load_rules()
+    assert HOST_CHECKS
+    for rule in HOST_CHECKS:
+        assert "host" in rules[rule].roles, rule
+
+
+def test_simplex_waits_for_each_answer():
+    w = Wire()
+    w.frame(b"!0V1000", 0)                      # answered at 1 ms after its CR
+    w.frame(b"!0A100", 0.5)                     # sent before that answer came: spec 2
+    w.frame(b"!0B100", 50)
+    assert broken(w.judge())["2.link.simplex"] == ["!0A100"]
+
+
+def test_a_host_may_give_an_answer_up_after_waiting_long_enough():
+    w = Wire()
+    w.frame(b"!0V1000", 0, lost=True)
+    w.frame(b"!0@", PATIENCE_MS + 5, answer=b"0,1\r")
+    assert "2.link.simplex" not in broken(w.judge())
+    w = Wire()
+    w.frame(b"!0V1000", 0, lost=True)
+    w.frame(b"!0@", PATIENCE_MS / 2, answer=b"0,1\r")
+    assert "2.link.simplex" in broken(w.judge())
+
+
+def test_members_get_no_answer_so_the_next_frame_follows_at_once():
+    w = Wire()
+    w.frame(b"!0*S", 0, answer=None)
+    w.frame(b"!0C1,0,0", 0.2, answer=None)
+    w.frame(b"!0C2,0,0", 0.4, answer=None)
+    w.frame(b"!0*E2", 0.6, answer=b"0,2\r")
+    assert broken(w.judge()) == {}
+
+
+def test_packet_counts_and_members():
+    w = Wire()
+    w.frame(b"!0*S", 0, answer=None)
+    w.frame(b"!0C1,0,0", 1, answer=None)
+    w.frame(b"!0V100", 2, answer=None)           # not a member (spec 7)
+    w.frame(b"!0*E1", 3, answer=b"4,2\r")        # two members were sent
+    found = broken(w.judge())
+    assert found["7.packet.members"] == ["!0V100"]
+    assert found["7.packet.count"] == ["!0*E1"]
+
+
+def test_gaps_below_the_watchdog():
+    w = Wire()
+    w.frame(b"!0V1000", 0, gap_ms=20)            # a COM_SEND host: 20 ms a byte
+    w.frame(b"!0V2000", 500, gap_ms=120)         # slower than the 100 ms watchdog
+    j = w.judge()
+    assert broken(j)["3.frame.watchdog"] == ["!0V2000"]
+    assert any("slowest gap" in n and "120.0 ms" in n for n in j.notes)
+
+
+def test_a_gap_while_the_relay_itself_stalled_is_not_held_against_the_host():
+    w = Wire()
+    w.frame(b"!0V2000", 0, gap_ms=120)
+    w.rec.stalls.append((0, 1000 * 1_000_000))      # the relay was late all along
+    assert "3.frame.watchdog" not in broken(w.judge())
+
+
+def test_a_lost_answer_is_recovered_with_the_index():
+    w = Wire()
+    w.frame(b"!0L1000,0,0", 0, lost=True, fault="lost-answer")
+    w.frame(b"!0@", 300, answer=b"0,5\r")
+    w.frame(b"!0>", 301, answer=b"0\r")
+    assert broken(w.judge()) == {}
+
+
+def test_a_vector_resent_blindly():
+    w = Wire()
+    w.frame(b"!0L1000,0,0", 0, lost=True, fault="lost-answer")
+    w.frame(b"!0L1000,0,0", 300)
+    assert broken(w.judge())["8.recovery.no-blind-resend"] == ["!0L1000,0,0"]
+
+
+def test_a_setting_resent_blindly_or_an_answer_ignored():
+    w = Wire()
+    w.frame(b"!0V1000", 0, lost=True, fault="lost-answer")
+    w.frame(b"!0V1000", 300)
+    w.frame(b"!0A100", 400, lost=True, fault="lost-answer")
+    w.frame(b"!0B100", 700)
+    assert broken(w.judge())["8.recovery.ask-index"] == ["!0V1000", "!0B100"]
+
+
+def test_an_answer_whose_checksum_fails_is_not_trusted():
+    w = Wire()
+    w.frame(b"!0V1000,C4", 0, answer=b"0,5C\r", given=b"1,5C\r", fault="corrupt-answer",
+            checksums=True)
+    w.frame(b"!0V1000,C4", 10, answer=b"0,5C\r", checksums=True)
+    assert broken(w.judge())["6.checksum.response-sum"] == ["!0V1000,C4"]
+
+
+def test_noise_before_a_whole_answer_may_simply_be_skipped():
+    w = Wire()
+    w.frame(b"!0V1000", 0, given=b"\x00\xff0\r", fault="noise")
+    w.frame(b"!0A100", 10)
+    assert broken(w.judge()) == {}
+
+
+def test_a_full_queue_is_tried_again():
+    w = Wire()
+    w.frame(b"!0L10,0,0", 0, answer=b"1\r")
+    w.frame(b"!0L20,0,0", 10, answer=b"1\r")
+    w.frame(b"!0L10,0,0", 20)
+    assert broken(w.judge())["5.code.queue-full"] == ["!0L20,0,0"]
+
+
+def test_refusals_are_the_hosts_fault():
+    w = Wire()
+    w.frame(b"!0l100,0,0", 0, answer=b"3\r")
+    w.frame(b"!0V1000.0", 10, answer=b"4\r")
+    w.frame(b"!0SW8,F1", 20, answer=b"5\r")
+    w.frame(b"!0N", 30, answer=b"7\r")                # while moving (spec 5, 10.1)
+    found = broken(w.judge())
+    assert found["10.1.queue.wait-idiom"] == ["!0N"]
+    assert found["5.code.unknown"] == ["!0l100,0,0"]
+    assert found["5.code.syntax"] == ["!0V1000.0"]
+    assert found["5.code.range"] == ["!0SW8,F1"]
+
+
+def test_nothing_is_sent_while_the_unit_restarts_after_j():
+    w = Wire()
+    w.frame(b"!0J", 0)
+    w.frame(b"!0@", 500, answer=None)            # the unit restarts for 2000 ms
+    w.frame(b"!0@", 2500, answer=b"0,0\r")
+    assert broken(w.judge())["2.link.ready-after-restart"] == ["!0@"]
+
+
+def test_port_settings():
+    w = Wire()
+    w.rec.settings.append((0, "115200 8N2"))
+    assert broken(w.judge())["2.link.serial-8n1"] == ["(port settings)"]
+
+
+def test_coverage_counts_the_host_checks():
+    from conformance.coverage import coverage
+
+    (pc,) = coverage(["GVE84-100"], role="host", cases=[])
+    assert "8.recovery.exactly-once" in next(s for s in pc.sections if s.section == "8").covered
+    # all but 11.golden.g2, the example of a checksummed frame: 6.checksum.sum judges it
+    assert pc.covered >= pc.total - 1

@@ -1,0 +1,85 @@
+"""A host's frame judged against spec 3, 6 and 10: each problem names its rule. The
+expected rules and frames come from the spec's own examples."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.host.grammar import parse_frame
+from gve_fixtures.profile import load_profile
+
+GVE84 = {0: load_profile("GVE84-100")}
+GVE54 = {0: load_profile("GVE54")}
+GVE114 = {0: load_profile("GVE114-500"), 7: load_profile("GVE114-500")}
+
+
+def rules(raw: bytes, units=GVE84, checksums: bool = False) -> list[str]:
+    return [p.rule for p in parse_frame(raw, units, checksums).problems]
+
+
+@pytest.mark.parametrize("raw", [
+    b"!0V1000", b"!0L1000,0,0", b"!0C-1000,20,0", b"!0SW1,3F", b"!0SR2", b"!0PF", b"!0?",
+    b"!0VL25000,25000,30000", b"!0WY,-20000,1000,2000,500", b"!0WY-20000,1000,2000,500",
+    b"!0O0,FB", b"!0EW01,00", b"!0NX100", b"!0*S", b"!0*E10", b"!0XM200", b"!0T0000000000005",
+    b"!0SW0,001",
+])
+def test_the_spec_examples_are_well_formed(raw):
+    assert rules(raw) == []
+
+
+def test_checksums_as_spec_6_sums_them():
+    assert rules(b"!0A100,4F", checksums=True) == []           # spec 6, G2
+    assert rules(b"!0A100,4E", checksums=True) == ["6.checksum.sum"]
+    assert rules(b"!0A100", checksums=True) == ["6.checksum.sum"]   # missing
+    assert rules(b"!0%-,CF", checksums=True) == []             # spec 6, G1
+
+
+@pytest.mark.parametrize(("raw", "rule"), [
+    (b"!0l1000,0,0", "3.frame.upper-case"),                     # spec 3: `!0l…` → 3
+    (b"!0?5", "3.params.none-expected"),                        # spec 3: `!0?5` → 4
+    (b"!0@1", "3.params.none-expected"),
+    (b"!0V20000.0", "3.params.decimal"),                        # a non-digit → 4
+    (b"!0V+5", "3.params.decimal"),                             # a `+` → 4
+    (b"!0L100,,0", "3.params.decimal"),                         # an empty field → 4
+    (b"!0L100 0 0", "3.params.commas"),                         # spec 3: commas
+    (b"!0L1,2,3,4", "1.profile.axes"),                          # three axes on the GVE84
+    (b"!0L1,2", "10.cmd.vector"),
+    (b"!0SW8,F1", "5.code.range"),                              # spec 5 / G4: → 5
+    (b"!0SW2,FFF", "5.code.range"),                             # spec 3: → 5
+    (b"!0SW1,XY", "3.params.hex-fields"),
+    (b"!0L9999999999999,0,0", "1.profile.vector-range"),        # spec 3: → 5
+    (b"!0V200000", "1.profile.v-b-range"),                      # above the variant's max
+    (b"!0A0", "10.cmd.accel-range"),
+    (b"!0T25", "10.cmd.modal"),
+    (b"!0VL5,100,100", "10.cmd.axis-limits"),
+    (b"!1V1000", "2.link.addressed-only"),                      # no unit at address 1
+    (b"!9V1000", "3.frame.grammar"),                            # no address 0..7
+    (b"!0ZZ", "1.profile.command-set"),
+    (b"!0M4", "1.profile.command-set"),                         # M is the GVE54's
+    (b"!0" + b"T" + b"0" * 93 + b"5", "3.frame.max-length"),   # 97 bytes
+])
+def test_each_problem_names_its_rule(raw, rule):
+    assert rule in rules(raw)
+
+
+def test_family_rules():
+    assert rules(b"!0*S", GVE54) == ["1.profile.gve54-no-checksums"]   # spec 1
+    assert rules(b"!0V30", GVE54) == ["1.profile.v-b-range-gve54"]      # M54: 40..50000
+    assert rules(b"!0L65536,0,0", GVE54) == ["1.profile.vector-range"]  # ±65535
+    assert rules(b"!0MF", GVE54) == []
+    assert rules(b"!0L1,2,3,4", GVE114) == []                           # 3 or 4 values
+    assert rules(b"!0EFW10,1e+3", GVE114) == []                         # spec 3
+    assert rules(b"!0EFW10,+1", GVE114) == ["3.params.float-syntax"]
+    assert rules(b"!0EUW10,FF", GVE114) == ["3.params.word-values-decimal"]
+
+
+def test_the_spindle_address():
+    assert rules(b"!7V300", GVE114) == []                               # spec 12, G8
+    assert rules(b"!7V1001", GVE114) == ["12.spindle.speed"]
+    assert rules(b"!7L1,0,0", GVE114) == ["1.profile.command-set"]      # spec 12: → 3
+
+
+def test_every_judged_frame_names_the_rules_it_was_held_to():
+    f = parse_frame(b"!0V1000,C4", GVE84, True)
+    assert {"3.frame.grammar", "6.checksum.sum", "1.profile.v-b-range"} <= f.judged
+    assert f.command == "V" and f.params == ["1000"] and f.checksum == "C4"

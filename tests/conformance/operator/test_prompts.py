@@ -1,0 +1,112 @@
+"""The technician's side of a run on a real unit, driven through a pseudo-terminal: the
+question before the first frame that can move an axis, and the hand steps (done and
+verified by reading the input port back, skipped, or done wrong and caught by the
+read-back)."""
+
+from __future__ import annotations
+
+import json
+import signal
+
+import pytest
+
+from tests.conformance.operator.terminal import EmulatedUnit, Terminal, suite
+
+pytestmark = pytest.mark.pty
+
+HAND_CASE = "10.3.inputs.level-after-clearing"      # grounds IN0 (ctx.operator), then moves
+MOVING_CASE = "10.2.motion.targets-reached"
+GROUND = "Ground input IN0 (the X reference input) now, then press Enter; s to skip:"
+RELEASE = "Release input IN0 (the X reference input) now, then press Enter; s to skip:"
+QUESTION = "Move this machine? [y/N]"
+
+
+@pytest.fixture
+def unit():
+    u = EmulatedUnit("GVE84-100")
+    yield u
+    u.close()
+
+
+def _start(unit: EmulatedUnit, *cases: str) -> Terminal:
+    return Terminal(suite("--target", f"serial:{unit.path}", "--profile", "GVE84-100",
+                          "--cases", "1.profile.version", *(f"--cases={c}" for c in cases),
+                          "--no-reports"))
+
+
+def _asked(term: Terminal) -> None:
+    asked = term.expect(QUESTION)
+    assert "IP84 v3 27.1.2010, Q 25020304, judged as GVE84-100" in asked
+    assert "X ±2000, Y ±2000, Z ±2000" in asked and "destructive tests" in asked
+
+
+def test_no_confirmation_moves_nothing(unit):
+    term = _start(unit, MOVING_CASE)
+    _asked(term)
+    term.answer("n")
+    term.expect(f"COULD-NOT-TEST  {MOVING_CASE} [GVE84-100]  -- safety stop: ")
+    term.finish()
+    assert "motion was not confirmed" in term.seen
+    state = json.loads(unit.rig("state"))
+    assert state["excursion"] == [[0, 0], [0, 0], [0, 0]]       # not one step, any axis
+
+
+def _step(term: Terminal, step: str) -> None:
+    """Wait for ``step``; the question before moving may come first (the first frame
+    that can move an axis is sent when the case or its known state needs it)."""
+    if term.expect_any(QUESTION, step) == QUESTION:
+        term.answer("y")
+        term.expect(step)
+
+
+def test_hand_steps_done_are_verified(unit):
+    term = _start(unit, HAND_CASE)
+    for _ in ("G", "D", "K", "R"):
+        _step(term, GROUND)
+        unit.rig("in 1 FE")                          # the technician grounds IN0
+        term.answer("")
+        term.expect("verified: I1 = FE")
+        _step(term, RELEASE)
+        unit.rig("in 1 FF")
+        term.answer("")
+        term.expect("verified: I1 = FF")
+    term.expect(f"PASS            {HAND_CASE} [GVE84-100]")
+    assert term.finish() == 0 and "PASSED" in term.seen
+    assert term.seen.count(QUESTION) == 1
+
+
+def test_a_skipped_step_is_could_not_test_with_the_reason(unit):
+    term = _start(unit, HAND_CASE)
+    _step(term, GROUND)
+    term.answer("s")
+    term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
+                "IN0 (the X reference input): skipped by the operator")
+    assert term.finish() == 0                        # never a FAIL
+
+
+def test_a_wrong_action_is_caught_by_the_read_back(unit):
+    term = _start(unit, HAND_CASE)
+    _step(term, GROUND)
+    unit.rig("in 1 FD")                              # IN1 grounded instead of IN0
+    term.answer("")
+    term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
+                "IN0 (the X reference input): not verified, I1 reads FD (IN0 should read 0)")
+    assert term.finish() == 0
+
+
+def test_yes_skips_the_question_and_no_operator_says_why(unit):
+    term = Terminal(suite("--target", f"serial:{unit.path}", "--profile", "GVE84-100",
+                          "--cases", HAND_CASE, "--cases", MOVING_CASE,
+                          "--no-reports", "--yes", "--no-operator"))
+    term.expect(f"PASS            {MOVING_CASE} [GVE84-100]")
+    term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: needs a hand")
+    assert term.finish() == 0 and QUESTION not in term.seen
+
+
+def test_ctrl_c_at_the_question_stops_the_run_and_moves_nothing(unit):
+    term = _start(unit, MOVING_CASE)
+    _asked(term)
+    term.proc.send_signal(signal.SIGINT)
+    term.finish()
+    assert "interrupted by Ctrl-C" in term.seen and "FAILED" in term.seen
+    assert json.loads(unit.rig("state"))["excursion"] == [[0, 0], [0, 0], [0, 0]]

@@ -1,0 +1,130 @@
+"""The HTML page: banner, metadata, matrix with section names, filters, folded logs and
+checks, pictures (and none without matplotlib), hostile bytes made harmless."""
+
+from __future__ import annotations
+
+import re
+import sys
+from html.parser import HTMLParser
+
+from conformance.reports import plots
+from conformance.reports.html import render_html
+from conformance.verdict import ERROR
+from tests.conformance.reports.toy import HOSTILE, result, toy_run
+
+
+class _Tags(HTMLParser):
+    """Collects start tags and checks that every opened element (but the void ones)
+    is closed in order: the page is well nested."""
+    VOID = {"meta", "input", "br", "img", "link", "path", "use", "rect", "stop"}
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.stack: list[str] = []
+        self.starts: list[tuple[str, dict]] = []
+
+    def handle_starttag(self, tag, attrs):
+        self.starts.append((tag, dict(attrs)))
+        if tag not in self.VOID:
+            self.stack.append(tag)
+
+    def handle_startendtag(self, tag, attrs):
+        self.starts.append((tag, dict(attrs)))
+
+    def handle_endtag(self, tag):
+        if tag in self.VOID:
+            return
+        assert self.stack and self.stack[-1] == tag, f"</{tag}> closes {self.stack[-3:]}"
+        self.stack.pop()
+
+
+def parse(page: str) -> _Tags:
+    p = _Tags()
+    p.feed(page)
+    p.close()
+    assert p.stack == [], p.stack
+    return p
+
+
+def test_banner_and_metadata_head_the_page(no_plots):
+    page = render_html(toy_run())
+    assert re.search(r"class='banner FAILED'>FAILED<", page)
+    top = page[:page.index("id='cases'")]
+    for shown in ("2026-11-25T10:00:00+01:00", "J. Novák", "IP84 v3 27.1.2010", "25020304",
+                  "--seed", "1234", "--max-travel", "2000", "--cases", "10.*",
+                  "suite version", "host"):
+        assert shown in top, shown
+    run = toy_run()
+    run.results = [r for r in run.results if r.verdict != "FAIL"]
+    assert re.search(r"class='banner PASSED'>PASSED<", render_html(run))
+
+
+def test_the_matrix_names_sections_and_links_to_cases(no_plots):
+    page = render_html(toy_run())
+    tags = parse(page)
+    assert "10.5 KEEP / RESTORE" in page and "6 Checksums" in page   # spec headings
+    links = [a for t, a in tags.starts if t == "a" and a.get("data-verdict") == "FAIL"]
+    assert links and links[0]["href"] == "#sec-6" and links[0]["data-section"] == "6"
+    ids = {a.get("id") for _, a in tags.starts}
+    assert "sec-6" in ids and "case-6.toy.fails-GVE84-100" in ids
+    # the filters: one box per verdict, a section list, the script that applies them
+    boxes = [a["value"] for t, a in tags.starts if t == "input" and a.get("type") == "checkbox"]
+    assert "NON-STRICT" in boxes and "COULD-NOT-TEST" in boxes
+    assert "document.querySelectorAll('details.case')" in page
+
+
+def test_could_not_test_says_why_on_its_line(no_plots):
+    page = render_html(toy_run())
+    line = re.search(r"<summary><b>COULD-NOT-TEST</b>.*?</summary>", page).group(0)
+    assert "nobody grounded IN0 (X limit)" in line
+
+
+def test_passing_logs_and_checks_are_folded_unless_full_logs(no_plots):
+    page = render_html(toy_run())
+    assert "96 lines left out" in page and "and 49 more passed checks" in page
+    assert "0.000000050 &gt; !0@" not in page
+    full = render_html(toy_run(full_logs=True))
+    assert "lines left out" not in full and "0.000000050 &gt; !0@" in full
+
+
+def test_hostile_unit_bytes_are_harmless(no_plots):
+    run = toy_run()
+    run.results.append(result("5.toy.broken", ERROR, notes=[HOSTILE]))
+    page = render_html(run)
+    parse(page)
+    assert "\x00" not in page and "\x1b" not in page and "\x7f" not in page
+    assert "<script>alert" not in page and "</pre><script>" not in page
+    assert "&lt;/pre&gt;&lt;script&gt;alert(1)" in page and "\\x00\\x07\\x1B" in page
+
+
+def test_motion_traces_are_drawn_as_inline_svg():
+    page = render_html(toy_run())
+    case = page[page.index("id='case-10.2.toy.moves-GVE84-100'"):]
+    case = case[:case.index("</details>")]
+    assert "<svg" in case and "trapezoid X" in case
+    assert page.count("<svg") == 2                 # the case and the verdict chart
+    assert "<?xml" not in page and "<!DOCTYPE svg" not in page
+
+
+def test_a_case_passing_on_several_profiles_shows_once():
+    run = toy_run()
+    twin = result("10.2.toy.moves", "PASS", traces=run.results[1].traces)
+    twin.profile = "GVE84-50"
+    run.results.append(twin)
+    page = render_html(run)
+    assert page.count("trapezoid X") == 1 and page.count("<b>PASS</b> 10.2.toy.moves") == 1
+    assert "10.2.toy.moves [GVE84-100, GVE84-50]" in page and "Passed on 2 profiles" in page
+    each = render_html(run, full_logs=True)
+    assert each.count("<b>PASS</b> 10.2.toy.moves") == 2
+
+
+def test_without_matplotlib_the_page_says_plots_are_off(monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)        # import fails
+    plots.available.cache_clear()
+    try:
+        page = render_html(toy_run())
+    finally:
+        plots.available.cache_clear()
+    parse(page)
+    assert "<svg" not in page
+    assert "Plots are off" in page and "trapezoid X: plots are off" in page

@@ -1,0 +1,57 @@
+"""JUnit XML and JSON: the run's metadata and verdict, per-testcase properties that
+show NON-STRICT and INFO, well-formed whatever the unit sent."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+from conformance.reports import to_json, write_junit, write_reports
+from conformance.verdict import FAILED
+from tests.conformance.reports.toy import HOSTILE, toy_run
+
+
+def _props(el: ET.Element) -> dict[str, str]:
+    return {p.get("name"): p.get("value") for p in el.findall("./properties/property")}
+
+
+def test_junit_carries_timestamp_hostname_and_verdicts(tmp_path):
+    path = write_junit(toy_run(), tmp_path / "ci" / "gve.xml")     # --junitxml PATH
+    suite = ET.parse(path).getroot().find("testsuite")
+    assert suite.get("timestamp") == "2026-11-25T10:00:00+01:00" and suite.get("hostname")
+    props = _props(suite)
+    assert props["--seed"] == "1234" and props["operator"] == "J. Novák"
+    assert props["unit version (?)"] == "IP84 v3 27.1.2010"
+    assert props["run verdict"].startswith(FAILED)
+    cases = {c.get("name"): _props(c) for c in suite.findall("testcase")}
+    assert cases["8.toy.lenient[GVE84-100]"]["verdict"] == "NON-STRICT"
+    assert cases["9.toy.informs[GVE84-100]"]["verdict"] == "INFO"
+    assert cases["10.5.toy.passes[GVE84-100]"] == {
+        "verdict": "PASS", "tag": "M", "section": "10.5 KEEP / RESTORE"}
+
+
+def test_junit_is_well_formed_with_hostile_bytes(tmp_path):
+    text = write_junit(toy_run(), tmp_path / "j.xml").read_text(encoding="utf-8")
+    root = ET.fromstring(text)                              # raises if not well-formed
+    failure = root.find(".//testcase[@name='6.toy.fails[GVE84-100]']/failure")
+    assert "</pre><script>alert(1)</script>" in failure.text
+    assert "\\x00\\x07\\x1B" in failure.text and "\x00" not in text
+
+
+def test_json_has_the_same_metadata_and_the_overall_verdict(tmp_path, no_plots):
+    folder = write_reports(toy_run(), tmp_path)
+    data = json.loads((folder / "results.json").read_text())
+    assert data["verdict"] == FAILED and "1 FAIL" in data["reason"]
+    assert data["meta"]["seed"] == 1234 and data["meta"]["operator"] == "J. Novák"
+    assert data["meta"]["started"] == "2026-11-25T10:00:00+01:00"
+    assert data["meta"]["targets"][0]["processor_id"] == "25020304"
+    passing = next(r for r in data["results"] if r["id"] == "10.5.toy.passes")
+    assert passing["wire_log_lines"] == 100 and len(passing["wire_log"]) == 5
+    assert passing["checks_total"] == 50 and len(passing["checks"]) == 2
+    assert data["sections"]["10.5"] == "KEEP / RESTORE"
+    assert data["cases"]["10.5.toy.passes"]["rule"] == "a rule"
+    moving = next(r for r in data["results"] if r["id"] == "10.2.toy.moves")
+    assert moving["traces_total"] == 1 and moving["traces"] == []     # drawn on the page
+    failing = next(r for r in data["results"] if r["id"] == "6.toy.fails")
+    assert failing["wire_log"][-1] == f"< {HOSTILE}"       # JSON escapes by itself
+    assert to_json(toy_run(full_logs=True))["results"][0]["wire_log_lines"] == 100
