@@ -215,8 +215,6 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
                 first.stopped = stopped
                 add(first)
                 cases = cases[1:]
-            elif isinstance(err, SessionError):
-                run.problems.append(stopped)
         except KeyboardInterrupt:
             session.emergency_stop()
             return

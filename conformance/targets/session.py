@@ -197,6 +197,7 @@ class Session:
                 self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
                                f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
                                "mode; stop it before running the suite")
+                self.report.problems.append(self.failed)
                 raise SessionError(self.failed)
         self.counters = self._position(link)
         self.guard.envelope.origin(self.counters)
