@@ -176,10 +176,24 @@ def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config
                 target=target, settings_name=config.getoption("--gve-settings")))
 
 
-def pytest_unconfigure(config: pytest.Config) -> None:
-    """The end of the pytest run (also after Ctrl-C): every session puts its unit back."""
-    for target in config.stash.get(_TARGETS, []):
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """The end of the pytest run (also after Ctrl-C): every session puts its unit back;
+    what could not be put back is printed and fails the run."""
+    problems = []
+    for target in session.config.stash.get(_TARGETS, []):
         report = target.session.finish()
         target.close()
-        for problem in report.problems:
-            print(f"gve-conformance: PROBLEM on {target.info.spec}: {problem}")
+        problems += [f"{target.info.spec}: {p}" for p in report.problems]
+    for problem in problems:
+        print(f"\ngve-conformance: PROBLEM on {problem}")
+    if problems and session.exitstatus == pytest.ExitCode.OK:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """A run that ended before its session finished (a usage error later on): the
+    sessions still put their units back."""
+    for target in config.stash.get(_TARGETS, []):
+        target.session.finish()
+        target.close()

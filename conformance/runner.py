@@ -15,7 +15,7 @@ from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
 from conformance.operator import Console, Hands
-from conformance.targets import SessionError, Target
+from conformance.targets import Session, SessionError, Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
 #: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
@@ -145,6 +145,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                 link.settle(final=True)
             for violation in link.violations:
                 ctx.expect(False, violation, tag=ALWAYS)
+        if ended:
+            _after_case(session, ctx)
     result.seconds = time.perf_counter() - start
     verdicts += [grade(c.tag, profile.implements_decisions) for c in ctx.checks if not c.ok]
     if not verdicts and not ctx.checks:
@@ -158,6 +160,14 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                        ["# link", *link.transcript_lines()]]
     result.frames = sum(link.frames for link in ctx.links)
     return result
+
+
+def _after_case(session: Session, ctx: CaseContext) -> None:
+    """The session's clean-up after a case (EEPROM bytes it wrote put back)."""
+    try:
+        session.after_case()
+    except (KeyboardInterrupt, TargetNotResponding, SafetyStop) as err:
+        ctx.note(f"after the case: {type(err).__name__} {err}")
 
 
 def run(targets: list[Target], cases: list[Case], *, settings_name: str | None = None,
@@ -205,8 +215,6 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
                 first.stopped = stopped
                 add(first)
                 cases = cases[1:]
-            elif isinstance(err, SessionError):
-                run.problems.append(stopped)
         except KeyboardInterrupt:
             session.emergency_stop()
             return

@@ -226,7 +226,9 @@ class Link:
         if data:
             self._record(UNIT, data)
             real.received_at = self.now
-        self._last = (_ANSWERED if real is not None and real.code is not None else _TIMED_OUT,
+        answered = real is not None and real.code is not None
+        # a frame an injected fault dropped cannot be answered late
+        self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
                       self._last[1], data)
         if not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first

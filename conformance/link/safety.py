@@ -260,37 +260,34 @@ class Guard:
                code: int | None) -> Callable[[Envelope], None] | None:
         """What ``command`` does to the envelope with ``outcome`` (None: nothing);
         ``code`` is the answer's code when there was one."""
-        axes = self.envelope.axes
-        name = command.name
-        if name in ("L", "C"):
-            steps = command.fields(axes)
-            if name == "C" and self.packet_open:          # a member: judged with the packet
-                members = [*self.packet, steps]
-                return lambda e: _commit(e, members, outcome)
-            return lambda e: e.vector(steps, outcome, stand_alone=name == "L")
-        if name == "*E":
-            members = list(self.packet)
-            return lambda e: _commit(e, members, outcome)
-        if name == "D":
-            return lambda e: e.discard(outcome)
-        if name == "K":
-            return lambda e: e.discard(outcome, keep=True)
-        if name == "J":
-            return lambda e: e.discard(outcome, restart=True)
-        if name == "R":
-            return lambda e: e.restore(outcome)
-        if name in ("G", "SW6"):
-            return lambda e: e.unsettle()
-        if name == "N" or name in ("NX", "NY", "NZ", "NA"):
-            return self._counters(command, outcome)
-        if name == "W":
-            return self._reference(command, outcome, code)
-        if name == "M" and self.profile.microstep:
-            factor = self.profile.microstep.factors.get(command.params.strip())
-            return None if factor is None else (lambda e: e.mode(factor, outcome))
-        return None
+        simple = _EVENTS.get(command.name)
+        if simple is not None:
+            return lambda e: simple(e, outcome)
+        build = {"L": self._vector, "C": self._vector, "*E": self._vector,
+                 "N": self._counters, "NX": self._counters, "NY": self._counters,
+                 "NZ": self._counters, "NA": self._counters, "W": self._reference,
+                 "M": self._mode}.get(command.name)
+        return None if build is None else build(command, outcome, code)
 
-    def _counters(self, command: Command, outcome: Outcome) -> Callable[[Envelope], None]:
+    def _vector(self, command: Command, outcome: Outcome,
+                code: int | None) -> Callable[[Envelope], None]:
+        """`L`, `C`, and `*E` committing the packet's `C` members (a member sent while
+        the packet is open is judged with the members before it)."""
+        steps = command.fields(self.envelope.axes)
+        if command.name == "*E" or (command.name == "C" and self.packet_open):
+            members = list(self.packet) + ([steps] if command.name == "C" else [])
+            return lambda e: _commit(e, members, outcome)
+        return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
+
+    def _mode(self, command: Command, outcome: Outcome,
+              code: int | None) -> Callable[[Envelope], None] | None:
+        """GVE54 `M`: the micro-step mode of later vectors (currents change nothing)."""
+        micro = self.profile.microstep
+        factor = micro.factors.get(command.params.strip()) if micro else None
+        return None if factor is None else (lambda e: e.mode(factor, outcome))
+
+    def _counters(self, command: Command, outcome: Outcome,
+                  code: int | None) -> Callable[[Envelope], None]:
         """`N` zeroes every counter, `N<axis> n` sets one; a value the guard cannot read
         leaves that counter unknown."""
         names = self.profile.axes
@@ -392,6 +389,17 @@ class Guard:
     def excursion(self) -> list[tuple[float, float]]:
         """Per axis, the farthest the axis may have gone each way, in full steps."""
         return [(_steps(s.lo, self.scale), _steps(s.hi, self.scale)) for s in self.envelope.seen]
+
+
+#: commands whose effect needs nothing but the outcome
+_EVENTS: dict[str, Callable[[Envelope, Outcome], None]] = {
+    "D": lambda e, o: e.discard(o),                  # the queue emptied where the axes stand
+    "K": lambda e, o: e.discard(o, keep=True),       # ... and saved whole
+    "J": lambda e, o: e.discard(o, restart=True),    # ... counters zeroed, mode reset
+    "R": lambda e, o: e.restore(o),
+    "G": lambda e, o: e.unsettle(),                  # resumes what is already counted
+    "SW6": lambda e, o: e.unsettle(),
+}
 
 
 def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:

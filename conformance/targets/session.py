@@ -102,6 +102,7 @@ class Session:
         self.checksums: bool | None = None         # the checksum mode as found
         self.eeprom: dict[int, int] = {}           # EEPROM bytes as found
         self.counters: dict[int, int] = {}         # position counters as found (PF)
+        self.eeprom_touched: set[int] = set()      # bytes the run wrote (put back since)
         self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
                                     self.real, max_travel=info.max_travel if self.real else None)
         self.started = False
@@ -196,6 +197,7 @@ class Session:
                 self.failed = (f"{self.target.info.spec}: the unit reports RUN or STOP "
                                f"(ST6 = {st6:02X}): it is moving, or in hand-wheel (MPG) "
                                "mode; stop it before running the suite")
+                self.report.problems.append(self.failed)
                 raise SessionError(self.failed)
         self.counters = self._position(link)
         self.guard.envelope.origin(self.counters)
@@ -393,11 +395,25 @@ class Session:
             self.report.problems.append(f"position counters not restored: PF reads {read}, "
                                         f"expected {settable}")
 
-    def _restore_eeprom(self, link: Link) -> None:
-        if not self.guard.eeprom_written:
+    def after_case(self) -> None:
+        """EEPROM bytes a case wrote are put back as soon as it ends, so that no later
+        case meets them (e.g. 06 turning the GVE114's hand wheel on after a J); the end
+        of the run verifies every byte again."""
+        if not (self.real and self.guard.eeprom_written) or self.failed:
             return
+        link = self._new_link()
+        try:
+            with self.guard.own_frames():
+                self._eeprom_back(link, sorted(self.guard.eeprom_written))
+        finally:
+            self._keep_log(link)
+
+    def _eeprom_back(self, link: Link, addresses: list[int]) -> list[str]:
+        """Read ``addresses``, write back those that differ from the originals and read
+        them again; returns those written back (a failure is a problem)."""
         changed = []
-        for address, value in sorted(self.eeprom.items()):
+        for address in addresses:
+            value = self.eeprom[address]
             r = link.send("ER%02X" % address)
             if _hex_ok(r) and r.hex() == value:
                 continue
@@ -408,9 +424,16 @@ class Session:
             else:
                 self.report.problems.append(f"EEPROM {address:02X} not restored to {value:02X} "
                                             f"(reads {r})")
+        self.eeprom_touched.update(addresses)
+        self.guard.eeprom_written.clear()
+        return changed
+
+    def _restore_eeprom(self, link: Link) -> None:
+        if not (self.guard.eeprom_written or self.eeprom_touched):
+            return
+        changed = self._eeprom_back(link, sorted(self.eeprom))
         self.report.restored.append(f"EEPROM: {len(self.eeprom)} bytes verified"
                                     + (f", {' '.join(changed)} written back" if changed else ""))
-        self.guard.eeprom_written.clear()
 
     def _restore_status(self, link: Link) -> None:
         for n in RESTORE_ORDER:

@@ -4,6 +4,8 @@ pytest plugin leaves the unit as found."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from conformance.cli import main
@@ -25,6 +27,11 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
         in out
     assert "restored: axes back where the run began" in out
     assert "restored: ST0..ST5 as found: 00 00 00 00 00 00" in out
+    (folder,) = tmp_path.iterdir()
+    html = (folder / "report.html").read_text()
+    assert "restored: axes back where the run began" in html and "±800" in html
+    session = json.loads((folder / "results.json").read_text())["sessions"]
+    assert next(iter(session.values()))["excursion"] == [[0, 500], [0, 0], [0, 0]]
 
 
 def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
@@ -39,3 +46,26 @@ def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
     # one session for the whole pytest run: the unit as found is read once (the checksum
     # probe and the identity ask ? once each)
     assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 2
+
+
+def _mpg_unit(tmp_path) -> list[str]:
+    """A GVE114 whose EEPROM 06 makes its hand wheel hold RUN (spec 9): found moving."""
+    image = tmp_path / "unit.eeprom"
+    image.write_bytes(b"\xff" * 6 + b"\x01" + b"\xff" * 249)
+    return ["--model", "GVE114-500", "--eeprom", str(image)]
+
+
+def test_a_problem_makes_the_exit_status_non_zero(tmp_path, capsys):
+    with unit_behind_proxy(*_mpg_unit(tmp_path)) as (_, proxy):
+        status = main(["--target", f"serial:{proxy.path}", "--profile", "GVE114-500",
+                       "--cases", "5.errors.ok", "--no-reports"])
+    assert status == 1
+    assert "PROBLEM" in capsys.readouterr().out
+
+
+def test_a_problem_fails_the_pytest_run_too(pytester, tmp_path):
+    with unit_behind_proxy(*_mpg_unit(tmp_path)) as (_, proxy):
+        result = pytester.runpytest("--gve-target", f"serial:{proxy.path}", "--gve-profile",
+                                    "GVE114-500", "--gve-cases", "5.errors.ok", "-q")
+    assert result.ret == pytest.ExitCode.TESTS_FAILED
+    result.stdout.fnmatch_lines(["*PROBLEM on serial:*the unit reports RUN*"])
