@@ -94,7 +94,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
-                         "section and profile, and the rules without one; exit 0")
+                         "section and profile, and the rules without one (exit 1 if any)")
     ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
     return ap.parse_args(argv)
 
@@ -162,7 +162,8 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
         except LookupError as err:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
-        return 0
+        # a gate for CI: a rule no case can fail is a defect of the suite
+        return 1 if any(pc.uncovered for pc in report) else 0
     if args.jobs < 1:
         raise UsageError("--jobs must be 1 or more")
     if not args.no_reports:

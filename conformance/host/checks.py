@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
+from conformance.host.examples import worked_frames
 from conformance.host.recording import Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
 from gve_fixtures.profile import Profile
@@ -290,13 +291,31 @@ def unsolicited(rec: Recording, line: LineFacts, out: Judgement) -> None:
                              f"{b''.join(u.lines)!r} to no complete frame (its watchdog)")
 
 
+def worked_examples(rec: Recording, line: LineFacts, out: Judgement) -> None:
+    """A checksummed frame the spec works out (11 G2: `!0A100,4F`) sent byte for byte as
+    the example has it: the host sums its frames as the manuals do."""
+    examples = worked_frames()
+    out.judged |= {w.rule for w in examples.values()}
+    for ex in rec.exchanges:
+        raw = ex.frame.raw.rstrip(b"\r")
+        body, _, checksum = raw.rpartition(b",")
+        w = examples.get(body) if len(checksum) == 2 else None
+        unit = line.units.get(ex.parsed.address) if w else None
+        if w is None or unit is None or not (not w.families or unit.family in w.families
+                                             or unit.name in w.families):
+            continue
+        if raw != w.frame:
+            out.add(w.rule, _at(ex.frame.start, line), ex.text,
+                    f"the spec's worked example sends {w.frame.decode('latin-1')}")
+
+
 def _ours(u: Unsolicited, rec: Recording) -> bool:
     return any(ex.fault == "cut-frame" and ex.frame.end <= u.t for ex in rec.exchanges)
 
 
 #: the checks run on every recording, in order
 CHECKS: tuple[Check, ...] = (frames, refusals, gaps, simplex, packets, restarts, recovery,
-                             queue_full, port_settings, unsolicited)
+                             queue_full, port_settings, unsolicited, worked_examples)
 
 #: every rule a host can fail on the wire -> the check that judges it
 WIRE_CHECKS: dict[str, Check] = {
@@ -322,6 +341,7 @@ WIRE_CHECKS: dict[str, Check] = {
     "6.checksum.response-sum": recovery,
     "5.code.queue-full": queue_full,
     "2.link.serial-8n1": port_settings,
+    **{w.rule: worked_examples for w in worked_frames().values()},
 }
 
 

@@ -54,6 +54,12 @@ def test_the_command_prints_coverage_and_exits_0(capsys):
     assert "GVE54" in out and "total" in out
 
 
+def test_the_command_exits_1_when_a_rule_has_no_case(capsys):
+    # with only the version case selected, nearly every rule is left without one
+    assert main(["--coverage", "--profile", "GVE54", "--cases", "1.profile.version"]) == 1
+    assert "without a case that can fail them" in capsys.readouterr().out
+
+
 def test_every_unit_rule_is_covered_on_every_profile():
     report = coverage()
     missing = {pc.profile: pc.uncovered for pc in report if pc.uncovered}
