@@ -273,9 +273,12 @@ class Session:
         link.send("D")
 
     def _settle(self, link: Link) -> None:
-        """Stopped, interrupts off, queue and save empty, the reset values of what cannot
-        be read. A KEEP left by the last case leaves a queue that takes only L (spec
-        10.5): K saves the empty queue over it and R restores that, which moves nothing."""
+        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
+        interrupts off, queue and save empty, the reset values of what cannot be read. A
+        KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
+        the empty queue over it and R restores that, which moves nothing."""
+        if link.rig is not None:
+            link.rig.hands_off()
         self._stop(link)
         for body in self._reset_frames():
             link.send(body)
