@@ -312,9 +312,12 @@ class Session:
         if self.real and self._link is not None:
             self.report.interrupted = True
             wait = None if self.guard.responding else MARGIN
-            with self.guard.emergency():
-                self._halt(self._link, timeout=wait)
-                self._link.send("D", timeout=wait)
+            try:
+                with self.guard.emergency():
+                    self._halt(self._link, timeout=wait)
+                    self._link.send("D", timeout=wait)
+            except TargetNotResponding as err:          # gone (its port, its program)
+                self.report.problems.append(f"H and D after Ctrl-C not sent: {err}")
         self.interrupts.handle()
 
     def finish(self) -> SessionReport:
