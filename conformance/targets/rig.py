@@ -43,6 +43,9 @@ class ControlRig:
         self.program = program
         self.address = address
         self.on_power_on = on_power_on
+        # a simulator of several units answers `state` per address: then every command
+        # names the target's unit (a simulator of one needs no @ADDRESS)
+        self.several = "position" not in found and isinstance(found.get(str(address)), dict)
         self.found = self._unit(found)             # the first `state`, as found
         self._touched: dict[int, int] = {}         # input ports set since the hands were off
         self._switches: set[str] = set()           # axes with a switch the suite placed
@@ -81,21 +84,28 @@ class ControlRig:
             return state[str(self.address)]
         return state
 
+    def _at(self, address: int | None) -> str:
+        """`` @ADDRESS`` for a command to one unit, when it must say which."""
+        if address is None and self.several:
+            address = self.address
+        return "" if address is None else f" @{address}"
+
     # -- what the suite uses ---------------------------------------------------------------------
     def set_input(self, port: int, value: int, address: int | None = None) -> None:
-        self._do(f"in {port} {value:02X}{_at(address)}")
+        self._do(f"in {port} {value:02X}{self._at(address)}")
         self._touched[port] = value
 
     def set_switch(self, axis: str, position: int | None, address: int | None = None) -> None:
-        self._do(f"switch {axis} {'none' if position is None else position}{_at(address)}")
+        where = "none" if position is None else position
+        self._do(f"switch {axis} {where}{self._at(address)}")
         self._switches.add(axis)
 
     def power_on(self, address: int | None = None) -> None:
-        self._do(f"power-on{_at(address)}")
+        self._do("power-on" + ("" if address is None else f" @{address}"))   # None: all
         self.on_power_on()
 
     def state(self, address: int | None = None) -> dict:
-        reply = self._ask(f"state{_at(address)}")
+        reply = self._ask(f"state{self._at(address)}")
         state = _object(reply)
         if state is None:
             raise CouldNotTest(f"the rig's state is not one JSON object: {reply[:200]!r}")
@@ -125,12 +135,8 @@ class ControlRig:
             except ValueError:
                 value = RELEASED
             if self._touched[port] != value:
-                self._do(f"in {port} {value:02X}")
+                self._do(f"in {port} {value:02X}{self._at(None)}")
         for axis in sorted(self._switches):
-            self._do(f"switch {axis} none")
+            self._do(f"switch {axis} none{self._at(None)}")
         self._touched.clear()
         self._switches.clear()
-
-
-def _at(address: int | None) -> str:
-    return "" if address is None else f" @{address}"

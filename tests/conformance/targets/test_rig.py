@@ -64,7 +64,10 @@ def test_several_units_answer_for_the_target_s_address(started):
     p = started([*EMULATOR, "--unit", "GVE84-100@0", "--unit", "GVE54@1"])
     rig = ControlRig.detect(p, 1)
     assert rig is not None and rig.found["profile"] == "GVE54"
-    assert rig.state()["profile"] == "GVE54"
+    rig.set_input(1, 0xFE)
+    assert rig.state()["profile"] == "GVE54" and rig.state()["inputs"]["1"] == "FE"
+    p.send("state @0")
+    assert json.loads(p.line(10) or "")["inputs"]["1"] == "FF", "the other unit untouched"
 
 
 def test_a_program_that_does_not_read_its_input_has_no_rig(started):
