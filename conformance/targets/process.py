@@ -111,6 +111,9 @@ class ProgramPort:
     def close(self) -> None:
         self._port.close()
 
+    def __getattr__(self, name: str):
+        return getattr(self._port, name)          # the rest as pyserial has it
+
 
 @dataclass
 class ProcessTarget(PortTarget):
