@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 import sys
 
 import pytest
@@ -101,3 +102,12 @@ def test_a_program_that_cannot_start_is_one_line():
     with pytest.raises(ProgramError, match="cannot start 'no-such-program-here': No such "
                                            "file or directory"):
         Program(["no-such-program-here"])
+
+
+def test_a_program_left_running_is_stopped_when_the_interpreter_exits():
+    script = ("import sys\nfrom conformance.targets.program import Program\n"
+              f"p = Program({ECHO!r})\nprint(p.process.pid, flush=True)\nsys.exit(2)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60, check=False)
+    assert done.returncode == 2 and done.stderr == "", done.stderr
+    assert not running(int(done.stdout))
