@@ -42,7 +42,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
     g.addoption("--gve-settings", default=None,
                 help="Hypothesis settings profile (default: ci on the emulator, hardware on "
-                     "serial/tcp targets)")
+                     "serial/tcp/exec targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
     g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",
