@@ -11,6 +11,7 @@ import serial
 
 from conformance.case import TargetInfo
 from conformance.targets.base import Target, TargetError
+from conformance.targets.targetport import TargetPort
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
@@ -45,14 +46,14 @@ def open_port(url: str, baud: int, spec: str) -> serial.SerialBase:
 class PortTarget(Target):
     def __post_init__(self) -> None:
         super().__post_init__()
-        self._port: serial.SerialBase | None = None
+        self._port: TargetPort | None = None
 
     def preflight(self) -> None:
         self._open()
 
     def _open(self) -> serial.SerialBase:
         if self._port is None:
-            self._port = open_port(self.url, self.baud, self.info.spec)
+            self._port = TargetPort(open_port(self.url, self.baud, self.info.spec))
         return self._port
 
     def connect(self, address: int | None):

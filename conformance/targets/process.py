@@ -16,20 +16,16 @@ import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
 
-import serial
-
 from conformance.case import TargetInfo
-from conformance.link.safety import TargetNotResponding
 from conformance.targets.base import Target, TargetError
 from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
+from conformance.targets.targetport import ENDING_SECONDS, TargetPort
 from gve_fixtures.profile import available_profiles
 
 #: how long the program may take to print its port
 FIRST_LINE_SECONDS = 10.0
-#: after the port failed, how long the program may take to be seen ending
-ENDING_SECONDS = 1.0
 
 
 def port_url(line: str) -> str | None:
@@ -45,76 +41,6 @@ def port_url(line: str) -> str | None:
     return None
 
 
-class ProgramPort:
-    """The program's serial port, as pyserial's: when the program has ended (or the port
-    fails with it) the target is gone — TargetNotResponding saying how it ended, never an
-    error of the suite, never a wait for frames nobody answers."""
-
-    def __init__(self, port: serial.SerialBase, program: Program) -> None:
-        self._port = port
-        self._program = program
-
-    def _gone(self, err: Exception | None = None) -> NoReturn:
-        if self._program.alive:
-            self._program.wait(ENDING_SECONDS)
-        ended = self._program.ended()
-        raise TargetNotResponding(f"the target's program ended: {ended}" if ended else
-                                  f"the target's port failed: {err}")
-
-    def read(self, size: int = 1) -> bytes:
-        try:
-            data = self._port.read(size)
-        except (serial.SerialException, OSError) as err:
-            self._gone(err)
-        if not data and not self._program.alive:
-            self._gone()
-        return data
-
-    def read_until(self, expected: bytes = b"\n", size: int | None = None) -> bytes:
-        try:
-            data = self._port.read_until(expected, size)
-        except (serial.SerialException, OSError) as err:
-            self._gone(err)
-        if not data.endswith(expected) and not self._program.alive:
-            self._gone()
-        return data
-
-    def write(self, data: bytes) -> int | None:
-        if not self._program.alive:
-            self._gone()
-        try:
-            return self._port.write(data)
-        except (serial.SerialException, OSError) as err:
-            self._gone(err)
-
-    @property
-    def in_waiting(self) -> int:
-        try:
-            return self._port.in_waiting
-        except (serial.SerialException, OSError) as err:
-            self._gone(err)
-
-    @property
-    def timeout(self) -> float | None:
-        return self._port.timeout
-
-    @timeout.setter
-    def timeout(self, value: float | None) -> None:
-        self._port.timeout = value
-
-    def reset_input_buffer(self) -> None:
-        try:
-            self._port.reset_input_buffer()
-        except (serial.SerialException, OSError) as err:
-            self._gone(err)
-
-    def close(self) -> None:
-        self._port.close()
-
-    def __getattr__(self, name: str):
-        return getattr(self._port, name)          # the rest as pyserial has it
-
-
 @dataclass
 class ProcessTarget(PortTarget):
     command: tuple[str, ...] = ()
@@ -128,7 +54,7 @@ class ProcessTarget(PortTarget):
         if self._port is None:
             url = self._start()
             try:
-                self._port = ProgramPort(open_port(url, self.baud, self.info.spec),
+                self._port = TargetPort(open_port(url, self.baud, self.info.spec),
                                          self.program)
             except TargetError:
                 self._stop()

@@ -1,0 +1,69 @@
+"""A port that fails mid-run (a USB adapter pulled out: here the pseudo-terminal's other
+side gone with its emulator) ends the run for its target with the target's failure, at
+once: never an ERROR of the suite, never a wait for frames nobody answers."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+import serial
+
+from conformance.catalogue import select
+from conformance.link.safety import TargetNotResponding
+from conformance.runner import run
+from conformance.targets import parse_target
+from conformance.targets.targetport import TargetPort
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from tests.emulator.process import Emulator
+
+
+class Unplugged:
+    """A pyserial port whose every use fails as a pulled-out adapter's does."""
+
+    def _fail(self, *args, **kwargs):
+        raise serial.SerialException("device reports readiness to read but returned no "
+                                     "data (device disconnected or multiple access on port?)")
+
+    read = read_until = write = reset_input_buffer = _fail
+
+    @property
+    def in_waiting(self):
+        raise OSError(5, "Input/output error")
+
+    def close(self):
+        raise OSError(5, "Input/output error")
+
+
+@pytest.mark.parametrize("use", [lambda p: p.read(1), lambda p: p.read_until(b"\r"),
+                                 lambda p: p.write(b"!0?\r"), lambda p: p.in_waiting,
+                                 lambda p: p.reset_input_buffer()])
+def test_every_use_of_a_failed_port_is_the_target_gone(use):
+    with pytest.raises(TargetNotResponding, match=r"the target's port failed: .*(disconnected"
+                       r"|Input/output error)"):
+        use(TargetPort(Unplugged()))
+    TargetPort(Unplugged()).close()           # closing what is gone is no error
+
+
+@pytest.mark.pty
+def test_a_unit_unplugged_mid_run_ends_the_run_with_the_target_s_failure():
+    emulator = Emulator("--model", "GVE84-100", "--pty")
+    target = parse_target(f"serial:{emulator.first}", profile="GVE84-100")
+    target.preflight()
+
+    def unplug_after_the_first(result) -> None:
+        if emulator.proc.poll() is None:
+            emulator.stop()
+
+    try:
+        start = time.monotonic()
+        result = run([target], select(["5.errors.ok", "5.errors.unknown", "6.*"]),
+                     on_result=unplug_after_the_first)
+        took = time.monotonic() - start
+    finally:
+        emulator.stop()
+    got = [r.verdict for r in result.results]
+    assert ERROR not in got, [(r.id, r.notes) for r in result.results if r.verdict == ERROR]
+    assert got[0] == PASS and got[1] == FAIL and set(got[2:]) == {COULD_NOT_TEST}, got
+    assert "port failed" in result.results[1].failed_checks[0]["what"]
+    assert took < 20, f"{took:.1f} s"
