@@ -69,7 +69,7 @@ class GveItem(pytest.Item):
             self.target.preflight()
         except (ValueError, LookupError) as err:
             pytest.fail(str(err), pytrace=False)
-        with interrupts.catching_sigint():
+        with interrupts.catching():
             result = run_case(self.case, self.target, self.settings_name)
         if result.interrupted:
             raise KeyboardInterrupt

@@ -189,7 +189,7 @@ def run(targets: list[Target], cases: list[Case], *, settings_name: str | None =
         if on_result:
             on_result(r)
 
-    with interrupts.catching_sigint():
+    with interrupts.catching():
         for target in targets:
             if interrupts.stopped:
                 break

@@ -1,8 +1,9 @@
-"""Ctrl-C during a run (issue 8 item 4).
+"""Ctrl-C during a run.
 
-The first SIGINT does not raise where it lands: it is counted, the frame in flight gets
-its answer (or times out), and the link raises :class:`Interrupted` before the next
-frame, so that the next frame on the line is the session's `H`, then `D`. A signal
+The first SIGINT (or SIGTERM, SIGHUP) does not raise where it lands: it is counted, the
+frame in flight gets its answer (or times out), and the link raises
+:class:`Interrupted` before the next frame, so that the next frame on the line is the
+session's `H`, then `D`. A signal
 during the restorations that follow stops them the same way (`H`, `D` again, the rest
 skipped). A third signal raises KeyboardInterrupt at once.
 """
@@ -18,6 +19,11 @@ from collections.abc import Iterator
 class Interrupted(KeyboardInterrupt):
     """Raised by the link before a frame once Ctrl-C was pressed: no frame of a case, a
     teardown or a machine goes out after the signal."""
+
+
+#: the signals that stop a run as Ctrl-C does: a CI job's timeout and a closed terminal
+#: send SIGTERM and SIGHUP, and the machine must halt for them too
+STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 class Interrupts:
@@ -49,14 +55,15 @@ class Interrupts:
         self.handled = self.count
 
     @contextlib.contextmanager
-    def catching_sigint(self) -> Iterator[Interrupts]:
-        """SIGINT counts here while the block runs (main thread only; elsewhere the
-        default behaviour stays)."""
+    def catching(self) -> Iterator[Interrupts]:
+        """SIGINT, SIGTERM and SIGHUP count here while the block runs (main thread only;
+        elsewhere the default behaviour stays)."""
         if threading.current_thread() is not threading.main_thread():
             yield self
             return
-        previous = signal.signal(signal.SIGINT, self.signal)
+        previous = {sig: signal.signal(sig, self.signal) for sig in STOPPING}
         try:
             yield self
         finally:
-            signal.signal(signal.SIGINT, previous)
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)

@@ -107,10 +107,12 @@ def test_a_program_that_dies_mid_run_ends_the_run_with_the_target_s_failure():
     assert target.program is None and gone(process_.pid)
 
 
-def test_the_program_is_stopped_after_ctrl_c(tmp_path):
-    """Ctrl-C on the terminal (SIGINT to the suite's process group) once the first case
-    has ended: the program, in a group of its own, is still there for H, then D (its wire
-    log shows them); the run reports the interruption; then the program has ended."""
+@pytest.mark.parametrize("stopping", [signal.SIGINT, signal.SIGTERM])
+def test_the_program_is_stopped_after_ctrl_c(tmp_path, stopping):
+    """Ctrl-C on the terminal (SIGINT to the suite's process group), or a CI job's
+    timeout (SIGTERM), once the first case has ended: the program, in a group of its own,
+    is still there for H, then D (its wire log shows them); the run reports the
+    interruption; then the program has ended."""
     pidfile, log = tmp_path / "pid", tmp_path / "wire.gvt"
     simulator = (f"echo $$ > {shlex.quote(str(pidfile))}; exec "
                  + shlex.join([*EMULATOR, "--pty", "--log", str(log)]))
@@ -124,7 +126,7 @@ def test_the_program_is_stopped_after_ctrl_c(tmp_path):
         assert suite.stdout is not None
         for line in suite.stdout:
             if "5.errors.ok" in line:            # the first case has ended
-                os.killpg(suite.pid, signal.SIGINT)   # as a terminal's Ctrl-C
+                os.killpg(suite.pid, stopping)   # as a terminal's Ctrl-C, a CI's timeout
                 break
         out, err = suite.communicate(timeout=60)
     finally:
