@@ -66,17 +66,20 @@ def fresh_reset(ctx: CaseContext) -> None:
     ctx.link.wait(2.5)
 
 
-def index(ctx: CaseContext) -> int | None:
-    r = ctx.link.send("@")
+def index(ctx: CaseContext, address: int | None = None) -> int | None:
+    """The index as ``@`` reads it (at ``address``; default the link's): on a real unit
+    it is wherever the unit's use left it, so cases judge how far it moves."""
+    r = ctx.link.send("@", address=address)
     if r is None or r.code != 0:
         return None
     return r.dec()
 
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
-                tag: str | None = None, rule: str | None = None) -> bool:
+                tag: str | None = None, rule: str | None = None,
+                address: int | None = None) -> bool:
     """Expect the index to have advanced by ``frames`` since ``before`` (spec 8)."""
-    after = index(ctx)
+    after = index(ctx, address)
     expected = None if before is None else (before + frames) % 256
     return ctx.expect(after is not None and after == expected, what, observed=after,
                       expected=expected, tag=tag, rule=rule)

@@ -5,7 +5,7 @@ that take no parameters, the bounded frame buffer, the output port."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, setup
+from conformance.cases._kit import answers, code, setup, show
 
 # parameter -> (frame template, the rule its range belongs to on GVE54 / on GVE84, GVE114)
 RANGES = {
@@ -77,8 +77,16 @@ def hex_fields(ctx: CaseContext) -> None:
     setup(ctx, "SW3,10")
     answers(ctx, ctx.link.send("SR3"), "0,10", "SW's value is hex: 10 is sixteen",
             rule="3.params.hex-fields")
-    answers(ctx, ctx.link.send("ER0D"), "0,FF", "ER's address is hex (0D, the baud byte)",
-            rule="3.params.hex-fields")
+    # the EEPROM holds the owner's bytes: the same address written three ways reads alike
+    forms = {body: ctx.link.send(body) for body in ("ER0D", "ERD", "ER00D")}
+    ok = all(r is not None and r.code == 0 and len(r.values) == 1 for r in forms.values())
+    read = {r.hex() for r in forms.values()} if ok else set()
+    ctx.expect(ok and len(read) == 1, "ER's address is hex: ER0D, ERD and ER00D read one byte",
+               observed=", ".join(f"{b} → {show(r)}" for b, r in forms.items()),
+               expected="0,XX three times", rule="3.params.hex-fields")
+    for body in ("ER0G", "ERG"):
+        answers(ctx, ctx.link.send(body), "4", f"{body}: not a hex address → 4",
+                rule="3.params.hex-fields")
     answers(ctx, ctx.link.send("SW3,001"), "0", "SW3,001: three digits, in range",
             rule="3.params.hex-digits")
     answers(ctx, ctx.link.send("SR3"), "0,01", "and the value is 01", rule="3.params.hex-digits")
