@@ -37,9 +37,12 @@ def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | No
     return r
 
 
-def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 1500) -> None:
-    """Setup: CONT vectors queued and running, then HALT (INTA = 1, RUN = 1)."""
-    setup(ctx, "V1000")
+def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> None:
+    """Setup: CONT vectors queued and running, then HALT (INTA = 1, RUN = 1): halted half
+    a second into the first vector (at V500 about 250 steps), the rest queued. The
+    vectors stay within the default envelope (2000 full steps) even counted twice, as a
+    real unit's guard counts a queue kept with K and restored with R."""
+    setup(ctx, "V500")
     for _ in range(vectors):
         setup(ctx, "C" + vector(ctx, steps))
     ctx.link.wait(0.5)

@@ -10,6 +10,7 @@ import serial
 
 import emulator  # noqa: F401  (registers gve://)
 from conformance.case import TargetInfo
+from conformance.targets.base import DEFAULT_MAX_TRAVEL
 from conformance.targets.port import PortTarget
 from gve_fixtures.profile import load_profile
 
@@ -62,10 +63,12 @@ class UsedUnit(PortTarget):
         return self.port.line.state()
 
 
-def used_unit(profile: str, *, allow_destructive: bool = False) -> UsedUnit:
+def used_unit(profile: str, *, allow_destructive: bool = False,
+              max_travel: int = DEFAULT_MAX_TRAVEL) -> UsedUnit:
     p = load_profile(profile)
     url = f"gve://?model={profile}"
-    info = TargetInfo("serial", f"serial:{url} (used)", False, False, allow_destructive, 2000)
+    info = TargetInfo("serial", f"serial:{url} (used)", False, False, allow_destructive,
+                      max_travel)
     unit = UsedUnit(info, p, p.address, p.default_baud, url)
     unit.use()
     return unit

@@ -127,3 +127,19 @@ def test_halt_waits_for_the_longest_stop_the_envelope_allows():
     assert g.answer_seconds("H") == pytest.approx(2 * 8 ** 0.5)
     assert g.answer_seconds("WY,-2000,1000,200,100") == pytest.approx(2 + 2 + 4 * 8 ** 0.5)
     assert g.answer_seconds("V100") is None
+
+
+def test_a_vector_may_be_asked_about_before_it_is_drawn_again():
+    # a Hypothesis machine draws another vector instead of ending COULD-NOT-TEST
+    g = guard(travel=500)
+    assert g.fits("C300,0,0") and g.farthest("C300,0,0") == 300
+    g.accepted("C300,0,0", parse_response(b"0\r", summed=False))
+    assert not g.fits("C300,0,0") and g.farthest("C300,0,0") == 600
+    assert g.fits("C-300,0,0") and g.farthest("V1000") == 300
+    assert g.farthest("Cx,0,0") == float("inf")
+
+
+def test_the_emulator_has_no_envelope():
+    g = Guard(load_profile("GVE84-100"), 0, enforce=False, max_travel=500,
+              allow_destructive=False)
+    assert g.fits("C2147483647,0,0")
