@@ -1,7 +1,8 @@
 """A used unit for the cases' tests: the emulator in process and in virtual time, judged
 as a real unit (a ``serial:`` target with no rig, one unit for the whole run, the
 session's guard and known state), after an owner has used it: the index elsewhere, the
-EEPROM holding the owner's bytes, the axes moved away and the counters set elsewhere.
+EEPROM holding the owner's bytes, the axes moved away and the counters set elsewhere,
+input polarities set and the checksum mode left on.
 A case that assumes a fresh unit FAILs here although the unit is correct."""
 
 from __future__ import annotations
@@ -58,6 +59,9 @@ class UsedUnit(PortTarget):
         if "NX" in self.profile.commands:
             assert self.send("NX12345") == b"0\r" and self.send("NZ-777") == b"0\r"
         assert self.send("V1000") == b"0\r"
+        assert self.send("SW2,2B") == b"0\r"        # the owner's input polarities
+        if "%" in self.profile.commands:             # and the checksum mode left on
+            assert self.send("%+") == b"0,5C\r"
 
     def state(self) -> dict:
         return self.port.line.state()
