@@ -56,7 +56,7 @@ def go_idle(ctx: CaseContext) -> None:
       rule="D, K, R, N while a vector runs answer 7")
 def busy(ctx: CaseContext) -> None:
     setup(ctx, "V1000")
-    setup(ctx, "C" + vector(ctx, 3000))
+    setup(ctx, "C" + vector(ctx, 1500))      # 1.5 s at V1000: moving for every probe
     ctx.link.wait(0.3)
     for body in ("D", "K", "R", "N"):
         code(ctx, ctx.link.send(body), 7, f"{body} while moving → 7")

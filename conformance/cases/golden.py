@@ -3,11 +3,15 @@ case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
 from conformance.case import CaseContext, case
+from conformance.link.framing import HostFramer, parse_response
+from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
+from gve_fixtures.profile import Profile
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
@@ -79,6 +83,44 @@ def _action(ctx: CaseContext, words: list[str], what: str, tag: str,
         raise ValueError(f"unknown transcript action {verb!r}")
 
 
+def envelope_needed(t: Transcript, profile: Profile) -> int | None:
+    """The least --max-travel (full steps) with which a real unit's guard lets the whole
+    exchange through, or None when none does (a frame it cannot bound): its frames judged
+    as the replay's are (a trailing ``,XX`` both ways) and booked with the answers the
+    transcript expects (a pattern: unclear, whichever reaches farther)."""
+    address = int(t.meta.get("address", profile.address))
+    guard = Guard(profile, address, enforce=True, max_travel=2**62, allow_destructive=True)
+    framer, summed, pending, need = HostFramer(), False, [], 0.0
+    for rec in t.records:
+        if rec.direction == HOST:
+            pending += framer.frames(rec.data)
+            continue
+        if rec.direction == ACTION and rec.action[0] in ("fill", "poll"):
+            frames = framer.frames(unescape(rec.action[2]))
+            if rec.action[0] == "poll":      # until its answer
+                batches = [(f, unescape(rec.action[3])) for f in frames]
+            else:    # until the queue is full, then 1 (more if vectors end meanwhile)
+                sent = int(rec.action[1])
+                batches = ([(f, b"0\r") for f in frames] * min(sent, profile.buffer)
+                           + [(f, b"1\r") for f in frames] * (sent > profile.buffer))
+        elif rec.direction in (UNIT, UNIT_MATCH):
+            # the answer is the last frame's; those before it got none (*S, members)
+            answer = rec.data if rec.direction == UNIT else None
+            batches = [(f, None) for f in pending[:-1]] + [(f, answer) for f in pending[-1:]]
+        else:
+            continue
+        pending = []
+        for f, answer in batches:
+            if f.address in guard.addresses:
+                need = max(need, *(guard.farthest(body) for body in f.bodies(None)))
+            body = f.bodies(summed)[0]
+            r = None if answer is None else parse_response(answer, summed=summed)
+            guard.accepted(body, r, f.address)
+            if body in ("%+", "%-") and r is not None and r.code == 0:
+                summed = body == "%+"
+    return None if math.isinf(need) else math.ceil(need)
+
+
 def _register(path: Path) -> None:
     t = load(path)
     families = t.meta.get("profiles", "").split()
@@ -100,7 +142,15 @@ def _register(path: Path) -> None:
     def replay(ctx: CaseContext) -> None:
         if address >= 0 and address != ctx.link.address:
             ctx.fresh_link(address)
-        play(ctx, t, rule)
+        try:
+            play(ctx, t, rule)
+        except BeyondEnvelope as stop:
+            # data from the manuals, replayed as it is: say what envelope it needs
+            need = envelope_needed(t, ctx.profile)
+            raise BeyondEnvelope(f"{stop}; " + (
+                f"the exchange needs --max-travel {need} or more" if need is not None else
+                "no envelope lets the exchange through (a frame the guard cannot bound): "
+                "the emulator only")) from None
 
 
 for _path in golden_transcripts():

@@ -36,7 +36,7 @@ def saves(ctx: CaseContext) -> None:
       tag="M", source=SRC,
       rule="K keeps the rest of the interrupted vector: after R and G no step is lost")
 def partial(ctx: CaseContext) -> None:
-    halted_with_queue(ctx, 2, 1500)
+    halted_with_queue(ctx)
     setup(ctx, "K")
     setup(ctx, "L" + vector(ctx, 0, 0, -100))
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
@@ -45,8 +45,8 @@ def partial(ctx: CaseContext) -> None:
     ctx.link.send("R")
     ctx.link.send("G")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
-    ctx.expect(position(ctx) == [3000, 0, 0], "the job finished exactly",
-               observed=position(ctx), expected=[3000, 0, 0])
+    ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
+               observed=position(ctx), expected=[990, 0, 0])
 
 
 @case("10.5.keep.single-l",

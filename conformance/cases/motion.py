@@ -88,11 +88,11 @@ def halt(ctx: CaseContext) -> None:
       tag="M", source="M84 12.5.8",
       rule="G resumes the interrupted vector from the exact step: no step lost or gained")
 def go(ctx: CaseContext) -> None:
-    halted_with_queue(ctx, 3, 1500)
+    halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
-    ctx.expect(position(ctx) == [4500, 0, 0], "all three vectors completed",
-               observed=position(ctx), expected=[4500, 0, 0])
+    ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
+               observed=position(ctx), expected=[990, 0, 0])
 
 
 @case("10.4.delete.clears",

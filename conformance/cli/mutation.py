@@ -1,7 +1,10 @@
 """`gve-conformance mutation`: the suite's mutation score. Every deliberate bug the
 emulator can plant (its registry, through the ``emu`` target) is hunted with the case
 catalogue until a case FAILs it; the command prints, per mutant, the case that caught it
-and the time it took, then the score, and exits 1 below 100 %.
+and the time it took, then the score, and exits 1 below 100 % or when a case reported
+ERROR on the way (a defect of the suite: a broken unit must make a case FAIL, never
+crash it). ``--sweep`` runs the whole catalogue against every mutant on one profile per
+family besides, for the ERRORs only a case that does not catch the mutant meets.
 
 A mutant is stopped at its first FAIL by a case that PASSes the clean emulator on the
 same profile (a case failing both proves nothing; it is reported). The cases of the
@@ -61,8 +64,9 @@ def closeness(case, area: str) -> int:
 
 
 def hunt(mutant: str, profiles: list[str] | None = None,
-         include: list[str] | None = None) -> Hunt:
-    """Run cases against ``mutant`` until one FAILs (see the module's text)."""
+         include: list[str] | None = None, sweep: bool = False) -> Hunt:
+    """Run cases against ``mutant`` until one FAILs (see the module's text); with
+    ``sweep`` go on through the catalogue on one profile per family, noting ERRORs."""
     from conformance.catalogue import select
     from conformance.runner import run_case
     from conformance.targets import emu, parse_target
@@ -84,26 +88,27 @@ def hunt(mutant: str, profiles: list[str] | None = None,
     start = time.perf_counter()
     for c, p in pairs:
         target, clean = targets[p]
-        if c.missing_for(target.profile):
+        if c.missing_for(target.profile) or (result.caught and p not in first):
             continue
         r = run_case(c, target, "mutation")
         result.runs += 1
         where = f"{c.id} [{p}]"
         if r.verdict == ERROR:
             result.errors.append(where)
-        if r.verdict != FAIL:
+        if r.verdict != FAIL or result.caught:
             continue
         if run_case(c, clean, "mutation").verdict in (FAIL, ERROR):
             result.clean_fails.append(where)
             continue
         result.caught_by = where
         result.seconds = time.perf_counter() - start
-        return result
+        if not sweep:
+            return result
     result.seconds = time.perf_counter() - start
     return result
 
 
-def _hunt(args: tuple[str, list[str] | None, list[str] | None]) -> Hunt:
+def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool]) -> Hunt:
     return hunt(*args)
 
 
@@ -117,6 +122,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
     ap.add_argument("--jobs", type=int, default=1, help="mutants hunted in parallel")
+    ap.add_argument("--sweep", action="store_true",
+                    help="also run the rest of the catalogue against each mutant (one "
+                         "profile per family), failing on any ERROR")
     args = ap.parse_args(argv)
     from conformance.targets import emu
     from gve_fixtures.profile import available_profiles
@@ -128,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return 2
     names = args.mutant or sorted(known)
-    jobs = [(m, args.profile or None, args.cases or None) for m in names]
+    jobs = [(m, args.profile or None, args.cases or None, args.sweep) for m in names]
     start = time.perf_counter()
     results = []
     with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else _Serial() as pool:
@@ -137,9 +145,11 @@ def main(argv: list[str] | None = None) -> int:
             _show(h)
     caught = sum(h.caught for h in results)
     score = 100.0 * caught / len(results) if results else 100.0
+    errors = sum(len(h.errors) for h in results)
     print(f"\nmutation score: {caught}/{len(results)} = {score:.1f} % "
-          f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s))")
-    return 0 if caught == len(results) else 1
+          f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
+          f"{sum(h.runs for h in results)} case runs, {errors} ERROR")
+    return 0 if caught == len(results) and not errors else 1
 
 
 def _show(h: Hunt) -> None:

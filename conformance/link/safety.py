@@ -41,6 +41,11 @@ class SafetyStop(BaseException):
     and tries the frame again."""
 
 
+class BeyondEnvelope(SafetyStop):
+    """A motion frame after which an axis could leave the envelope (a machine that draws
+    its vectors may draw another instead: :meth:`Guard.fits`)."""
+
+
 class TargetNotResponding(BaseException):
     """Several frames in a row got no answer: the run stops for this target."""
 
@@ -181,6 +186,15 @@ class Guard:
         if command.name in MOTION:
             self._check_motion(body, command)
 
+    def fits(self, body: str) -> bool:
+        """Whether the motion frame ``body`` keeps every axis in the envelope now (always
+        on the emulator); other reasons not to send it still raise."""
+        try:
+            self.check(body)
+        except BeyondEnvelope:
+            return False
+        return True
+
     def check_frames(self, frames: list[HostFrame], summed: bool | None) -> None:
         """:meth:`check` every reading of raw frames (with and without a trailing
         checksum when the mode is not known)."""
@@ -208,14 +222,24 @@ class Guard:
         size = self.profile.eeprom.size
         return [(int(start.lo) + i) % size for i in range(width)]
 
-    def _check_motion(self, body: str, command: Command) -> None:
+    def farthest(self, body: str) -> float:
+        """How far (full steps) from where the run began an axis could be once the frame
+        ``body`` went out: the envelope it needs now (inf: it cannot be bounded)."""
+        command = Command.parse(body)
+        reach = self._reach(command) if command.name in MOTION else self.envelope.reach()
+        return max(max(-_steps(s.lo, self.scale), _steps(s.hi, self.scale)) for s in reach)
+
+    def _reach(self, command: Command) -> list[Span]:
         event = self._event(command, Outcome.UNCLEAR, None)
+        return self.envelope.would_reach(event) if event else self.envelope.reach()
+
+    def _check_motion(self, body: str, command: Command) -> None:
         e = self.envelope
-        reach = e.would_reach(event) if event else e.reach()
+        reach = self._reach(command)
         axis = e.outside(reach)
         if axis is not None:
             span = reach[axis]
-            raise SafetyStop(
+            raise BeyondEnvelope(
                 f"{body}: axis {self.profile.axes[axis]} could reach "
                 f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")

@@ -26,6 +26,11 @@ class UnitMachine(RuleBasedStateMachine):
         self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1])
         return r
 
+    def fits(self, body: str) -> bool:
+        """Whether a drawn motion frame keeps a real unit in its envelope: a rule skips a
+        vector that does not (the emulator has no envelope: every vector fits)."""
+        return self.link.guard.fits(body)
+
     def idle(self) -> None:
         r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120)
         self.model.frame_arrived("L")

@@ -38,8 +38,10 @@ class ErrorMachine(UnitMachine):
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
         return (run and not inta) or bool(st6 & 0x01), run, inta
 
-    @rule(steps=st.integers(500, 3000))
+    @rule(steps=st.integers(500, 1500))
     def motion(self, steps: int) -> None:
+        if not self.fits(f"C{steps},0,0"):
+            return
         r = self.link.send(f"C{steps},0,0")
         self.model.frame_arrived("C")
         assert r is not None and r.code in (0, 1), f"C answered {r}"

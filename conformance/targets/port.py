@@ -30,8 +30,22 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
         parts = urlsplit("x://h" + (rest if rest.startswith("/") else "/" + rest))
         # a path as given: /dev/ttyUSB0, or COM3 on Windows
         return parts.path if rest.startswith("/") else parts.path[1:], parse_qs(parts.query)
-    host, _, q_text = rest.partition("?")
-    return f"socket://{host}", parse_qs(q_text)
+    where, _, q_text = rest.partition("?")
+    return f"socket://{_host_port(where)}", parse_qs(q_text)
+
+
+def _host_port(where: str) -> str:
+    """``HOST:PORT`` checked before anything is opened: pyserial would take an empty host
+    for this machine and report a missing or bad port only when connecting."""
+    try:
+        parts = urlsplit("//" + where)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host, port = None, None
+    if not host or port is None or not 1 <= port <= 65535 or parts.path or parts.username:
+        raise TargetError(f"tcp:{where}: give the simulator's address as tcp:HOST:PORT "
+                          "(a port 1..65535)")
+    return where
 
 
 def open_port(url: str, baud: int, spec: str) -> serial.SerialBase:

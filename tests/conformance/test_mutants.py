@@ -5,14 +5,17 @@ PASSes the clean emulator, cases of its rule area first."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from conformance.catalogue import select
-from conformance.cli.mutation import hunt, main
+from conformance.cli import mutation
+from conformance.cli.mutation import Hunt, hunt, main
 from conformance.runner import run
 from conformance.targets import emu, parse_target
 from conformance.verdict import ERROR, FAIL
-from gve_fixtures.profile import available_profiles
+from gve_fixtures.profile import available_profiles, load_profile
 
 MUTANTS = emu.mutants()
 
@@ -51,3 +54,31 @@ def test_a_mutant_no_case_checks_is_missed_and_the_score_says_so(capsys) -> None
 def test_bad_arguments_are_one_line_and_exit_2(argv, capsys) -> None:
     assert main(argv) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_an_error_on_the_way_fails_the_command(capsys, monkeypatch) -> None:
+    # a broken unit must make a case FAIL, never crash it: the score alone would hide that
+    mutant = sorted(MUTANTS)[0]
+
+    def crashed(name, *args):
+        h = Hunt(name, "6", "")
+        h.caught_by, h.runs, h.errors = "6.x [GVE84-100]", 2, ["6.y [GVE84-100]"]
+        return h
+
+    monkeypatch.setattr(mutation, "hunt", crashed)
+    assert main(["--mutant", mutant]) == 1
+    out = capsys.readouterr().out
+    assert "ERROR on the way (a defect of the suite): 6.y [GVE84-100]" in out
+    assert "1/1 = 100.0 %" in out and "1 ERROR" in out
+
+
+def test_the_sweep_runs_the_catalogue_past_the_catch(capsys) -> None:
+    argv = ["--mutant", "go-without-inta", "--profile", "GVE84-100", "--cases", "5.errors.*"]
+    assert main(argv) == 0
+    hunted = capsys.readouterr().out
+    assert main([*argv, "--sweep"]) == 0
+    swept = capsys.readouterr().out
+    runs = [int(re.search(r"; (\d+) case runs", text).group(1)) for text in (hunted, swept)]
+    assert runs[0] < runs[1] == len([c for c in select(["5.errors.*"])
+                                     if not c.missing_for(load_profile("GVE84-100"))])
+    assert "0 ERROR" in swept

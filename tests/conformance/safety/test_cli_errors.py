@@ -14,6 +14,11 @@ from tests.conformance.safety.proxy import unit_behind_proxy
 
 pytest_plugins = ["pytester"]
 
+#: tcp targets pyserial would open wrongly (an empty host is this machine) or refuse late
+BAD_TCP = {"with an empty host": "tcp::5114", "with nothing": "tcp:",
+           "without a port": "tcp:localhost", "with a port that is no number": "tcp:h:notaport",
+           "with a port beyond 65535": "tcp:h:99999"}
+
 MISTAKES = {
     "port that does not exist": (["--target", "serial:/dev/gve-nosuch", "--profile",
                                   "GVE84-100"], "cannot open"),
@@ -40,6 +45,8 @@ MISTAKES = {
     "real target without a profile": (["--target", "tcp:127.0.0.1:9"], "--profile"),
     "mutant on a real target": (["--target", "serial:/dev/null", "--profile", "GVE84-100",
                                  "--mutant", "go-without-inta"], "--mutant"),
+    **{f"tcp target {what}": (["--target", spec, "--profile", "GVE84-100"], "tcp:HOST:PORT")
+       for what, spec in BAD_TCP.items()},
 }
 
 
@@ -80,6 +87,9 @@ PLUGIN_MISTAKES = {
     "profile contradicting emu": (["--gve-target", "emu:GVE54", "--gve-profile", "GVE84-100"],
                                   "contradicts"),
     "unknown mutant": (["--gve-target", "emu:GVE84-100?mutant=nosuch"], "unknown mutant"),
+    **{f"tcp target {what}": (["--gve-target", spec, "--gve-profile", "GVE84-100"],
+                              "tcp:HOST:PORT")
+       for what, spec in BAD_TCP.items()},
 }
 
 

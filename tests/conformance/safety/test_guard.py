@@ -141,3 +141,19 @@ def test_a_power_cycle_by_the_rig_is_booked_as_a_restart():
     assert g.envelope.position()[0] == 300
     with pytest.raises(SafetyStop, match="beyond the envelope"):
         g.check("L300,0,0")                               # 600 > 500
+
+
+def test_a_vector_may_be_asked_about_before_it_is_drawn_again():
+    # a Hypothesis machine draws another vector instead of ending COULD-NOT-TEST
+    g = guard(travel=500)
+    assert g.fits("C300,0,0") and g.farthest("C300,0,0") == 300
+    g.accepted("C300,0,0", parse_response(b"0\r", summed=False))
+    assert not g.fits("C300,0,0") and g.farthest("C300,0,0") == 600
+    assert g.fits("C-300,0,0") and g.farthest("V1000") == 300
+    assert g.farthest("Cx,0,0") == float("inf")
+
+
+def test_the_emulator_has_no_envelope():
+    g = Guard(load_profile("GVE84-100"), 0, enforce=False, max_travel=500,
+              allow_destructive=False)
+    assert g.fits("C2147483647,0,0")

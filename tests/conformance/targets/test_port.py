@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.targets import parse_target
+from conformance.targets import TargetError, parse_target
 from conformance.targets.port import locate
 
 
@@ -27,3 +27,20 @@ def test_a_target_opens_what_pyserial_is_given():
                      profile="GVE84-100")
     assert (t.url, t.baud, t.address) == ("socket://127.0.0.1:5114", 38400, 3)
     assert parse_target("tcp:127.0.0.1:5114", profile="GVE54").url == "socket://127.0.0.1:5114"
+
+
+@pytest.mark.parametrize("rest", ["", ":5114", "localhost", "h:notaport", "h:99999", "h:0",
+                                  "h:5114/x", "user@h:5114"])
+def test_a_tcp_target_needs_a_host_and_a_port(rest):
+    # pyserial would take an empty host for this machine and a bad port only on connecting
+    with pytest.raises(TargetError, match=r"tcp:HOST:PORT \(a port 1\.\.65535\)"):
+        parse_target(f"tcp:{rest}", profile="GVE84-100")
+
+
+@pytest.mark.parametrize(("rest", "url"), [
+    ("127.0.0.1:5114", "socket://127.0.0.1:5114"),
+    ("sim.local:65535?address=2", "socket://sim.local:65535"),
+    ("[::1]:5114", "socket://[::1]:5114"),
+])
+def test_a_tcp_target_with_a_host_and_a_port(rest, url):
+    assert parse_target(f"tcp:{rest}", profile="GVE84-100").url == url
