@@ -1,0 +1,307 @@
+"""The differential engine: a sequence of steps sent to a target and a reference alike,
+answer by answer compared; Hypothesis draws the sequences from the grammar and shrinks
+each disagreement to a minimal sequence, which is labelled, graded and kept once.
+
+A sequence stops at its first disagreement: after it the two sides are in different
+states and everything later would differ too.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import random
+import re
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from hypothesis import HealthCheck, Phase, find, settings
+from hypothesis.errors import NoSuchExample
+
+from conformance.diff.compare import Judge, difference
+from conformance.diff.grammar import Options, load_grammar, sequences
+from conformance.diff.labels import command_of, label, verdict_of
+from conformance.diff.sides import Exchange, Side
+from conformance.diff.steps import FILL, INPUT, WAIT, Step, frames_in
+from conformance.link.safety import SafetyStop, TargetNotResponding
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import St6
+
+#: frames that close an open packet (spec 7)
+_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+_LONG_DECIMAL = re.compile(r"\d{13,}")
+
+
+@dataclass
+class Record:
+    """One step as it went: the step, the frame's bytes and both sides' exchanges."""
+
+    step: Step
+    target: Exchange | None = None
+    reference: Exchange | None = None
+    repeat: int = 0                      # FILL: frames of it before this one
+
+
+@dataclass
+class Disagreement:
+    index: int                           # the record it happened on
+    command: str
+    kind: str
+    target: Exchange
+    reference: Exchange
+    context: frozenset[str]
+    earlier: frozenset[str]
+    rule: str | None = None
+    verdict: str = ""
+    tag: str = ""
+
+    @property
+    def signature(self) -> tuple:
+        return (self.rule, self.command, self.kind)
+
+
+@dataclass
+class Outcome:
+    records: list[Record] = field(default_factory=list)
+    disagreement: Disagreement | None = None
+    frames: int = 0
+    refused: list[str] = field(default_factory=list)     # steps the guard did not send
+    ended: str = ""                                      # why the sequence ended early
+
+
+class Pair:
+    """A target and its reference, run step by step."""
+
+    def __init__(self, target: Side, reference: Side, profile: Profile) -> None:
+        self.target = target
+        self.reference = reference
+        self.profile = profile
+        self.exact = target.virtual and reference.virtual
+        scale = profile.position_scale
+        self.judge = Judge(exact=self.exact, rate=profile.max_rate * scale * 8)
+
+    # -- one example ----------------------------------------------------------------------
+    def run(self, steps: list[Step]) -> Outcome:
+        out = Outcome()
+        self.target.open()
+        self.reference.open()
+        if not self.exact:
+            self._prelude()
+        context_packet = False
+        earlier: set[str] = set()
+        for step in steps:
+            if step.kind == WAIT:
+                self.target.wait(step.seconds)
+                self.reference.wait(max(0, self.target.now - self.reference.now) / 1e9)
+                out.records.append(Record(step))
+                continue
+            if step.kind == INPUT:
+                if self.target.has_rig and self.reference.has_rig:
+                    self.target.set_input(step.port, step.value)
+                    self.reference.set_input(step.port, step.value)
+                    out.records.append(Record(step))
+                    earlier.add("input")
+                continue
+            command = command_of(step.body)
+            context = self._context(step, context_packet)
+            times = step.times if step.kind == FILL else 1
+            for i in range(times):
+                rec = self._exchange(step, out)
+                if rec is None:
+                    break
+                rec.repeat = i
+                out.records.append(rec)
+                kind = self._difference(command, rec)
+                if kind is not None:
+                    d = Disagreement(len(out.records) - 1, command, kind, rec.target,
+                                     rec.reference, frozenset(context), frozenset(earlier))
+                    d.rule = label(command, kind, context, earlier,
+                                   None if rec.reference.code is None
+                                   else rec.reference.code & 7)
+                    d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
+                    out.disagreement = d
+                    return self._end(out)
+                if step.kind == FILL and rec.reference.code != 0:
+                    break
+            if out.ended:
+                return self._end(out)
+            if command:
+                earlier.add(command)
+            if command == "*S" and step.address is None:
+                context_packet = True
+            elif command in _PACKET_BREAKERS:
+                context_packet = False
+        return self._end(out)
+
+    def _end(self, out: Outcome) -> Outcome:
+        for side in (self.target, self.reference):
+            with contextlib.suppress(TargetNotResponding):
+                side.close_example()
+        return out
+
+    def _prelude(self) -> None:
+        """A real unit's index is not reset by the known state: read both, compare from
+        there; and give `>` the same history on both (`SR0`, answered 0,00 by both)."""
+        indexes = []
+        for side in (self.target, self.reference):
+            side.link.send("SR0")
+            r = side.link.send("@")
+            try:
+                indexes.append(r.dec(0) if r is not None else 0)
+            except AssertionError:
+                indexes.append(0)
+            side.link.send("SR0")
+        self.judge = Judge(False, self.judge.rate, (indexes[0] - indexes[1]) % 256)
+
+    def _sync(self) -> None:
+        """Each step starts at the same instant on both sides."""
+        self.reference.catch_up(self.target.now)
+        if self.exact:
+            self.target.catch_up(self.reference.now)
+
+    def _exchange(self, step: Step, out: Outcome) -> Record | None:
+        self._sync()
+        data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
+        rec = Record(step)
+        try:
+            rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
+                                              stall=step.stall)
+        except SafetyStop as err:
+            out.refused.append(f"{step}: {err}")
+            return None
+        except TargetNotResponding as err:
+            if not self.target.virtual:
+                raise
+            rec.target = Exchange(data, b"", 0, 0, None, step.lines)
+            out.ended = str(err)
+        out.frames += 1
+        if self.exact:
+            self.reference.catch_up(rec.target.sent_at)
+        try:
+            rec.reference = self.reference.exchange(data, lines=step.lines,
+                                                    answer=step.answer, stall=step.stall)
+        except TargetNotResponding as err:
+            rec.reference = Exchange(data, b"", 0, 0, None, step.lines)
+            out.ended = out.ended or str(err)
+        if out.ended and not rec.target.answer and not rec.reference.answer:
+            return None
+        return rec
+
+    def _difference(self, command: str, rec: Record) -> str | None:
+        moving = False
+        if not self.exact and command in ("P", "PF"):
+            moving = self._reference_moving()
+        return difference(command, rec.target, rec.reference, self.judge, moving=moving)
+
+    def _reference_moving(self) -> bool:
+        rig = self.reference.link.rig
+        if rig is None:
+            return True
+        state = rig.state()
+        return bool(int(state["status"][6], 16) & St6.RUN)
+
+    def _context(self, step: Step, in_packet: bool) -> set[str]:
+        g = load_grammar()["command"]
+        name = command_of(step.body)
+        entry = g.get(name, g.get(name + "0", {}))
+        flags = {
+            "other-address": step.address is not None,
+            "stalled": step.stall is not None,
+            "lower": any("a" <= ch <= "z" for ch in step.body),
+            "bad-checksum": step.checksum == "bad" and self.target.link.checksums,
+            "no-checksum": step.checksum == "none" and self.target.link.checksums,
+            "in-packet": in_packet,
+            "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
+            and step.body.upper() != name,
+            "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
+        }
+        return {k for k, on in flags.items() if on}
+
+
+# -- the search -------------------------------------------------------------------------------
+@dataclass
+class Finding:
+    """One disagreement, shrunk: its minimal sequence and how it went."""
+
+    steps: list[Step]
+    outcome: Outcome
+
+    @property
+    def disagreement(self) -> Disagreement:
+        assert self.outcome.disagreement is not None
+        return self.outcome.disagreement
+
+    @property
+    def frames(self) -> int:
+        return self.outcome.frames
+
+
+@dataclass
+class Budget:
+    """How long the search may go on: examples, seconds, or both."""
+
+    examples: int | None = 300
+    seconds: float | None = None
+    start: float = field(default_factory=time.perf_counter)
+    used: int = 0
+    frames: int = 0
+
+    def spent(self) -> bool:
+        if self.examples is not None and self.used >= self.examples:
+            return True
+        return self.seconds is not None and time.perf_counter() - self.start >= self.seconds
+
+    @property
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.start
+
+
+class _Spent(Exception):
+    """The budget ran out inside Hypothesis."""
+
+
+def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
+           stop_after: int | None = None,
+           on_finding: Callable[[Finding], None] | None = None) -> list[Finding]:
+    """Disagreements between the pair's sides, each shrunk and kept once (by its rule,
+    command and kind), until the budget is spent (or ``stop_after`` findings)."""
+    strategy = sequences(pair.profile, options)
+    findings: list[Finding] = []
+    known: set[tuple] = set()
+    rounds = 0
+    while not budget.spent() and (stop_after is None or len(findings) < stop_after):
+        best: dict[str, Finding] = {}
+
+        def fails(steps: list[Step], best: dict[str, Finding] = best) -> bool:
+            if budget.spent() and "found" not in best:
+                raise _Spent
+            budget.used += 1
+            outcome = pair.run(steps)
+            budget.frames += outcome.frames
+            d = outcome.disagreement
+            if d is None or d.signature in known:
+                return False
+            found = Finding(list(steps), outcome)
+            if "found" not in best or frames_in(steps) <= frames_in(best["found"].steps):
+                best["found"] = found
+            if budget.spent():
+                raise _Spent       # shrinking stops here: the smallest seen is kept
+            return True
+
+        left = (budget.examples - budget.used) if budget.examples is not None else 10**6
+        chosen = settings(max_examples=max(1, left), database=None, deadline=None,
+                          phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
+                          suppress_health_check=list(HealthCheck))
+        with contextlib.suppress(NoSuchExample, _Spent):
+            find(strategy, fails, settings=chosen, random=random.Random(seed + rounds))
+        rounds += 1
+        if "found" not in best:
+            if budget.spent() or budget.examples is not None:
+                break                  # (with examples left: Hypothesis found nothing new)
+            continue
+        finding = best["found"]
+        known.add(finding.disagreement.signature)
+        findings.append(finding)
+        if on_finding is not None:
+            on_finding(finding)
+    return findings
