@@ -116,8 +116,7 @@ class Pair:
                     d = Disagreement(len(out.records) - 1, command, kind, rec.target,
                                      rec.reference, frozenset(context), frozenset(earlier))
                     d.rule = label(command, kind, context, earlier,
-                                   None if rec.reference.code is None
-                                   else rec.reference.code & 7)
+                                   _code(rec.reference), _code(rec.target))
                     d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
                     out.disagreement = d
                     return self._end(out)
@@ -216,6 +215,10 @@ class Pair:
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
         }
         return {k for k, on in flags.items() if on}
+
+
+def _code(exchange: Exchange) -> int | None:
+    return None if exchange.code is None else exchange.code & 7
 
 
 # -- the search -------------------------------------------------------------------------------

@@ -117,12 +117,18 @@ class Grammar:
 
     def __init__(self, profile: Profile, options: Options) -> None:
         g = self.g = load_grammar()
+        self._cache: dict[tuple, st.SearchStrategy] = {}
         self.profile = profile
         self.options = options
         self.names = command_names(profile, options)
         self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
         kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
         self.fields = {k: _field(profile, k, g) for k in kinds}
+        self.valid = {k: _valid(profile, k, g) for k in kinds}
+        self.modal = [n for n in g["motion"]["modal"] if n in self.names]
+        self.vectors = [n for n in ("L", "C") if n in self.names]
+        self.events = [e for e in g["motion"]["events"]
+                       if e.rstrip("0123456789,") in profile.commands]
         self.checksums = "%" in profile.commands
         self.vector_counts = [3, 4] if profile.family == "GVE114" else [len(profile.axes)]
         steps = g["steps"]
@@ -133,27 +139,45 @@ class Grammar:
             self.kinds += ["packet"] * g["packet"]["weight"]
         if "C" in profile.commands:
             self.kinds += ["fill"] * g["fill"]["weight"]
+        if self.vectors:
+            self.kinds += ["motion"] * g["motion"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
         self.ports = ports or [1]
         self.member_names = [n for n in ("C", "B") if n in profile.commands]
         self.other_members = [n for n in ("L", "V", "PF") if n in profile.commands]
 
     # -- pieces ----------------------------------------------------------------------------
-    def body(self, draw, name: str) -> str:
+    def pick(self, draw, choices) -> object:
+        """One of ``choices`` (strategies built once: building one per draw is slow)."""
+        key = ("pick", tuple(choices))
+        if key not in self._cache:
+            self._cache[key] = st.sampled_from(list(choices))
+        return draw(self._cache[key])
+
+    def number(self, draw, lo: int, hi: int) -> int:
+        key = ("int", lo, hi)
+        if key not in self._cache:
+            self._cache[key] = st.integers(lo, hi)
+        return draw(self._cache[key])
+
+    def body(self, draw, name: str, *, valid: bool = False) -> str:
         entry = self.g["command"][name]
         kinds = entry.get("params", [])
+        fields = self.valid if valid else self.fields
         if kinds == ["vector"]:
-            n = draw(st.sampled_from(self.vector_counts))
-            params = [draw(self.fields["vector"]) for _ in range(n)]
+            n = self.pick(draw, self.vector_counts)
+            params = [draw(fields["vector"]) for _ in range(n)]
         else:
-            params = [draw(self.fields[k]) for k in kinds]
+            params = [draw(fields[k]) for k in kinds]
         body = _body(name, entry, params)
+        if valid:
+            return body
         inv = self.g["invalid"]
-        roll = draw(st.integers(0, 99))
+        roll = self.number(draw, 0, 99)
         if roll < inv["lower"] * 100:
             return body.lower()
         if roll < (inv["lower"] + inv["extra"]) * 100:
-            extra = draw(st.sampled_from(["1", "0,0"]))
+            extra = self.pick(draw, ["1", "0,0"])
             return body + (extra if not kinds else "," + extra)
         return body
 
@@ -161,7 +185,7 @@ class Grammar:
         entry = self.g["command"][name]
         fr = self.g["frames"]
         body = self.body(draw, name)
-        roll = draw(st.integers(0, 99))
+        roll = self.number(draw, 0, 99)
         checksum, address, stall = "auto", None, None
         if self.checksums and roll < fr["bad_checksum"] * 100:
             checksum = "bad"
@@ -170,7 +194,7 @@ class Grammar:
         elif roll >= 100 - fr["other_address"] * 100:
             address = (self.profile.address + 1 + roll % 6) % 8
         elif roll >= 100 - (fr["other_address"] + fr["stall"]) * 100:
-            stall = (draw(st.integers(2, 4)), (self.profile.watchdog_ms + 50) / 1000)
+            stall = (self.number(draw, 2, 4), (self.profile.watchdog_ms + 50) / 1000)
         answer = entry.get("answer", True) and address is None
         out = [Step(FRAME, body, checksum, address, answer, entry.get("lines", 1), stall)]
         if entry.get("then_wait") == "restart":
@@ -179,35 +203,60 @@ class Grammar:
 
     def packet(self, draw) -> list[Step]:
         pk = self.g["packet"]
-        count = draw(st.integers(1, pk["members"]))
+        count = self.number(draw, 1, pk["members"])
         members = []
         for _ in range(count):
-            other = draw(st.integers(0, 99)) < pk["other_member"] * 100
-            name = draw(st.sampled_from(self.other_members if other else self.member_names))
+            other = self.number(draw, 0, 99) < pk["other_member"] * 100
+            name = self.pick(draw, self.other_members if other else self.member_names)
             members.append(Step(FRAME, self.body(draw, name), answer=False))
         off = 0
-        if draw(st.integers(0, 99)) < pk["wrong_count"] * 100:
-            off = draw(st.sampled_from([-1, 1]))
+        if self.number(draw, 0, 99) < pk["wrong_count"] * 100:
+            off = self.pick(draw, [-1, 1])
         return [Step(FRAME, "*S", answer=False), *members,
                 Step(FRAME, f"*E{max(count + off, 0)}")]
 
-    def fill(self) -> list[Step]:
+    def fill(self, draw) -> list[Step]:
         zeros = ",0" * (len(self.profile.axes) - 1)
-        return [Step(FILL, f"C{self.g['fill']['vector']}{zeros}", times=self.profile.buffer + 2)]
+        most = self.profile.buffer + 2
+        times = draw(st.one_of(st.integers(1, most), st.just(most)))
+        return [Step(FILL, f"C{self.g['fill']['vector']}{zeros}", times=times)]
+
+    def motion(self, draw) -> list[Step]:
+        m = self.g["motion"]
+        out = []
+        for _ in range(self.number(draw, 0, 2)):
+            if self.modal:
+                out.append(Step(FRAME, self.body(draw, self.pick(draw, self.modal),
+                                                 valid=True)))
+        for _ in range(self.number(draw, 1, m["vectors"])):
+            out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors),
+                                             valid=True)))
+        waits = self.g["moves"]["waits"]
+        for _ in range(self.number(draw, 1, m["reads"])):
+            what = self.number(draw, 0, 2)
+            if what == 0:
+                out.append(Step(FRAME, "PF" if "PF" in self.profile.commands else "P"))
+            elif what == 1:
+                out.append(Step(WAIT, seconds=self.pick(draw, waits)))
+            elif self.events:
+                out.append(Step(FRAME, self.pick(draw, self.events)))
+        return out
 
     def group(self, draw) -> list[Step]:
-        kind = draw(st.sampled_from(self.kinds))
+        kind = self.pick(draw, self.kinds)
         if kind == "frame":
-            return self.frame(draw, draw(st.sampled_from(self.weighted)))
+            return self.frame(draw, self.pick(draw, self.weighted))
         if kind == "wait":
-            return [Step(WAIT, seconds=draw(st.sampled_from(self.g["moves"]["waits"])))]
+            return [Step(WAIT, seconds=self.pick(draw, self.g["moves"]["waits"]))]
         if kind == "input":
             value = draw(st.one_of(st.sampled_from([0xFF, 0xFE, 0x7F, 0x00, 0xFD]),
                                    st.integers(0, 255)))
-            return [Step(INPUT, port=draw(st.sampled_from(self.ports)), value=value)]
+            return [Step(INPUT, port=self.pick(draw, self.ports), value=value)]
         if kind == "packet":
             return self.packet(draw)
-        return self.fill()
+        if kind == "motion":
+            return self.motion(draw)
+        return self.fill(draw)
 
 
 def sequences(profile: Profile, options: Options) -> st.SearchStrategy[list[Step]]:

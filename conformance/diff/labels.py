@@ -15,7 +15,7 @@ from conformance.verdict import INFO, grade
 from gve_fixtures.rules import load_rules
 
 LABELS_FILE = Path(__file__).with_name("labels.toml")
-_FIELDS = ("command", "kind", "context", "earlier", "reference")
+_FIELDS = ("command", "kind", "context", "earlier", "reference", "target")
 
 #: spec 10's command names, longest first (so `PF` is not read as `P`)
 NAMES = sorted(["?", "Q", "L", "C", "T", "$", "A", "V", "VL", "B", "VK", "VN", "XA", "XU",
@@ -72,10 +72,11 @@ def load_labels(path: Path = LABELS_FILE) -> tuple[Label, ...]:
 
 
 def label(command: str, kind: str, context: set[str], earlier: set[str],
-          reference: int | None) -> str | None:
-    """The rule a disagreement touches (None: no known rule)."""
+          reference: int | None, target: int | None = None) -> str | None:
+    """The rule a disagreement touches (None: no known rule); ``reference`` and
+    ``target`` are the two sides' error codes (None: no answer)."""
     facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
-             "reference": reference}
+             "reference": reference, "target": target}
     for entry in load_labels():
         if entry.matches(facts):
             return entry.rule
