@@ -37,6 +37,12 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+def one_line(err: BaseException) -> str:
+    """An error as one line for the user (a KeyError's text without its quotes)."""
+    text = err.args[0] if err.args and isinstance(err.args[0], str) else str(err)
+    return (text.splitlines() or [type(err).__name__])[0]
+
+
 def common(ap: argparse.ArgumentParser) -> None:
     """The options diff and replay share."""
     ap.add_argument("--target", required=True,
@@ -90,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
         args = parse_args(argv)
         target, reference = targets(args)
     except (UsageError, TargetError, LookupError, ValueError) as err:
-        print(f"{PROG}: {str(err).splitlines()[0] if str(err) else err!r}", file=sys.stderr)
+        print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     run_id = new_run_id()
     folder = None if args.no_reports else Path(args.report_dir) / run_id

@@ -9,7 +9,7 @@ import argparse
 import sys
 from typing import NoReturn
 
-from conformance.cli.diff import UsageError, common, targets
+from conformance.cli.diff import UsageError, common, one_line, targets
 from conformance.diff.engine import Pair
 from conformance.diff.gvt import steps_of
 from conformance.diff.sides import Side
@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
             raise UsageError(f"{args.file}: no frames to replay")
     except (UsageError, TargetError, TranscriptError, LookupError, ValueError,
             OSError) as err:
-        print(f"{PROG}: {str(err).splitlines()[0] if str(err) else err!r}", file=sys.stderr)
+        print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     recorded = [r for r in t.records if r.direction == UNIT]
     session = target.begin()
