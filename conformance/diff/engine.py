@@ -57,7 +57,9 @@ class Disagreement:
 
     @property
     def signature(self) -> tuple:
-        return (self.rule, self.command, self.kind)
+        """What makes two disagreements one: the rule and the kind of difference (one
+        bug shows on many commands), or the command where no rule is known."""
+        return (self.rule, self.kind) if self.rule else (None, self.command, self.kind)
 
 
 @dataclass
@@ -266,8 +268,8 @@ class _Spent(Exception):
 def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
            stop_after: int | None = None,
            on_finding: Callable[[Finding], None] | None = None) -> list[Finding]:
-    """Disagreements between the pair's sides, each shrunk and kept once (by its rule,
-    command and kind), until the budget is spent (or ``stop_after`` findings)."""
+    """Disagreements between the pair's sides, each shrunk and kept once (by its rule
+    and kind), until the budget is spent (or ``stop_after`` findings)."""
     strategy = sequences(pair.profile, options)
     findings: list[Finding] = []
     known: set[tuple] = set()
