@@ -30,6 +30,10 @@ from gve_fixtures.protocol import St6
 #: frames that close an open packet (spec 7)
 _PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: real time: how long the reference must have been at rest, besides the target's
+#: window, for positions to be compared exactly (a target's motion ends when the unit
+#: says, the reference's when its model does)
+SETTLE_NS = 50_000_000
 
 
 @dataclass
@@ -79,14 +83,18 @@ class Pair:
         self.reference = reference
         self.profile = profile
         self.exact = target.virtual and reference.virtual
-        scale = profile.position_scale
-        self.judge = Judge(exact=self.exact, rate=profile.max_rate * scale * 8)
+        # the fastest an axis's counter can change: the variant's top rate, in counter
+        # units (GVE54: a coarse micro-step mode moves several sixteenths a step)
+        factor = max(profile.microstep.factors.values()) if profile.microstep else 1
+        self.judge = Judge(exact=self.exact, rate=profile.max_rate * factor)
+        self._idle_since: int | None = 0
 
     # -- one example ----------------------------------------------------------------------
     def run(self, steps: list[Step]) -> Outcome:
         out = Outcome()
         self.target.open()
         self.reference.open()
+        self._idle_since = 0
         if not self.exact:
             self._prelude()
         context_packet = False
@@ -190,16 +198,30 @@ class Pair:
 
     def _difference(self, command: str, rec: Record) -> str | None:
         moving = False
-        if not self.exact and command in ("P", "PF"):
-            moving = self._reference_moving()
+        if not self.exact:
+            self._watch_reference()
+            if command in ("P", "PF"):
+                moving = self._moving_near(rec)
         return difference(command, rec.target, rec.reference, self.judge, moving=moving)
 
-    def _reference_moving(self) -> bool:
+    def _watch_reference(self) -> None:
+        """Real time: note when the reference was first seen at rest (after each step;
+        a late note only makes the comparison more lenient)."""
         rig = self.reference.link.rig
-        if rig is None:
+        run = rig is None or bool(int(rig.state()["status"][6], 16) & St6.RUN)
+        if run:
+            self._idle_since = None
+        elif self._idle_since is None:
+            self._idle_since = self.reference.now
+
+    def _moving_near(self, rec: Record) -> bool:
+        """Whether the reading may have been taken while the axes moved on either side:
+        the reference had not been at rest for as long as the target's window is wide
+        (the target may have processed the frame that much later or earlier)."""
+        if self._idle_since is None:
             return True
-        state = rig.state()
-        return bool(int(state["status"][6], 16) & St6.RUN)
+        width = rec.target.received_at - rec.target.sent_at
+        return rec.reference.sent_at - self._idle_since < 2 * width + SETTLE_NS
 
     def _context(self, step: Step, in_packet: bool) -> set[str]:
         g = load_grammar()["command"]
@@ -278,8 +300,8 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
         best: dict[str, Finding] = {}
 
         def fails(steps: list[Step], best: dict[str, Finding] = best) -> bool:
-            if budget.spent() and "found" not in best:
-                raise _Spent
+            if budget.spent():
+                raise _Spent           # also while shrinking: the smallest seen is kept
             budget.used += 1
             outcome = pair.run(steps)
             budget.frames += outcome.frames
