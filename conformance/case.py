@@ -99,7 +99,7 @@ def case(id: str, *, rule: str | None = None, tag: str | None = None, source: st
 
 @dataclass(frozen=True)
 class TargetInfo:
-    kind: str                  # emu, serial, tcp
+    kind: str                  # emu, serial, tcp, exec
     spec: str                  # as given on the command line
     virtual_time: bool
     has_rig: bool
@@ -177,9 +177,10 @@ class CaseContext:
 
     def step_train(self, name: str) -> None:
         """Record the pulses per axis the emulator's stepper core gave on the current link
-        so far, for the reports (through the test rig; nothing on a real unit)."""
+        so far, for the reports (through the test rig; nothing on a real unit, nor through
+        a simulator's control channel, which gives no pulses)."""
         rig = self.link.rig
-        if rig is None:
+        if rig is None or not hasattr(rig, "pulses"):
             return
         origin = rig.now - self.link.now            # the link's instant 0 on the rig's clock
         pulses = [[(t - origin) / 1e9, mask] for t, mask in rig.pulses(origin)]

@@ -35,12 +35,14 @@ _INTERRUPTS = pytest.StashKey[Interrupts]()
 def pytest_addoption(parser: pytest.Parser) -> None:
     g = parser.getgroup("gve-conformance", "GVE protocol conformance suite")
     g.addoption("--gve-target", action="append", default=[],
-                help="run the suite's cases against this target (emu:PROFILE, serial:..., tcp:...)")
-    g.addoption("--gve-profile", default=None, help="the profile a serial/tcp target behaves as")
+                help="run the suite's cases against this target (emu:PROFILE, serial:..., "
+                     "tcp:..., exec:COMMAND)")
+    g.addoption("--gve-profile", default=None,
+                help="the profile a serial/tcp/exec target behaves as")
     g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
     g.addoption("--gve-settings", default=None,
                 help="Hypothesis settings profile (default: ci on the emulator, hardware on "
-                     "serial/tcp targets)")
+                     "serial/tcp/exec targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
     g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",
@@ -61,6 +63,12 @@ class GveItem(pytest.Item):
 
     def runtest(self) -> None:
         interrupts = self.config.stash[_INTERRUPTS]
+        try:
+            # a worker starts its targets here, at its first item of each (an exec:
+            # target's program: whether it has a rig decides the rig cases)
+            self.target.preflight()
+        except (ValueError, LookupError) as err:
+            pytest.fail(str(err), pytrace=False)
         with interrupts.catching_sigint():
             result = run_case(self.case, self.target, self.settings_name)
         if result.interrupted:

@@ -93,7 +93,9 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
         result.verdict, result.notes = MISSING, [why]
         return result
     if case.rig and not target.info.has_rig:
-        result.verdict, result.notes = COULD_NOT_TEST, ["needs the emulator's test rig"]
+        result.verdict = COULD_NOT_TEST
+        result.notes = ["needs a test rig (the emulator's, or an exec: simulator's control "
+                        "channel)"]
         return result
     if case.destructive and not target.info.allow_destructive:
         result.verdict, result.notes = COULD_NOT_TEST, ["destructive: needs --allow-destructive"]

@@ -48,8 +48,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
-                         "tcp:HOST:PORT; repeatable")
-    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target "
+                         "tcp:HOST:PORT, exec:COMMAND (a simulator it starts, docs/rig.md); "
+                         "repeatable")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp/exec target "
                                       "(with no --target: run the emulator as this profile); "
                                       "'auto': ask the unit (? and Q) and choose")
     ap.add_argument("--variant", help="with --profile auto, where the unit's answer does not "
@@ -64,7 +65,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
     ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
                     help="Hypothesis settings profile (default: ci on the emulator, "
-                         "hardware on serial/tcp targets)")
+                         "hardware on serial/tcp/exec targets)")
     ap.add_argument("--seed", type=int, metavar="N",
                     help="the Hypothesis machines' seed: the same N replays the same examples "
                          "(default: a fresh one, printed; none for derandomized settings)")

@@ -32,6 +32,9 @@ def resolve(spec: str, profile: str | None, variant: str | None, console: Consol
         return spec, profile, "emulated" if kind == "emu" else "--profile"
     if kind == "emu":
         return spec, None, "emulated"                 # the emulated unit is its profile
+    if kind == "exec":
+        raise ValueError(f"{spec}: name the profile the simulator behaves as (--profile "
+                         "auto asks a unit already on a port)")
     url, q = locate(kind, rest)
     address = int(q.get("address", ["0"])[-1])
     identity = ask(url, address, bauds(int(q["baud"][-1]) if "baud" in q else None))

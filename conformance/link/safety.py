@@ -256,6 +256,13 @@ class Guard:
             event(self.envelope)
         self._learn(command, response, outcome)
 
+    def restarted(self) -> None:
+        """The unit restarted by other means than `J` (a test rig's power cycle): booked
+        as a `J` it accepted (counters zeroed, queue and packet gone, the axes stay)."""
+        if self.enforce:
+            self.envelope.discard(Outcome.ACCEPTED, restart=True)
+            self.packet_open = False
+
     def _event(self, command: Command, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
         """What ``command`` does to the envelope with ``outcome`` (None: nothing);

@@ -1,12 +1,13 @@
 """Targets: where the suite's links go, one small module per scheme (as pyserial's URL
 handlers are): ``emu:PROFILE`` (emu.py, the embedded emulator in virtual time),
 ``serial:PATH?baud=&address=`` and ``tcp:HOST:PORT`` (port.py, a unit or a clone's
-simulator in real time). :func:`parse_target` picks the module by the scheme; the
+simulator in real time), ``exec:COMMAND`` (process.py, a simulator the suite starts,
+with its control channel as the test rig). :func:`parse_target` picks the module by the scheme; the
 run-wide session (session.py) opens links and keeps the unit safe."""
 
 from __future__ import annotations
 
-from conformance.targets import emu, port
+from conformance.targets import emu, port, process
 from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
 from conformance.targets.session import Session, SessionError, SessionReport
 
@@ -14,7 +15,7 @@ __all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Session", "SessionError", "SessionR
            "Target", "TargetError", "parse_target"]
 
 #: scheme -> the module that parses it (``parse(kind, rest, **options) -> Target``)
-SCHEMES = {"emu": emu, "serial": port, "tcp": port}
+SCHEMES = {"emu": emu, "serial": port, "tcp": port, "exec": process}
 
 
 def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bool = False,
@@ -24,8 +25,8 @@ def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bo
     kind, _, rest = spec.partition(":")
     module = SCHEMES.get(kind)
     if module is None:
-        raise TargetError(f"unknown target {spec!r}: use "
-                          "emu:PROFILE, serial:PATH?baud=&address=, or tcp:HOST:PORT")
+        raise TargetError(f"unknown target {spec!r}: use emu:PROFILE, "
+                          "serial:PATH?baud=&address=, tcp:HOST:PORT, or exec:COMMAND")
     return module.parse(kind, rest, spec=spec, profile=profile,
                         allow_destructive=allow_destructive, max_travel=max_travel,
                         mutant=mutant)

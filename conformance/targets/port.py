@@ -11,7 +11,7 @@ import serial
 
 from conformance.case import TargetInfo
 from conformance.targets.base import Target, TargetError
-from gve_fixtures.profile import available_profiles, load_profile
+from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
 OURS = ("baud", "address")
@@ -33,6 +33,15 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
     return f"socket://{host}", parse_qs(q_text)
 
 
+def open_port(url: str, baud: int, spec: str) -> serial.SerialBase:
+    """The pyserial port at ``url`` (a path, or a URL such as ``socket://host:port``);
+    TargetError with one line when it cannot be opened."""
+    try:
+        return serial.serial_for_url(url, baudrate=baud, timeout=0.5)
+    except (serial.SerialException, OSError, ValueError) as err:
+        raise TargetError(f"{spec}: cannot open {url}: {_reason(err)}") from None
+
+
 class PortTarget(Target):
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -43,11 +52,7 @@ class PortTarget(Target):
 
     def _open(self) -> serial.SerialBase:
         if self._port is None:
-            try:
-                self._port = serial.serial_for_url(self.url, baudrate=self.baud, timeout=0.5)
-            except (serial.SerialException, OSError, ValueError) as err:
-                raise TargetError(f"{self.info.spec}: cannot open {self.url}: "
-                                  f"{_reason(err)}") from None
+            self._port = open_port(self.url, self.baud, self.info.spec)
         return self._port
 
     def connect(self, address: int | None):
@@ -78,18 +83,26 @@ def _number(q: dict, key: str, default: int, spec: str, lo: int, hi: int) -> int
     return value
 
 
-def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
-    url, q = locate(kind, rest)
+def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel: int,
+                 mutant_hint: str = "") -> Profile:
+    """The profile a unit in real time is judged as, once the options make sense for it
+    (TargetError with one line otherwise)."""
     if profile is None:
         raise TargetError(f"{spec}: say which profile the unit should behave as "
                           f"(--profile, one of {', '.join(available_profiles())})")
     if mutant is not None:
-        raise TargetError(f"--mutant plants a bug in the embedded emulator; {spec} is not one")
+        raise TargetError(f"--mutant plants a bug in the embedded emulator; {spec} is not one"
+                          + (f" ({mutant_hint})" if mutant_hint else ""))
     if max_travel <= 0:
         raise TargetError(f"--max-travel {max_travel}: the envelope needs a positive "
                           "number of full steps")
-    p = load_profile(profile)
+    return load_profile(profile)
+
+
+def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
+          max_travel: int, mutant: str | None) -> Target:
+    url, q = locate(kind, rest)
+    p = real_profile(spec, profile, mutant, max_travel)
     baud = _number(q, "baud", p.default_baud, spec, 1, 10_000_000)
     address = _number(q, "address", p.address, spec, 0, 7)
     info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)

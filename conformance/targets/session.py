@@ -273,9 +273,12 @@ class Session:
         link.send("D")
 
     def _settle(self, link: Link) -> None:
-        """Stopped, interrupts off, queue and save empty, the reset values of what cannot
-        be read. A KEEP left by the last case leaves a queue that takes only L (spec
-        10.5): K saves the empty queue over it and R restores that, which moves nothing."""
+        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
+        interrupts off, queue and save empty, the reset values of what cannot be read. A
+        KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
+        the empty queue over it and R restores that, which moves nothing."""
+        if link.rig is not None:
+            link.rig.hands_off()
         self._stop(link)
         for body in self._reset_frames():
             link.send(body)
@@ -309,9 +312,12 @@ class Session:
         if self.real and self._link is not None:
             self.report.interrupted = True
             wait = None if self.guard.responding else MARGIN
-            with self.guard.emergency():
-                self._halt(self._link, timeout=wait)
-                self._link.send("D", timeout=wait)
+            try:
+                with self.guard.emergency():
+                    self._halt(self._link, timeout=wait)
+                    self._link.send("D", timeout=wait)
+            except TargetNotResponding as err:          # gone (its port, its program)
+                self.report.problems.append(f"H and D after Ctrl-C not sent: {err}")
         self.interrupts.handle()
 
     def finish(self) -> SessionReport:

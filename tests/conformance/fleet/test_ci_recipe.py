@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pytest
 
-from conformance.targets import SCHEMES
 from tests.conformance.fleet.recipe import blocks, commands, run_recipe
 from tests.conformance.fleet.services import free_port
 
@@ -47,12 +46,16 @@ def test_the_shell_job_runs_a_tcp_simulator_and_publishes(tmp_path):
 
 
 def test_the_shell_job_runs_an_exec_simulator_and_publishes(tmp_path):
-    if "exec" not in SCHEMES:
-        pytest.skip("exec: targets are not in this suite yet; the tcp: recipe is tested")
-    env = environment(0, f"{EMULATOR} --pty", "5.errors.*")
+    pidfile = tmp_path / "simulator.pid"
+    simulator = f"sh -c 'echo $$ > {pidfile}; exec {EMULATOR} --pty'"
+    env = environment(0, simulator, "5.errors.*")
     done = run_recipe(["settings", "run-exec", "publish"], tmp_path, env)
     assert done.returncode == 0, done.stdout + done.stderr
+    assert "PASSED" in done.stdout
     assert len(published(tmp_path).findall("./testsuite/testcase")) > 0
+    # the suite stopped the simulator it started
+    with pytest.raises(ProcessLookupError):
+        os.kill(int(pidfile.read_text()), 0)
 
 
 def test_the_github_workflow_runs_the_shell_job_s_commands():

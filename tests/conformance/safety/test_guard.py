@@ -127,3 +127,17 @@ def test_halt_waits_for_the_longest_stop_the_envelope_allows():
     assert g.answer_seconds("H") == pytest.approx(2 * 8 ** 0.5)
     assert g.answer_seconds("WY,-2000,1000,200,100") == pytest.approx(2 + 2 + 4 * 8 ** 0.5)
     assert g.answer_seconds("V100") is None
+
+
+def test_a_power_cycle_by_the_rig_is_booked_as_a_restart():
+    """The counters start again at 0 and the axes stay: a later PF of 0 is read as where
+    the axis already was, not as a move back to where the run began."""
+    g = guard()
+    g.envelope.origin({0: 0, 1: 0, 2: 0})                  # the counters as found
+    g.accepted("L300,0,0", parse_response(b"0\r", summed=False))
+    g.accepted("SR6", parse_response(b"0,00\r", summed=False))  # it ended
+    g.restarted()
+    g.accepted("PF", parse_response(b"0,0,0,0\r", summed=False))
+    assert g.envelope.position()[0] == 300
+    with pytest.raises(SafetyStop, match="beyond the envelope"):
+        g.check("L300,0,0")                               # 600 > 500

@@ -1,0 +1,197 @@
+"""``exec:COMMAND``: a program the suite starts itself — a firmware clone's simulator, or
+the emulator (``exec:python -m emulator --pty``) — judged in real time as a real unit.
+
+The program prints where its serial port is on its first line (docs/rig.md: a pty path,
+``socket://HOST:PORT``, ``HOST:PORT`` or ``tcp HOST:PORT``); the port is opened as
+port.py opens any other. When it answers `state` on its standard input with a JSON
+object within a second, the control channel is the run's test rig (rig.py) and rig cases
+run; otherwise they are COULD-NOT-TEST. The program is stopped when the target is closed
+(at the end of the run, also after Ctrl-C once the session has halted the unit), and a
+program that ends during the run makes the target not responding at once.
+"""
+
+from __future__ import annotations
+
+import shlex
+from dataclasses import dataclass, replace
+from typing import NoReturn
+
+import serial
+
+from conformance.case import TargetInfo
+from conformance.link.safety import TargetNotResponding
+from conformance.targets.base import Target, TargetError
+from conformance.targets.port import PortTarget, open_port, real_profile
+from conformance.targets.program import Program, ProgramError
+from conformance.targets.rig import ControlRig
+from gve_fixtures.profile import available_profiles
+
+#: how long the program may take to print its port
+FIRST_LINE_SECONDS = 10.0
+#: after the port failed, how long the program may take to be seen ending
+ENDING_SECONDS = 1.0
+
+
+def port_url(line: str) -> str | None:
+    """The pyserial URL of the port a program's first line names (None: not a port)."""
+    text = line.strip()
+    if text.startswith("tcp "):
+        text = text[4:].strip()
+    if text.startswith("/") or "://" in text:
+        return text
+    host, colon, port = text.rpartition(":")
+    if colon and host and port.isdigit() and " " not in host:
+        return f"socket://{host}:{port}"
+    return None
+
+
+class ProgramPort:
+    """The program's serial port, as pyserial's: when the program has ended (or the port
+    fails with it) the target is gone — TargetNotResponding saying how it ended, never an
+    error of the suite, never a wait for frames nobody answers."""
+
+    def __init__(self, port: serial.SerialBase, program: Program) -> None:
+        self._port = port
+        self._program = program
+
+    def _gone(self, err: Exception | None = None) -> NoReturn:
+        if self._program.alive:
+            self._program.wait(ENDING_SECONDS)
+        ended = self._program.ended()
+        raise TargetNotResponding(f"the target's program ended: {ended}" if ended else
+                                  f"the target's port failed: {err}")
+
+    def read(self, size: int = 1) -> bytes:
+        try:
+            data = self._port.read(size)
+        except (serial.SerialException, OSError) as err:
+            self._gone(err)
+        if not data and not self._program.alive:
+            self._gone()
+        return data
+
+    def read_until(self, expected: bytes = b"\n", size: int | None = None) -> bytes:
+        try:
+            data = self._port.read_until(expected, size)
+        except (serial.SerialException, OSError) as err:
+            self._gone(err)
+        if not data.endswith(expected) and not self._program.alive:
+            self._gone()
+        return data
+
+    def write(self, data: bytes) -> int | None:
+        if not self._program.alive:
+            self._gone()
+        try:
+            return self._port.write(data)
+        except (serial.SerialException, OSError) as err:
+            self._gone(err)
+
+    @property
+    def in_waiting(self) -> int:
+        try:
+            return self._port.in_waiting
+        except (serial.SerialException, OSError) as err:
+            self._gone(err)
+
+    @property
+    def timeout(self) -> float | None:
+        return self._port.timeout
+
+    @timeout.setter
+    def timeout(self, value: float | None) -> None:
+        self._port.timeout = value
+
+    def reset_input_buffer(self) -> None:
+        try:
+            self._port.reset_input_buffer()
+        except (serial.SerialException, OSError) as err:
+            self._gone(err)
+
+    def close(self) -> None:
+        self._port.close()
+
+    def __getattr__(self, name: str):
+        return getattr(self._port, name)          # the rest as pyserial has it
+
+
+@dataclass
+class ProcessTarget(PortTarget):
+    command: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.program: Program | None = None
+        self.rig: ControlRig | None = None
+
+    def _open(self):
+        if self._port is None:
+            url = self._start()
+            try:
+                self._port = ProgramPort(open_port(url, self.baud, self.info.spec),
+                                         self.program)
+            except TargetError:
+                self._stop()
+                raise
+        return self._port
+
+    def _fail(self, why: str) -> NoReturn:
+        self._stop()
+        raise TargetError(f"{self.info.spec}: {why}")
+
+    def _start(self) -> str:
+        """Start the program, find its port and its rig; the port's URL."""
+        try:
+            self.program = program = Program(list(self.command))
+        except ProgramError as err:
+            raise TargetError(f"{self.info.spec}: {err}") from None
+        first = program.line(FIRST_LINE_SECONDS)
+        if first is None:
+            program.wait(ENDING_SECONDS)
+            tail = program.stderr_tail()
+            self._fail(f"the program printed no port: {program.ended()}" if not program.alive
+                       else f"the program printed no port within {FIRST_LINE_SECONDS:g} s"
+                       + (f" (stderr: {tail})" if tail else ""))
+        url = port_url(first)
+        if url is None:
+            self._fail(f"the program's first line {first[:200]!r} is not a port (a pty "
+                       "path, socket://HOST:PORT or HOST:PORT)")
+        self.rig = ControlRig.detect(program, self.address, self._restarted)
+        self.info = replace(self.info, has_rig=self.rig is not None)
+        named = self.rig.found.get("profile") if self.rig else None
+        if named in available_profiles() and named != self.profile.name:
+            self._fail(f"--profile {self.profile.name} contradicts the program, whose rig "
+                       f"says it behaves as {named}")
+        return url
+
+    def _restarted(self) -> None:
+        """The rig cycled the power: the guard books it as a restart (J)."""
+        self.session.guard.restarted()
+
+    def connect(self, address: int | None):
+        port, baud, virtual, _ = super().connect(address)
+        return port, baud, virtual, self.rig
+
+    def _stop(self) -> None:
+        if self.program is not None:
+            self.program.stop()
+        self.program = self.rig = None
+
+    def close(self) -> None:
+        super().close()
+        self._stop()
+
+
+def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
+          max_travel: int, mutant: str | None) -> Target:
+    try:
+        command = shlex.split(rest)
+    except ValueError as err:
+        raise TargetError(f"{spec}: cannot read the command: {err}") from None
+    if not command:
+        raise TargetError(f"{spec}: give the command that starts the simulator "
+                          "(exec:'./clone-sim --pty')")
+    p = real_profile(spec, profile, mutant, max_travel,
+                     "put --mutant NAME in the command when it is the emulator")
+    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
+    return ProcessTarget(info, p, p.address, p.default_baud, spec, command=tuple(command))

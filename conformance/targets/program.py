@@ -1,0 +1,178 @@
+"""The program behind an ``exec:`` target: started in a process group of its own (so
+that Ctrl-C on the terminal reaches the suite alone, which halts the unit before the
+program is stopped), its standard output read line by line, its standard input written
+line by line, its standard error kept for the one line that says why it failed.
+
+Stopping it (:meth:`Program.stop`) asks first (``quit`` on standard input, docs/rig.md),
+then terminates and finally kills its whole process group, each with a bounded wait, and
+reaps it: no zombie, no orphan. Every program still running when the interpreter exits
+is stopped the same way.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import os
+import queue
+import shlex
+import signal
+import subprocess
+import tempfile
+import threading
+import time
+
+#: how long the program may take to end after ``quit``, then after SIGTERM
+QUIT_SECONDS = 2.0
+TERM_SECONDS = 2.0
+#: lines of standard output held for a reader that does not take them
+HELD_LINES = 1000
+
+_RUNNING: set[Program] = set()
+
+
+class ProgramError(Exception):
+    """The program cannot be started or did not do what an ``exec:`` target needs."""
+
+
+class Program:
+    """A running program: lines out (:meth:`line`), lines in (:meth:`send`)."""
+
+    def __init__(self, command: list[str]) -> None:
+        self.command = command
+        self._stderr = tempfile.TemporaryFile()  # noqa: SIM115  (open while it runs)
+        try:
+            self.process = subprocess.Popen(
+                command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr,
+                process_group=0, close_fds=True)
+        except (OSError, ValueError) as err:
+            self._stderr.close()
+            reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
+            raise ProgramError(f"cannot start {command[0]!r}: {reason}") from None
+        self._lines: queue.Queue[str | None] = queue.Queue(HELD_LINES)
+        self._eof = False
+        _RUNNING.add(self)
+        threading.Thread(target=self._read, name=f"exec-{self.process.pid}",
+                         daemon=True).start()
+
+    def _read(self) -> None:
+        """Standard output, line by line, until its end (then None); lines beyond
+        HELD_LINES that nobody takes are dropped, so the program never blocks on it."""
+        assert self.process.stdout is not None
+        with contextlib.suppress(OSError, ValueError):       # closed by stop()
+            for raw in self.process.stdout:
+                text = raw.decode("utf-8", "replace").rstrip("\r\n")
+                with contextlib.suppress(queue.Full):
+                    self._lines.put_nowait(text)
+        with contextlib.suppress(queue.Full):
+            self._lines.put_nowait(None)
+        self._eof = True
+
+    # -- what it says ---------------------------------------------------------------------
+    def line(self, timeout: float) -> str | None:
+        """The next line of standard output within ``timeout`` seconds (None: none came,
+        or the output ended)."""
+        if self._eof and self._lines.empty():
+            return None
+        try:
+            return self._lines.get(timeout=timeout)
+        except queue.Empty:
+            return None
+
+    def discard(self) -> list[str]:
+        """The lines already printed and not taken (dropped)."""
+        out = []
+        while True:
+            try:
+                text = self._lines.get_nowait()
+            except queue.Empty:
+                return out
+            if text is not None:
+                out.append(text)
+
+    def send(self, text: str) -> bool:
+        """One line on its standard input; False when it no longer reads it."""
+        stdin = self.process.stdin
+        if stdin is None or stdin.closed:
+            return False
+        try:
+            stdin.write(text.encode() + b"\n")
+            stdin.flush()
+        except (OSError, ValueError):
+            return False
+        return True
+
+    @property
+    def alive(self) -> bool:
+        return self.process.poll() is None
+
+    def wait(self, seconds: float) -> bool:
+        """Wait up to ``seconds`` for it to end; True when it has."""
+        try:
+            self.process.wait(seconds)
+        except subprocess.TimeoutExpired:
+            return False
+        return True
+
+    def stderr_tail(self) -> str:
+        """The last line it wrote on standard error ('' if none)."""
+        with contextlib.suppress(OSError, ValueError):
+            self._stderr.seek(0)
+            lines = [x for x in self._stderr.read()[-4096:].decode("utf-8", "replace")
+                     .splitlines() if x.strip()]
+            return lines[-1].strip() if lines else ""
+        return ""
+
+    def ended(self) -> str:
+        """Why it is no longer running, in one line ('' while it runs)."""
+        status = self.process.poll()
+        if status is None:
+            return ""
+        how = (f"was killed by signal {-status}" if status < 0 else
+               f"exited with status {status}")
+        tail = self.stderr_tail()
+        return f"{shlex.join(self.command)} {how}" + (f" (stderr: {tail})" if tail else "")
+
+    # -- the end -----------------------------------------------------------------------------
+    def stop(self) -> None:
+        """`quit`, then SIGTERM, then SIGKILL to its process group, each with a bounded
+        wait; reaped, and whatever of its group is left ended too. Idempotent."""
+        if self not in _RUNNING:
+            return
+        _RUNNING.discard(self)
+        group = self.process.pid
+        if self.alive and not (self.send("quit") and self.wait(QUIT_SECONDS)):
+            for sig, seconds in ((signal.SIGTERM, TERM_SECONDS), (signal.SIGKILL, None)):
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.killpg(group, sig)
+                if self.wait(seconds if seconds is not None else TERM_SECONDS):
+                    break
+        self.process.wait()                            # reaped: no zombie
+        _end_group(group)                              # what it started: no orphan
+        for stream in (self.process.stdin, self.process.stdout):
+            with contextlib.suppress(OSError, ValueError):
+                if stream is not None:
+                    stream.close()
+        self._stderr.close()
+
+
+def _end_group(group: int) -> None:
+    """End the processes left in ``group`` (the program's children), gently first."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(group, sig)
+        except (ProcessLookupError, PermissionError):
+            return
+        end = time.monotonic() + TERM_SECONDS
+        while time.monotonic() < end:
+            try:
+                os.killpg(group, 0)
+            except (ProcessLookupError, PermissionError):
+                return
+            time.sleep(0.02)
+
+
+@atexit.register
+def _stop_all() -> None:
+    for program in list(_RUNNING):
+        program.stop()

@@ -1,0 +1,142 @@
+"""The test rig of an ``exec:`` target: docs/rig.md's control channel, spoken over the
+program's standard input (commands) and standard output (one reply a line).
+
+It offers what the suite uses of a rig (``link.rig``): ``set_input``, ``set_switch``,
+``power_on``, ``outputs``, ``spindle``, ``state``. What the channel cannot give is not
+there: no ``pulses`` (the reports show no step train) and no clock. Every command waits
+for its reply, so that what the rig's hands did has happened before the next frame.
+
+A rig that does not answer in time or refuses a command makes the case COULD-NOT-TEST
+(saying which command); a program that has ended makes the target not responding.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+from conformance.case import CouldNotTest
+from conformance.link.safety import TargetNotResponding
+from conformance.targets.program import Program
+
+#: how long `state` may take to answer when the suite asks whether there is a rig
+DETECT_SECONDS = 1.0
+#: how long any later command may take to answer
+REPLY_SECONDS = 5.0
+#: an input port the rig's hands do not touch reads all ones (nothing grounded)
+RELEASED = 0xFF
+
+
+def _object(reply: str | None) -> dict | None:
+    try:
+        value = json.loads(reply) if reply else None
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
+
+
+class ControlRig:
+    """The rig over a running program's control channel (see the module's docstring)."""
+
+    def __init__(self, program: Program, found: dict, address: int,
+                 on_power_on: Callable[[], None] = lambda: None) -> None:
+        self.program = program
+        self.address = address
+        self.on_power_on = on_power_on
+        # a simulator of several units answers `state` per address: then every command
+        # names the target's unit (a simulator of one needs no @ADDRESS)
+        self.several = "position" not in found and isinstance(found.get(str(address)), dict)
+        self.found = self._unit(found)             # the first `state`, as found
+        self._touched: dict[int, int] = {}         # input ports set since the hands were off
+        self._switches: set[str] = set()           # axes with a switch the suite placed
+
+    @classmethod
+    def detect(cls, program: Program, address: int,
+               on_power_on: Callable[[], None] = lambda: None) -> ControlRig | None:
+        """The rig, when the program answers `state` with a JSON object within
+        DETECT_SECONDS; else None (it has no rig)."""
+        program.discard()
+        if not program.send("state"):
+            return None
+        found = _object(program.line(DETECT_SECONDS))
+        return None if found is None else cls(program, found, address, on_power_on)
+
+    # -- the channel ---------------------------------------------------------------------------
+    def _ask(self, command: str) -> str:
+        self.program.discard()              # lines nobody asked for are not a reply
+        reply = self.program.line(REPLY_SECONDS) if self.program.send(command) else None
+        if reply is None:
+            if not self.program.alive or self.program.wait(0.5):
+                raise TargetNotResponding(self.program.ended())
+            raise CouldNotTest(f"the rig did not answer {command!r} within {REPLY_SECONDS:g} s")
+        if reply.startswith("error"):
+            raise CouldNotTest(f"the rig refused {command!r}: {reply}")
+        return reply
+
+    def _do(self, command: str) -> None:
+        reply = self._ask(command)
+        if reply.strip().lower() != "ok":
+            raise CouldNotTest(f"the rig answered {command!r} with {reply!r}, not ok")
+
+    def _unit(self, state: dict) -> dict:
+        """One unit's state (a simulator of several units answers one per address)."""
+        if "position" not in state and isinstance(state.get(str(self.address)), dict):
+            return state[str(self.address)]
+        return state
+
+    def _at(self, address: int | None) -> str:
+        """`` @ADDRESS`` for a command to one unit, when it must say which."""
+        if address is None and self.several:
+            address = self.address
+        return "" if address is None else f" @{address}"
+
+    # -- what the suite uses ---------------------------------------------------------------------
+    def set_input(self, port: int, value: int, address: int | None = None) -> None:
+        self._do(f"in {port} {value:02X}{self._at(address)}")
+        self._touched[port] = value
+
+    def set_switch(self, axis: str, position: int | None, address: int | None = None) -> None:
+        where = "none" if position is None else position
+        self._do(f"switch {axis} {where}{self._at(address)}")
+        self._switches.add(axis)
+
+    def power_on(self, address: int | None = None) -> None:
+        self._do("power-on" + ("" if address is None else f" @{address}"))   # None: all
+        self.on_power_on()
+
+    def state(self, address: int | None = None) -> dict:
+        reply = self._ask(f"state{self._at(address)}")
+        state = _object(reply)
+        if state is None:
+            raise CouldNotTest(f"the rig's state is not one JSON object: {reply[:200]!r}")
+        return self._unit(state)
+
+    def _number(self, key: str, base: int) -> int:
+        value = self.state().get(key)
+        try:
+            return int(str(value), base)
+        except ValueError:
+            raise CouldNotTest(f"the rig's state gives no readable {key!r}: {value!r}") from None
+
+    def outputs(self, address: int | None = None) -> int:
+        return self._number("outputs", 16)
+
+    def spindle(self, address: int | None = None) -> int:
+        return self._number("spindle", 10)
+
+    def hands_off(self) -> None:
+        """The rig as found: the inputs the suite set back to their levels then, the
+        switches it placed removed (part of a real unit's known state)."""
+        inputs = self.found.get("inputs")
+        for port in sorted(self._touched):
+            level = inputs.get(str(port), "FF") if isinstance(inputs, dict) else "FF"
+            try:
+                value = int(str(level), 16)
+            except ValueError:
+                value = RELEASED
+            if self._touched[port] != value:
+                self._do(f"in {port} {value:02X}{self._at(None)}")
+        for axis in sorted(self._switches):
+            self._do(f"switch {axis} none{self._at(None)}")
+        self._touched.clear()
+        self._switches.clear()

@@ -1,0 +1,113 @@
+"""The program behind an exec: target: lines out and in, why it ended, and stopping it —
+asked with `quit`, else terminated, else killed, and what it started ended too: no
+zombie, no orphan."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from conformance.targets import program as program_module
+from conformance.targets.program import Program, ProgramError
+
+#: reads standard input and answers every line; ends on `quit`
+ECHO = [sys.executable, "-c",
+        "import sys\nprint('ready', flush=True)\nfor line in sys.stdin:\n"
+        "    if line.strip() == 'quit': break\n    print('got ' + line.strip(), flush=True)"]
+#: ignores `quit` and SIGTERM: only SIGKILL ends it
+STUBBORN = [sys.executable, "-c",
+            "import signal, sys, time\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\n"
+            "print('ready', flush=True)\nsys.stdin.read()\ntime.sleep(60)"]
+
+
+def running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] not in "ZX"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.fixture
+def quick(monkeypatch):
+    monkeypatch.setattr(program_module, "QUIT_SECONDS", 0.3)
+    monkeypatch.setattr(program_module, "TERM_SECONDS", 0.3)
+
+
+def test_lines_out_and_in_and_quit_ends_it():
+    p = Program(ECHO)
+    assert p.line(10) == "ready"
+    assert p.send("hello")
+    assert p.line(10) == "got hello"
+    p.stop()
+    assert p.process.returncode == 0, "quit should have ended it"
+    assert not running(p.process.pid)
+    p.stop()                                  # idempotent
+
+
+def test_lines_come_in_order_and_none_is_made_up():
+    p = Program(ECHO)
+    try:
+        assert p.line(10) == "ready"
+        for word in ("one", "two", "three"):
+            p.send(word)
+        assert [p.line(10) for _ in range(3)] == ["got one", "got two", "got three"]
+        assert p.discard() == []
+        assert p.line(0.05) is None           # nothing more was printed
+    finally:
+        p.stop()
+
+
+def test_a_program_deaf_to_quit_and_sigterm_is_killed(quick):
+    p = Program(STUBBORN)
+    assert p.line(10) == "ready"
+    p.stop()
+    assert p.process.returncode == -signal.SIGKILL
+    assert not running(p.process.pid)
+
+
+def test_what_the_program_started_is_ended_with_it(quick):
+    # the child runs on after its parent (cat) ends: an orphan unless its group is ended
+    p = Program(["sh", "-c", "sleep 60 & echo $!; exec cat"])
+    child = int(p.line(10) or 0)
+    assert running(child)
+    p.stop()
+    assert not running(child)
+
+
+def test_how_it_ended_names_the_command_the_status_and_stderr():
+    p = Program(["sh", "-c", "echo first >&2; echo last words >&2; exit 3"])
+    assert p.line(10) is None                 # its output ended
+    assert p.wait(10)
+    assert p.ended() == "sh -c 'echo first >&2; echo last words >&2; exit 3' exited with " \
+                        "status 3 (stderr: last words)"
+    p.stop()
+
+
+def test_a_program_killed_by_a_signal_says_so():
+    p = Program(ECHO)
+    assert p.ended() == ""
+    os.kill(p.process.pid, signal.SIGKILL)
+    assert p.wait(10)
+    assert "was killed by signal 9" in p.ended()
+    assert not p.send("anything")             # nobody reads it any more: no exception
+    p.stop()
+
+
+def test_a_program_that_cannot_start_is_one_line():
+    with pytest.raises(ProgramError, match="cannot start 'no-such-program-here': No such "
+                                           "file or directory"):
+        Program(["no-such-program-here"])
+
+
+def test_a_program_left_running_is_stopped_when_the_interpreter_exits():
+    script = ("import sys\nfrom conformance.targets.program import Program\n"
+              f"p = Program({ECHO!r})\nprint(p.process.pid, flush=True)\nsys.exit(2)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60, check=False)
+    assert done.returncode == 2 and done.stderr == "", done.stderr
+    assert not running(int(done.stdout))
