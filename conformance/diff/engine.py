@@ -283,6 +283,31 @@ class Budget:
         return time.perf_counter() - self.start
 
 
+#: at most this many runs for the last pass over a shrunk sequence
+MINIMISE_RUNS = 300
+
+
+def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
+    """Hypothesis shrinks by its own measure (the choices it drew); this last pass takes
+    out single steps while the same command still disagrees the same way, so the
+    transcript and the steps its label reads are what the disagreement needs."""
+    steps, outcome = finding.steps, finding.outcome
+    want = (outcome.disagreement.command, outcome.disagreement.kind)
+    runs = 0
+    i = 0
+    while i < len(steps) and runs < MINIMISE_RUNS:
+        candidate = steps[:i] + steps[i + 1:]
+        runs += 1
+        trial = pair.run(candidate)
+        budget.frames += trial.frames
+        d = trial.disagreement
+        if d is not None and (d.command, d.kind) == want:
+            steps, outcome = candidate, trial
+        else:
+            i += 1
+    return Finding(steps, outcome)
+
+
 class _Spent(Exception):
     """The budget ran out inside Hypothesis."""
 
@@ -326,7 +351,9 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
             if budget.spent() or budget.examples is not None:
                 break                  # (with examples left: Hypothesis found nothing new)
             continue
-        finding = best["found"]
+        finding = minimise(pair, best["found"], budget)
+        if finding.disagreement.signature in known:
+            continue
         known.add(finding.disagreement.signature)
         findings.append(finding)
         if on_finding is not None:

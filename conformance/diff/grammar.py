@@ -143,6 +143,10 @@ class Grammar:
             self.kinds += ["fill"] * g["fill"]["weight"]
         if self.vectors:
             self.kinds += ["motion"] * g["motion"]["weight"]
+        self.readbacks = [(w, r) for w, r in g["readback"]["pairs"]
+                          if w in self.names and r in self.names]
+        if self.readbacks:
+            self.kinds += ["readback"] * g["readback"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
         self.ports = ports or [1]
         self.member_names = [n for n in ("C", "B") if n in profile.commands]
@@ -258,7 +262,17 @@ class Grammar:
             return self.packet(draw)
         if kind == "motion":
             return self.motion(draw)
+        if kind == "readback":
+            return self.readback(draw)
         return self.fill(draw)
+
+    def readback(self, draw) -> list[Step]:
+        write, read = self.pick(draw, self.readbacks)
+        body = self.body(draw, write, valid=True)
+        text = self.g["command"][write].get("text", write)
+        first = body[len(text):].split(",")[0]
+        place = "" if read == "PF" else first
+        return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
 
 
 def sequences(profile: Profile, options: Options) -> st.SearchStrategy[list[Step]]:
