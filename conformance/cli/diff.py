@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from conformance.cli.ending import counted, end, new_run_id
+from conformance.cli.unit import ask_before_motion
 from conformance.diff.engine import Budget, Finding, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.gvt import transcript, write
@@ -19,6 +20,8 @@ from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
+from conformance.metadata import RunMeta
+from conformance.operator import Console
 from conformance.runner import RunResult
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
 from conformance.verdict import COULD_NOT_TEST, FAIL
@@ -54,6 +57,8 @@ def common(ap: argparse.ArgumentParser) -> None:
                     help="also J, W and EEPROM writes (real units: backed up and restored)")
     ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in full steps per axis")
+    ap.add_argument("--yes", action="store_true",
+                    help="real units: move without asking first (unattended benches)")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -91,6 +96,13 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
     return target, reference
 
 
+def ask_first(args: argparse.Namespace, target: Target) -> None:
+    """Real units: the question before the first frame that can move an axis, as the
+    suite's run asks it (no terminal and no --yes: nothing moves)."""
+    if target.info.kind != "emu" and not args.yes:
+        target.session.before_motion = ask_before_motion(target, Console(), RunMeta())
+
+
 def main(argv: list[str] | None = None) -> int:
     try:
         args = parse_args(argv)
@@ -102,6 +114,7 @@ def main(argv: list[str] | None = None) -> int:
     folder = None if args.no_reports else Path(args.report_dir) / run_id
     interrupts = Interrupts()
     session = target.begin(interrupts)
+    ask_first(args, target)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     options = Options(destructive=args.allow_destructive,
                       rig=target.info.has_rig and reference.info.has_rig)

@@ -9,7 +9,7 @@ import argparse
 import sys
 from typing import NoReturn
 
-from conformance.cli.diff import UsageError, common, one_line, targets
+from conformance.cli.diff import UsageError, ask_first, common, one_line, targets
 from conformance.diff.engine import Pair
 from conformance.diff.gvt import steps_of
 from conformance.diff.sides import Side
@@ -47,6 +47,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     recorded = [r for r in t.records if r.direction == UNIT]
     session = target.begin()
+    ask_first(args, target)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     try:
         outcome = pair.run(steps)

@@ -45,8 +45,9 @@ def test_usage_errors_are_one_line_and_status_2(argv, capsys):
 def test_the_emulator_agrees_with_itself_over_a_pty(tmp_path, capsys):
     emu = Emulator("--model", "GVE84-100", "--pty")
     try:
+        # a small envelope: the guard refuses the longer moves, the sequences go on
         status = main(["diff", "--target", f"serial:{emu.first}", "--profile", "GVE84-100",
-                       "--examples", "12", "--no-reports"])
+                       "--examples", "12", "--no-reports", "--yes", "--max-travel", "100"])
     finally:
         emu.proc.terminate()
         emu.proc.wait(10)
