@@ -13,7 +13,7 @@ import random
 import re
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import NoSuchExample
@@ -296,6 +296,18 @@ def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
     runs = 0
     i = 0
     while i < len(steps) and runs < MINIMISE_RUNS:
+        s = steps[i]
+        if s.kind == FILL and s.times > 1:
+            # a filled queue: first try it half as full
+            shorter = replace(s, times=s.times // 2)
+            candidate = [*steps[:i], shorter, *steps[i + 1:]]
+            runs += 1
+            trial = pair.run(candidate)
+            budget.frames += trial.frames
+            d = trial.disagreement
+            if d is not None and (d.command, d.kind) == want:
+                steps, outcome = candidate, trial
+                continue
         candidate = steps[:i] + steps[i + 1:]
         runs += 1
         trial = pair.run(candidate)

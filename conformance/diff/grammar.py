@@ -11,6 +11,7 @@ from pathlib import Path
 
 from hypothesis import strategies as st
 
+from conformance.diff.labels import command_of
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from gve_fixtures.profile import Profile
 
@@ -23,6 +24,11 @@ class Options:
 
     destructive: bool = False
     rig: bool = False
+
+
+def _has(profile: Profile, name: str) -> bool:
+    """Whether the profile has a command by the name `command_of` gives (`SW6`: `SW`)."""
+    return (name[:-1] if name == "SW6" else name) in profile.commands
 
 
 @cache
@@ -147,6 +153,10 @@ class Grammar:
                           if w in self.names and r in self.names]
         if self.readbacks:
             self.kinds += ["readback"] * g["readback"]["weight"]
+        self.scenarios = [tuple(s) for s in g["scenarios"]["list"]
+                          if all(_has(profile, command_of(f)) for f in s)]
+        if self.scenarios:
+            self.kinds += ["scenario"] * g["scenarios"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
         self.ports = ports or [1]
         self.member_names = [n for n in ("C", "B") if n in profile.commands]
@@ -264,6 +274,12 @@ class Grammar:
             return self.motion(draw)
         if kind == "readback":
             return self.readback(draw)
+        if kind == "scenario":
+            moved = []
+            if self.vectors and self.number(draw, 0, 1):
+                moved = [Step(FRAME, self.body(draw, self.pick(draw, self.vectors),
+                                                valid=True))]
+            return moved + [Step(FRAME, f) for f in self.pick(draw, self.scenarios)]
         return self.fill(draw)
 
     def readback(self, draw) -> list[Step]:
