@@ -26,11 +26,6 @@ class Options:
     rig: bool = False
 
 
-def _has(profile: Profile, name: str) -> bool:
-    """Whether the profile has a command by the name `command_of` gives (`SW6`: `SW`)."""
-    return (name[:-1] if name == "SW6" else name) in profile.commands
-
-
 @cache
 def load_grammar(path: Path = GRAMMAR_FILE) -> dict:
     return tomllib.loads(path.read_text(encoding="utf-8"))
@@ -153,8 +148,9 @@ class Grammar:
                           if w in self.names and r in self.names]
         if self.readbacks:
             self.kinds += ["readback"] * g["readback"]["weight"]
+        allowed = set(self.names) | {"SW6"}
         self.scenarios = [tuple(s) for s in g["scenarios"]["list"]
-                          if all(_has(profile, command_of(f)) for f in s)]
+                          if all(f.startswith("wait ") or command_of(f) in allowed for f in s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
@@ -214,7 +210,7 @@ class Grammar:
         answer = entry.get("answer", True) and address is None
         out = [Step(FRAME, body, checksum, address, answer, entry.get("lines", 1), stall)]
         if entry.get("then_wait") == "restart":
-            out.append(Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05))
+            out.append(self.restart_wait())
         return out
 
     def packet(self, draw) -> list[Step]:
@@ -275,12 +271,24 @@ class Grammar:
         if kind == "readback":
             return self.readback(draw)
         if kind == "scenario":
-            moved = []
-            if self.vectors and self.number(draw, 0, 1):
-                moved = [Step(FRAME, self.body(draw, self.pick(draw, self.vectors),
-                                                valid=True))]
-            return moved + [Step(FRAME, f) for f in self.pick(draw, self.scenarios)]
+            return self.scenario(draw)
         return self.fill(draw)
+
+    def scenario(self, draw) -> list[Step]:
+        out = []
+        if self.vectors and self.number(draw, 0, 1):
+            out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors), valid=True)))
+        for f in self.pick(draw, self.scenarios):
+            if f.startswith("wait "):
+                out.append(Step(WAIT, seconds=float(f.split()[1])))
+                continue
+            out.append(Step(FRAME, f))
+            if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
+                out.append(self.restart_wait())
+        return out
+
+    def restart_wait(self) -> Step:
+        return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
 
     def readback(self, draw) -> list[Step]:
         write, read = self.pick(draw, self.readbacks)
