@@ -28,7 +28,8 @@ def frames_per_second(mutant: str | None, frames: int) -> tuple[float, int]:
     # searches until the frames are sent (a finding ends one search; the next goes on)
     while budget.frames < frames:
         budget.examples = budget.used + 50
-        found += len(search(pair, Options(destructive=True, rig=True), budget))
+        found += len(search(pair, Options(destructive=True, rig=True), budget,
+                            seed=budget.used))
     total = budget.elapsed
     return budget.frames / total, found
 

@@ -113,7 +113,6 @@ class Pair:
                     earlier.add("input")
                 continue
             command = command_of(step.body)
-            context = self._context(step, context_packet)
             times = step.times if step.kind == FILL else 1
             for i in range(times):
                 rec = self._exchange(step, out)
@@ -123,6 +122,7 @@ class Pair:
                 out.records.append(rec)
                 kind = self._difference(command, rec)
                 if kind is not None:
+                    context = self._context(step, context_packet)
                     d = Disagreement(len(out.records) - 1, command, kind, rec.target,
                                      rec.reference, frozenset(context), frozenset(earlier))
                     d.rule = label(command, kind, context, earlier,
@@ -174,7 +174,7 @@ class Pair:
         rec = Record(step)
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
-                                              stall=step.stall)
+                                              stall=step.stall, body=step.body)
         except SafetyStop as err:
             out.refused.append(f"{step}: {err}")
             return None
@@ -188,7 +188,8 @@ class Pair:
             self.reference.catch_up(rec.target.sent_at)
         try:
             rec.reference = self.reference.exchange(data, lines=step.lines,
-                                                    answer=step.answer, stall=step.stall)
+                                                    answer=step.answer, stall=step.stall,
+                                                    body=step.body)
         except TargetNotResponding as err:
             rec.reference = Exchange(data, b"", 0, 0, None, step.lines)
             out.ended = out.ended or str(err)

@@ -89,13 +89,6 @@ def _invalid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
     return st.sampled_from(out)
 
 
-def _field(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
-    """A field: its valid values, now and then an invalid form."""
-    chance = round(g["invalid"]["chance"] * 100)
-    return st.tuples(st.integers(0, 99), _valid(profile, kind, g),
-                     _invalid(profile, kind, g)).map(lambda t: t[2] if t[0] < chance else t[1])
-
-
 def _body(name: str, entry: dict, params: list[str]) -> str:
     text = entry.get("text", name)
     kinds = entry.get("params", [])
@@ -126,8 +119,9 @@ class Grammar:
         self.names = command_names(profile, options)
         self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
         kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
-        self.fields = {k: _field(profile, k, g) for k in kinds}
+        self.invalid = {k: _invalid(profile, k, g) for k in kinds}
         self.valid = {k: _valid(profile, k, g) for k in kinds}
+        self.invalid_chance = round(g["invalid"]["chance"] * 100)
         self.modal = [n for n in g["motion"]["modal"] if n in self.names]
         self.vectors = [n for n in ("L", "C") if n in self.names]
         self.events = [e for e in g["motion"]["events"]
@@ -172,15 +166,18 @@ class Grammar:
             self._cache[key] = st.integers(lo, hi)
         return draw(self._cache[key])
 
+    def field(self, draw, kind: str, valid: bool) -> str:
+        """A field: a valid value, now and then (unless ``valid``) an invalid form."""
+        if not valid and self.number(draw, 0, 99) < self.invalid_chance:
+            return draw(self.invalid[kind])
+        return draw(self.valid[kind])
+
     def body(self, draw, name: str, *, valid: bool = False) -> str:
         entry = self.g["command"][name]
         kinds = entry.get("params", [])
-        fields = self.valid if valid else self.fields
         if kinds == ["vector"]:
-            n = self.pick(draw, self.vector_counts)
-            params = [draw(fields["vector"]) for _ in range(n)]
-        else:
-            params = [draw(fields[k]) for k in kinds]
+            kinds = ["vector"] * self.pick(draw, self.vector_counts)
+        params = [self.field(draw, k, valid) for k in kinds]
         body = _body(name, entry, params)
         if valid:
             return body

@@ -79,12 +79,15 @@ class Side:
             self.link.port.line.advance_to(self.link.port.line.now + (t - self.now))
 
     def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
-                 stall: tuple[int, float] | None = None) -> Exchange:
+                 stall: tuple[int, float] | None = None, body: str | None = None
+                 ) -> Exchange:
         """Send a frame's bytes (through the guard: SafetyStop when refused) and take
         what comes back: its answer (``answer``), else whatever arrives while the
-        answer's bytes would have taken."""
+        answer's bytes would have taken. ``body``: the frame's command, when known (it
+        decides how long an answer may take)."""
         link = self.link
-        body = _body(data, link.checksums)
+        if body is None:
+            body = _body(data, link.checksums)
         if stall is not None:
             link.inject("host", "delay", at=stall[0], seconds=stall[1])
         sent_at = self.now
