@@ -144,7 +144,8 @@ class Grammar:
             self.kinds += ["readback"] * g["readback"]["weight"]
         allowed = set(self.names) | {"SW6"}
         self.scenarios = [tuple(s) for s in g["scenarios"]["list"]
-                          if all(f.startswith("wait ") or command_of(f) in allowed for f in s)]
+                          if all(f.startswith("wait ") or command_of(f.removeprefix("bad:"))
+                                 in allowed for f in s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
@@ -278,6 +279,9 @@ class Grammar:
         for f in self.pick(draw, self.scenarios):
             if f.startswith("wait "):
                 out.append(Step(WAIT, seconds=float(f.split()[1])))
+                continue
+            if f.startswith("bad:"):
+                out.append(Step(FRAME, f.removeprefix("bad:"), checksum="bad"))
                 continue
             out.append(Step(FRAME, f))
             if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
