@@ -165,6 +165,12 @@ def main(argv: list[str] | None = None) -> int:
     if report is not None:
         run.sessions[target.info.spec] = report.to_dict()
         run.problems += report.problems
+    for f in pair.unconfirmed:
+        d = f.disagreement
+        print(f"not confirmed (seen once, not when replayed): {readable(d.target.sent)} "
+              f"target {readable(d.target.answer) or '(none)'} / reference "
+              f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted",
+              flush=True)
     if not run.results:
         run.results.append(agreement_result(
             profile=target.profile.name, target=target.info.spec, examples=budget.used,

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from hypothesis import HealthCheck, Phase, find, settings
-from hypothesis.errors import NoSuchExample
+from hypothesis.errors import Flaky, NoSuchExample
 
 from conformance.diff.compare import Judge, difference
 from conformance.diff.grammar import Options, load_grammar, sequences
@@ -88,6 +88,8 @@ class Pair:
         factor = max(profile.microstep.factors.values()) if profile.microstep else 1
         self.judge = Judge(exact=self.exact, rate=profile.max_rate * factor)
         self._idle_since: int | None = 0
+        #: real time: disagreements seen once that their sequence did not show again
+        self.unconfirmed: list[Finding] = []
 
     # -- one example ----------------------------------------------------------------------
     def run(self, steps: list[Step]) -> Outcome:
@@ -284,6 +286,15 @@ class Budget:
         return time.perf_counter() - self.start
 
 
+def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
+    """Real time: whether the shrunk sequence disagrees the same way once more (a
+    disagreement seen once may be the timing of that run, not the target)."""
+    trial = pair.run(finding.steps)
+    budget.frames += trial.frames
+    d = trial.disagreement
+    return d is not None and d.signature == finding.disagreement.signature
+
+
 #: at most this many runs for the last pass over a shrunk sequence
 MINIMISE_RUNS = 300
 
@@ -332,6 +343,7 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
     and kind), until the budget is spent (or ``stop_after`` findings)."""
     strategy = sequences(pair.profile, options)
     findings: list[Finding] = []
+    unconfirmed = pair.unconfirmed
     known: set[tuple] = set()
     rounds = 0
     while not budget.spent() and (stop_after is None or len(findings) < stop_after):
@@ -357,8 +369,14 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
         chosen = settings(max_examples=max(1, left), database=None, deadline=None,
                           phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
                           suppress_health_check=list(HealthCheck))
-        with contextlib.suppress(NoSuchExample, _Spent):
+        try:
             find(strategy, fails, settings=chosen, random=random.Random(seed + rounds))
+        except (NoSuchExample, _Spent):
+            pass
+        except Flaky:
+            # real time: a disagreement Hypothesis could not see again (kept below only
+            # if it shows once more)
+            pass
         rounds += 1
         if "found" not in best:
             if budget.spent() or budget.examples is not None:
@@ -366,6 +384,10 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
             continue
         finding = minimise(pair, best["found"], budget)
         if finding.disagreement.signature in known:
+            continue
+        if not pair.exact and not _again(pair, finding, budget):
+            unconfirmed.append(finding)
+            known.add(finding.disagreement.signature)
             continue
         known.add(finding.disagreement.signature)
         findings.append(finding)
