@@ -142,16 +142,24 @@ class Grammar:
                           if w in self.names and r in self.names]
         if self.readbacks:
             self.kinds += ["readback"] * g["readback"]["weight"]
-        allowed = set(self.names) | {"SW6"}
-        self.scenarios = [tuple(s) for s in g["scenarios"]["list"]
-                          if all(f.startswith("wait ") or command_of(f.removeprefix("bad:"))
-                                 in allowed for f in s)]
+        self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self._can(s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
         self.ports = ports or [1]
         self.member_names = [n for n in ("C", "B") if n in profile.commands]
         self.other_members = [n for n in ("L", "V", "PF") if n in profile.commands]
+
+    def _can(self, idiom: list[str]) -> bool:
+        """Whether every step of an idiom can be sent on this profile and run."""
+        allowed = set(self.names) | {"SW6"}
+        for f in idiom:
+            if f.startswith("input "):
+                if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
+                    return False
+            elif not f.startswith("wait ") and command_of(f.removeprefix("bad:")) not in allowed:
+                return False
+        return True
 
     # -- pieces ----------------------------------------------------------------------------
     def pick(self, draw, choices) -> object:
@@ -279,6 +287,10 @@ class Grammar:
         for f in self.pick(draw, self.scenarios):
             if f.startswith("wait "):
                 out.append(Step(WAIT, seconds=float(f.split()[1])))
+                continue
+            if f.startswith("input "):
+                _, port, value = f.split()
+                out.append(Step(INPUT, port=int(port), value=int(value, 16)))
                 continue
             if f.startswith("bad:"):
                 out.append(Step(FRAME, f.removeprefix("bad:"), checksum="bad"))
