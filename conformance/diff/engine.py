@@ -366,7 +366,10 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
             return True
 
         left = (budget.examples - budget.used) if budget.examples is not None else 10**6
-        chosen = settings(max_examples=max(1, left), database=None, deadline=None,
+        # Hypothesis's own defaults, not whatever profile the process loaded (the suite's
+        # pytest plugin loads derandomized ones): the seed alone decides the sequences
+        chosen = settings(settings.get_profile("default"), derandomize=False,
+                          max_examples=max(1, left), database=None, deadline=None,
                           phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
                           suppress_health_check=list(HealthCheck))
         try:

@@ -47,7 +47,7 @@ def test_the_emulator_agrees_with_itself(profile):
 
 @pytest.mark.parametrize("mutant", QUICK)
 def test_a_mutant_is_found_shrunk_and_labelled(mutant):
-    _, f = hunt(mutant, 600)
+    _, f = hunt(mutant, 1000)
     d = f.disagreement
     area = mutants()[mutant][0]
     # the rule's part of the spec is the mutant's (10.4's D may show at 10's F)
