@@ -34,6 +34,8 @@ _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: window, for positions to be compared exactly (a target's motion ends when the unit
 #: says, the reference's when its model does)
 SETTLE_NS = 50_000_000
+#: real time: how long the fresh reference stands before a sequence
+AGE_SECONDS = 1.0
 
 
 @dataclass
@@ -152,7 +154,10 @@ class Pair:
 
     def _prelude(self) -> None:
         """A real unit's index is not reset by the known state: read both, compare from
-        there; and give `>` the same history on both (`SR0`, answered 0,00 by both)."""
+        there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
+        reference, a fresh unit, first stands a while: the real one's last motion ended
+        long ago (a vector right away would otherwise wait the dwell T on one side only)."""
+        self.reference.age(AGE_SECONDS)
         indexes = []
         for side in (self.target, self.reference):
             side.link.send("SR0")
