@@ -1,6 +1,6 @@
 """Run every benchmark: `python -m bench`."""
 
-from bench import bench_emulator, bench_host, bench_stepper
+from bench import bench_diff, bench_emulator, bench_host, bench_stepper
 
 if __name__ == "__main__":
     bench_emulator.main()
@@ -8,3 +8,5 @@ if __name__ == "__main__":
     bench_stepper.main()
     print()
     bench_host.main([])
+    print()
+    bench_diff.main([])

@@ -18,6 +18,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
                  "with the catalogue until a case FAILs it"),
     "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
+    "diff": ("conformance.cli.diff", "differential fuzzing: the target against the emulator, "
+             "each disagreement shrunk to a transcript"),
+    "replay": ("conformance.cli.replay", "replay a transcript on a target and the emulator "
+               "alike: is the disagreement still there?"),
 }
 
 

@@ -1,0 +1,182 @@
+"""`gve-conformance diff`: differential fuzzing. Sequences drawn from a grammar of spec 10
+go to the target and to a reference (the embedded emulator) alike; every disagreement is
+shrunk to a minimal transcript, kept once, labelled with the rule it touches and graded
+by its tag, in the usual reports. docs/diff.md."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import NoReturn
+
+from conformance.cli.ending import counted, end, new_run_id
+from conformance.cli.unit import ask_before_motion
+from conformance.diff.engine import Budget, Finding, Pair, search
+from conformance.diff.grammar import Options
+from conformance.diff.gvt import transcript, write
+from conformance.diff.results import agreement_result, finding_result
+from conformance.diff.sides import Side
+from conformance.link.framing import readable
+from conformance.link.interrupts import Interrupts
+from conformance.link.safety import TargetNotResponding
+from conformance.metadata import RunMeta
+from conformance.operator import Console
+from conformance.runner import RunResult
+from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
+from conformance.verdict import COULD_NOT_TEST, FAIL
+
+PROG = "gve-conformance diff"
+#: sequences tried when neither --examples nor --seconds is given
+DEFAULT_EXAMPLES = 2000
+
+
+class UsageError(Exception):
+    """A mistake on the command line: one line, exit status 2, nothing sent."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def one_line(err: BaseException) -> str:
+    """An error as one line for the user (a KeyError's text without its quotes)."""
+    text = err.args[0] if err.args and isinstance(err.args[0], str) else str(err)
+    return (text.splitlines() or [type(err).__name__])[0]
+
+
+def common(ap: argparse.ArgumentParser) -> None:
+    """The options diff and replay share."""
+    ap.add_argument("--target", required=True,
+                    help="emu:PROFILE[?mutant=NAME], serial:PATH?baud=&address=, tcp:HOST:PORT")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target")
+    ap.add_argument("--against", help="the reference: emu:PROFILE (default: the profile's "
+                    "embedded emulator)")
+    ap.add_argument("--allow-destructive", action="store_true",
+                    help="also J, W and EEPROM writes (real units: backed up and restored)")
+    ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
+                    help="real units: the motion envelope in full steps per axis")
+    ap.add_argument("--yes", action="store_true",
+                    help="real units: move without asking first (unattended benches)")
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
+    common(ap)
+    ap.add_argument("--examples", type=int, metavar="N",
+                    help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
+    ap.add_argument("--seconds", type=float, metavar="S", help="search for S seconds")
+    ap.add_argument("--seed", type=int, default=0, help="the search's seed (default 0)")
+    ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
+    ap.add_argument("--no-reports", action="store_true",
+                    help="write no reports (the transcripts are printed instead)")
+    args = ap.parse_args(argv)
+    if args.examples is not None and args.examples < 1:
+        raise UsageError("--examples must be at least 1")
+    if args.seconds is not None and args.seconds <= 0:
+        raise UsageError("--seconds must be positive")
+    return args
+
+
+def targets(args: argparse.Namespace) -> tuple[Target, Target]:
+    """The target and its reference, checked before anything is sent."""
+    target = parse_target(args.target, profile=args.profile,
+                          allow_destructive=args.allow_destructive, max_travel=args.max_travel)
+    against = args.against or f"emu:{target.profile.name}"
+    reference = parse_target(against)
+    if reference.info.kind != "emu":
+        raise UsageError(f"--against {against}: the reference is the embedded emulator "
+                         "(emu:PROFILE)")
+    if reference.profile.name != target.profile.name:
+        raise UsageError(f"--against {against} behaves as {reference.profile.name}, the "
+                         f"target as {target.profile.name}")
+    target.preflight()
+    reference.preflight()
+    return target, reference
+
+
+def ask_first(args: argparse.Namespace, target: Target) -> None:
+    """Real units: the question before the first frame that can move an axis, as the
+    suite's run asks it (no terminal and no --yes: nothing moves)."""
+    if target.info.kind != "emu" and not args.yes:
+        target.session.before_motion = ask_before_motion(target, Console(), RunMeta())
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = parse_args(argv)
+        target, reference = targets(args)
+    except (UsageError, TargetError, LookupError, ValueError) as err:
+        print(f"{PROG}: {one_line(err)}", file=sys.stderr)
+        return 2
+    run_id = new_run_id()
+    folder = None if args.no_reports else Path(args.report_dir) / run_id
+    interrupts = Interrupts()
+    session = target.begin(interrupts)
+    ask_first(args, target)
+    pair = Pair(Side(target, session), Side(reference), target.profile)
+    options = Options(destructive=args.allow_destructive,
+                      rig=target.info.has_rig and reference.info.has_rig)
+    examples = args.examples if args.examples is not None or args.seconds else DEFAULT_EXAMPLES
+    budget = Budget(examples=examples, seconds=args.seconds)
+    run = RunResult(run_id, targets=[target.info.spec], settings="diff")
+    print(f"diff: {target.info.spec} against {reference.info.spec} "
+          f"({target.profile.name}), seed {args.seed}, "
+          + (f"{examples} sequences" if examples else f"{args.seconds:g} s"), flush=True)
+
+    def found(f: Finding) -> None:
+        n = len(run.results) + 1
+        t = transcript(f, profile=target.profile.name, target=target.info.spec,
+                       reference=reference.info.spec, seed=args.seed)
+        path = ""
+        if folder is not None:
+            folder.mkdir(parents=True, exist_ok=True)
+            path = str(write(folder / f"diff-{n:02d}.gvt", t))
+        r = finding_result(f, profile=target.profile.name, target=target.info.spec,
+                           transcript=list(t.lines()), path=path)
+        run.results.append(r)
+        d = f.disagreement
+        print(f"{d.verdict:11} {d.rule or '(no known rule)'}: {readable(d.target.sent)} "
+              f"target {readable(d.target.answer) or '(none)'} / reference "
+              f"{readable(d.reference.answer) or '(none)'} ({d.kind}; {f.frames} frame(s))"
+              + (f"  -> {path}" if path else ""), flush=True)
+        if folder is None:
+            print("\n".join("    " + line for line in t.lines()), flush=True)
+
+    try:
+        with interrupts.catching_sigint():
+            search(pair, options, budget, seed=args.seed, on_finding=found)
+    except (TargetNotResponding, SessionError) as err:
+        r = agreement_result(profile=target.profile.name, target=target.info.spec,
+                             examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
+        r.verdict, r.stopped = (FAIL if isinstance(err, TargetNotResponding)
+                                else COULD_NOT_TEST), str(err)
+        r.checks = [{"ok": False, "what": str(err), "observed": "", "expected": "",
+                     "tag": "always", "rule": ""}]
+        run.results.append(r)
+        print(f"{r.verdict}: {err}", file=sys.stderr)
+    except KeyboardInterrupt:
+        run.interrupted = True
+        session.emergency_stop()
+    finally:
+        report = session.finish() if session.real else None
+        target.close()
+    if report is not None:
+        run.sessions[target.info.spec] = report.to_dict()
+        run.problems += report.problems
+    for f in pair.unconfirmed:
+        d = f.disagreement
+        print(f"not confirmed (seen once, not when replayed): {readable(d.target.sent)} "
+              f"target {readable(d.target.answer) or '(none)'} / reference "
+              f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted",
+              flush=True)
+    if not run.results:
+        run.results.append(agreement_result(
+            profile=target.profile.name, target=target.info.spec, examples=budget.used,
+            frames=budget.frames, seconds=budget.elapsed))
+    run.frames, run.seconds = budget.frames, budget.elapsed
+    print(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
+          f"{counted(run)}", flush=True)
+    status = end(run, None if args.no_reports else args.report_dir)
+    return 1 if run.problems else status

@@ -1,0 +1,95 @@
+"""Two answers to one frame compared: alike, or the kind of their difference.
+
+Kinds: ``silence`` (one side answered, the other did not), ``code`` (the error codes
+differ), ``inta`` (only the INTA bit differs), ``checksum`` (only the response's checksum
+differs), ``position`` (`P`/`PF` readings differ), ``data`` (other values), ``bytes``
+(anything else: unreadable bytes, a line more), ``timing`` (the same bytes at different
+instants: virtual time only, where both sides are exact).
+
+In virtual time on both sides everything is exact. With a target in real time, positions
+read while moving may differ by the band of ``conformance/motion/tolerance.py`` (the
+rate times the width of the windows in which the two frames were processed, plus a step
+of placement); at rest they must be equal. The index (`@`) is compared from where each
+side's example began (a real unit's index is not reset by the known state).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from conformance.diff.sides import Exchange
+from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+
+POSITION_COMMANDS = ("P", "PF")
+
+
+@dataclass(frozen=True)
+class Judge:
+    """How exactly two exchanges are compared."""
+
+    exact: bool = True              # both sides in virtual time
+    rate: int = 0                   # the fastest an axis may step (counter units/s)
+    index_offset: int = 0           # target's index minus the reference's at the start
+
+
+def difference(command: str, target: Exchange, reference: Exchange, judge: Judge,
+               *, moving: bool = False) -> str | None:
+    """The kind of difference between the two answers (None: alike)."""
+    a, b = target.answer, reference.answer
+    if a == b:
+        if judge.exact and (target.received_at - target.sent_at
+                            != reference.received_at - reference.sent_at):
+            return "timing"
+        return None
+    if not a or not b:
+        return "silence"
+    ra, rb = target.response, reference.response
+    if ra is None or rb is None or ra.code is None or rb.code is None:
+        return "bytes"
+    if ra.code & 7 != rb.code & 7:
+        return "code"
+    if ra.inta != rb.inta:
+        return "inta"
+    if len(ra.lines) != len(rb.lines):
+        return "bytes"
+    if list(ra.values) == list(rb.values):
+        return "checksum" if ra.checksum != rb.checksum else "bytes"
+    if command in POSITION_COMMANDS:
+        if not judge.exact and _positions_close(target, reference, judge, moving):
+            return None
+        return "position"
+    if command == "@" and not judge.exact and _same_index(ra.values, rb.values, judge):
+        return None
+    return "data"
+
+
+def _numbers(values: list[str]) -> list[int] | None:
+    try:
+        return [int(v) for v in values]
+    except ValueError:
+        return None
+
+
+def band(target: Exchange, reference: Exchange, judge: Judge, moving: bool) -> int:
+    """Steps two readings may differ by: exact at rest; while moving the rate times how
+    far apart the two instants can be, plus placement."""
+    if not moving:
+        return 0
+    a = Window(target.sent_at, target.received_at)
+    b = Window(reference.sent_at, reference.received_at)
+    return reading_band(a, b, judge.rate, placement=PLACEMENT_STEPS)
+
+
+def _positions_close(target: Exchange, reference: Exchange, judge: Judge,
+                     moving: bool) -> bool:
+    xs, ys = _numbers(target.response.values), _numbers(reference.response.values)
+    if xs is None or ys is None or len(xs) != len(ys):
+        return False
+    limit = band(target, reference, judge, moving)
+    return all(abs(x - y) <= limit for x, y in zip(xs, ys, strict=True))
+
+
+def _same_index(xs: list[str], ys: list[str], judge: Judge) -> bool:
+    a, b = _numbers(xs), _numbers(ys)
+    return (a is not None and b is not None and len(a) == len(b) == 1
+            and (a[0] - judge.index_offset) % 256 == b[0] % 256)

@@ -1,0 +1,404 @@
+"""The differential engine: a sequence of steps sent to a target and a reference alike,
+answer by answer compared; Hypothesis draws the sequences from the grammar and shrinks
+each disagreement to a minimal sequence, which is labelled, graded and kept once.
+
+A sequence stops at its first disagreement: after it the two sides are in different
+states and everything later would differ too.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import random
+import re
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+from hypothesis import HealthCheck, Phase, find, settings
+from hypothesis.errors import Flaky, NoSuchExample
+
+from conformance.diff.compare import Judge, difference
+from conformance.diff.grammar import Options, load_grammar, sequences
+from conformance.diff.labels import command_of, label, verdict_of
+from conformance.diff.sides import Exchange, Side
+from conformance.diff.steps import FILL, INPUT, WAIT, Step, frames_in
+from conformance.link.safety import SafetyStop, TargetNotResponding
+from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import St6
+
+#: frames that close an open packet (spec 7)
+_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+_LONG_DECIMAL = re.compile(r"\d{13,}")
+#: real time: how long the reference must have been at rest, besides the target's
+#: window, for positions to be compared exactly (a target's motion ends when the unit
+#: says, the reference's when its model does)
+SETTLE_NS = 50_000_000
+#: real time: how long the fresh reference stands before a sequence
+AGE_SECONDS = 1.0
+
+
+@dataclass
+class Record:
+    """One step as it went: the step, the frame's bytes and both sides' exchanges."""
+
+    step: Step
+    target: Exchange | None = None
+    reference: Exchange | None = None
+    repeat: int = 0                      # FILL: frames of it before this one
+
+
+@dataclass
+class Disagreement:
+    index: int                           # the record it happened on
+    command: str
+    kind: str
+    target: Exchange
+    reference: Exchange
+    context: frozenset[str]
+    earlier: frozenset[str]
+    rule: str | None = None
+    verdict: str = ""
+    tag: str = ""
+
+    @property
+    def signature(self) -> tuple:
+        """What makes two disagreements one: the rule and the kind of difference (one
+        bug shows on many commands), or the command where no rule is known."""
+        return (self.rule, self.kind) if self.rule else (None, self.command, self.kind)
+
+
+@dataclass
+class Outcome:
+    records: list[Record] = field(default_factory=list)
+    disagreement: Disagreement | None = None
+    frames: int = 0
+    refused: list[str] = field(default_factory=list)     # steps the guard did not send
+    ended: str = ""                                      # why the sequence ended early
+
+
+class Pair:
+    """A target and its reference, run step by step."""
+
+    def __init__(self, target: Side, reference: Side, profile: Profile) -> None:
+        self.target = target
+        self.reference = reference
+        self.profile = profile
+        self.exact = target.virtual and reference.virtual
+        # the fastest an axis's counter can change: the variant's top rate, in counter
+        # units (GVE54: a coarse micro-step mode moves several sixteenths a step)
+        factor = max(profile.microstep.factors.values()) if profile.microstep else 1
+        self.judge = Judge(exact=self.exact, rate=profile.max_rate * factor)
+        self._idle_since: int | None = 0
+        #: real time: disagreements seen once that their sequence did not show again
+        self.unconfirmed: list[Finding] = []
+
+    # -- one example ----------------------------------------------------------------------
+    def run(self, steps: list[Step]) -> Outcome:
+        out = Outcome()
+        self.target.open()
+        self.reference.open()
+        self._idle_since = 0
+        if not self.exact:
+            self._prelude()
+        context_packet = False
+        earlier: set[str] = set()
+        for step in steps:
+            if step.kind == WAIT:
+                self.target.wait(step.seconds)
+                self.reference.wait(max(0, self.target.now - self.reference.now) / 1e9)
+                out.records.append(Record(step))
+                continue
+            if step.kind == INPUT:
+                if self.target.has_rig and self.reference.has_rig:
+                    self.target.set_input(step.port, step.value)
+                    self.reference.set_input(step.port, step.value)
+                    out.records.append(Record(step))
+                    earlier.add("input")
+                continue
+            command = command_of(step.body)
+            times = step.times if step.kind == FILL else 1
+            for i in range(times):
+                rec = self._exchange(step, out)
+                if rec is None:
+                    break
+                rec.repeat = i
+                out.records.append(rec)
+                kind = self._difference(command, rec)
+                if kind is not None:
+                    context = self._context(step, context_packet)
+                    d = Disagreement(len(out.records) - 1, command, kind, rec.target,
+                                     rec.reference, frozenset(context), frozenset(earlier))
+                    d.rule = label(command, kind, context, earlier,
+                                   _code(rec.reference), _code(rec.target))
+                    d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
+                    out.disagreement = d
+                    return self._end(out)
+                if step.kind == FILL and rec.reference.code != 0:
+                    break
+            if out.ended:
+                return self._end(out)
+            if command:
+                earlier.add(command)
+            if command == "*S" and step.address is None:
+                context_packet = True
+            elif command in _PACKET_BREAKERS:
+                context_packet = False
+        return self._end(out)
+
+    def _end(self, out: Outcome) -> Outcome:
+        for side in (self.target, self.reference):
+            with contextlib.suppress(TargetNotResponding):
+                side.close_example()
+        return out
+
+    def _prelude(self) -> None:
+        """A real unit's index is not reset by the known state: read both, compare from
+        there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
+        reference, a fresh unit, first stands a while: the real one's last motion ended
+        long ago (a vector right away would otherwise wait the dwell T on one side only)."""
+        self.reference.age(AGE_SECONDS)
+        indexes = []
+        for side in (self.target, self.reference):
+            side.link.send("SR0")
+            r = side.link.send("@")
+            try:
+                indexes.append(r.dec(0) if r is not None else 0)
+            except AssertionError:
+                indexes.append(0)
+            side.link.send("SR0")
+        self.judge = Judge(False, self.judge.rate, (indexes[0] - indexes[1]) % 256)
+
+    def _sync(self) -> None:
+        """Each step starts at the same instant on both sides."""
+        self.reference.catch_up(self.target.now)
+        if self.exact:
+            self.target.catch_up(self.reference.now)
+
+    def _exchange(self, step: Step, out: Outcome) -> Record | None:
+        self._sync()
+        data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
+        rec = Record(step)
+        try:
+            rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
+                                              stall=step.stall, body=step.body)
+        except SafetyStop as err:
+            out.refused.append(f"{step}: {err}")
+            return None
+        except TargetNotResponding as err:
+            if not self.target.virtual:
+                raise
+            rec.target = Exchange(data, b"", 0, 0, None, step.lines)
+            out.ended = str(err)
+        out.frames += 1
+        if self.exact:
+            self.reference.catch_up(rec.target.sent_at)
+        try:
+            rec.reference = self.reference.exchange(data, lines=step.lines,
+                                                    answer=step.answer, stall=step.stall,
+                                                    body=step.body)
+        except TargetNotResponding as err:
+            rec.reference = Exchange(data, b"", 0, 0, None, step.lines)
+            out.ended = out.ended or str(err)
+        if out.ended and not rec.target.answer and not rec.reference.answer:
+            return None
+        return rec
+
+    def _difference(self, command: str, rec: Record) -> str | None:
+        moving = False
+        if not self.exact:
+            self._watch_reference()
+            if command in ("P", "PF"):
+                moving = self._moving_near(rec)
+        return difference(command, rec.target, rec.reference, self.judge, moving=moving)
+
+    def _watch_reference(self) -> None:
+        """Real time: note when the reference was first seen at rest (after each step;
+        a late note only makes the comparison more lenient)."""
+        rig = self.reference.link.rig
+        run = rig is None or bool(int(rig.state()["status"][6], 16) & St6.RUN)
+        if run:
+            self._idle_since = None
+        elif self._idle_since is None:
+            self._idle_since = self.reference.now
+
+    def _moving_near(self, rec: Record) -> bool:
+        """Whether the reading may have been taken while the axes moved on either side:
+        the reference had not been at rest for as long as the target's window is wide
+        (the target may have processed the frame that much later or earlier)."""
+        if self._idle_since is None:
+            return True
+        width = rec.target.received_at - rec.target.sent_at
+        return rec.reference.sent_at - self._idle_since < 2 * width + SETTLE_NS
+
+    def _context(self, step: Step, in_packet: bool) -> set[str]:
+        g = load_grammar()["command"]
+        name = command_of(step.body)
+        entry = g.get(name, g.get(name + "0", {}))
+        flags = {
+            "other-address": step.address is not None,
+            "stalled": step.stall is not None,
+            "lower": any("a" <= ch <= "z" for ch in step.body),
+            "bad-checksum": step.checksum == "bad" and self.target.link.checksums,
+            "no-checksum": step.checksum == "none" and self.target.link.checksums,
+            "in-packet": in_packet,
+            "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
+            and step.body.upper() != name,
+            "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
+        }
+        return {k for k, on in flags.items() if on}
+
+
+def _code(exchange: Exchange) -> int | None:
+    return None if exchange.code is None else exchange.code & 7
+
+
+# -- the search -------------------------------------------------------------------------------
+@dataclass
+class Finding:
+    """One disagreement, shrunk: its minimal sequence and how it went."""
+
+    steps: list[Step]
+    outcome: Outcome
+
+    @property
+    def disagreement(self) -> Disagreement:
+        assert self.outcome.disagreement is not None
+        return self.outcome.disagreement
+
+    @property
+    def frames(self) -> int:
+        return self.outcome.frames
+
+
+@dataclass
+class Budget:
+    """How long the search may go on: examples, seconds, or both."""
+
+    examples: int | None = 300
+    seconds: float | None = None
+    start: float = field(default_factory=time.perf_counter)
+    used: int = 0
+    frames: int = 0
+
+    def spent(self) -> bool:
+        if self.examples is not None and self.used >= self.examples:
+            return True
+        return self.seconds is not None and time.perf_counter() - self.start >= self.seconds
+
+    @property
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.start
+
+
+def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
+    """Real time: whether the shrunk sequence disagrees the same way once more (a
+    disagreement seen once may be the timing of that run, not the target)."""
+    trial = pair.run(finding.steps)
+    budget.frames += trial.frames
+    d = trial.disagreement
+    return d is not None and d.signature == finding.disagreement.signature
+
+
+#: at most this many runs for the last pass over a shrunk sequence
+MINIMISE_RUNS = 300
+
+
+def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
+    """Hypothesis shrinks by its own measure (the choices it drew); this last pass takes
+    out single steps while the same command still disagrees the same way, so the
+    transcript and the steps its label reads are what the disagreement needs."""
+    steps, outcome = finding.steps, finding.outcome
+    want = (outcome.disagreement.command, outcome.disagreement.kind)
+    runs = 0
+    i = 0
+    while i < len(steps) and runs < MINIMISE_RUNS:
+        s = steps[i]
+        if s.kind == FILL and s.times > 1:
+            # a filled queue: first try it half as full
+            shorter = replace(s, times=s.times // 2)
+            candidate = [*steps[:i], shorter, *steps[i + 1:]]
+            runs += 1
+            trial = pair.run(candidate)
+            budget.frames += trial.frames
+            d = trial.disagreement
+            if d is not None and (d.command, d.kind) == want:
+                steps, outcome = candidate, trial
+                continue
+        candidate = steps[:i] + steps[i + 1:]
+        runs += 1
+        trial = pair.run(candidate)
+        budget.frames += trial.frames
+        d = trial.disagreement
+        if d is not None and (d.command, d.kind) == want:
+            steps, outcome = candidate, trial
+        else:
+            i += 1
+    return Finding(steps, outcome)
+
+
+class _Spent(Exception):
+    """The budget ran out inside Hypothesis."""
+
+
+def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
+           stop_after: int | None = None,
+           on_finding: Callable[[Finding], None] | None = None) -> list[Finding]:
+    """Disagreements between the pair's sides, each shrunk and kept once (by its rule
+    and kind), until the budget is spent (or ``stop_after`` findings)."""
+    strategy = sequences(pair.profile, options)
+    findings: list[Finding] = []
+    unconfirmed = pair.unconfirmed
+    known: set[tuple] = set()
+    rounds = 0
+    while not budget.spent() and (stop_after is None or len(findings) < stop_after):
+        best: dict[str, Finding] = {}
+
+        def fails(steps: list[Step], best: dict[str, Finding] = best) -> bool:
+            if budget.spent():
+                raise _Spent           # also while shrinking: the smallest seen is kept
+            budget.used += 1
+            outcome = pair.run(steps)
+            budget.frames += outcome.frames
+            d = outcome.disagreement
+            if d is None or d.signature in known:
+                return False
+            found = Finding(list(steps), outcome)
+            if "found" not in best or frames_in(steps) <= frames_in(best["found"].steps):
+                best["found"] = found
+            if budget.spent():
+                raise _Spent       # shrinking stops here: the smallest seen is kept
+            return True
+
+        left = (budget.examples - budget.used) if budget.examples is not None else 10**6
+        # Hypothesis's own defaults, not whatever profile the process loaded (the suite's
+        # pytest plugin loads derandomized ones): the seed alone decides the sequences
+        chosen = settings(settings.get_profile("default"), derandomize=False,
+                          max_examples=max(1, left), database=None, deadline=None,
+                          phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
+                          suppress_health_check=list(HealthCheck))
+        try:
+            find(strategy, fails, settings=chosen, random=random.Random(seed + rounds))
+        except (NoSuchExample, _Spent):
+            pass
+        except Flaky:
+            # real time: a disagreement Hypothesis could not see again (kept below only
+            # if it shows once more)
+            pass
+        rounds += 1
+        if "found" not in best:
+            if budget.spent() or budget.examples is not None:
+                break                  # (with examples left: Hypothesis found nothing new)
+            continue
+        finding = minimise(pair, best["found"], budget)
+        if finding.disagreement.signature in known:
+            continue
+        if not pair.exact and not _again(pair, finding, budget):
+            unconfirmed.append(finding)
+            known.add(finding.disagreement.signature)
+            continue
+        known.add(finding.disagreement.signature)
+        findings.append(finding)
+        if on_finding is not None:
+            on_finding(finding)
+    return findings

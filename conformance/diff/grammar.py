@@ -1,0 +1,320 @@
+"""Spec 10's commands as Hypothesis strategies for one profile (``grammar.toml``): valid
+and invalid parameters, checksums right, wrong and missing, other addresses, packets,
+a filled queue, waits, rig inputs; destructive commands only when allowed."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from hypothesis import strategies as st
+
+from conformance.diff.labels import command_of
+from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
+from gve_fixtures.profile import Profile
+
+GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
+
+
+@dataclass(frozen=True)
+class Options:
+    """What a run allows: destructive commands, rig inputs (both sides have a rig)."""
+
+    destructive: bool = False
+    rig: bool = False
+
+
+@cache
+def load_grammar(path: Path = GRAMMAR_FILE) -> dict:
+    return tomllib.loads(path.read_text(encoding="utf-8"))
+
+
+def _range_of(profile: Profile, kind: str) -> tuple[int, int] | None:
+    """The valid values of a field kind, when it is numeric."""
+    head, _, rest = kind.partition(":")
+    if head == "range":
+        r = profile.range(rest)
+        return r.lo, r.hi
+    if head in ("dec", "hex"):
+        lo, hi = rest.split(":")
+        return int(lo), int(hi)
+    return None
+
+
+def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
+    head, _, rest = kind.partition(":")
+    moves = g["moves"]
+    if kind == "vector":
+        v = moves["vector"]
+        return st.one_of(st.integers(-v, v), st.sampled_from([0, 1, -1, v])).map(str)
+    if kind == "travel":
+        v = moves["travel"]
+        return st.integers(-v, v).filter(bool).map(str)
+    if kind == "axis":
+        return st.sampled_from(profile.axes)
+    if kind == "float":
+        return st.sampled_from(["0", "1.5", "-2e3", "1e+3", "3.4e39", "0.1"])
+    if head == "choice":
+        return st.sampled_from(rest.split("|"))
+    lo, hi = _range_of(profile, kind)
+    if head == "range" and rest in ("position",):
+        lo, hi = max(lo, -moves["vector"]), min(hi, moves["vector"])
+    numbers = st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi]))
+    if head == "hex":
+        # EEPROM addresses and bytes from a few values, so a write is read back
+        numbers = st.one_of(st.sampled_from([lo, min(lo + 1, hi), hi]), numbers)
+        return numbers.map(lambda n: "%02X" % n)
+    if head == "range" and rest in ("V", "B", "VL"):
+        # rates low enough that a short move lasts long enough to be read moving
+        numbers = st.one_of(numbers, st.integers(lo, min(hi, max(lo, 5000))))
+    return numbers.map(str)
+
+
+def _invalid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
+    forms = list(g["invalid"]["forms"])
+    bounds = _range_of(profile, kind)
+    out = []
+    for form in forms:
+        if form in ("below", "above"):
+            if bounds is not None:
+                value = bounds[0] - 1 if form == "below" else bounds[1] + 1
+                out.append("%02X" % value if kind.startswith("hex") and value >= 0 else
+                           str(value))
+        else:
+            out.append(form)
+    if kind.startswith("choice") or kind == "axis":
+        out += ["?", "0"]
+    return st.sampled_from(out)
+
+
+def _body(name: str, entry: dict, params: list[str]) -> str:
+    text = entry.get("text", name)
+    kinds = entry.get("params", [])
+    if not params:
+        return text
+    if kinds and (kinds[0].startswith("choice") or kinds[0] == "axis"):
+        # a glued first field (`M4`, `%+`, `WY,...`)
+        return text + params[0] + "".join("," + p for p in params[1:])
+    return text + ",".join(params)
+
+
+def command_names(profile: Profile, options: Options) -> list[str]:
+    """The grammar's commands the profile has and the run allows."""
+    g = load_grammar()
+    return [name for name, entry in g["command"].items()
+            if name in profile.commands and (options.destructive or not entry.get("destructive"))]
+
+
+class Grammar:
+    """The strategies of one profile and run, built once (drawing from prebuilt
+    strategies inside one composite is much cheaper than building them per example)."""
+
+    def __init__(self, profile: Profile, options: Options) -> None:
+        g = self.g = load_grammar()
+        self._cache: dict[tuple, st.SearchStrategy] = {}
+        self.profile = profile
+        self.options = options
+        self.names = command_names(profile, options)
+        self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
+        kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
+        self.invalid = {k: _invalid(profile, k, g) for k in kinds}
+        self.valid = {k: _valid(profile, k, g) for k in kinds}
+        self.invalid_chance = round(g["invalid"]["chance"] * 100)
+        self.modal = [n for n in g["motion"]["modal"] if n in self.names]
+        self.vectors = [n for n in ("L", "C") if n in self.names]
+        self.events = [e for e in g["motion"]["events"]
+                       if e.rstrip("0123456789,") in profile.commands]
+        self.checksums = "%" in profile.commands
+        self.vector_counts = [3, 4] if profile.family == "GVE114" else [len(profile.axes)]
+        steps = g["steps"]
+        self.kinds = ["frame"] * steps["frame"] + ["wait"] * steps["wait"]
+        if options.rig and profile.input_ports:
+            self.kinds += ["input"] * steps["input"]
+        if "*S" in profile.commands:
+            self.kinds += ["packet"] * g["packet"]["weight"]
+        if "C" in profile.commands:
+            self.kinds += ["fill"] * g["fill"]["weight"]
+        if self.vectors:
+            self.kinds += ["motion"] * g["motion"]["weight"]
+        self.readbacks = [(w, r) for w, r in g["readback"]["pairs"]
+                          if w in self.names and r in self.names]
+        if self.readbacks:
+            self.kinds += ["readback"] * g["readback"]["weight"]
+        self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self._can(s)]
+        if self.scenarios:
+            self.kinds += ["scenario"] * g["scenarios"]["weight"]
+        ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
+        self.ports = ports or [1]
+        self.member_names = [n for n in ("C", "B") if n in profile.commands]
+        self.other_members = [n for n in ("L", "V", "PF") if n in profile.commands]
+
+    def _can(self, idiom: list[str]) -> bool:
+        """Whether every step of an idiom can be sent on this profile and run."""
+        allowed = set(self.names) | {"SW6"}
+        for f in idiom:
+            if f.startswith("input "):
+                if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
+                    return False
+            elif not f.startswith("wait ") and command_of(f.removeprefix("bad:")) not in allowed:
+                return False
+        return True
+
+    # -- pieces ----------------------------------------------------------------------------
+    def pick(self, draw, choices) -> object:
+        """One of ``choices`` (strategies built once: building one per draw is slow)."""
+        key = ("pick", tuple(choices))
+        if key not in self._cache:
+            self._cache[key] = st.sampled_from(list(choices))
+        return draw(self._cache[key])
+
+    def number(self, draw, lo: int, hi: int) -> int:
+        key = ("int", lo, hi)
+        if key not in self._cache:
+            self._cache[key] = st.integers(lo, hi)
+        return draw(self._cache[key])
+
+    def field(self, draw, kind: str, valid: bool) -> str:
+        """A field: a valid value, now and then (unless ``valid``) an invalid form."""
+        if not valid and self.number(draw, 0, 99) < self.invalid_chance:
+            return draw(self.invalid[kind])
+        return draw(self.valid[kind])
+
+    def body(self, draw, name: str, *, valid: bool = False) -> str:
+        entry = self.g["command"][name]
+        kinds = entry.get("params", [])
+        if kinds == ["vector"]:
+            kinds = ["vector"] * self.pick(draw, self.vector_counts)
+        params = [self.field(draw, k, valid) for k in kinds]
+        body = _body(name, entry, params)
+        if valid:
+            return body
+        inv = self.g["invalid"]
+        roll = self.number(draw, 0, 99)
+        if roll < inv["lower"] * 100:
+            return body.lower()
+        if roll < (inv["lower"] + inv["extra"]) * 100:
+            extra = self.pick(draw, ["1", "0,0"])
+            return body + (extra if not kinds else "," + extra)
+        return body
+
+    def frame(self, draw, name: str) -> list[Step]:
+        entry = self.g["command"][name]
+        fr = self.g["frames"]
+        body = self.body(draw, name)
+        roll = self.number(draw, 0, 99)
+        checksum, address, stall = "auto", None, None
+        if self.checksums and roll < fr["bad_checksum"] * 100:
+            checksum = "bad"
+        elif self.checksums and roll < (fr["bad_checksum"] + fr["no_checksum"]) * 100:
+            checksum = "none"
+        elif roll >= 100 - fr["other_address"] * 100:
+            address = (self.profile.address + 1 + roll % 6) % 8
+        elif roll >= 100 - (fr["other_address"] + fr["stall"]) * 100:
+            stall = (self.number(draw, 2, 4), (self.profile.watchdog_ms + 50) / 1000)
+        answer = entry.get("answer", True) and address is None
+        out = [Step(FRAME, body, checksum, address, answer, entry.get("lines", 1), stall)]
+        if entry.get("then_wait") == "restart":
+            out.append(self.restart_wait())
+        return out
+
+    def packet(self, draw) -> list[Step]:
+        pk = self.g["packet"]
+        count = self.number(draw, 1, pk["members"])
+        members = []
+        for _ in range(count):
+            other = self.number(draw, 0, 99) < pk["other_member"] * 100
+            name = self.pick(draw, self.other_members if other else self.member_names)
+            members.append(Step(FRAME, self.body(draw, name), answer=False))
+        off = 0
+        if self.number(draw, 0, 99) < pk["wrong_count"] * 100:
+            off = self.pick(draw, [-1, 1])
+        return [Step(FRAME, "*S", answer=False), *members,
+                Step(FRAME, f"*E{max(count + off, 0)}")]
+
+    def fill(self, draw) -> list[Step]:
+        zeros = ",0" * (len(self.profile.axes) - 1)
+        most = self.profile.buffer + 2
+        times = draw(st.one_of(st.integers(1, most), st.just(most)))
+        return [Step(FILL, f"C{self.g['fill']['vector']}{zeros}", times=times)]
+
+    def motion(self, draw) -> list[Step]:
+        m = self.g["motion"]
+        out = []
+        for _ in range(self.number(draw, 0, 2)):
+            if self.modal:
+                out.append(Step(FRAME, self.body(draw, self.pick(draw, self.modal),
+                                                 valid=True)))
+        for _ in range(self.number(draw, 1, m["vectors"])):
+            out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors),
+                                             valid=True)))
+        waits = self.g["moves"]["waits"]
+        for _ in range(self.number(draw, 1, m["reads"])):
+            what = self.number(draw, 0, 2)
+            if what == 0:
+                out.append(Step(FRAME, "PF" if "PF" in self.profile.commands else "P"))
+            elif what == 1:
+                out.append(Step(WAIT, seconds=self.pick(draw, waits)))
+            elif self.events:
+                out.append(Step(FRAME, self.pick(draw, self.events)))
+        return out
+
+    def group(self, draw) -> list[Step]:
+        kind = self.pick(draw, self.kinds)
+        if kind == "frame":
+            return self.frame(draw, self.pick(draw, self.weighted))
+        if kind == "wait":
+            return [Step(WAIT, seconds=self.pick(draw, self.g["moves"]["waits"]))]
+        if kind == "input":
+            value = draw(st.one_of(st.sampled_from([0xFF, 0xFE, 0x7F, 0x00, 0xFD]),
+                                   st.integers(0, 255)))
+            return [Step(INPUT, port=self.pick(draw, self.ports), value=value)]
+        if kind == "packet":
+            return self.packet(draw)
+        if kind == "motion":
+            return self.motion(draw)
+        if kind == "readback":
+            return self.readback(draw)
+        if kind == "scenario":
+            return self.scenario(draw)
+        return self.fill(draw)
+
+    def scenario(self, draw) -> list[Step]:
+        out = []
+        if self.vectors and self.number(draw, 0, 1):
+            out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors), valid=True)))
+        for f in self.pick(draw, self.scenarios):
+            if f.startswith("wait "):
+                out.append(Step(WAIT, seconds=float(f.split()[1])))
+                continue
+            if f.startswith("input "):
+                _, port, value = f.split()
+                out.append(Step(INPUT, port=int(port), value=int(value, 16)))
+                continue
+            if f.startswith("bad:"):
+                out.append(Step(FRAME, f.removeprefix("bad:"), checksum="bad"))
+                continue
+            out.append(Step(FRAME, f))
+            if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
+                out.append(self.restart_wait())
+        return out
+
+    def restart_wait(self) -> Step:
+        return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
+
+    def readback(self, draw) -> list[Step]:
+        write, read = self.pick(draw, self.readbacks)
+        body = self.body(draw, write, valid=True)
+        text = self.g["command"][write].get("text", write)
+        first = body[len(text):].split(",")[0]
+        place = "" if read == "PF" else first
+        return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+
+
+def sequences(profile: Profile, options: Options) -> st.SearchStrategy[list[Step]]:
+    """A sequence of steps for one example (groups flattened)."""
+    grammar = Grammar(profile, options)
+    group = st.composite(lambda draw: grammar.group(draw))()
+    return st.lists(group, min_size=1, max_size=grammar.g["steps"]["max"]).map(
+        lambda gs: [s for grp in gs for s in grp])

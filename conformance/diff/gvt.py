@@ -1,0 +1,141 @@
+"""A finding as a transcript (``fixtures/README.md``): the frames exactly as sent, the
+reference's answers as the expected `<` records, the target's answer beside each one as a
+comment, waits, rig inputs and filled queues as actions; and back into steps for
+`gve-conformance replay`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conformance.diff.engine import Finding, Record
+from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
+from conformance.link.framing import HostFramer, readable
+from gve_fixtures.transcript import ACTION, HOST, UNIT, Transcript, unescape
+from gve_fixtures.transcript import Record as Line
+
+
+def transcript(finding: Finding, *, profile: str, target: str, reference: str,
+               seed: int | None = None) -> Transcript:
+    d = finding.disagreement
+    meta = {
+        "title": f"diff: {d.command or '?'} answered differently ({d.kind})",
+        "source": "gve-conformance diff",
+        "rules": d.rule or "",
+        "tag": d.tag,
+        "profiles": profile,
+        "target": target,
+        "reference": reference,
+        "verdict": d.verdict,
+        "target-answer": readable(d.target.answer) or "(none)",
+        "reference-answer": readable(d.reference.answer) or "(none)",
+    }
+    if seed is not None:
+        meta["seed"] = str(seed)
+    if not d.rule:
+        del meta["rules"]
+    lines: list[Line] = []
+    records = finding.outcome.records
+    for i, rec in enumerate(records):
+        last = i == len(records) - 1
+        if rec.step.kind == FILL and not last and _fill_ends(records, i):
+            first = records[i - rec.repeat]
+            lines.append(Line(ACTION, f"fill {rec.repeat + 1} {_payload(first)}".encode(),
+                              first.target.sent_at))
+            continue
+        if rec.step.kind == FILL and not last:
+            continue
+        lines += _lines(rec, last and d is not None, d.rule if last else None, d.verdict)
+    return Transcript(meta, lines)
+
+
+def _payload(rec: Record) -> str:
+    return Line(HOST, rec.target.sent).line().split(" ", 1)[1]
+
+
+def _fill_ends(records: list[Record], i: int) -> bool:
+    """Whether record ``i`` ends the part of its fill written as one action: the next
+    record is another step, or the last one (the disagreement, written as a frame)."""
+    nxt = records[i + 1]
+    return nxt.step is not records[i].step or nxt.repeat == 0 or i + 2 == len(records)
+
+
+def _lines(rec: Record, disagreeing: bool, rule: str | None, verdict: str) -> list[Line]:
+    step = rec.step
+    if step.kind == WAIT:
+        return [Line(ACTION, f"wait {step.seconds:g}".encode())]
+    if step.kind == INPUT:
+        return [Line(ACTION, f"input {step.port} {step.value:02X}".encode())]
+    out: list[Line] = []
+    sent = rec.target.sent
+    if step.stall is not None:
+        at, seconds = step.stall
+        out += [Line(HOST, sent[:at], rec.target.sent_at),
+                Line(ACTION, f"wait {seconds:g}".encode(), comment="stalled: the watchdog"),
+                Line(HOST, sent[at:])]
+    else:
+        out.append(Line(HOST, sent, rec.target.sent_at))
+    expected = rec.reference.answer
+    differs = rec.target.answer != expected
+    note = f"target: {readable(rec.target.answer) or '(none)'}" if differs else ""
+    if disagreeing:
+        note = f"[{verdict} {rule or 'no known rule'}] {note}".strip()
+    pieces = [p + b"\r" for p in expected.split(b"\r")[:-1]] if expected else []
+    if expected and not expected.endswith(b"\r"):
+        pieces.append(expected.rsplit(b"\r", 1)[-1])
+    for j, piece in enumerate(pieces):
+        out.append(Line(UNIT, piece, rec.reference.received_at if j == 0 else None,
+                        note if j == len(pieces) - 1 else ""))
+    if not pieces and note:
+        out.append(Line(ACTION, b"silence 0", comment=f"reference: (none); {note}"))
+    return out
+
+
+def write(path: str | Path, t: Transcript) -> Path:
+    path = Path(path)
+    path.write_text(t.dumps(), encoding="ascii")
+    return path
+
+
+def steps_of(t: Transcript) -> list[Step]:
+    """The steps a transcript replays: each frame's bytes exactly, an answer due when
+    `<` records follow it (as many lines as there are), waits, inputs, fills."""
+    steps: list[Step] = []
+    records = t.records
+    i = 0
+    while i < len(records):
+        r = records[i]
+        if r.direction == HOST:
+            data, stall = r.data, None
+            j = i + 1
+            # a frame in pieces with a wait between: a stalled frame
+            if (j + 1 < len(records) and records[j].direction == ACTION
+                    and records[j].action[0] == "wait" and records[j + 1].direction == HOST
+                    and not data.endswith(b"\r")):
+                stall = (len(data), float(records[j].action[1]))
+                data += records[j + 1].data
+                j += 2
+            lines = 0
+            while j < len(records) and records[j].direction == UNIT:
+                lines += 1
+                j += 1
+            steps.append(Step(FRAME, _body(data), answer=lines > 0, lines=max(lines, 1),
+                              stall=stall, raw=data))
+            i = j
+            continue
+        if r.direction == ACTION:
+            words = r.action
+            if words[0] == "wait":
+                steps.append(Step(WAIT, seconds=float(words[1])))
+            elif words[0] == "input":
+                steps.append(Step(INPUT, port=int(words[1]), value=int(words[2], 16)))
+            elif words[0] == "fill":
+                data = unescape(words[2])
+                steps.append(Step(FILL, _body(data), times=int(words[1]), raw=data))
+        i += 1
+    return steps
+
+
+def _body(data: bytes) -> str:
+    frames = HostFramer().frames(data)
+    return frames[-1].bodies(None)[-1] if frames else ""

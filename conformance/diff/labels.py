@@ -1,0 +1,91 @@
+"""A disagreement labelled with the rule it touches (``labels.toml``) and graded by that
+rule's tag, as the suite grades a failed check (M, M-ex: FAIL; D: NON-STRICT, or FAIL
+on a profile that implements the project's decisions; D-info: INFO); a disagreement
+touching no known rule is INFO."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from conformance.verdict import INFO, grade
+from gve_fixtures.rules import load_rules
+
+LABELS_FILE = Path(__file__).with_name("labels.toml")
+_FIELDS = ("command", "kind", "context", "earlier", "reference", "target")
+
+#: spec 10's command names, longest first (so `PF` is not read as `P`)
+NAMES = sorted(["?", "Q", "L", "C", "T", "$", "A", "V", "VL", "B", "VK", "VN", "XA", "XU",
+                "XD", "XM", "P", "PF", "N", "NX", "NY", "NZ", "NA", "W", "K", "R", "H",
+                "D", "G", "ER", "EW", "EFR", "EFW", "EUR", "EUW", "O", "I0", "I1", "I2",
+                "SR", "SW", "F", "M", "Y", "@", ">", "J", "%", "*S", "*E"],
+               key=len, reverse=True)
+
+
+def command_of(body: str) -> str:
+    """The spec 10 name of a frame's command (`SW6` for a write of ST6), read as upper
+    case; "" when none matches."""
+    text = body.upper()
+    for name in NAMES:
+        if text.startswith(name):
+            if name == "SW" and re.match(r"SW0*6(,|$)", text):
+                return "SW6"
+            return name
+    return ""
+
+
+@dataclass(frozen=True)
+class Label:
+    rule: str
+    conditions: dict
+
+    def matches(self, facts: dict) -> bool:
+        for key, wanted in self.conditions.items():
+            if key == "context":
+                if not set(wanted) <= facts["context"]:
+                    return False
+            elif key == "earlier":
+                if not set(wanted) & facts["earlier"]:
+                    return False
+            elif facts[key] not in wanted:
+                return False
+        return True
+
+
+@cache
+def load_labels(path: Path = LABELS_FILE) -> tuple[Label, ...]:
+    raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    rules = load_rules()
+    out = []
+    for i, entry in enumerate(raw.get("label", [])):
+        rule = entry.get("rule")
+        if rule not in rules:
+            raise ValueError(f"{path.name}: label #{i + 1}: unknown rule {rule!r}")
+        unknown = set(entry) - {"rule", *_FIELDS}
+        if unknown:
+            raise ValueError(f"{path.name}: label #{i + 1}: unknown field(s) {sorted(unknown)}")
+        out.append(Label(rule, {k: entry[k] for k in _FIELDS if k in entry}))
+    return tuple(out)
+
+
+def label(command: str, kind: str, context: set[str], earlier: set[str],
+          reference: int | None, target: int | None = None) -> str | None:
+    """The rule a disagreement touches (None: no known rule); ``reference`` and
+    ``target`` are the two sides' error codes (None: no answer)."""
+    facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
+             "reference": reference, "target": target}
+    for entry in load_labels():
+        if entry.matches(facts):
+            return entry.rule
+    return None
+
+
+def verdict_of(rule: str | None, implements_decisions: bool) -> tuple[str, str]:
+    """(verdict, tag) of a disagreement touching ``rule``."""
+    if rule is None:
+        return INFO, "D-info"
+    tag = load_rules()[rule].tag
+    return grade(tag, implements_decisions), tag

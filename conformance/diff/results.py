@@ -1,0 +1,55 @@
+"""Findings as the suite's results, so the usual reports (JUnit, JSON, HTML) show them:
+one result per disagreement, filed under its rule's section, with both answers side by
+side (observed: the target's, expected: the reference's) and its transcript; one
+result for the whole search when the sides agreed throughout."""
+
+from __future__ import annotations
+
+import re
+
+from conformance.diff.engine import Finding
+from conformance.link.framing import readable
+from conformance.runner import CaseResult
+from conformance.verdict import PASS
+from gve_fixtures.rules import load_rules
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-") or "frame"
+
+
+def finding_result(f: Finding, *, profile: str, target: str, transcript: list[str],
+                   path: str = "") -> CaseResult:
+    d = f.disagreement
+    rule = load_rules().get(d.rule) if d.rule else None
+    section = rule.section if rule else "diff"
+    slug = _slug({"*E": "packet-end", "*S": "packet-start", "@": "index", ">": "repeat",
+                  "?": "version", "%": "checksum-mode", "$": "short"}.get(d.command, d.command))
+    r = CaseResult(f"{section}.diff.{slug}-{d.kind}", section,
+                   rule.text if rule else "the target answers as the reference does",
+                   d.tag, rule.source if rule else "gve-conformance diff", profile, target,
+                   d.verdict)
+    sent = readable(d.target.sent)
+    r.checks = [{"ok": False, "what": f"{sent} answered differently ({d.kind})",
+                 "observed": readable(d.target.answer) or "(no answer)",
+                 "expected": readable(d.reference.answer) or "(no answer)",
+                 "tag": d.tag, "rule": d.rule or ""}]
+    r.notes = [f"rule touched: {d.rule or 'none known'}",
+               f"shrunk to {f.frames} frame(s): " + " | ".join(str(s) for s in f.steps)]
+    if f.outcome.refused:
+        r.notes.append("not sent (the guard): " + "; ".join(f.outcome.refused))
+    r.wire_log = transcript
+    r.frames = f.frames
+    if path:
+        r.artifacts = {"transcript": path}
+    return r
+
+
+def agreement_result(*, profile: str, target: str, examples: int, frames: int,
+                     seconds: float) -> CaseResult:
+    r = CaseResult("diff.search.agreement", "diff", "the target answers as the reference "
+                   "does", "M", "gve-conformance diff", profile, target, PASS)
+    r.checks = [{"ok": True, "what": f"{examples} sequences, {frames} frames: every answer "
+                 "alike", "observed": "", "expected": "", "tag": "M", "rule": ""}]
+    r.frames, r.seconds = frames, seconds
+    return r

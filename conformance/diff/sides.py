@@ -1,0 +1,129 @@
+"""One side of a differential run: a target's link for one example, the frames sent
+through the run's session (its guard judges every one before it goes out), and the
+clock the two sides share.
+
+The target leads; the reference follows it in time. When both are in virtual time
+(the embedded emulator against a mutant of itself) each step starts on both at the
+same instant: the one behind is advanced to the other (exact). When the target runs in
+real time, the reference (virtual) is advanced, before each step, to the instant the
+target has reached since the example began.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from conformance.link.framing import HostFramer, Response, parse_response
+from conformance.link.link import MARGIN, Link
+from conformance.targets import Session, Target
+
+#: answers summed after the command whatever the mode before (spec 6, 10 J)
+_MODE_AFTER = {"%+": True, "%-": False, "J": False}
+
+
+@dataclass
+class Exchange:
+    """One frame on one side: what went out, what came back and when (ns since the
+    example began, on that side's clock)."""
+
+    sent: bytes
+    answer: bytes
+    sent_at: int
+    received_at: int
+    response: Response | None
+    lines: int = 1
+
+    @property
+    def code(self) -> int | None:
+        return None if self.response is None else self.response.code
+
+
+class Side:
+    """A target as one side of the comparison."""
+
+    def __init__(self, target: Target, session: Session | None = None) -> None:
+        self.target = target
+        self.session = session
+        self.link: Link | None = None
+        self._origin = 0
+
+    @property
+    def virtual(self) -> bool:
+        return self.target.info.virtual_time
+
+    @property
+    def has_rig(self) -> bool:
+        return self.link is not None and self.link.rig is not None
+
+    def open(self) -> Link:
+        """A link in the known state for a new example: on the emulator a fresh unit (and
+        a session of its own, so one example's silences do not count in the next); on a
+        real unit the run's session's known state."""
+        if self.virtual and self.target.info.kind == "emu":
+            self.session = Session(self.target, self.session.interrupts if self.session
+                                   else None)
+        elif self.session is None:
+            self.session = self.target.begin()
+        self.link = self.session.open_link()
+        self._origin = self.link.now
+        return self.link
+
+    def age(self, seconds: float) -> None:
+        """Virtual time: let a fresh unit stand for ``seconds`` and begin the example
+        there (a unit with a history: no dwell counted from its power-on)."""
+        if self.virtual:
+            self.link.port.line.advance(seconds)
+            self._origin = self.link.now
+
+    @property
+    def now(self) -> int:
+        """Nanoseconds since the example began."""
+        return self.link.now - self._origin
+
+    def catch_up(self, t: int) -> None:
+        """Virtual time: advance to ``t`` (ns since the example began) if behind."""
+        if self.virtual and t > self.now:
+            self.link.port.line.advance_to(self.link.port.line.now + (t - self.now))
+
+    def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
+                 stall: tuple[int, float] | None = None, body: str | None = None
+                 ) -> Exchange:
+        """Send a frame's bytes (through the guard: SafetyStop when refused) and take
+        what comes back: its answer (``answer``), else whatever arrives while the
+        answer's bytes would have taken. ``body``: the frame's command, when known (it
+        decides how long an answer may take)."""
+        link = self.link
+        if body is None:
+            body = _body(data, link.checksums)
+        if stall is not None:
+            link.inject("host", "delay", at=stall[0], seconds=stall[1])
+        sent_at = self.now
+        link.send_raw(data)
+        if answer:
+            slow = link.guard.answer_seconds(body) or 0.0
+            timeout = MARGIN + link.byte_seconds(len(data) + 64) + slow
+            r = link.read_response(timeout, lines, summed=_MODE_AFTER.get(body, link.checksums))
+            back = r.raw if r is not None else b""
+        else:
+            back = link.wait(link.byte_seconds(len(data) + 64) + 0.005)
+            r = parse_response(back, summed=link.checksums) if back else None
+        return Exchange(data, back, sent_at, self.now, r, lines)
+
+    def wait(self, seconds: float) -> bytes:
+        return self.link.wait(seconds)
+
+    def set_input(self, port: int, value: int) -> None:
+        self.link.rig.set_input(port, value)
+
+    def close_example(self) -> None:
+        """Take what is still on its way (an answer after the last frame)."""
+        if self.link is not None:
+            self.link.settle(final=True)
+
+
+def _body(data: bytes, summed: bool) -> str:
+    frames = HostFramer().frames(data)
+    if not frames:
+        return ""
+    bodies = frames[-1].bodies(summed)
+    return bodies[0] if bodies else ""

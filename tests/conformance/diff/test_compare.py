@@ -1,0 +1,45 @@
+"""Two answers compared: exact in virtual time, positions within the band in real time
+while the axes may move, exact at rest; the index from where each side began."""
+
+from conformance.diff.compare import Judge, difference
+from conformance.diff.sides import Exchange
+from conformance.link.framing import parse_response
+
+MS = 1_000_000
+
+
+def ex(answer: bytes, sent_at: int = 0, received_at: int = MS) -> Exchange:
+    r = parse_response(answer, summed=False) if answer else None
+    return Exchange(b"!0PF\r", answer, sent_at, received_at, r)
+
+
+def test_alike_answers_at_the_same_instant_agree():
+    assert difference("PF", ex(b"0,1,2,3\r"), ex(b"0,1,2,3\r"), Judge()) is None
+
+
+def test_in_virtual_time_an_answer_at_another_instant_is_a_timing_difference():
+    assert difference("H", ex(b"8\r", 0, MS), ex(b"8\r", 0, 5 * MS), Judge()) == "timing"
+
+
+def test_kinds():
+    judge = Judge()
+    assert difference("V", ex(b"0\r"), ex(b""), judge) == "silence"
+    assert difference("V", ex(b"4\r"), ex(b"5\r"), judge) == "code"
+    assert difference("V", ex(b"0\r"), ex(b"8\r"), judge) == "inta"
+    assert difference("PF", ex(b"0,1,2,3\r"), ex(b"0,1,2,4\r"), judge) == "position"
+    assert difference("SR", ex(b"0,01\r"), ex(b"0,FF\r"), judge) == "data"
+
+
+def test_real_time_positions_within_the_band_while_moving_and_exact_at_rest():
+    judge = Judge(exact=False, rate=1000)                  # 1000 steps/s: 1 step per ms
+    near, far = ex(b"0,100,0,0\r", 0, 2 * MS), ex(b"0,103,0,0\r", 0, 0)
+    assert difference("PF", near, far, judge, moving=True) is None     # 2 ms + placement
+    assert difference("PF", ex(b"0,110,0,0\r", 0, 2 * MS), far, judge, moving=True) \
+        == "position"
+    assert difference("PF", near, far, judge, moving=False) == "position"
+
+
+def test_real_time_index_compared_from_where_each_side_began():
+    judge = Judge(exact=False, index_offset=40)
+    assert difference("@", ex(b"0,45\r"), ex(b"0,5\r"), judge) is None
+    assert difference("@", ex(b"0,46\r"), ex(b"0,5\r"), judge) == "data"

@@ -1,0 +1,83 @@
+"""The engine in process: the emulator against itself agrees exactly; against a mutant
+of itself the disagreement is found, shrunk to a few frames and labelled with a rule of
+the mutant's area; the transcript replays it."""
+
+import pytest
+
+from conformance.diff.engine import Budget, Pair, search
+from conformance.diff.grammar import Options
+from conformance.diff.gvt import steps_of, transcript
+from conformance.diff.sides import Side
+from conformance.targets import parse_target
+from conformance.targets.emu import mutants
+from gve_fixtures.rules import load_rules
+from gve_fixtures.transcript import parse
+
+#: mutants the default run hunts (each found in a few hundred sequences); every mutant
+#: is hunted by the slow test below
+QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-commands",
+         "index-counts-queries", "go-without-inta", "range-error-code",
+         "wrong-address-answers", "inta-bit-missing", "checksum-unchecked",
+         "line-while-busy", "delete-while-moving")
+#: where a mutant shows only on one family
+PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
+           "mpg-not-moving": "GVE114-500"}
+EVERYTHING = Options(destructive=True, rig=True)
+
+
+def pair(mutant: str | None, profile: str = "GVE84-100") -> Pair:
+    spec = f"emu:{profile}" + (f"?mutant={mutant}" if mutant else "")
+    target, reference = parse_target(spec), parse_target(f"emu:{profile}")
+    return Pair(Side(target), Side(reference), target.profile)
+
+
+def hunt(mutant: str, examples: int):
+    p = pair(mutant, PROFILE.get(mutant, "GVE84-100"))
+    found = search(p, EVERYTHING, Budget(examples=examples), stop_after=1)
+    assert found, f"{mutant} not found in {examples} sequences"
+    return p, found[0]
+
+
+@pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
+def test_the_emulator_agrees_with_itself(profile):
+    budget = Budget(examples=60)
+    assert search(pair(None, profile), EVERYTHING, budget) == []
+    assert budget.used == 60 and budget.frames > 300
+
+
+@pytest.mark.parametrize("mutant", QUICK)
+def test_a_mutant_is_found_shrunk_and_labelled(mutant):
+    _, f = hunt(mutant, 1000)
+    d = f.disagreement
+    area = mutants()[mutant][0]
+    # the rule's part of the spec is the mutant's (10.4's D may show at 10's F)
+    section = load_rules()[d.rule].section if d.rule else ""
+    assert section.split(".")[0] == area.split(".")[0], (d.rule, f.steps)
+    assert f.frames <= 6, f.steps
+    assert d.target.answer != d.reference.answer
+
+
+def test_the_transcript_replays_the_disagreement():
+    p, f = hunt("go-without-inta", 600)
+    t = parse(transcript(f, profile="GVE84-100", target="t", reference="r").dumps())
+    assert t.meta["rules"] == f.disagreement.rule
+    again = p.run(steps_of(t))
+    assert again.disagreement is not None
+    assert again.disagreement.signature == f.disagreement.signature
+    clean = pair(None).run(steps_of(t))
+    assert clean.disagreement is None
+
+
+def test_a_fill_keeps_the_queue_it_needs():
+    _, f = hunt("queue-one-short", 600)
+    assert f.disagreement.rule == "10.1.queue.cont-buffer"
+    assert f.frames == 64                      # the 64th C: one too few taken
+    lines = transcript(f, profile="GVE84-100", target="t", reference="r").dumps()
+    assert "= fill 63 !0C50,0,0\\r" in lines
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mutant", sorted(mutants()))
+def test_every_mutant_is_found(mutant):
+    _, f = hunt(mutant, 3000)
+    assert f.disagreement.rule is not None
