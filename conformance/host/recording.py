@@ -11,6 +11,10 @@ from conformance.host.framer import Fragment, HostFrame
 from conformance.host.grammar import ParsedFrame
 from gve_fixtures.transcript import ACTION, HOST, UNIT, Record, escape
 
+#: a relay loop turn later than this (ns) is a stall of the relay itself, booked in
+#: :attr:`Recording.stalls` and not held against hosts
+STALL_NS = 20_000_000
+
 
 @dataclass
 class Exchange:

@@ -31,7 +31,7 @@ from conformance.host.faults import Fault
 from conformance.host.framer import HostFrame, HostFramer
 from conformance.host.grammar import LineGrammar
 from conformance.host.ports import HostPort
-from conformance.host.recording import Exchange, Recording, Unsolicited
+from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView, by_address, profiles_by_address
 
 MS = 1_000_000
@@ -44,8 +44,6 @@ SHORT = 24
 IDLE_S = 0.02
 #: how far the line's clock may lag the wall clock before the relay brings it up
 LAG = MS // 2
-#: a loop turn later than this is a stall of the relay itself (not held against hosts)
-STALL = 20 * MS
 #: commands that answer when the motion has stopped (spec 2)
 DEFERRED = ("H", "W")
 
@@ -128,7 +126,7 @@ class Relay:
         start = now()
         ready, _, _ = select.select([self.port.fileno()], [], [], wait)
         woke = now()
-        if woke - start > wait * SECOND + STALL:
+        if woke - start > wait * SECOND + STALL_NS:
             self.rec.stalls.append((start + round(wait * SECOND), woke))
         if ready:
             self.take_host(self.port.read(), woke)
@@ -137,7 +135,7 @@ class Relay:
         self.fault.tick(now(), self)
         self.deliver()
         done = now()
-        if done - woke > STALL:
+        if done - woke > STALL_NS:
             self.rec.stalls.append((woke, done))
 
     def _wait(self, max_wait: float) -> float:

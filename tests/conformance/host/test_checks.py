@@ -3,7 +3,7 @@ is and kept where it is not."""
 
 from __future__ import annotations
 
-from conformance.host.checks import PATIENCE_MS
+from conformance.host.checks import MS, PATIENCE_MS
 from conformance.host.oracle import HOST_CHECKS
 from gve_fixtures.rules import load_rules
 from tests.conformance.host.records import Wire, broken
@@ -33,6 +33,19 @@ def test_a_host_may_give_an_answer_up_after_waiting_long_enough():
     w.frame(b"!0V1000", 0, lost=True)
     w.frame(b"!0@", PATIENCE_MS / 2, answer=b"0,1\r")
     assert "2.link.simplex" in broken(w.judge())
+
+
+def test_frames_the_relay_read_together_after_a_stall_of_its_own_are_not_judged():
+    # the host gave `@` up after its timeout and sent `?`; the relay, descheduled for
+    # 300 ms, read both in one chunk and stamped them at the same instant
+    w = Wire()
+    w.frame(b"!0@", 300, lost=True)
+    w.frame(b"!0?", 300, answer=b"0,IP114\r")
+    assert "2.link.simplex" in broken(w.judge())
+    w.rec.stalls.append((round(1 * MS), round(300 * MS)))
+    j = w.judge()
+    assert "2.link.simplex" not in broken(j)
+    assert any("not judged for 2.link.simplex" in n for n in j.notes)
 
 
 def test_members_get_no_answer_so_the_next_frame_follows_at_once():
