@@ -253,6 +253,10 @@ class Pair:
         return {k for k, on in flags.items() if on}
 
 
+#: frames that change the course of a motion: a difference after them is theirs
+_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+
+
 class _Dwell:
     """The modal dwell T and when the reference last took a vector: a frame sent less
     than T after it may have met the vector still in its dwell (spec 10.2), which is what
@@ -267,6 +271,8 @@ class _Dwell:
             return
         if command in ("L", "C"):
             self.vector_at = reference.sent_at
+        elif command in _COURSE_CHANGERS:
+            self.vector_at = None          # what follows is the halt's, the resume's...
         elif command == "T" and body[1:].isdigit():
             self.t_ns = int(body[1:]) * 1_000_000
 
