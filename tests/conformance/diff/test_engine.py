@@ -20,7 +20,8 @@ from gve_fixtures.transcript import parse
 QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-commands",
          "index-counts-queries", "go-without-inta", "range-error-code",
          "wrong-address-answers", "inta-bit-missing", "checksum-unchecked",
-         "line-while-busy", "delete-while-moving", "dwell-ignored", "restore-drops-partial")
+         "line-while-busy", "delete-while-moving", "dwell-ignored", "restore-drops-partial",
+         "dwell-between-continuous", "eeprom-write-lost")
 #: where a mutant shows only on one family
 PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
            "mpg-not-moving": "GVE114-500"}
