@@ -145,7 +145,7 @@ def main(argv: list[str] | None = None) -> int:
             print("\n".join("    " + line for line in t.lines()), flush=True)
 
     try:
-        with interrupts.catching_sigint():
+        with interrupts.catching():
             search(pair, options, budget, seed=args.seed, on_finding=found)
     except (TargetNotResponding, SessionError) as err:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,

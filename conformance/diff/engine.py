@@ -212,8 +212,8 @@ class Pair:
         moving = False
         if not self.exact:
             self._watch_reference()
-            if command in ("P", "PF"):
-                moving = self._moving_near(rec)
+            if command in ("P", "PF", ">"):
+                moving = self._moving_near(rec) if command != ">" else True
         return difference(command, rec.target, rec.reference, self.judge, moving=moving)
 
     def _watch_reference(self) -> None:

@@ -46,3 +46,23 @@ def test_idioms_that_show_the_dwell_and_an_eeprom_write_are_drawn():
     assert ("EW10,5A", "ER10") in everything
     assert any(s[:2] == ("T24", "A10000") and s.count("C100") >= 2 for s in everything)
     assert ("EW10,5A", "ER10") not in Grammar(GVE84, Options()).scenarios
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_every_repeat_awaits_its_two_lines(data):
+    # `>` answers the frame it repeats, then the answer: drawn as an event of a motion or
+    # in an idiom too, both lines are read (one line would leave the answer behind and
+    # count the repeated frame as a silence of the target)
+    steps = data.draw(sequences(GVE84, Options(destructive=True)))
+    for s in steps:
+        if s.kind == FRAME and command_of(s.body) == ">":
+            assert s.lines == 2, s
+        if s.kind == FRAME and command_of(s.body) == "*S":
+            assert not s.answer, s
+
+
+def test_an_event_repeat_is_read_whole():
+    g = Grammar(GVE84, Options())
+    assert g.fixed(">").lines == 2 and g.fixed("H").lines == 1
+    assert not g.fixed("*S").answer
