@@ -22,6 +22,9 @@ QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-c
          "wrong-address-answers", "inta-bit-missing", "checksum-unchecked",
          "line-while-busy", "delete-while-moving", "dwell-ignored", "restore-drops-partial",
          "dwell-between-continuous", "eeprom-write-lost")
+#: frames a shrunk finding may keep where the rule needs a motion set up (settings, two
+#: C joined, the reads at the junction)
+FRAMES = {"dwell-between-continuous": 12}
 #: where a mutant shows only on one family
 PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
            "mpg-not-moving": "GVE114-500"}
@@ -62,7 +65,7 @@ def test_a_mutant_is_found_shrunk_and_labelled(mutant):
     _, f = hunt(mutant, 1000)
     d = f.disagreement
     assert in_area(d.rule, mutant), (d.rule, f.steps)
-    assert f.frames <= 6, f.steps
+    assert f.frames <= FRAMES.get(mutant, 6), f.steps
     # the same bytes differ in when they came, or the bytes differ
     assert (d.target.received_at - d.target.sent_at != d.reference.received_at
             - d.reference.sent_at) if d.kind == "timing" else d.target.answer != d.reference.answer
