@@ -30,6 +30,8 @@ from gve_fixtures.protocol import St6
 #: frames that close an open packet (spec 7)
 _PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: a vector that moves nothing (and so waits no dwell)
+_ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: real time: how long the reference must have been at rest, besides the target's
 #: window, for positions to be compared exactly (a target's motion ends when the unit
 #: says, the reference's when its model does)
@@ -269,7 +271,7 @@ class _Dwell:
     def note(self, command: str, body: str, reference: Exchange) -> None:
         if reference.code != 0:
             return
-        if command in ("L", "C"):
+        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
