@@ -54,13 +54,23 @@ def difference(command: str, target: Exchange, reference: Exchange, judge: Judge
         return "bytes"
     if list(ra.values) == list(rb.values):
         return "checksum" if ra.checksum != rb.checksum else "bytes"
-    if command in POSITION_COMMANDS:
+    if command in POSITION_COMMANDS or (command == ">" and _repeats_position(ra, rb)):
         if not judge.exact and _positions_close(target, reference, judge, moving):
             return None
         return "position"
     if command == "@" and not judge.exact and _same_index(ra.values, rb.values, judge):
         return None
     return "data"
+
+
+def _repeats_position(ra, rb) -> bool:
+    """Both `>` answers repeat the same position read: its values were taken while the
+    axes may have moved, and are compared as that read was (the first line is the frame
+    repeated, `!0PF`)."""
+    if len(ra.lines) != 2 or ra.lines[0] != rb.lines[0]:
+        return False
+    frame = ra.lines[0].decode("latin-1")
+    return frame[2:].upper() in POSITION_COMMANDS
 
 
 def _numbers(values: list[str]) -> list[int] | None:

@@ -30,6 +30,8 @@ from gve_fixtures.protocol import St6
 #: frames that close an open packet (spec 7)
 _PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: a vector that moves nothing (and so waits no dwell)
+_ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: real time: how long the reference must have been at rest, besides the target's
 #: window, for positions to be compared exactly (a target's motion ends when the unit
 #: says, the reference's when its model does)
@@ -103,6 +105,7 @@ class Pair:
             self._prelude()
         context_packet = False
         earlier: set[str] = set()
+        dwell = _Dwell(self.profile.reset.T)
         for step in steps:
             if step.kind == WAIT:
                 self.target.wait(step.seconds)
@@ -127,6 +130,8 @@ class Pair:
                 kind = self._difference(command, rec)
                 if kind is not None:
                     context = self._context(step, context_packet)
+                    if dwell.within(rec.reference.sent_at):
+                        context.add("in-dwell")
                     d = Disagreement(len(out.records) - 1, command, kind, rec.target,
                                      rec.reference, frozenset(context), frozenset(earlier))
                     d.rule = label(command, kind, context, earlier,
@@ -134,6 +139,7 @@ class Pair:
                     d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
                     out.disagreement = d
                     return self._end(out)
+                dwell.note(command, step.body, rec.reference)
                 if step.kind == FILL and rec.reference.code != 0:
                     break
             if out.ended:
@@ -208,8 +214,8 @@ class Pair:
         moving = False
         if not self.exact:
             self._watch_reference()
-            if command in ("P", "PF"):
-                moving = self._moving_near(rec)
+            if command in ("P", "PF", ">"):
+                moving = self._moving_near(rec) if command != ">" else True
         return difference(command, rec.target, rec.reference, self.judge, moving=moving)
 
     def _watch_reference(self) -> None:
@@ -247,6 +253,33 @@ class Pair:
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
         }
         return {k for k, on in flags.items() if on}
+
+
+#: frames that change the course of a motion: a difference after them is theirs
+_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+
+
+class _Dwell:
+    """The modal dwell T and when the reference last took a vector: a frame sent less
+    than T after it may have met the vector still in its dwell (spec 10.2), which is what
+    a difference there points at, whatever command showed it."""
+
+    def __init__(self, t_ms: int) -> None:
+        self.t_ns = t_ms * 1_000_000
+        self.vector_at: int | None = None
+
+    def note(self, command: str, body: str, reference: Exchange) -> None:
+        if reference.code != 0:
+            return
+        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+            self.vector_at = reference.sent_at
+        elif command in _COURSE_CHANGERS:
+            self.vector_at = None          # what follows is the halt's, the resume's...
+        elif command == "T" and body[1:].isdigit():
+            self.t_ns = int(body[1:]) * 1_000_000
+
+    def within(self, t: int) -> bool:
+        return self.vector_at is not None and t - self.vector_at < self.t_ns
 
 
 def _code(exchange: Exchange) -> int | None:

@@ -4,6 +4,7 @@ a filled queue, waits, rig inputs; destructive commands only when allowed."""
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass
 from functools import cache
@@ -16,6 +17,8 @@ from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from gve_fixtures.profile import Profile
 
 GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
+#: an idiom's vector along the first axis only
+_ONE_COMPONENT = re.compile(r"[LC]-?\d+")
 
 
 @dataclass(frozen=True)
@@ -257,7 +260,7 @@ class Grammar:
             elif what == 1:
                 out.append(Step(WAIT, seconds=self.pick(draw, waits)))
             elif self.events:
-                out.append(Step(FRAME, self.pick(draw, self.events)))
+                out.append(self.fixed(self.pick(draw, self.events)))
         return out
 
     def group(self, draw) -> list[Step]:
@@ -293,12 +296,26 @@ class Grammar:
                 out.append(Step(INPUT, port=int(port), value=int(value, 16)))
                 continue
             if f.startswith("bad:"):
-                out.append(Step(FRAME, f.removeprefix("bad:"), checksum="bad"))
+                out.append(self.fixed(f.removeprefix("bad:"), checksum="bad"))
                 continue
-            out.append(Step(FRAME, f))
+            out.append(self.fixed(self._padded(f)))
             if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
                 out.append(self.restart_wait())
         return out
+
+    def fixed(self, body: str, checksum: str = "auto") -> Step:
+        """A frame written in the grammar (an event, an idiom's step), answered as its
+        command is: `>`'s two lines (the frame it repeats, then the answer), none after
+        `*S`."""
+        entry = self.g["command"].get(command_of(body), {})
+        return Step(FRAME, body, checksum, answer=entry.get("answer", True),
+                    lines=entry.get("lines", 1))
+
+    def _padded(self, body: str) -> str:
+        """An idiom's one-component vector (`C100`) with the profile's other axes 0."""
+        if _ONE_COMPONENT.fullmatch(body):
+            return body + ",0" * (len(self.profile.axes) - 1)
+        return body
 
     def restart_wait(self) -> Step:
         return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)

@@ -377,8 +377,10 @@ class Guard:
     def answered(self, response: Response | None) -> None:
         """Count frames in a row that got no answer (or bytes that are not one)."""
         if response is not None and response.code is not None:
-            self.silences = 0
+            self.silences, self.garbage = 0, ""
             return
+        if response is None and self.packet_open:
+            return              # a packet's members are answered by nothing (spec 7)
         self.silences += 1
         if response is not None:
             self.garbage = response.text

@@ -43,3 +43,21 @@ def test_real_time_index_compared_from_where_each_side_began():
     judge = Judge(exact=False, index_offset=40)
     assert difference("@", ex(b"0,45\r"), ex(b"0,5\r"), judge) is None
     assert difference("@", ex(b"0,46\r"), ex(b"0,5\r"), judge) == "data"
+
+
+def repeat(answer: bytes, received_at: int = 2 * MS) -> Exchange:
+    return Exchange(b"!0>\r", answer, 0, received_at, parse_response(answer, summed=False,
+                                                                      lines=2), 2)
+
+
+def test_real_time_a_repeated_position_read_is_compared_as_that_read():
+    judge = Judge(exact=False, rate=1000)
+    near, far = repeat(b"!0PF\r0,-1,36,275\r"), repeat(b"!0PF\r0,-1,35,273\r", 0)
+    assert difference(">", near, far, judge, moving=True) is None
+    assert difference(">", repeat(b"!0PF\r0,-1,36,299\r"), far, judge, moving=True) \
+        == "position"
+    # another repeated command's values stay exact; in virtual time everything does
+    assert difference(">", repeat(b"!0SR0\r0,01\r"), repeat(b"!0SR0\r0,02\r", 0), judge,
+                      moving=True) == "data"
+    assert difference(">", near, repeat(b"!0PF\r0,-1,35,273\r"), Judge(), moving=True) \
+        == "position"

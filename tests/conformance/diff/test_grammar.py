@@ -3,7 +3,7 @@
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conformance.diff.grammar import Options, command_names, sequences
+from conformance.diff.grammar import Grammar, Options, command_names, sequences
 from conformance.diff.labels import command_of
 from conformance.diff.steps import FILL, FRAME, INPUT
 from gve_fixtures.profile import load_profile
@@ -33,3 +33,36 @@ def test_sequences_stay_inside_the_profile(data):
             assert name in GVE54.commands or name in ("", "SW6") or name == "O", s
             assert not s.body.upper().startswith(("J", "EW", "%", "*")), s
         assert s.kind != INPUT                       # no rig asked for
+
+
+def test_an_idiom_vector_gets_the_profile_axes():
+    assert Grammar(GVE84, Options())._padded("C100") == "C100,0,0"
+    assert Grammar(GVE54, Options())._padded("L-5") == "L-5" + ",0" * (len(GVE54.axes) - 1)
+    assert Grammar(GVE84, Options())._padded("C1,2,3") == "C1,2,3"
+
+
+def test_idioms_that_show_the_dwell_and_an_eeprom_write_are_drawn():
+    everything = Grammar(GVE84, Options(destructive=True)).scenarios
+    assert ("EW10,5A", "ER10") in everything
+    assert any(s[:2] == ("T24", "A10000") and s.count("C100") >= 2 for s in everything)
+    assert ("EW10,5A", "ER10") not in Grammar(GVE84, Options()).scenarios
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_every_repeat_awaits_its_two_lines(data):
+    # `>` answers the frame it repeats, then the answer: drawn as an event of a motion or
+    # in an idiom too, both lines are read (one line would leave the answer behind and
+    # count the repeated frame as a silence of the target)
+    steps = data.draw(sequences(GVE84, Options(destructive=True)))
+    for s in steps:
+        if s.kind == FRAME and command_of(s.body) == ">":
+            assert s.lines == 2, s
+        if s.kind == FRAME and command_of(s.body) == "*S":
+            assert not s.answer, s
+
+
+def test_an_event_repeat_is_read_whole():
+    g = Grammar(GVE84, Options())
+    assert g.fixed(">").lines == 2 and g.fixed("H").lines == 1
+    assert not g.fixed("*S").answer

@@ -28,3 +28,23 @@ def test_grading_follows_the_rule_tag():
     assert verdict_of("10.5.restore.pops", False)[0] == NON_STRICT    # D
     assert verdict_of("10.5.restore.pops", True)[0] == FAIL           # D, decisions kept
     assert verdict_of(None, True) == (INFO, "D-info")
+
+
+def test_a_difference_within_the_dwell_is_the_dwell():
+    # an H answered at another instant: the halt's ramp, unless the vector was in its T
+    assert label("H", "timing", set(), {"L"}, 0) == "10.4.halt.ramp"
+    assert label("H", "timing", {"in-dwell"}, {"L"}, 0) == "10.2.motion.dwell"
+
+
+def test_a_modal_setting_the_sequence_needs_wins_over_the_command_and_packet():
+    # an L refused on one side only: the queue rule, unless a rate set earlier decides
+    # when the vector before it ends
+    assert label("L", "code", set(), {"L"}, 3, 0) == "10.1.queue.line-alone"
+    assert label("L", "code", set(), {"L", "VL"}, 3, 0) == "10.2.motion.axis-caps"
+    assert label("P", "position", set(), {"L", "XU", "*S", "*E"}, 0) == \
+        "10.cmd.exchange-velocity"
+
+
+def test_a_position_after_go_is_the_resume_even_after_restore():
+    assert label("PF", "position", set(), {"L", "H", "K", "R", "G"}, 0) == "10.4.go.resume"
+    assert label("SR", "data", set(), {"L", "H", "K", "R"}, 0) == "10.5.restore.exact"

@@ -157,3 +157,29 @@ def test_the_emulator_has_no_envelope():
     g = Guard(load_profile("GVE84-100"), 0, enforce=False, max_travel=500,
               allow_destructive=False)
     assert g.fits("C2147483647,0,0")
+
+
+def test_silence_inside_an_open_packet_is_no_silence():
+    g = guard()
+    g.check("*S")
+    g.accepted("*S", None)
+    for _ in range(6):
+        g.answered(None)                    # members: the unit answers nothing until *E
+    assert g.responding
+    g.check("*E6")
+    g.accepted("*E6", None)
+    for _ in range(3):
+        g.answered(None)
+    with pytest.raises(TargetNotResponding, match="4 frames unanswered"):
+        g.answered(None)
+
+
+def test_the_bytes_named_are_those_of_the_silence_that_gave_up():
+    g = guard()
+    g.answered(parse_response(b"!0C1,0,167\r", summed=False))    # not an answer
+    g.answered(parse_response(b"0\r", summed=False))
+    for _ in range(3):
+        g.answered(None)
+    with pytest.raises(TargetNotResponding) as err:
+        g.answered(None)
+    assert "not an answer" not in str(err.value)
