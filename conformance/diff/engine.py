@@ -344,26 +344,27 @@ def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
     steps, outcome = finding.steps, finding.outcome
     want = (outcome.disagreement.command, outcome.disagreement.kind)
     runs = 0
+
+    def same(candidate: list[Step]):
+        """The candidate's outcome when it disagrees as the finding does, else None."""
+        nonlocal runs
+        runs += 1
+        trial = pair.run(candidate)
+        budget.frames += trial.frames
+        d = trial.disagreement
+        return trial if d is not None and (d.command, d.kind) == want else None
+
     i = 0
     while i < len(steps) and runs < MINIMISE_RUNS:
         s = steps[i]
         if s.kind == FILL and s.times > 1:
             # a filled queue: first try it half as full
-            shorter = replace(s, times=s.times // 2)
-            candidate = [*steps[:i], shorter, *steps[i + 1:]]
-            runs += 1
-            trial = pair.run(candidate)
-            budget.frames += trial.frames
-            d = trial.disagreement
-            if d is not None and (d.command, d.kind) == want:
+            candidate = [*steps[:i], replace(s, times=s.times // 2), *steps[i + 1:]]
+            if (trial := same(candidate)) is not None:
                 steps, outcome = candidate, trial
                 continue
         candidate = steps[:i] + steps[i + 1:]
-        runs += 1
-        trial = pair.run(candidate)
-        budget.frames += trial.frames
-        d = trial.disagreement
-        if d is not None and (d.command, d.kind) == want:
+        if (trial := same(candidate)) is not None:
             steps, outcome = candidate, trial
         else:
             i += 1

@@ -20,8 +20,10 @@ from gve_fixtures.transcript import parse
 QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-commands",
          "index-counts-queries", "go-without-inta", "range-error-code",
          "wrong-address-answers", "inta-bit-missing", "checksum-unchecked",
-         "line-while-busy", "delete-while-moving", "dwell-ignored", "restore-drops-partial",
+         "line-while-busy", "delete-while-moving", "dwell-ignored",
          "dwell-between-continuous", "eeprom-write-lost")
+# restore-drops-partial is left to the slow sweep: within 1000 sequences it was found in
+# one whole test run and not when its test ran alone
 #: frames a shrunk finding may keep where the rule needs a motion set up (settings, two
 #: C joined, the reads at the junction)
 FRAMES = {"dwell-between-continuous": 12}
