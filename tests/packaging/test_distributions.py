@@ -112,4 +112,6 @@ def test_tox_passes_on_a_fresh_clone(tmp_path):
     tracked()
     clone = tmp_path / "clone"
     run(["git", "clone", "--quiet", str(ROOT), str(clone)], tmp_path)
-    run([sys.executable, "-m", "tox", "-e", "lint,py311", "--", "-q"], clone, timeout=3000)
+    done = run([sys.executable, "-m", "tox", "-e", "lint,py311", "--", "-q"], clone,
+               timeout=3000)
+    assert done.returncode == 0

@@ -107,4 +107,5 @@ def test_ctrl_c_at_random_instants(tmp_path, instant):
                counting(rb"!0ER", rnd.randrange(1, 256)),         # the EEPROM backup
                counting(rb"!0EW", rnd.randrange(1, 4)),           # a case writing EEPROM
                in_machine(rnd.randrange(1, 8))][instant % 4]        # inside a machine
-    ctrl_c_run(tmp_path, trigger)
+    after, _, report = ctrl_c_run(tmp_path, trigger)   # (the whole protocol checked there)
+    assert after[0][2:3] == b"H" and report["interrupted"] is True
