@@ -24,7 +24,7 @@ from conformance.diff.compare import Judge, difference
 from conformance.diff.grammar import Options, load_grammar, sequences
 from conformance.diff.labels import command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
-from conformance.diff.steps import FILL, INPUT, WAIT, Step, frames_in
+from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
@@ -50,6 +50,7 @@ class Record:
     target: Exchange | None = None
     reference: Exchange | None = None
     repeat: int = 0                      # FILL: frames of it before this one
+    place: int = 0                       # the step's place in its sequence
 
 
 @dataclass
@@ -108,17 +109,18 @@ class Pair:
         context_packet = False
         earlier: set[str] = set()
         dwell = _Dwell(self.profile.reset.T)
-        for step in steps:
+        queued: str | None = None
+        for place, step in enumerate(steps):
             if step.kind == WAIT:
                 self.target.wait(step.seconds)
                 self.reference.wait(max(0, self.target.now - self.reference.now) / 1e9)
-                out.records.append(Record(step))
+                out.records.append(Record(step, place=place))
                 continue
             if step.kind == INPUT:
                 if self.target.has_rig and self.reference.has_rig:
                     self.target.set_input(step.port, step.value)
                     self.reference.set_input(step.port, step.value)
-                    out.records.append(Record(step))
+                    out.records.append(Record(step, place=place))
                     earlier.add("input")
                 continue
             command = command_of(step.body)
@@ -127,7 +129,7 @@ class Pair:
                 rec = self._exchange(step, out)
                 if rec is None:
                     break
-                rec.repeat = i
+                rec.repeat, rec.place = i, place
                 out.records.append(rec)
                 kind = self._difference(command, rec)
                 if kind is not None:
@@ -141,7 +143,11 @@ class Pair:
                     d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
                     out.disagreement = d
                     return self._end(out)
-                dwell.note(command, step.body, rec.reference)
+                if i == 0:             # a fill's later vectors join the first: no dwell
+                    dwell.note(command, step.body, rec.reference)
+                queued = _queued(command, step.body, rec.reference, queued)
+                if queued == "C+C":
+                    earlier.add("junction")
                 if step.kind == FILL and rec.reference.code != 0:
                     break
             if out.ended:
@@ -284,6 +290,16 @@ class _Dwell:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
 
 
+def _queued(command: str, body: str, reference: Exchange, last: str | None) -> str | None:
+    """The last vector the reference queued after ``last``: ``C+C`` when a C followed a C
+    (the two meet at a junction, spec 10.2); a D empties the queue."""
+    if command == "D" and reference.code == 0:
+        return None
+    if command not in ("L", "C") or reference.code != 0 or _ZERO_VECTOR.fullmatch(body.upper()):
+        return last
+    return "C+C" if command == "C" and last in ("C", "C+C") else command
+
+
 def _code(exchange: Exchange) -> int | None:
     return None if exchange.code is None else exchange.code & 7
 
@@ -340,9 +356,12 @@ MINIMISE_RUNS = 300
 
 
 def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
-    """Hypothesis shrinks by its own measure (the choices it drew); this last pass takes
-    out single steps while the same command still disagrees the same way, so the
-    transcript and the steps its label reads are what the disagreement needs."""
+    """Hypothesis shrinks by its own measure (the choices it drew); this last pass makes
+    each step the least the same command still disagrees the same way with, so the
+    transcript and the steps its label reads are what the disagreement needs: a step
+    taken out, else sent plain (its own checksum, no stall), else replaced by a wait as
+    long as its exchange took (a frame that only let time pass); two fills of one frame
+    or two waits become one, a fill is tried half as full."""
     steps, outcome = finding.steps, finding.outcome
     want = (outcome.disagreement.command, outcome.disagreement.kind)
     runs = 0
@@ -358,26 +377,39 @@ def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
 
     i = 0
     while i < len(steps) and runs < MINIMISE_RUNS:
-        s = steps[i]
-        nxt = steps[i + 1] if i + 1 < len(steps) else None
-        if s.kind == FILL and nxt is not None and replace(nxt, times=s.times) == s:
-            # two fills of one frame: one fill as long as both
-            candidate = [*steps[:i], replace(s, times=s.times + nxt.times), *steps[i + 2:]]
+        found = False
+        for candidate in _lesser(steps, i, outcome):
             if (trial := same(candidate)) is not None:
-                steps, outcome = candidate, trial
-                continue
-        if s.kind == FILL and s.times > 1:
-            # a filled queue: first try it half as full
-            candidate = [*steps[:i], replace(s, times=s.times // 2), *steps[i + 1:]]
-            if (trial := same(candidate)) is not None:
-                steps, outcome = candidate, trial
-                continue
-        candidate = steps[:i] + steps[i + 1:]
-        if (trial := same(candidate)) is not None:
-            steps, outcome = candidate, trial
-        else:
+                steps, outcome, found = candidate, trial, True
+                break
+        if not found:
             i += 1
     return Finding(steps, outcome)
+
+
+def _lesser(steps: list[Step], i: int, outcome: Outcome) -> Iterator[list[Step]]:
+    """Sequences with step ``i`` made less, most reduced first."""
+    s = steps[i]
+    nxt = steps[i + 1] if i + 1 < len(steps) else None
+    if nxt is not None and s.kind in (FILL, WAIT) and replace(nxt, times=s.times,
+                                                              seconds=s.seconds) == s:
+        joined = (replace(s, times=s.times + nxt.times) if s.kind == FILL
+                  else replace(s, seconds=round(s.seconds + nxt.seconds, 5)))
+        yield [*steps[:i], joined, *steps[i + 2:]]
+    if s.kind == FILL and s.times > 1:
+        yield [*steps[:i], replace(s, times=s.times // 2), *steps[i + 1:]]
+    yield steps[:i] + steps[i + 1:]
+    if s.kind == FRAME and (s.checksum != "auto" or s.stall is not None):
+        yield [*steps[:i], replace(s, checksum="auto", stall=None), *steps[i + 1:]]
+    last = outcome.disagreement.index if outcome.disagreement else len(outcome.records)
+    took = sum(r.reference.received_at - r.reference.sent_at
+               for r in outcome.records[:last] if r.place == i and r.reference is not None)
+    if s.kind in (FRAME, FILL) and took > 0:
+        prev = steps[i - 1] if i > 0 else None
+        if prev is not None and prev.kind == WAIT:      # the wait before takes it in
+            longer = replace(prev, seconds=round(prev.seconds + took / 1e9, 5))
+            yield [*steps[:i - 1], longer, *steps[i + 1:]]
+        yield [*steps[:i], Step(WAIT, seconds=round(took / 1e9, 5)), *steps[i + 1:]]
 
 
 class _Spent(Exception):

@@ -97,3 +97,17 @@ def test_a_fill_keeps_the_queue_it_needs():
 def test_every_mutant_is_found_and_named_by_its_area(mutant):
     _, f = hunt(mutant, 3000)
     assert in_area(f.disagreement.rule, mutant), (f.disagreement.rule, f.steps)
+
+
+def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
+    """Hypothesis draws now and then a constant from the source of the modules imported:
+    a module full of them, imported between two searches, changes nothing."""
+    first = hunt("queue-one-short", 600)[1]
+    (tmp_path / "many_constants.py").write_text(
+        "VALUES = [" + ", ".join(str(n) for n in range(-300, 300, 7)) + "]\n"
+        "WORDS = ['C50,0,0', 'L1,2,3', 'SW6,80', 'XM10']\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    __import__("many_constants")
+    again = hunt("queue-one-short", 600)[1]
+    assert [str(s) for s in again.steps] == [str(s) for s in first.steps]
+    assert again.frames == first.frames
