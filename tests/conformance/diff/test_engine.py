@@ -22,8 +22,7 @@ QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-c
          "wrong-address-answers", "inta-bit-missing", "checksum-unchecked",
          "line-while-busy", "delete-while-moving", "dwell-ignored",
          "dwell-between-continuous", "eeprom-write-lost")
-# restore-drops-partial is left to the slow sweep: within 1000 sequences it was found in
-# one whole test run and not when its test ran alone
+# (the others, restore-drops-partial among them, need a full queue or a longer search)
 #: frames a shrunk finding may keep where the rule needs a motion set up (settings, two
 #: C joined, the reads at the junction)
 FRAMES = {"dwell-between-continuous": 12}
