@@ -95,6 +95,7 @@ class Pair:
         factor = max(profile.microstep.factors.values()) if profile.microstep else 1
         self.judge = Judge(exact=self.exact, rate=profile.max_rate * factor)
         self._idle_since: int | None = 0
+        self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
 
@@ -171,6 +172,7 @@ class Pair:
         there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
         reference, a fresh unit, first stands a while: the real one's last motion ended
         long ago (a vector right away would otherwise wait the dwell T on one side only)."""
+        self._same_eeprom()
         self.reference.age(AGE_SECONDS)
         indexes = []
         for side in (self.target, self.reference):
@@ -182,6 +184,18 @@ class Pair:
                 indexes.append(0)
             side.link.send("SR0")
         self.judge = Judge(False, self.judge.rate, (indexes[0] - indexes[1]) % 256)
+
+    def _same_eeprom(self) -> None:
+        """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
+        gets the bytes the target was found with (read once; the session puts back what
+        an example wrote) where they differ from its own."""
+        if self.target.session is None or "ER" not in self.profile.commands:
+            return
+        if self._eeprom_changes is None:
+            found = self.target.session.eeprom_as_found()
+            fresh = self.reference.eeprom()
+            self._eeprom_changes = {a: v for a, v in found.items() if fresh.get(a) != v}
+        self.reference.write_eeprom(self._eeprom_changes)
 
     def _sync(self) -> None:
         """Each step starts at the same instant on both sides."""

@@ -116,9 +116,28 @@ class Side:
         self.link.rig.set_input(port, value)
 
     def close_example(self) -> None:
-        """Take what is still on its way (an answer after the last frame)."""
+        """Take what is still on its way (an answer after the last frame); on a real unit
+        put back the EEPROM bytes the example wrote, as after a case (the reference of the
+        next example is fresh)."""
         if self.link is not None:
             self.link.settle(final=True)
+        if self.session is not None and self.session.real:
+            self.session.after_case()
+
+    def eeprom(self) -> dict[int, int]:
+        """Every EEPROM byte as it reads now (a fresh unit's image)."""
+        image = {}
+        for address in range(self.target.profile.eeprom.size):
+            r = self.link.send("ER%02X" % address)
+            if r is not None and r.code == 0 and r.values:
+                image[address] = r.hex()
+        return image
+
+    def write_eeprom(self, image: dict[int, int]) -> None:
+        """Virtual time: give the reference these EEPROM bytes (a real unit's, as found)
+        before the example begins."""
+        for address, value in sorted(image.items()):
+            self.link.send("EW%02X,%02X" % (address, value))
 
 
 def _body(data: bytes, summed: bool) -> str:

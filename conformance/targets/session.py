@@ -227,6 +227,18 @@ class Session:
         except AssertionError:
             return {}
 
+    def eeprom_as_found(self) -> dict[int, int]:
+        """The EEPROM bytes as the run found them (read now if they were not: reading
+        changes nothing); empty where the unit has no `ER`."""
+        if not self.eeprom and self.real and "ER" in self.profile.commands:
+            link = self._new_link()
+            try:
+                with self.guard.own_frames():
+                    self._backup_eeprom(link)
+            finally:
+                self._keep_log(link)
+        return self.eeprom
+
     def _backup_eeprom(self, link: Link) -> None:
         """Every byte the run can write, before its first EEPROM write: all of them."""
         for address in range(self.profile.eeprom.size):

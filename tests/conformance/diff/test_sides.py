@@ -1,0 +1,36 @@
+"""A real unit as a side: its EEPROM holds its own bytes (the reference is given them
+before every sequence) and what a sequence wrote is put back before the next."""
+
+from conformance.diff.engine import Pair
+from conformance.diff.sides import Side
+from conformance.diff.steps import FRAME, Step
+from conformance.targets import parse_target
+from tests.emulator.process import Emulator
+
+#: a unit that has been configured: none of its bytes is a fresh unit's FF
+IMAGE = bytes((0x5A + 7 * i) % 0xFF for i in range(256))
+
+
+def test_a_unit_with_its_own_eeprom_agrees_and_is_left_as_found(tmp_path):
+    image = tmp_path / "eeprom.img"
+    image.write_bytes(IMAGE)
+    emu = Emulator("--model", "GVE84-100", "--pty", "--eeprom", str(image))
+    try:
+        target = parse_target(f"serial:{emu.first}", profile="GVE84-100",
+                              allow_destructive=True)
+        reference = parse_target("emu:GVE84-100")
+        session = target.begin()
+        p = Pair(Side(target, session), Side(reference), target.profile)
+        writes = p.run([Step(FRAME, "ER00"), Step(FRAME, "EW00,12"), Step(FRAME, "ER00"),
+                        Step(FRAME, "ERC3")])
+        reads = p.run([Step(FRAME, "ER00"), Step(FRAME, "ER01")])
+        report = session.finish()
+        target.close()
+    finally:
+        emu.proc.terminate()
+        emu.proc.wait(10)
+    assert writes.disagreement is None and reads.disagreement is None
+    answers = [r.target.answer for r in writes.records + reads.records]
+    assert answers == [b"0,5A\r", b"0\r", b"0,12\r", b"0,%02X\r" % IMAGE[0xC3],
+                       b"0,5A\r", b"0,%02X\r" % IMAGE[1]]
+    assert image.read_bytes() == IMAGE and not report.problems
