@@ -9,6 +9,7 @@ states and everything later would differ too.
 from __future__ import annotations
 
 import contextlib
+import math
 import random
 import re
 import time
@@ -92,8 +93,9 @@ class Pair:
         self.exact = target.virtual and reference.virtual
         # the fastest an axis's counter can change: the variant's top rate, in counter
         # units (GVE54: a coarse micro-step mode moves several sixteenths a step)
-        factor = max(profile.microstep.factors.values()) if profile.microstep else 1
-        self.judge = Judge(exact=self.exact, rate=profile.max_rate * factor)
+        self._factor = max(profile.microstep.factors.values()) if profile.microstep else 1
+        self.judge = Judge(exact=self.exact, rate=profile.max_rate * self._factor)
+        self._ceiling = _Ceiling(profile)
         self._idle_since: int | None = 0
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         #: real time: disagreements seen once that their sequence did not show again
@@ -110,6 +112,7 @@ class Pair:
         context_packet = False
         earlier: set[str] = set()
         dwell = _Dwell(self.profile.reset.T)
+        self._ceiling = _Ceiling(self.profile)
         queued: str | None = None
         for place, step in enumerate(steps):
             if step.kind == WAIT:
@@ -147,6 +150,7 @@ class Pair:
                 if i == 0:             # a fill's later vectors join the first: no dwell
                     dwell.note(command, step.body, rec.reference)
                 queued = _queued(command, step.body, rec.reference, queued)
+                self._ceiling.note(command, step.body, rec.reference)
                 if queued == "C+C":
                     earlier.add("junction")
                 if step.kind == FILL and rec.reference.code != 0:
@@ -238,7 +242,8 @@ class Pair:
             self._watch_reference()
             if command in ("P", "PF", ">"):
                 moving = self._moving_near(rec) if command != ">" else True
-        return difference(command, rec.target, rec.reference, self.judge, moving=moving)
+        judge = replace(self.judge, rate=self._ceiling.rate * self._factor)
+        return difference(command, rec.target, rec.reference, judge, moving=moving)
 
     def _watch_reference(self) -> None:
         """Real time: note when the reference was first seen at rest (after each step;
@@ -302,6 +307,44 @@ class _Dwell:
 
     def within(self, t: int) -> bool:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
+
+
+class _Ceiling:
+    """The fastest the reference's axes can have stepped so far in the example (steps/s):
+    the highest V and B it took, raised by the highest override (XM, and XU's 17/16);
+    a reference run (W) or the hand wheel (Y) may step at the variant's top rate. A
+    reading taken while moving is uncertain by this rate times its window, not by the
+    top rate (spec 10.2: no ramp exceeds the cruise rate, no cruise the modal V or B)."""
+
+    def __init__(self, profile: Profile) -> None:
+        self.top = profile.max_rate
+        self.speed = max(profile.reset.V, profile.reset.B)
+        self.override = max(100, profile.reset.XM) / 100
+        self.up = 1.0
+
+    @property
+    def rate(self) -> int:
+        return min(self.top, math.ceil(self.speed * self.override * self.up))
+
+    def note(self, command: str, body: str, reference: Exchange) -> None:
+        if reference.code != 0:
+            return
+        value = _first_number(body[len(command):])
+        if command in ("V", "B") and value is not None:
+            self.speed = max(self.speed, value)
+        elif command == "XM" and value is not None:
+            self.override = max(self.override, value / 100)
+        elif command == "XU":
+            self.up = 17 / 16
+        elif command in ("W", "Y"):
+            self.speed = self.top
+
+
+def _first_number(params: str) -> int | None:
+    try:
+        return int(params.split(",")[0])
+    except ValueError:
+        return None
 
 
 def _queued(command: str, body: str, reference: Exchange, last: str | None) -> str | None:

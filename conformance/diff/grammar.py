@@ -37,8 +37,8 @@ def load_grammar(path: Path = GRAMMAR_FILE) -> dict:
 def _range_of(profile: Profile, kind: str) -> tuple[int, int] | None:
     """The valid values of a field kind, when it is numeric."""
     head, _, rest = kind.partition(":")
-    if head == "range":
-        r = profile.range(rest)
+    if head == "range" or kind == "seek-rate":
+        r = profile.range(rest or "V")
         return r.lo, r.hi
     if head in ("dec", "hex"):
         lo, hi = rest.split(":")
@@ -57,6 +57,9 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
         return st.integers(-v, v).filter(bool).map(str)
     if kind == "axis":
         return st.sampled_from(profile.axes)
+    if kind == "seek-rate":
+        lo, hi = _range_of(profile, kind)
+        return st.integers(min(hi, max(lo, 3 * moves["travel"])), hi).map(str)
     if kind == "float":
         return st.sampled_from(["0", "1.5", "-2e3", "1e+3", "3.4e39", "0.1"])
     if head == "choice":

@@ -66,3 +66,18 @@ def test_an_event_repeat_is_read_whole():
     g = Grammar(GVE84, Options())
     assert g.fixed(">").lines == 2 and g.fixed("H").lines == 1
     assert not g.fixed("*S").answer
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.data())
+def test_a_reference_run_lasts_a_fraction_of_a_second(data):
+    """W answers when its run has ended: each leg (at most 300 steps) at a rate of at
+    least 900 steps/s, or the line would be held for minutes."""
+    steps = data.draw(sequences(GVE84, Options(destructive=True)))
+    for s in steps:
+        if s.kind == FRAME and s.body.startswith("W"):
+            fields = s.body[2:].lstrip(",").split(",")
+            if len(fields) == 4 and all(f.lstrip("-").isdigit() for f in fields):
+                travel, rate = abs(int(fields[0])) + abs(int(fields[2])), min(
+                    int(fields[1]), int(fields[3]))
+                assert travel / rate <= 2 / 3, s
