@@ -58,6 +58,9 @@ MOTION = frozenset({"L", "C", "*E", "G", "R", "W", "SW6"})
 #: frames that change what outlives the run: restart, reference run, EEPROM
 DESTRUCTIVE = frozenset({"J", "W", "EW", "EFW", "EUW"})
 _EEPROM_WIDTH = {"EW": 1, "EFW": 4, "EUW": 4}
+#: the longest an answer is waited for (a `W` whose run would take longer: the unit
+#: refuses such a travel or rate, or the run is not one a test should wait out)
+LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
 _PACKET_BREAKERS = frozenset({"H", "@", ">", "J"})
 #: consecutive frames without an answer after which the target is given up
@@ -414,8 +417,9 @@ class Guard:
         if command.name == "W":
             n2, n3, n4, n5 = Command("W", command.params[1:].lstrip(",")).fields(4)
             if all(x.exact for x in (n2, n3, n4, n5)) and n3.lo > 0 and n5.lo > 0:
-                return abs(n2.lo) / n3.lo + abs(n4.lo) / n5.lo + 4 * self.stop_seconds()
-            return 600.0
+                run = abs(n2.lo) / n3.lo + abs(n4.lo) / n5.lo + 4 * self.stop_seconds()
+                return min(run, LONGEST_ANSWER_S)
+            return LONGEST_ANSWER_S
         return None
 
     # -- the report ---------------------------------------------------------------------------

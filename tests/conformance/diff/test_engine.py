@@ -6,6 +6,7 @@ import itertools
 
 import pytest
 
+from conformance.cli.diff import DEFAULT_EXAMPLES
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.gvt import steps_of, transcript
@@ -94,7 +95,7 @@ def test_a_fill_keeps_the_queue_it_needs():
 @pytest.mark.slow
 @pytest.mark.parametrize("mutant", sorted(mutants()))
 def test_every_mutant_is_found_and_named_by_its_area(mutant):
-    _, f = hunt(mutant, 3000)
+    _, f = hunt(mutant, DEFAULT_EXAMPLES)     # what `gve-conformance diff` tries
     assert in_area(f.disagreement.rule, mutant), (f.disagreement.rule, f.steps)
 
 

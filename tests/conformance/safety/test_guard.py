@@ -127,6 +127,9 @@ def test_halt_waits_for_the_longest_stop_the_envelope_allows():
     assert g.answer_seconds("H") == pytest.approx(2 * 8 ** 0.5)
     assert g.answer_seconds("WY,-2000,1000,200,100") == pytest.approx(2 + 2 + 4 * 8 ** 0.5)
     assert g.answer_seconds("V100") is None
+    # a travel no unit takes is not waited for until the clock runs out (ten minutes)
+    assert g.answer_seconds("w,99999999999999,+1,,900") == 600
+    assert g.answer_seconds("WX,-99999999999999,1,1,1") == 600
 
 
 def test_a_power_cycle_by_the_rig_is_booked_as_a_restart():
