@@ -153,8 +153,10 @@ class Line:
         return self._ready_count(now)
 
     def _take(self, size: int, terminator: bytes | None) -> bytes:
-        out = bytearray()
         now, rx = self.now, self._rx
+        if not rx or rx[0][0] > now:
+            return b""                 # no byte complete yet (a read's usual first look)
+        out = bytearray()
         while rx and len(out) < size:
             chunk = rx[0]
             first, data, taken = chunk
