@@ -25,9 +25,10 @@ def frames_per_second(mutant: str | None, frames: int) -> tuple[float, int]:
     budget = Budget(examples=None)
     total = 0.0
     found = 0
-    # searches until the frames are sent (a finding ends one search; the next goes on)
+    # searches of 500 sequences (a run's is one of 2000) until the frames are sent; a
+    # finding ends one search, the next goes on
     while budget.frames < frames:
-        budget.examples = budget.used + 50
+        budget.examples = budget.used + 500
         found += len(search(pair, Options(destructive=True, rig=True), budget,
                             seed=budget.used))
     total = budget.elapsed
