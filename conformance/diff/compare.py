@@ -8,9 +8,10 @@ instants: virtual time only, where both sides are exact).
 
 In virtual time on both sides everything is exact. With a target in real time, positions
 read while moving may differ by the band of ``conformance/motion/tolerance.py`` (the
-fastest rate the reference can have stepped at, times the width of the windows in which the two frames were processed, plus a step
-of placement); at rest they must be equal. The index (`@`) is compared from where each
-side's example began (a real unit's index is not reset by the known state).
+fastest rate the reference can have stepped at, times the width of the windows in which
+the two frames were processed, plus a step of placement); at rest they must be equal.
+The index (`@`) is compared from where each side's example began (a real unit's index is
+not reset by the known state).
 """
 
 from __future__ import annotations
