@@ -72,12 +72,8 @@ class Line:
             unit.advance(t)
 
     def next_deadline(self) -> int | None:
-        best = None
-        for unit in self.units:
-            d = unit.next_deadline()
-            if d is not None and (best is None or d < best):
-                best = d
-        return best
+        due = [d for d in (u.next_deadline() for u in self.units) if d is not None]
+        return min(due) if due else None
 
     def advance(self, seconds: float) -> None:
         """Let ``seconds`` pass (virtual time), handling every unit event on the way."""
@@ -153,10 +149,8 @@ class Line:
         return self._ready_count(now)
 
     def _take(self, size: int, terminator: bytes | None) -> bytes:
-        now, rx = self.now, self._rx
-        if not rx or rx[0][0] > now:
-            return b""                 # no byte complete yet (a read's usual first look)
         out = bytearray()
+        now, rx = self.now, self._rx
         while rx and len(out) < size:
             chunk = rx[0]
             first, data, taken = chunk
@@ -205,18 +199,14 @@ class Line:
             if len(out) >= size or (terminator and out.endswith(terminator)):
                 return bytes(out)
             ready = self._complete_at(size - len(out), terminator)
-            event = self.next_deadline()
-            t = event if ready is None else ready if event is None else min(ready, event)
+            nxt = [x for x in (ready, self.next_deadline()) if x is not None]
+            t = min(nxt) if nxt else None
             if t is None or (deadline is not None and t > deadline):
                 if deadline is not None:
                     self.advance_to(deadline)
                     out += self._take(size - len(out), terminator)
                 return bytes(out)
-            if event is None or t < event:     # no unit acts before the bytes are there
-                self.clock.advance_to(t)
-                self._settle(t)
-            else:
-                self.advance_to(t)
+            self.advance_to(t)
 
     def take_ready(self) -> bytes:
         """Real time: every byte due by now (the server writes them to its port)."""
