@@ -23,7 +23,8 @@ session still carries Ctrl-C and the count of unanswered frames.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
@@ -168,12 +169,8 @@ class Session:
         self.started = True
         if not self.real:
             return
-        link = self._new_link()
-        try:
-            with self.guard.own_frames():
-                self._read_as_found(link)
-        finally:
-            self._keep_log(link)
+        with self._own_link() as link:
+            self._read_as_found(link)
 
     def _read_as_found(self, link: Link) -> None:
         """Identity, checksum mode, status words, where the axes are, EEPROM."""
@@ -204,6 +201,16 @@ class Session:
         if self.target.info.allow_destructive and "ER" in self.profile.commands:
             self._backup_eeprom(link)
 
+    @contextlib.contextmanager
+    def _own_link(self) -> Iterator[Link]:
+        """A link for the session's own frames, its log kept for the report."""
+        link = self._new_link()
+        try:
+            with self.guard.own_frames():
+                yield link
+        finally:
+            self._keep_log(link)
+
     def _keep_log(self, link: Link) -> None:
         """The session's own frames and what went wrong there, for the report."""
         self.report.wire_log += link.transcript_lines()
@@ -231,12 +238,8 @@ class Session:
         """The EEPROM bytes as the run found them (read now if they were not: reading
         changes nothing); empty where the unit has no `ER`."""
         if not self.eeprom and self.real and "ER" in self.profile.commands:
-            link = self._new_link()
-            try:
-                with self.guard.own_frames():
-                    self._backup_eeprom(link)
-            finally:
-                self._keep_log(link)
+            with self._own_link() as link:
+                self._backup_eeprom(link)
         return self.eeprom
 
     def _backup_eeprom(self, link: Link) -> None:
@@ -419,12 +422,8 @@ class Session:
         of the run verifies every byte again."""
         if not (self.real and self.guard.eeprom_written) or self.failed:
             return
-        link = self._new_link()
-        try:
-            with self.guard.own_frames():
-                self._eeprom_back(link, sorted(self.guard.eeprom_written))
-        finally:
-            self._keep_log(link)
+        with self._own_link() as link:
+            self._eeprom_back(link, sorted(self.guard.eeprom_written))
 
     def _eeprom_back(self, link: Link, addresses: list[int]) -> list[str]:
         """Read ``addresses``, write back those that differ from the originals and read
