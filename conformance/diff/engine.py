@@ -197,8 +197,9 @@ class Pair:
             return
         if self._eeprom_changes is None:
             found = self.target.session.eeprom_as_found()
-            fresh = self.reference.eeprom()
-            self._eeprom_changes = {a: v for a, v in found.items() if fresh.get(a) != v}
+            image = self.profile.eeprom          # a fresh unit's: erased, with defaults
+            self._eeprom_changes = {a: v for a, v in found.items()
+                                    if image.defaults.get(a, image.erased) != v}
         self.reference.write_eeprom(self._eeprom_changes)
 
     def _sync(self) -> None:

@@ -124,15 +124,6 @@ class Side:
         if self.session is not None and self.session.real:
             self.session.after_case()
 
-    def eeprom(self) -> dict[int, int]:
-        """Every EEPROM byte as it reads now (a fresh unit's image)."""
-        image = {}
-        for address in range(self.target.profile.eeprom.size):
-            r = self.link.send("ER%02X" % address)
-            if r is not None and r.code == 0 and r.values:
-                image[address] = r.hex()
-        return image
-
     def write_eeprom(self, image: dict[int, int]) -> None:
         """Virtual time: give the reference these EEPROM bytes (a real unit's, as found)
         before the example begins."""
