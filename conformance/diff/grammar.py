@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
 
@@ -17,8 +17,11 @@ from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from gve_fixtures.profile import Profile
 
 GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
+PROBES_FILE = Path(__file__).with_name("probes.toml")
 #: an idiom's vector along the first axis only
 _ONE_COMPONENT = re.compile(r"[LC]-?\d+")
+#: how an idiom's frame is sent, written before its body
+_PREFIX = re.compile(r"^(bad|stalled|other):")
 
 
 @dataclass(frozen=True)
@@ -32,6 +35,11 @@ class Options:
 @cache
 def load_grammar(path: Path = GRAMMAR_FILE) -> dict:
     return tomllib.loads(path.read_text(encoding="utf-8"))
+
+
+@cache
+def load_probes(path: Path = PROBES_FILE) -> tuple[dict, ...]:
+    return tuple(tomllib.loads(path.read_text(encoding="utf-8"))["probe"])
 
 
 def _range_of(profile: Profile, kind: str) -> tuple[int, int] | None:
@@ -163,7 +171,10 @@ class Grammar:
             if f.startswith("input "):
                 if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
                     return False
-            elif not f.startswith("wait ") and command_of(f.removeprefix("bad:")) not in allowed:
+            elif f.startswith("fill "):
+                if command_of(f.split()[2]) not in allowed:
+                    return False
+            elif not f.startswith("wait ") and command_of(_PREFIX.sub("", f)) not in allowed:
                 return False
         return True
 
@@ -290,20 +301,36 @@ class Grammar:
         out = []
         if self.vectors and self.number(draw, 0, 1):
             out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors), valid=True)))
-        for f in self.pick(draw, self.scenarios):
-            if f.startswith("wait "):
-                out.append(Step(WAIT, seconds=float(f.split()[1])))
-                continue
-            if f.startswith("input "):
-                _, port, value = f.split()
+        return out + self.idiom(self.pick(draw, self.scenarios))
+
+    def idiom(self, lines: list[str] | tuple[str, ...]) -> list[Step]:
+        """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`,
+        `fill N BODY`, `bad:BODY` (a wrong checksum in checksum mode), `stalled:BODY` (a
+        pause longer than the watchdog after its second byte), `other:BODY` (to another
+        address), else a frame; `J` is followed by its restart's wait."""
+        out = []
+        for f in lines:
+            word, _, rest = f.partition(" ")
+            if word == "wait":
+                out.append(Step(WAIT, seconds=float(rest)))
+            elif word == "input":
+                port, value = rest.split()
                 out.append(Step(INPUT, port=int(port), value=int(value, 16)))
-                continue
-            if f.startswith("bad:"):
-                out.append(self.fixed(f.removeprefix("bad:"), checksum="bad"))
-                continue
-            out.append(self.fixed(self._padded(f)))
-            if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
-                out.append(self.restart_wait())
+            elif word == "fill":
+                times, body = rest.split()
+                out.append(Step(FILL, self._padded(body), times=int(times)))
+            elif f.startswith("bad:"):
+                out.append(self.fixed(self._padded(f.removeprefix("bad:")), checksum="bad"))
+            elif f.startswith("stalled:"):
+                step = self.fixed(self._padded(f.removeprefix("stalled:")))
+                out.append(replace(step, stall=(2, (self.profile.watchdog_ms + 50) / 1000)))
+            elif f.startswith("other:"):
+                step = self.fixed(self._padded(f.removeprefix("other:")))
+                out.append(replace(step, address=(self.profile.address + 1) % 8, answer=False))
+            else:
+                out.append(self.fixed(self._padded(f)))
+                if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
+                    out.append(self.restart_wait())
         return out
 
     def fixed(self, body: str, checksum: str = "auto") -> Step:
@@ -320,6 +347,12 @@ class Grammar:
             return body + ",0" * (len(self.profile.axes) - 1)
         return body
 
+    def probes(self) -> list[tuple[dict, list[Step]]]:
+        """The probes of ``probes.toml`` this profile and run can send, with their steps."""
+        return [(p, self.idiom(p["steps"])) for p in load_probes()
+                if self.profile.family in p.get("families", [self.profile.family])
+                and self._can(p["steps"])]
+
     def restart_wait(self) -> Step:
         return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
 
@@ -330,6 +363,11 @@ class Grammar:
         first = body[len(text):].split(",")[0]
         place = "" if read == "PF" else first
         return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+
+
+def probes(profile: Profile, options: Options) -> list[tuple[dict, list[Step]]]:
+    """The probes the search runs whole before it draws a sequence (``probes.toml``)."""
+    return Grammar(profile, options).probes()
 
 
 def sequences(profile: Profile, options: Options) -> st.SearchStrategy[list[Step]]:

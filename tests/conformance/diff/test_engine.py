@@ -8,9 +8,10 @@ import pytest
 
 from conformance.cli.diff import DEFAULT_EXAMPLES
 from conformance.diff.engine import Budget, Pair, search
-from conformance.diff.grammar import Options
+from conformance.diff.grammar import Options, probes
 from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.sides import Side
+from conformance.diff.steps import FILL
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
 from gve_fixtures.rules import load_rules
@@ -48,29 +49,44 @@ def in_area(rule: str | None, mutant: str) -> bool:
     return ".".join(numbered) == mutants()[mutant][0]
 
 
-def hunt(mutant: str, examples: int):
+def hunt(mutant: str, examples: int, *, probes: bool = True):
     p = pair(mutant, PROFILE.get(mutant, "GVE84-100"))
-    found = search(p, EVERYTHING, Budget(examples=examples), stop_after=1)
+    found = search(p, EVERYTHING, Budget(examples=examples), stop_after=1,
+                   with_probes=probes)
     assert found, f"{mutant} not found in {examples} sequences"
     return p, found[0]
 
 
 @pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
 def test_the_emulator_agrees_with_itself(profile):
-    budget = Budget(examples=60)
-    assert search(pair(None, profile), EVERYTHING, budget) == []
-    assert budget.used == 60 and budget.frames > 300
+    p = pair(None, profile)
+    written = len(probes(p.profile, EVERYTHING))
+    budget = Budget(examples=written + 60)
+    assert search(p, EVERYTHING, budget) == []
+    assert budget.used == written + 60 and budget.frames > 300
 
 
 @pytest.mark.parametrize("mutant", QUICK)
 def test_a_mutant_is_found_shrunk_and_labelled(mutant):
-    _, f = hunt(mutant, 1000)
+    _, f = hunt(mutant, 1000, probes=False)
     d = f.disagreement
     assert in_area(d.rule, mutant), (d.rule, f.steps)
     assert f.frames <= FRAMES.get(mutant, 6), f.steps
     # the same bytes differ in when they came, or the bytes differ
     assert (d.target.received_at - d.target.sent_at != d.reference.received_at
             - d.reference.sent_at) if d.kind == "timing" else d.target.answer != d.reference.answer
+
+
+@pytest.mark.parametrize("mutant", sorted(mutants()))
+def test_every_mutant_is_shown_by_a_probe(mutant):
+    """The probes alone (as many sequences as there are probes) find every mutant, under
+    a rule of its own area, in a few frames."""
+    p = pair(mutant, PROFILE.get(mutant, "GVE84-100"))
+    budget = Budget(examples=len(probes(p.profile, EVERYTHING)))
+    found = [f for f in search(p, EVERYTHING, budget) if in_area(f.disagreement.rule, mutant)]
+    assert found, f"no probe shows {mutant}"
+    steps = found[0].steps
+    assert found[0].frames <= 7 or any(s.kind == FILL for s in steps), steps
 
 
 def test_the_transcript_replays_the_disagreement():
@@ -85,7 +101,7 @@ def test_the_transcript_replays_the_disagreement():
 
 
 def test_a_fill_keeps_the_queue_it_needs():
-    _, f = hunt("queue-one-short", 600)
+    _, f = hunt("queue-one-short", 600, probes=False)
     assert f.disagreement.rule == "10.1.queue.cont-buffer"
     assert f.frames == 64                      # the 64th C: one too few taken
     lines = transcript(f, profile="GVE84-100", target="t", reference="r").dumps()
@@ -95,19 +111,20 @@ def test_a_fill_keeps_the_queue_it_needs():
 @pytest.mark.slow
 @pytest.mark.parametrize("mutant", sorted(mutants()))
 def test_every_mutant_is_found_and_named_by_its_area(mutant):
-    _, f = hunt(mutant, DEFAULT_EXAMPLES)     # what `gve-conformance diff` tries
+    # the search alone, without the probes, within what `gve-conformance diff` tries
+    _, f = hunt(mutant, DEFAULT_EXAMPLES, probes=False)
     assert in_area(f.disagreement.rule, mutant), (f.disagreement.rule, f.steps)
 
 
 def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
     """Hypothesis draws now and then a constant from the source of the modules imported:
     a module full of them, imported between two searches, changes nothing."""
-    first = hunt("queue-one-short", 600)[1]
+    first = hunt("queue-one-short", 600, probes=False)[1]
     (tmp_path / "many_constants.py").write_text(
         "VALUES = [" + ", ".join(str(n) for n in range(-300, 300, 7)) + "]\n"
         "WORDS = ['C50,0,0', 'L1,2,3', 'SW6,80', 'XM10']\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     __import__("many_constants")
-    again = hunt("queue-one-short", 600)[1]
+    again = hunt("queue-one-short", 600, probes=False)[1]
     assert [str(s) for s in again.steps] == [str(s) for s in first.steps]
     assert again.frames == first.frames
