@@ -68,6 +68,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
     ap.add_argument("--seconds", type=float, metavar="S", help="search for S seconds")
     ap.add_argument("--seed", type=int, default=0, help="the search's seed (default 0)")
+    ap.add_argument("--no-probes", action="store_true",
+                    help="draw sequences only (the written probes, run first by default, "
+                    "are left out)")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
     ap.add_argument("--no-reports", action="store_true",
                     help="write no reports (the transcripts are printed instead)")
@@ -146,7 +149,8 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         with interrupts.catching():
-            search(pair, options, budget, seed=args.seed, on_finding=found)
+            search(pair, options, budget, seed=args.seed, with_probes=not args.no_probes,
+                   on_finding=found)
     except (TargetNotResponding, SessionError) as err:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)

@@ -16,10 +16,11 @@ not reset by the known state).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from conformance.diff.sides import Exchange
-from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+from conformance.motion.tolerance import PLACEMENT_STEPS, SECOND, Window, reading_band
 
 POSITION_COMMANDS = ("P", "PF")
 
@@ -31,6 +32,10 @@ class Judge:
     exact: bool = True              # both sides in virtual time
     rate: int = 0                   # the fastest an axis may step (counter units/s)
     index_offset: int = 0           # target's index minus the reference's at the start
+    #: real time: how much later the target may have acted than the reference on the
+    #: frames that changed a running motion's course (H, G, XM, an input...), summed:
+    #: positions even at rest may differ by the rate times this
+    slack_ns: int = 0
 
 
 def difference(command: str, target: Exchange, reference: Exchange, judge: Judge,
@@ -83,12 +88,14 @@ def _numbers(values: list[str]) -> list[int] | None:
 
 def band(target: Exchange, reference: Exchange, judge: Judge, moving: bool) -> int:
     """Steps two readings may differ by: exact at rest; while moving the rate times how
-    far apart the two instants can be, plus placement."""
+    far apart the two instants can be, plus placement; and the rate times how late the
+    target may have acted on what changed the motion's course."""
+    late = math.ceil(judge.rate * judge.slack_ns / SECOND)
     if not moving:
-        return 0
+        return late + PLACEMENT_STEPS if late else 0
     a = Window(target.sent_at, target.received_at)
     b = Window(reference.sent_at, reference.received_at)
-    return reading_band(a, b, judge.rate, placement=PLACEMENT_STEPS)
+    return reading_band(a, b, judge.rate, placement=PLACEMENT_STEPS) + late
 
 
 def _positions_close(target: Exchange, reference: Exchange, judge: Judge,

@@ -97,6 +97,7 @@ class Pair:
         self.judge = Judge(exact=self.exact, rate=profile.max_rate * self._factor)
         self._ceiling = _Ceiling(profile)
         self._idle_since: int | None = 0
+        self._latency_ns = self._slack_ns = 0      # real time: see _retimed
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
@@ -107,6 +108,7 @@ class Pair:
         self.target.open()
         self.reference.open()
         self._idle_since = 0
+        self._latency_ns = self._slack_ns = 0
         if not self.exact:
             self._prelude()
         context_packet = False
@@ -122,6 +124,7 @@ class Pair:
                 continue
             if step.kind == INPUT:
                 if self.target.has_rig and self.reference.has_rig:
+                    self._retimed("input", None)
                     self.target.set_input(step.port, step.value)
                     self.reference.set_input(step.port, step.value)
                     out.records.append(Record(step, place=place))
@@ -135,6 +138,7 @@ class Pair:
                     break
                 rec.repeat, rec.place = i, place
                 out.records.append(rec)
+                self._retimed(command, rec)
                 kind = self._difference(command, rec)
                 if kind is not None:
                     context = self._context(step, context_packet)
@@ -175,9 +179,12 @@ class Pair:
         """A real unit's index is not reset by the known state: read both, compare from
         there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
         reference, a fresh unit, first stands a while: the real one's last motion ended
-        long ago (a vector right away would otherwise wait the dwell T on one side only)."""
+        long ago (a vector right away would otherwise wait the dwell T on one side only),
+        and the target's too: the known state may have moved its axes back just before,
+        so the sequence begins once the longest dwell T after that has passed."""
         self._same_eeprom()
         self.reference.age(AGE_SECONDS)
+        self.target.wait(self.profile.range("T").hi / 1000)
         indexes = []
         for side in (self.target, self.reference):
             side.link.send("SR0")
@@ -243,8 +250,22 @@ class Pair:
             self._watch_reference()
             if command in ("P", "PF", ">"):
                 moving = self._moving_near(rec) if command != ">" else True
-        judge = replace(self.judge, rate=self._ceiling.rate * self._factor)
+        judge = replace(self.judge, rate=self._ceiling.rate * self._factor,
+                        slack_ns=self._slack_ns)
         return difference(command, rec.target, rec.reference, judge, moving=moving)
+
+    def _retimed(self, command: str, rec: Record | None) -> None:
+        """Real time: the reference acts on a frame when the target's exchange began, the
+        target somewhere within its latency. A frame (or rig input) that changes a running
+        motion's course therefore makes every later position uncertain by the rate times
+        that latency: the largest an immediate answer took in the sequence so far."""
+        if self.exact:
+            return
+        if rec is not None and command not in _DEFERRED and rec.target.answer:
+            self._latency_ns = max(self._latency_ns,
+                                   rec.target.received_at - rec.target.sent_at)
+        if command in _RETIMING and self._idle_since is None:
+            self._slack_ns += self._latency_ns
 
     def _watch_reference(self) -> None:
         """Real time: note when the reference was first seen at rest (after each step;
@@ -285,6 +306,11 @@ class Pair:
 
 #: frames that change the course of a motion: a difference after them is theirs
 _COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+#: what changes a running motion's course at the instant the unit acts on it (an input
+#: set by the rig too): in real time that instant is known only within a latency
+_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+#: frames answered when their action ends, not at once
+_DEFERRED = ("H", "W", "J")
 
 
 class _Dwell:

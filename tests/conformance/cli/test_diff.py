@@ -7,12 +7,16 @@ import json
 import pytest
 
 from conformance.cli import main
+from conformance.diff.grammar import Options, probes
+from gve_fixtures.profile import load_profile
 from tests.emulator.process import Emulator
 
 
 def test_diff_reports_the_mutant_rule_and_replay_finds_it_again(tmp_path, capsys):
+    # the search alone (the probes would show it at once)
     status = main(["diff", "--target", "emu:GVE84-100?mutant=lower-case-command",
-                   "--examples", "300", "--report-dir", str(tmp_path), "--seed", "1"])
+                   "--examples", "300", "--report-dir", str(tmp_path), "--seed", "1",
+                   "--no-probes"])
     out = capsys.readouterr().out
     assert status == 1 and "3.frame.upper-case" in out
     (folder,) = tmp_path.iterdir()
@@ -54,3 +58,30 @@ def test_the_emulator_agrees_with_itself_over_a_pty(tmp_path, capsys):
     out = capsys.readouterr().out
     assert status == 0, out
     assert "12 sequences" in out and "PASS 1" in out
+
+
+def _probes_over_a_pty(mutant: str | None, capsys) -> tuple[int, str]:
+    written = str(len(probes(load_profile("GVE84-100"), Options(destructive=True))))
+    emu = Emulator("--model", "GVE84-100", "--pty", *(("--mutant", mutant) if mutant else ()))
+    try:
+        status = main(["diff", "--target", f"serial:{emu.first}", "--profile", "GVE84-100",
+                       "--examples", written, "--no-reports", "--yes", "--allow-destructive"])
+    finally:
+        emu.proc.terminate()
+        emu.proc.wait(10)
+    return status, capsys.readouterr().out
+
+
+def test_over_a_pty_the_probes_raise_nothing_against_the_emulator(capsys):
+    """Every probe in real time against the correct emulator: their slow rates, waits
+    and reads at rest leave no disagreement within the timing band."""
+    status, out = _probes_over_a_pty(None, capsys)
+    assert status == 0 and "PASS 1" in out and "not confirmed" not in out, out
+
+
+@pytest.mark.slow
+def test_over_a_pty_a_probe_shows_a_millisecond_timing_bug(capsys):
+    """The dwell T ignored (a few milliseconds between two vectors), which the search
+    alone did not find in ten minutes over a pty, is shown by its probe."""
+    status, out = _probes_over_a_pty("dwell-ignored", capsys)
+    assert status == 1 and "FAIL        10.2.motion.dwell" in out, out

@@ -39,6 +39,19 @@ def test_real_time_positions_within_the_band_while_moving_and_exact_at_rest():
     assert difference("PF", near, far, judge, moving=False) == "position"
 
 
+def test_real_time_at_rest_after_a_course_change_within_its_latency():
+    """An H (or G, XM, an input...) sent while the axes ran: the target acted on it up to
+    its latency later than the reference did, so even at rest the positions may differ by
+    the rate times that latency, plus placement; no further."""
+    judge = Judge(exact=False, rate=1000, slack_ns=6 * MS)              # 6 steps late
+    at_rest = ex(b"8,300,0,0\r", 0, 0)
+    assert difference("PF", ex(b"8,306,0,0\r"), at_rest, judge) is None
+    assert difference("PF", ex(b"8,307,0,0\r"), at_rest, judge) is None    # placement
+    assert difference("PF", ex(b"8,308,0,0\r"), at_rest, judge) == "position"
+    assert difference("PF", ex(b"8,301,0,0\r"), at_rest, Judge(exact=False, rate=1000)) \
+        == "position"
+
+
 def test_real_time_index_compared_from_where_each_side_began():
     judge = Judge(exact=False, index_offset=40)
     assert difference("@", ex(b"0,45\r"), ex(b"0,5\r"), judge) is None
