@@ -3,10 +3,11 @@
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conformance.diff.grammar import Grammar, Options, command_names, sequences
+from conformance.diff.grammar import Grammar, Options, command_names, load_probes, probes, sequences
 from conformance.diff.labels import command_of
-from conformance.diff.steps import FILL, FRAME, INPUT
+from conformance.diff.steps import FILL, FRAME, INPUT, WAIT
 from gve_fixtures.profile import load_profile
+from gve_fixtures.rules import load_rules
 
 GVE54 = load_profile("GVE54")
 GVE84 = load_profile("GVE84-100")
@@ -84,3 +85,27 @@ def test_a_reference_run_lasts_a_fraction_of_a_second(data):
             n2, n3, n4, n5 = (int(f) for f in fields)
             if max(abs(n2), abs(n4)) <= 300 and all(v.lo <= n <= v.hi for n in (n3, n5)):
                 assert (abs(n2) + abs(n4)) / min(n3, n5) <= 2 / 3, s
+
+
+def test_an_idiom_is_written_as_steps_on_the_profile():
+    g = Grammar(GVE84, Options(destructive=True, rig=True))
+    steps = g.idiom(["wait 0.5", "input 1 FE", "fill 9 C2", "bad:V100", "stalled:?",
+                     "other:?", "L300", "J"])
+    assert [s.kind for s in steps] == [WAIT, INPUT, FILL, FRAME, FRAME, FRAME, FRAME, FRAME,
+                                       WAIT]
+    wait, inp, fill, bad, stalled, other, line, _, restart = steps
+    assert (wait.seconds, inp.port, inp.value) == (0.5, 1, 0xFE)
+    assert (fill.body, fill.times) == ("C2,0,0", 9)
+    assert bad.checksum == "bad" and stalled.stall[1] > GVE84.watchdog_ms / 1000
+    assert other.address != GVE84.address and not other.answer
+    assert line.body == "L300,0,0" and restart.seconds >= GVE84.restart_ms / 1000
+
+
+def test_probes_name_rules_and_are_left_out_where_they_cannot_be_sent():
+    rules = load_rules()
+    assert all(p["rule"] in rules for p in load_probes())
+    on_gve54 = [p["rule"] for p, _ in probes(GVE54, Options(destructive=True))]
+    assert "10.2.motion.path-rate" not in on_gve54           # no VK on the GVE54
+    safe = [p["steps"] for p, _ in probes(GVE84, Options())]
+    assert ["EW10,5A", "ER10"] not in safe
+    assert ["EW10,5A", "ER10"] in [p["steps"] for p, _ in probes(GVE84, Options(True))]
