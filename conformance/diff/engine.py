@@ -97,7 +97,8 @@ class Pair:
         self.judge = Judge(exact=self.exact, rate=profile.max_rate * self._factor)
         self._ceiling = _Ceiling(profile)
         self._idle_since: int | None = 0
-        self._latency_ns = self._slack_ns = 0      # real time: see _retimed
+        self._latency_ns = self._slack_ns = self._cut_ns = 0   # real time: see _retimed
+        self._lost = False
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
@@ -108,7 +109,8 @@ class Pair:
         self.target.open()
         self.reference.open()
         self._idle_since = 0
-        self._latency_ns = self._slack_ns = 0
+        self._latency_ns = self._slack_ns = self._cut_ns = 0
+        self._lost = False
         if not self.exact:
             self._prelude()
         context_packet = False
@@ -250,32 +252,44 @@ class Pair:
             self._watch_reference()
             if command in ("P", "PF", ">"):
                 moving = self._moving_near(rec) if command != ">" else True
-        judge = replace(self.judge, rate=self._ceiling.rate * self._factor,
-                        slack_ns=self._slack_ns)
+        late = self._cut_ns + (self._slack_ns if moving else 0)
+        judge = replace(self.judge, rate=self._ceiling.rate * self._factor, slack_ns=late)
         return difference(command, rec.target, rec.reference, judge, moving=moving)
 
     def _retimed(self, command: str, rec: Record | None) -> None:
         """Real time: the reference acts on a frame when the target's exchange began, the
-        target somewhere within its latency. A frame (or rig input) that changes a running
-        motion's course therefore makes every later position uncertain by the rate times
-        that latency: the largest an immediate answer took in the sequence so far."""
+        target somewhere within its latency (the largest an immediate answer took in the
+        sequence so far). A frame (or rig input) that changes a running motion's course
+        makes the readings while it runs uncertain by the rate times that latency; one
+        that stops it short (H, INTA written, an input) the positions at rest too, until
+        the vector it cut has run to its end — for good once D or K threw the rest away."""
         if self.exact:
             return
         if rec is not None and command not in _DEFERRED and rec.target.answer:
             self._latency_ns = max(self._latency_ns,
                                    rec.target.received_at - rec.target.sent_at)
+        if command in ("D", "K") and self._cut_ns:
+            self._lost = True
         if command in _RETIMING and self._idle_since is None:
             self._slack_ns += self._latency_ns
+            if command in _STOPPING:
+                self._cut_ns += self._latency_ns
 
     def _watch_reference(self) -> None:
         """Real time: note when the reference was first seen at rest (after each step;
-        a late note only makes the comparison more lenient)."""
+        a late note only makes the comparison more lenient); at rest and not interrupted,
+        every vector has reached its end, and when they were acted on no longer shows."""
         rig = self.reference.link.rig
-        run = rig is None or bool(int(rig.state()["status"][6], 16) & St6.RUN)
-        if run:
+        st6 = 0xFF if rig is None else int(rig.state()["status"][6], 16)
+        if st6 & St6.RUN:
             self._idle_since = None
-        elif self._idle_since is None:
+            return
+        if self._idle_since is None:
             self._idle_since = self.reference.now
+        if not st6 & St6.INTA:
+            self._slack_ns = 0
+            if not self._lost:
+                self._cut_ns = 0
 
     def _moving_near(self, rec: Record) -> bool:
         """Whether the reading may have been taken while the axes moved on either side:
@@ -309,6 +323,8 @@ _COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
 #: what changes a running motion's course at the instant the unit acts on it (an input
 #: set by the rig too): in real time that instant is known only within a latency
 _RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+#: of those, what stops a motion short of its vectors' ends
+_STOPPING = ("H", "SW6", "input")
 #: frames answered when their action ends, not at once
 _DEFERRED = ("H", "W", "J")
 

@@ -132,21 +132,22 @@ def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
 
 def test_in_real_time_a_course_change_while_moving_widens_later_readings():
     """The latency is the slowest immediate answer so far (an H answers when stopped: not
-    a latency); what changes a running motion's course adds it, a setting at rest does
-    not."""
+    a latency); what changes a running motion's course adds it to the readings while it
+    runs, what stops it short to the positions at rest too; a setting at rest adds
+    nothing."""
     p = pair(None)
     p.exact = False                                  # as with a target in real time
     ms = 1_000_000
 
-    def sent(command: str, took_ms: int) -> None:
+    def sent(command: str, took_ms: int) -> tuple[int, int, int]:
         reply = Exchange(command.encode(), b"0\r", 0, took_ms * ms, None)
         p._retimed(command, Record(Step(FRAME, command), target=reply))
+        return p._latency_ns // ms, p._slack_ns // ms, p._cut_ns // ms
 
     p._idle_since = None                             # the reference was moving
-    sent("V", 2)
-    assert (p._latency_ns, p._slack_ns) == (2 * ms, 0)
-    sent("H", 200)
-    assert (p._latency_ns, p._slack_ns) == (2 * ms, 2 * ms)
+    assert sent("V", 2) == (2, 0, 0)
+    assert sent("XM", 1) == (2, 2, 0)
+    assert sent("H", 200) == (2, 4, 2)
     p._idle_since = 5                                # at rest since
-    sent("XM", 3)
-    assert (p._latency_ns, p._slack_ns) == (3 * ms, 2 * ms)
+    assert sent("XM", 3) == (3, 4, 2)
+    assert not p._lost and sent("D", 1) == (3, 4, 2) and p._lost
