@@ -456,13 +456,15 @@ def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
 MINIMISE_RUNS = 300
 
 
-def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
+def minimise(pair: Pair, finding: Finding, budget: Budget, *,
+             frames_only: bool = False) -> Finding:
     """Hypothesis shrinks by its own measure (the choices it drew); this last pass makes
     each step the least the same command still disagrees the same way with, so the
     transcript and the steps its label reads are what the disagreement needs: a step
     taken out, else sent plain (its own checksum, no stall), else replaced by a wait as
     long as its exchange took (a frame that only let time pass); two fills of one frame
-    or two waits become one, a fill is tried half as full."""
+    or two waits become one, a fill is tried half as full. With ``frames_only`` a frame
+    may only be taken out: waits and fills stay as they are."""
     steps, outcome = finding.steps, finding.outcome
     want = (outcome.disagreement.command, outcome.disagreement.kind)
     runs = 0
@@ -479,7 +481,9 @@ def minimise(pair: Pair, finding: Finding, budget: Budget) -> Finding:
     i = 0
     while i < len(steps) and runs < MINIMISE_RUNS:
         found = False
-        for candidate in _lesser(steps, i, outcome):
+        lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
+            if frames_only else _lesser(steps, i, outcome)
+        for candidate in lesser:
             if (trial := same(candidate)) is not None:
                 steps, outcome, found = candidate, trial, True
                 break
@@ -553,13 +557,18 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
 
     def keep(found: Finding, *, written: bool = False) -> None:
         """A disagreement made minimal, confirmed in real time, kept once. A probe
-        (``written``) in real time stays as written: its waits and slow rates are what
-        make it show beyond the timing band, and one lucky run must not take them out."""
-        finding = found if written and not pair.exact else minimise(pair, found, budget)
+        (``written``) in real time only loses the frames it does not need (its waits and
+        slow rates are what make it show beyond the timing band), and stays as written
+        unless the lesser one shows again."""
+        finding = minimise(pair, found, budget, frames_only=written and not pair.exact)
         if finding.disagreement.signature in known:
             return
         known.add(finding.disagreement.signature)
-        if not pair.exact and not _again(pair, finding, budget):
+        confirmed = pair.exact or _again(pair, finding, budget)
+        if not confirmed and written and finding.steps != found.steps:
+            finding = found
+            confirmed = _again(pair, found, budget)
+        if not confirmed:
             pair.unconfirmed.append(finding)
             return
         findings.append(finding)
