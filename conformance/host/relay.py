@@ -80,6 +80,7 @@ class Relay:
         self.last_host = self.rec.origin   # when the host last sent anything
         self.last_given = self.rec.origin  # when the host was last given anything
         self._settings: str | None = None
+        self._turn_end: int | None = None       # when the relay's last turn ended
 
     # -- what faults may use (faults.Context) -------------------------------------------------
     def now(self) -> int:
@@ -126,6 +127,9 @@ class Relay:
         """One turn: wait for the host (or the next thing due), then move every byte."""
         wait = self._wait(max_wait)
         start = now()
+        last = self._turn_end                   # late between turns (the thread waited)
+        if last is not None and start - last > STALL_NS:
+            self.rec.stalls.append((last, start))
         ready, _, _ = select.select([self.port.fileno()], [], [], wait)
         woke = now()
         if woke - start > wait * SECOND + STALL_NS:
@@ -136,7 +140,7 @@ class Relay:
         self.take_unit()
         self.fault.tick(now(), self)
         self.deliver()
-        done = now()
+        done = self._turn_end = now()
         if done - woke > STALL_NS:
             self.rec.stalls.append((woke, done))
 
