@@ -18,6 +18,7 @@ from __future__ import annotations
 import re
 import sys
 import time
+from collections.abc import Callable
 
 import serial
 
@@ -186,16 +187,26 @@ class Session:
         until = time.monotonic() + ASK_FOR_S
         while time.monotonic() < until:
             self.send(self.frame("@"))
-            lines = self._settled(1)
+            # a late answer to an earlier command may come first: only a line with the
+            # shape of an index counts, and the last one is the answer to this `@`
+            lines = self._settled(1, lambda line: self._index_of(line) is not None)
+            indexes = [i for i in map(self._index_of, lines) if i is not None]
+            if indexes:
+                return indexes[-1]
             answer = lines[-1] if lines else None
-            parsed = wire.parse(answer, self.summed) if answer else None
-            if parsed is not None and parsed.code == 0 and len(parsed.values) == 1:
-                return int(parsed.values[0])
-            if answer and self.summed and wire.parse(answer, False) is not None:
+            if (answer and self.summed and wire.parse(answer, True) is None
+                    and wire.parse(answer, False) is not None):
                 raise UnitLost("the unit answers without checksums: it has restarted "
                                "(checksum mode is off after power-on, spec 6)")
             self.drain()
         return None
+
+    def _index_of(self, line: bytes) -> int | None:
+        """The index in an answer to `@` (`0,<index>`), None for any other line."""
+        parsed = wire.parse(line, self.summed)
+        if parsed is None or parsed.code != 0 or len(parsed.values) != 1:
+            return None
+        return int(parsed.values[0]) if parsed.values[0].isdigit() else None
 
     def repeat(self, summed: bool) -> tuple[bytes, Answer] | None:
         """`>`: the last frame the unit received, and the answer it gave it."""
@@ -207,16 +218,19 @@ class Session:
                 return (line.rstrip(wire.CR), answer) if answer is not None else None
         return None
 
-    def _settled(self, need: int) -> list[bytes]:
-        """Lines until ``need`` came and no more follow for a moment."""
+    def _settled(self, need: int,
+                 counts: Callable[[bytes], bool] = lambda line: True) -> list[bytes]:
+        """Lines until ``need`` that ``counts`` came and no more follow for a moment."""
         lines: list[bytes] = []
+        counted = 0
         deadline = time.monotonic() + (self.timeout or 1.0)
         while True:
             line = self.read_line(deadline)
             if line is None:
                 return lines
             lines.append(line)
-            if len(lines) >= need:
+            counted += counts(line)
+            if counted >= need:
                 deadline = time.monotonic() + SETTLE_S
 
 

@@ -5,7 +5,10 @@ host's traffic on the wire, under the faults a real line and unit bring.
     units.py    the emulated units behind the relay (gve://, its rig and its clock)
     framer.py   the host's byte stream cut into frames, every byte timed
     grammar.py  one frame judged against spec 3 and 10 (commands.toml: the parameters)
-    relay.py    host <-> units, answers paired with frames, faults applied
+    relay.py    host <-> units, answers paired with frames, faults applied: only what
+                the line needs while it runs
+    ledger.py   the frames read and the units' views booked in the relay's order, when
+                a fault or the end of the run asks
     faults.py   lost, damaged, late and noisy answers, lost and cut frames, a full queue,
                 an interrupt, a restart
     recording.py, unitview.py   what was seen both ways; what the units executed

@@ -112,7 +112,7 @@ class AnswerFault(Fault):
 
     def answer(self, ex: Exchange, ctx: Context) -> Delivery:
         data = b"".join(ex.answer)
-        if self.injected or ex.code != 0 or not self.target.matches(ex.parsed.raw, ctx):
+        if self.injected or ex.code != 0 or not self.target.matches(ex.frame.raw, ctx):
             return Delivery(data)
         self.injected = True
         ex.fault = self.kind
@@ -161,8 +161,8 @@ class FrameFault(Fault):
         return f"the frame {self.target} is {what}"
 
     def hold(self, partial: bytes, ctx: Context) -> bool:
-        return (not self.injected and self.target.reached(ctx)
-                and self.target.raw.startswith(partial))
+        return (not self.injected and self.target.raw.startswith(partial)
+                and self.target.reached(ctx))
 
     def frame(self, ex: Exchange, ctx: Context) -> bytes | None:
         raw = ex.frame.raw + b"\r"

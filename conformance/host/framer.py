@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 from itertools import pairwise
 
-CR, LF = 0x0D, 0x0A
+CR, LF, BANG = 0x0D, 0x0A, 0x21
 _SPECIAL = re.compile(rb"[!\r]")
 #: an unterminated frame is kept up to this many bytes (the rest is only counted)
 KEEP = 4096
@@ -83,6 +83,16 @@ class HostFramer:
         events: list[tuple[int, HostFrame | Fragment]] = []
         i, n = 0, len(data)
         while i < n:
+            if not self._raw and not self._stray and data[i] == BANG:
+                # the usual case first: a whole frame of ordinary length from here
+                m = _SPECIAL.search(data, i + 1)
+                if m is not None and data[m.start()] == CR and m.start() - i <= KEEP:
+                    end = m.start()
+                    events.append((end + 1, self._emit(HostFrame(data[i:end],
+                                                                 [t] * (end - i), t))))
+                    self._after_cr = True
+                    i = end + 1
+                    continue
             if not self._raw:
                 bang = data.find(b"!", i)
                 end = n if bang < 0 else bang

@@ -122,6 +122,16 @@ def parse_frame(raw: bytes, units: dict[int, Profile], checksums: bool) -> Parse
     return _parse(raw, units, checksums)
 
 
+def command_of(raw: bytes, units: dict[int, Profile]) -> str | None:
+    """The command :func:`parse_frame` finds in a frame, without judging the rest (what
+    the relay needs while the frame is on the line). A checksum is not cut off first: its
+    `,XX` never lengthens a name, as no name has a comma."""
+    digit = raw[1:2]
+    if not (digit.isdigit() and int(digit) <= 7 and int(digit) in units):
+        return None
+    return _longest_prefix(raw[2:5].decode("latin-1"), command_table())
+
+
 class LineGrammar:
     """:func:`parse_frame` for one line, remembering its answers: hosts repeat frames
     (polls, retries). A parsed frame is shared between equal frames: do not change it."""

@@ -5,6 +5,7 @@ oracle judge this record after the run; the HTML report shows its wire log."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from conformance.host.framer import Fragment, HostFrame
@@ -20,14 +21,16 @@ STALL_NS = 20_000_000
 class Exchange:
     """One host frame and what became of it.
 
-    ``to_unit``: the bytes the unit got for it (the frame itself, or what a fault made of
-    it; None: nothing). ``answer``: the lines the unit answered (CR included; empty: none).
-    ``delivered``: the bytes the host got (None: nothing, the answer was lost).
+    ``reading``: the frame as the judge reads it (None until the ledger has read it,
+    ledger.py; :attr:`parsed` reads it when asked). ``to_unit``: the bytes the unit got
+    for it (the frame itself, or what a fault made of it; None: nothing). ``answer``: the
+    lines the unit answered (CR included; empty: none). ``delivered``: the bytes the host
+    got (None: nothing, the answer was lost).
     """
 
     n: int
     frame: HostFrame
-    parsed: ParsedFrame
+    reading: ParsedFrame | None = None
     to_unit: bytes | None = None
     answer: list[bytes] = field(default_factory=list)
     answered_at: int | None = None
@@ -35,6 +38,14 @@ class Exchange:
     delivered_at: int | None = None
     fault: str | None = None
     vectors_before: int = 0         # vectors the units had accepted before this frame
+    settle: Callable[[], None] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def parsed(self) -> ParsedFrame:
+        if self.reading is None and self.settle is not None:
+            self.settle()
+        assert self.reading is not None, "an exchange the ledger never read"
+        return self.reading
 
     @property
     def text(self) -> str:

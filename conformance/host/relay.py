@@ -8,7 +8,9 @@ the host no sooner than the line could have carried it at its baud rate. Between
 a fault may act at one point of the job (faults.py). Every byte both ways is recorded
 with its instant (recording.py), and each frame is paired with the answer the unit gave
 it, so that the host rules (checks.py) and the motion the unit executed (unitview.py) can
-be judged from the wire alone.
+be judged from the wire alone. The relay does only what the line needs while it runs;
+reading the frames and booking the units' views waits in the ledger (ledger.py) until a
+fault or the end of the run asks for them.
 
 Answers are paired by time: a unit answers at once (spec 2), so an answer's first byte
 follows the frame's CR by one byte time; after passing a frame the relay reads the line
@@ -29,10 +31,11 @@ import serial
 
 from conformance.host.faults import Fault
 from conformance.host.framer import HostFrame, HostFramer
-from conformance.host.grammar import LineGrammar
+from conformance.host.grammar import command_of
+from conformance.host.ledger import Ledger
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
-from conformance.host.unitview import UnitView, by_address, profiles_by_address
+from conformance.host.unitview import UnitView
 
 MS = 1_000_000
 SECOND = 1_000_000_000
@@ -65,9 +68,8 @@ class Relay:
                  fault: Fault, baud: int) -> None:
         self.port, self.unit, self.views, self.fault = port, unit, views, fault
         self.line = unit.line  # type: ignore[attr-defined]  (the gve:// rig and clock)
-        self.view_at = by_address(views)
-        self.units = profiles_by_address(views)
-        self.grammar = LineGrammar(self.units)
+        self.ledger = Ledger(views)
+        self.units = self.ledger.units
         self.byte_ns = round(10 * SECOND / baud)
         self.rec = Recording(now())
         self.framer = HostFramer()
@@ -78,20 +80,21 @@ class Relay:
         self.last_host = self.rec.origin   # when the host last sent anything
         self.last_given = self.rec.origin  # when the host was last given anything
         self._settings: str | None = None
+        self._turn_end: int | None = None       # when the relay's last turn ended
 
     # -- what faults may use (faults.Context) -------------------------------------------------
     def now(self) -> int:
         return now()
 
     def vectors(self) -> int:
-        return sum(v.vectors for v in self.views)
+        return self.ledger.vectors()
 
     def in_packet(self, address: int | None) -> bool:
-        view = self.view_at.get(address) if address is not None else None
+        view = self.ledger.view(address)
         return view is not None and view.packet is not None
 
     def checksums(self, address: int | None) -> bool:
-        view = self.view_at.get(address) if address is not None else None
+        view = self.ledger.view(address)
         return view is not None and view.checksums
 
     def note_fault(self, kind: str, detail: str) -> None:
@@ -100,7 +103,7 @@ class Relay:
     def power_on(self, address: int) -> None:
         self._sync()
         self.line.power_on(address)
-        self.view_at[address].power_on(now())
+        self.ledger.power_on(address, now())
 
     def set_input(self, port: int, value: int, address: int) -> None:
         self._sync()
@@ -124,6 +127,9 @@ class Relay:
         """One turn: wait for the host (or the next thing due), then move every byte."""
         wait = self._wait(max_wait)
         start = now()
+        last = self._turn_end                   # late between turns (the thread waited)
+        if last is not None and start - last > STALL_NS:
+            self.rec.stalls.append((last, start))
         ready, _, _ = select.select([self.port.fileno()], [], [], wait)
         woke = now()
         if woke - start > wait * SECOND + STALL_NS:
@@ -134,7 +140,7 @@ class Relay:
         self.take_unit()
         self.fault.tick(now(), self)
         self.deliver()
-        done = now()
+        done = self._turn_end = now()
         if done - woke > STALL_NS:
             self.rec.stalls.append((woke, done))
 
@@ -152,6 +158,7 @@ class Relay:
         self.take_unit()
         for frag in self.framer.finish(now()):
             self.rec.fragments.append(frag)
+        self.ledger.settle()
 
     # -- host -> units ---------------------------------------------------------------------
     def take_host(self, data: bytes, t: int) -> None:
@@ -186,10 +193,9 @@ class Relay:
         self.unit.write(data)
 
     def _complete(self, frame: HostFrame) -> None:
-        address = frame.raw[1] - 0x30 if len(frame.raw) > 1 else None
-        view = self.view_at.get(address) if address is not None else None
-        parsed = self.grammar.parse(frame.raw, view is not None and view.checksums)
-        ex = Exchange(len(self.rec.exchanges), frame, parsed, vectors_before=self.vectors())
+        command = command_of(frame.raw, self.units)
+        ex = Exchange(len(self.rec.exchanges), frame)
+        self.ledger.frame(ex)
         self.rec.exchanges.append(ex)
         held, self.held = bytes(self.held), bytearray()
         whole = held.endswith(frame.raw + b"\r")
@@ -204,19 +210,19 @@ class Relay:
             sent, ex.to_unit = held, frame.raw + b"\r"
         if sent:
             self.unit.write(sent)            # the line's clock is the wall clock's now
-        lines = self._answer(ex) if sent and sent.endswith(b"\r") else []
-        if not lines and parsed.command in DEFERRED and sent:
+        lines = self._answer(command) if sent and sent.endswith(b"\r") else []
+        if not lines and command in DEFERRED and sent:
             self.deferred.append(ex)         # booked when its answer comes
             return
         self._answered(ex, lines)
 
-    def _answer(self, ex: Exchange) -> list[bytes]:
+    def _answer(self, command: str | None) -> list[bytes]:
         """The lines the unit answers right away (`>` answers two, spec 8): the first
         byte of an answer is complete one byte time after the frame's CR."""
         first = self._line(self.byte_ns)
         if first is None:
             return []
-        if ex.parsed.command != ">":
+        if command != ">":
             return [first]
         second = self._line(self.byte_ns)
         return [first] if second is None else [first, second]
@@ -240,14 +246,10 @@ class Relay:
         del self.from_unit[: cr + 1]
         return line
 
-    def _book(self, ex: Exchange) -> None:
-        for view in self.views:
-            view.apply(ex, self.units)
-
     def _answered(self, ex: Exchange, lines: list[bytes]) -> None:
         ex.answer = lines
         ex.answered_at = self._on_line() if lines else None
-        self._book(ex)
+        self.ledger.answered(ex)
         if lines:
             out = self.fault.answer(ex, self)
             if out.data is not None:

@@ -72,8 +72,12 @@ class Line:
             unit.advance(t)
 
     def next_deadline(self) -> int | None:
-        due = [d for d in (u.next_deadline() for u in self.units) if d is not None]
-        return min(due) if due else None
+        best = None
+        for unit in self.units:
+            d = unit.next_deadline()
+            if d is not None and (best is None or d < best):
+                best = d
+        return best
 
     def advance(self, seconds: float) -> None:
         """Let ``seconds`` pass (virtual time), handling every unit event on the way."""
@@ -149,8 +153,10 @@ class Line:
         return self._ready_count(now)
 
     def _take(self, size: int, terminator: bytes | None) -> bytes:
-        out = bytearray()
         now, rx = self.now, self._rx
+        if not rx or rx[0][0] > now:
+            return b""                 # no byte complete yet (a read's usual first look)
+        out = bytearray()
         while rx and len(out) < size:
             chunk = rx[0]
             first, data, taken = chunk
@@ -199,14 +205,18 @@ class Line:
             if len(out) >= size or (terminator and out.endswith(terminator)):
                 return bytes(out)
             ready = self._complete_at(size - len(out), terminator)
-            nxt = [x for x in (ready, self.next_deadline()) if x is not None]
-            t = min(nxt) if nxt else None
+            event = self.next_deadline()
+            t = event if ready is None else ready if event is None else min(ready, event)
             if t is None or (deadline is not None and t > deadline):
                 if deadline is not None:
                     self.advance_to(deadline)
                     out += self._take(size - len(out), terminator)
                 return bytes(out)
-            self.advance_to(t)
+            if event is None or t < event:     # no unit acts before the bytes are there
+                self.clock.advance_to(t)
+                self._settle(t)
+            else:
+                self.advance_to(t)
 
     def take_ready(self) -> bytes:
         """Real time: every byte due by now (the server writes them to its port)."""

@@ -84,11 +84,20 @@ class Unit:
 
     # -- time -------------------------------------------------------------------------------
     def next_deadline(self) -> int | None:
-        now, best = self.now, None
-        for c in (self.framer.deadline(), self.device.motion.next_event(),
-                  self.device.deaf_until, *(d.instant for _, d, _ in self._pending)):
-            if c is not None and c > now and (best is None or c < best):
-                best = c
+        """The next instant after now at which the unit acts by itself: the watchdog, the
+        motion's next event, the end of a restart, an answer that is due later. The line
+        asks on every read and write, so the usual case (only the motion) goes first."""
+        now = self.now
+        best = self.device.motion.next_event()
+        if best is not None and best <= now:
+            best = None
+        deaf = self.device.deaf_until
+        if deaf > now and (best is None or deaf < best):
+            best = deaf
+        if self.framer.buf is not None or self._pending:
+            for c in (self.framer.deadline(), *(d.instant for _, d, _ in self._pending)):
+                if c is not None and c > now and (best is None or c < best):
+                    best = c
         return best
 
     def advance(self, t: int) -> None:

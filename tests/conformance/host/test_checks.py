@@ -176,3 +176,18 @@ def test_a_worked_example_is_sent_as_the_spec_sums_it():
     found = broken(w.judge())
     assert found["11.golden.g2"] == ["!0A100,4E"]
     assert found["6.checksum.sum"] == ["!0A100,4E"]
+
+
+def test_a_refusal_the_relay_gave_late_is_not_held_against_the_host():
+    # the relay stalled 300 ms (its process under load) before giving the `1`: the host
+    # had given it up for lost and asked `@`; it then stopped (exit status 1)
+    w = Wire()
+    w.frame(b"!0L10,0,0", 0, answer=b"1\r", given_ms=305)
+    w.frame(b"!0@", 300, answer=b"0,1\r")
+    w.rec.stalls.append((2 * MS, 302 * MS))
+    j = w.judge()
+    assert "5.code.queue-full" not in broken(j)
+    assert any("not judged for 5.code.queue-full" in n for n in j.notes)
+    # given at once, the same refusal is the host's to try again
+    w.rec.exchanges[0].delivered_at = 1 * MS
+    assert broken(w.judge())["5.code.queue-full"] == ["!0L10,0,0"]

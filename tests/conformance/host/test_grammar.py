@@ -4,8 +4,10 @@ expected rules and frames come from the spec's own examples."""
 from __future__ import annotations
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
-from conformance.host.grammar import parse_frame
+from conformance.host.grammar import command_of, parse_frame
 from gve_fixtures.profile import load_profile
 
 GVE84 = {0: load_profile("GVE84-100")}
@@ -83,3 +85,24 @@ def test_every_judged_frame_names_the_rules_it_was_held_to():
     f = parse_frame(b"!0V1000,C4", GVE84, True)
     assert {"3.frame.grammar", "6.checksum.sum", "1.profile.v-b-range"} <= f.judged
     assert f.command == "V" and f.params == ["1000"] and f.checksum == "C4"
+
+
+@pytest.mark.parametrize("raw", [
+    b"!0H", b"!0H,5A", b"!0W", b"!0WY,-20000,1000,2000,500", b"!0>", b"!0>,6E", b"!0N",
+    b"!0N,4E", b"!0NX100", b"!0NX100,12", b"!0XA", b"!0XA,AA", b"!0EFW1,2.5", b"!0*E3",
+    b"!0*E3,C2", b"!0h", b"!0?", b"!0,41", b"!0", b"!", b"!9V1000", b"!3V1000", b"!0ZZ",
+    b"!0V\xff", b"!7V1000", b"!7V1000,8E",
+])
+@pytest.mark.parametrize("checksums", [False, True])
+@pytest.mark.parametrize("units", [GVE84, GVE114, GVE54], ids=["GVE84", "GVE114", "GVE54"])
+def test_the_relays_command_is_the_judges(raw, checksums, units):
+    """The relay reads only the command while a frame is on the line; the judge reads
+    the whole frame later, in the checksum mode of its unit: both find the same command."""
+    assert command_of(raw, units) == parse_frame(raw, units, checksums).command
+
+
+@given(st.binary(max_size=12).map(lambda b: b"!0" + b)
+       | st.text("!0123456789HWNXAVLC*SE>?@,%+-", max_size=10).map(lambda s: s.encode()),
+       st.booleans())
+def test_the_relays_command_is_the_judges_for_any_bytes(raw, checksums):
+    assert command_of(raw, GVE114) == parse_frame(raw, GVE114, checksums).command
