@@ -3,12 +3,16 @@ transcript in the reports, the replay saying whether the disagreement is still t
 the emulator against itself over a pseudo-terminal in real time, usage errors."""
 
 import json
+import sys
+from pathlib import Path
 
 import pytest
 
 from conformance.cli import main
 from conformance.diff.grammar import Options, probes
+from conformance.targets.emu import mutants
 from gve_fixtures.profile import load_profile
+from tests.conformance.diff.test_engine import PROFILE, in_area
 from tests.emulator.process import Emulator
 
 
@@ -85,3 +89,21 @@ def test_over_a_pty_a_probe_shows_a_millisecond_timing_bug(capsys):
     alone did not find in ten minutes over a pty, is shown by its probe."""
     status, out = _probes_over_a_pty("dwell-ignored", capsys)
     assert status == 1 and "FAIL        10.2.motion.dwell" in out, out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mutant", sorted(mutants()))
+def test_every_mutant_is_named_over_exec_by_the_probes(mutant, tmp_path):
+    """What a clone's author runs, against each of the emulator's mutants as a program of
+    its own (`exec:`, a pty, real time): the probes alone name a rule of the mutant's
+    area, with the transcript of its finding (about half a minute each)."""
+    profile = PROFILE.get(mutant, "GVE84-100")
+    written = len(probes(load_profile(profile), Options(destructive=True, rig=True)))
+    target = f"exec:{sys.executable} -m emulator --pty --model {profile} --mutant {mutant}"
+    status = main(["diff", "--target", target, "--profile", profile, "--examples",
+                   str(written), "--allow-destructive", "--yes", "--report-dir", str(tmp_path)])
+    (folder,) = tmp_path.iterdir()
+    found = [r for r in json.loads((folder / "results.json").read_text())["results"]
+             if in_area(r["checks"][0]["rule"], mutant)]
+    assert status == 1 and found, mutant
+    assert "# rules: " in Path(found[0]["artifacts"]["transcript"]).read_text()
