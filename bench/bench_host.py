@@ -16,7 +16,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -24,6 +23,7 @@ from pathlib import Path
 import gve_host
 from conformance.host.certify import Plan, certify
 from conformance.host.faults import Fault
+from conformance.host.ports.silent import SilentPort
 from conformance.host.relay import Relay
 from conformance.host.scenarios import SCENARIOS
 from conformance.host.units import load_units, open_line
@@ -31,31 +31,6 @@ from conformance.host.unitview import line_views
 
 BAUD = 921_600
 JOB = Path(gve_host.__file__).parent / "jobs" / "square.job"
-
-
-class SilentPort:
-    """A host port that never sends and takes every answer (the stream is fed directly)."""
-
-    name = "(in process)"
-
-    def __init__(self) -> None:
-        self._r, self._w = os.pipe()
-
-    def fileno(self) -> int:
-        return self._r
-
-    def read(self) -> bytes:
-        return b""
-
-    def write(self, data: bytes) -> int:
-        return len(data)
-
-    def settings(self) -> None:
-        return None
-
-    def close(self) -> None:
-        os.close(self._r)
-        os.close(self._w)
 
 
 def stream(kind: str, n: int) -> tuple[list[bytes], int]:

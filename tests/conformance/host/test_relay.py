@@ -3,41 +3,15 @@ the relay's stalls did (recording.STALL_NS)."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
 
 from conformance.host import relay as relay_module
 from conformance.host.faults import Fault
+from conformance.host.ports.silent import SilentPort
 from conformance.host.recording import STALL_NS
 from conformance.host.relay import Relay
 from conformance.host.units import load_units, open_line
 from conformance.host.unitview import line_views
-
-
-class QuietPort:
-    """A host port that sends nothing (its fileno never becomes readable)."""
-
-    name = "(in process)"
-
-    def __init__(self) -> None:
-        self._r, self._w = os.pipe()
-
-    def fileno(self) -> int:
-        return self._r
-
-    def read(self) -> bytes:
-        return b""
-
-    def write(self, data: bytes) -> int:
-        return len(data)
-
-    def settings(self) -> None:
-        return None
-
-    def close(self) -> None:
-        os.close(self._r)
-        os.close(self._w)
 
 
 @pytest.fixture
@@ -49,7 +23,7 @@ def clock(monkeypatch):
 
 def test_a_turn_that_starts_late_is_a_stall(clock):
     units = load_units(["GVE84-100"])
-    line, port = open_line(units, 38400), QuietPort()
+    line, port = open_line(units, 38400), SilentPort()
     relay = Relay(port, line, line_views(units), Fault(), 38400)
     try:
         relay.step(0)
