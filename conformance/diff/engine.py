@@ -22,7 +22,7 @@ from hypothesis.internal.conjecture import providers
 from hypothesis.internal.constants_ast import Constants
 
 from conformance.diff.compare import Judge, difference
-from conformance.diff.grammar import Options, load_grammar, probes, sequences
+from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.labels import command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
@@ -584,7 +584,8 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
         if on_finding is not None:
             on_finding(finding)
 
-    for _, steps in probes(pair.profile, options) if with_probes else ():
+    grammar = Grammar(pair.profile, options)
+    for _, steps in grammar.probes() if with_probes else ():
         if not more():
             return findings
         budget.used += 1
@@ -594,7 +595,7 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
         if d is not None and d.signature not in known:
             keep(Finding(steps, outcome), written=True)
 
-    strategy = sequences(pair.profile, options)
+    strategy = grammar.sequences()
     rounds = 0
     while more():
         best: dict[str, Finding] = {}

@@ -20,8 +20,13 @@ GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
 PROBES_FILE = Path(__file__).with_name("probes.toml")
 #: an idiom's vector along the first axis only
 _ONE_COMPONENT = re.compile(r"[LC]-?\d+")
-#: how an idiom's frame is sent, written before its body
-_PREFIX = re.compile(r"^(bad|stalled|other):")
+#: how an idiom's frame is sent, written before its body, and what that changes of the step
+_SENT = {
+    "bad": lambda profile: {"checksum": "bad"},
+    "stalled": lambda profile: {"stall": (2, (profile.watchdog_ms + 50) / 1000)},
+    "other": lambda profile: {"address": (profile.address + 1) % 8, "answer": False},
+}
+_PREFIX = re.compile(r"^(%s):" % "|".join(_SENT))
 
 
 @dataclass(frozen=True)
@@ -319,14 +324,9 @@ class Grammar:
             elif word == "fill":
                 times, body = rest.split()
                 out.append(Step(FILL, self._padded(body), times=int(times)))
-            elif f.startswith("bad:"):
-                out.append(self.fixed(self._padded(f.removeprefix("bad:")), checksum="bad"))
-            elif f.startswith("stalled:"):
-                step = self.fixed(self._padded(f.removeprefix("stalled:")))
-                out.append(replace(step, stall=(2, (self.profile.watchdog_ms + 50) / 1000)))
-            elif f.startswith("other:"):
-                step = self.fixed(self._padded(f.removeprefix("other:")))
-                out.append(replace(step, address=(self.profile.address + 1) % 8, answer=False))
+            elif m := _PREFIX.match(f):
+                step = self.fixed(self._padded(f[m.end():]))
+                out.append(replace(step, **_SENT[m.group(1)](self.profile)))
             else:
                 out.append(self.fixed(self._padded(f)))
                 if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
@@ -353,6 +353,12 @@ class Grammar:
                 if self.profile.family in p.get("families", [self.profile.family])
                 and self._can(p["steps"])]
 
+    def sequences(self) -> st.SearchStrategy[list[Step]]:
+        """A sequence of steps for one example (groups flattened)."""
+        group = st.composite(lambda draw: self.group(draw))()
+        return st.lists(group, min_size=1, max_size=self.g["steps"]["max"]).map(
+            lambda gs: [s for grp in gs for s in grp])
+
     def restart_wait(self) -> Step:
         return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
 
@@ -372,7 +378,4 @@ def probes(profile: Profile, options: Options) -> list[tuple[dict, list[Step]]]:
 
 def sequences(profile: Profile, options: Options) -> st.SearchStrategy[list[Step]]:
     """A sequence of steps for one example (groups flattened)."""
-    grammar = Grammar(profile, options)
-    group = st.composite(lambda draw: grammar.group(draw))()
-    return st.lists(group, min_size=1, max_size=grammar.g["steps"]["max"]).map(
-        lambda gs: [s for grp in gs for s in grp])
+    return Grammar(profile, options).sequences()
