@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import os
 import secrets
+import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from hypothesis import HealthCheck, Phase, settings
+from hypothesis.configuration import set_hypothesis_home_dir
 from hypothesis.database import DirectoryBasedExampleDatabase, ExampleDatabase
 
 # every field pinned: Hypothesis loads its own profile when CI is set in the environment
@@ -88,9 +90,24 @@ def example_database(where: str | None) -> Iterator[None]:
         _check(where)
     before, _database = _database, where
     try:
-        yield
+        with _hypothesis_home():
+            yield
     finally:
         _database = before
+
+
+@contextmanager
+def _hypothesis_home() -> Iterator[None]:
+    """Hypothesis keeps more than examples under its home folder (a cache of the constants
+    it found in the code, `.hypothesis/` in the working directory by default): a run keeps
+    that in a temporary folder, removed at its end, so that only the example database
+    stays, where the run chose."""
+    with tempfile.TemporaryDirectory(prefix="gve-hypothesis-", ignore_cleanup_errors=True) as home:
+        set_hypothesis_home_dir(home)
+        try:
+            yield
+        finally:
+            set_hypothesis_home_dir(None)
 
 
 def database_for(profile: str) -> ExampleDatabase | None:
@@ -129,8 +146,9 @@ def _redis_client(url: str):  # -> redis.Redis, an optional dependency
     try:
         from redis import Redis, RedisError
     except ImportError:
-        raise ValueError(f"example database {url}: needs the redis package "
-                         "(pip install 'gve-conformance[redis]')") from None
+        raise ValueError(f"example database {url}: needs the redis package (install the "
+                         "suite with its [redis] extra, e.g. pip install "
+                         "'./gve-conformance[redis]')") from None
     try:
         client = Redis.from_url(url, socket_connect_timeout=5, socket_timeout=30)
         client.ping()

@@ -86,8 +86,8 @@ def _matrix(run: RunResult, sections: list[str]) -> list[str]:
     chart = plots.verdict_chart([(section_title(s), by_section[s]) for s in sections])
     out = ["<h2>Verdicts by spec section</h2>",
            f"<figure>{chart}</figure>" if chart else
-           "<p class='why'>Plots are off: install the plotting extra "
-           "(<code>pip install 'gve-conformance[plots]'</code>) to draw them.</p>",
+           "<p class='why'>Plots are off: install the suite with its <code>[plots]</code> "
+           "extra (e.g. <code>pip install './gve-conformance[plots]'</code>) to draw them.</p>",
            "<table><tr><th>section</th>",
            *(f"<th class='{h(v)}'>{h(v)}</th>" for v in ORDER), "</tr>"]
     for s in sections:

@@ -7,6 +7,7 @@ tests, ``python -m pytest -m slow tests/packaging``."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -18,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conformance.fleet.recipe import run_recipe
+from tests.conformance.fleet.recipe import DOCS, run_recipe
 from tests.conformance.fleet.services import free_port
 
 pytestmark = pytest.mark.slow
@@ -49,11 +50,33 @@ def tracked() -> list[str]:
 @pytest.fixture(scope="module")
 def dists(tmp_path_factory) -> dict[str, Path]:
     out = tmp_path_factory.mktemp("dist")
-    # an isolated build: pip fills its environment from the package index
-    run([sys.executable, "-m", "build", "--outdir", str(out), str(ROOT)], ROOT)
+    # an isolated build: pip fills its environment from the package index. Without
+    # PYTHONDONTWRITEBYTECODE, which makes setuptools warn that it cannot byte-compile.
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    done = subprocess.run([sys.executable, "-m", "build", "--outdir", str(out), str(ROOT)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=900, env=env,
+                          check=False)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     (sdist,) = out.glob("*.tar.gz")
     (wheel,) = out.glob("*.whl")
-    return {"sdist": sdist, "wheel": wheel}
+    return {"sdist": sdist, "wheel": wheel, "log": done.stdout + done.stderr}
+
+
+@pytest.fixture(scope="module")
+def checkout(dists, tmp_path_factory) -> Path:
+    """A folder ``gve-conformance`` holding the suite's source, as a user's clone does
+    (the sdist unpacked: the tracked tree)."""
+    top = tmp_path_factory.mktemp("user")
+    with tarfile.open(dists["sdist"]) as sdist:
+        sdist.extractall(top, filter="data")
+    (unpacked,) = [p for p in top.iterdir() if p.is_dir()]
+    unpacked.rename(top / "gve-conformance")
+    return top
+
+
+def test_the_build_prints_no_warning(dists):
+    warnings = [line for line in dists["log"].splitlines() if "warning" in line.lower()]
+    assert not warnings, warnings
 
 
 def fresh_env(folder: Path) -> Path:
@@ -115,3 +138,22 @@ def test_tox_passes_on_a_fresh_clone(tmp_path):
     done = run([sys.executable, "-m", "tox", "-e", "lint,py311", "--", "-q"], clone,
                timeout=3000)
     assert done.returncode == 0
+
+
+def test_the_ci_job_installs_its_default_suite_from_a_checkout(checkout):
+    """docs/ci.md's settings and install blocks as written, GVE_SUITE left at its
+    default: the checkout in ./gve-conformance installs and runs."""
+    assert "GVE_SUITE" not in os.environ
+    done = run_recipe(["settings", "install"], checkout, {}, timeout=900)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    bin_dir = checkout / ".gve-venv" / "bin"
+    assert "PASSED" in run([str(bin_dir / SMOKE[0]), *SMOKE[1:]], checkout).stdout
+
+
+def test_the_acceptance_install_block_installs_as_written(checkout):
+    """docs/acceptance.md's install block, run where the suite's source sits in
+    ./gve-conformance: the suite and its plotting extra are installed."""
+    done = run_recipe(["install"], checkout, {}, timeout=900, doc=DOCS / "acceptance.md")
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    python = checkout / ".venv" / "bin" / "python"
+    run([str(python), "-c", "import matplotlib, conformance, emulator"], checkout)

@@ -117,3 +117,24 @@ def test_benches_sharing_redis_try_each_others_failing_examples_first(tmp_path, 
                        "--no-reports")
     assert b[0] == a[-1] and len(b) == 2
     assert alone[0] != a[-1] and len(alone) > len(b)
+
+
+def test_the_plugin_leaves_no_hypothesis_folder_in_the_working_directory(pytester):
+    """Hypothesis's own cache goes to a temporary folder; the examples stay where the run
+    keeps its database (none here: the machine fails nothing on the clean emulator)."""
+    # in a process of its own: Hypothesis takes its default folder from the working
+    # directory it was imported in
+    result = pytester.runpytest_subprocess("--gve-target", "emu:GVE84-100", "--gve-cases",
+                                           CASE, "-p", "no:cacheprovider")
+    result.assert_outcomes(passed=1)
+    assert not (pytester.path / ".hypothesis").exists()
+    assert not (pytester.path / DEFAULT_DATABASE).exists()
+
+
+def test_a_run_leaves_no_hypothesis_folder_in_the_working_directory(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "conformance", "--target", MUTANT_TARGET,
+                           "--cases", CASE, "--report-dir", "reports", "-q"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300, check=False)
+    assert done.returncode == 1, done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["reports"]
+    assert (tmp_path / "reports" / DEFAULT_DATABASE).is_dir()
