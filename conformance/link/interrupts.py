@@ -54,6 +54,22 @@ class Interrupts:
         """The sessions sent H and D for every signal so far."""
         self.handled = self.count
 
+    @staticmethod
+    @contextlib.contextmanager
+    def held() -> Iterator[None]:
+        """The stopping signals held back while the block runs (main thread only): one
+        that comes meanwhile is delivered when it ends. The link asks whether it may
+        write and writes inside one such block, so a signal lands either before the
+        question (nothing is written) or after the bytes went out, never in between."""
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
     @contextlib.contextmanager
     def catching(self) -> Iterator[Interrupts]:
         """SIGINT, SIGTERM and SIGHUP count here while the block runs (main thread only;

@@ -152,11 +152,21 @@ class Link:
             if pause:
                 self._pause(pause)
             if piece:
-                self._record(HOST, piece)
-                self.port.write(piece)
+                self._write(piece)
         if frames:
             self._last = (_UNASKED, frames[-1].raw, b"")
         return frames
+
+    def _write(self, data: bytes) -> None:
+        """Write ``data`` unless the run must stop now. The guard judged the frames before
+        the link waited for a quiet line (or paused for an injected delay); a signal that
+        came meanwhile must still keep them off the line, so the guard is asked again at
+        the instant of writing, with the signals held between the question and the
+        write."""
+        with self.guard.interrupts.held():
+            self.guard.check_idle()
+            self._record(HOST, data)
+            self.port.write(data)
 
     def send_raw(self, data: bytes) -> None:
         """Bytes exactly as given (host faults apply). Every frame they complete is

@@ -12,6 +12,8 @@ import re
 import signal
 import subprocess
 import sys
+import threading
+import time
 from collections.abc import Callable
 
 import pytest
@@ -48,23 +50,44 @@ def in_machine(n: int) -> Callable[[int, bytes], bool]:
     return trigger
 
 
-def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool]) -> tuple[list[bytes], int, dict]:
+def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool], *, sig: int = signal.SIGINT,
+               after_s: float = 0.0, drop: bool = False) -> tuple[list[bytes], int, dict]:
+    """The run, signalled ``after_s`` after the frame ``trigger`` picks (at once: while it
+    is in flight). ``drop``: that frame's answer is lost, so the link waits for a quiet
+    line before its next frame and the signal lands inside that wait."""
     image = tmp_path / "unit.eeprom"
     data = bytearray(random.Random(str(tmp_path)).randbytes(256))
     image.write_bytes(bytes(data))
     pressed: list[int] = []
+    signalled: list[float] = []        # the instant of the signal (the proxy's clock)
+    dropping: list[bool] = []
     proc: list[subprocess.Popen] = []
     stopped: list[list[int]] = []      # where the axes are once H has been answered
+
+    def press() -> None:
+        signalled.append(time.monotonic())
+        os.kill(proc[0].pid, sig)
 
     def on_frame(i: int, frame: bytes) -> None:
         if proc and not pressed and trigger(i, frame):
             pressed.append(i)
-            os.kill(proc[0].pid, signal.SIGINT)
-        elif pressed and i == pressed[0] + 2:
+            if drop:
+                dropping.append(True)
+            if after_s:
+                threading.Timer(after_s, press).start()
+            else:
+                press()
+        elif signalled and frame[2:3] == b"D" and not stopped:
             stopped.append(emu.state()["physical"])
 
+    def lose_one(answer: bytes) -> list[tuple[float, bytes]]:
+        if dropping:
+            dropping.clear()
+            return []
+        return [(0.0, answer)]
+
     with unit_behind_proxy("--model", "GVE84-100", "--eeprom", str(image),
-                           on_frame=on_frame) as (emu, proxy):
+                           on_frame=on_frame, transform=lose_one) as (emu, proxy):
         emu.control("in 1 FF")
         proc.append(subprocess.Popen(
             [sys.executable, "-m", "conformance", "--target", f"serial:{proxy.path}",
@@ -73,18 +96,17 @@ def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool]) -> tuple[list[by
             stdout=subprocess.PIPE, stderr=subprocess.PIPE))
         out, err = proc[0].communicate(timeout=120)
         state = emu.state()
-    assert pressed, f"the trigger never fired\n{out.decode()}\n{err.decode()}"
+    assert signalled, f"the trigger never fired\n{out.decode()}\n{err.decode()}"
     assert b"Traceback" not in err, err.decode()
-    frames = proxy.sent()
-    after = frames[pressed[0] + 1:]
+    after = [f for t, f in proxy.frames if t > signalled[0]]
     assert [f[2:3] for f in after[:2]] == [b"H", b"D"], after[:4]
     assert not [f for f in after if MOTION.match(f) and not f.startswith(b"!0L0,0,0")]
     assert state["physical"] == stopped[0], "the axes moved after H"
     assert image.read_bytes() == bytes(data), "EEPROM not as found"
     assert state["status"][:6] == ["00"] * 6
-    (folder,) = (tmp_path / "reports").iterdir()
+    (folder,) = [p for p in (tmp_path / "reports").iterdir() if not p.name.startswith(".")]
     report = json.loads((folder / "results.json").read_text())
-    assert report["interrupted"] is True and proc[0].returncode == 1
+    assert report["interrupted"] is True and proc[0].returncode != 0
     return after, pressed[0], report
 
 
@@ -109,3 +131,15 @@ def test_ctrl_c_at_random_instants(tmp_path, instant):
                in_machine(rnd.randrange(1, 8))][instant % 4]        # inside a machine
     after, _, report = ctrl_c_run(tmp_path, trigger)   # (the whole protocol checked there)
     assert after[0][2:3] == b"H" and report["interrupted"] is True
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP],
+                         ids=["SIGINT", "SIGTERM", "SIGHUP"])
+@pytest.mark.parametrize("where", ["case", "machine"])
+def test_a_signal_inside_the_quiet_line_wait_sends_nothing_before_h(tmp_path, sig, where):
+    """The answer to a frame is lost; a second later (the frame's timeout has passed, the
+    2.5 s wait for a quiet line has not) the signal comes: the frame the link was about to
+    send after the wait never goes out, H does."""
+    trigger = in_machine(3) if where == "machine" else counting(rb"!0EW", 1)
+    after, _, report = ctrl_c_run(tmp_path, trigger, sig=sig, after_s=1.0, drop=True)
+    assert after[0].startswith(b"!0H") and report["interrupted"] is True
