@@ -114,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
     print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
-          f"{' (interrupted by Ctrl-C: the hosts were stopped)' if result.interrupted else ''}")
+          f"{' (interrupted by a signal: the hosts were stopped)' if result.interrupted else ''}")
     clean = next((r for r in result.results if r.id.endswith(".clean")), None)
     if clean is not None:
         print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the clean "

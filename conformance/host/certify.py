@@ -17,7 +17,7 @@ import subprocess
 import tempfile
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TextIO
@@ -31,6 +31,7 @@ from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.units import open_line
 from conformance.host.unitview import line_views, profiles_by_address
+from conformance.link.interrupts import STOPPING, Interrupts
 from conformance.metadata import now_iso
 from conformance.runner import RunResult
 from conformance.verdict import COULD_NOT_TEST, MISSING
@@ -54,6 +55,7 @@ class Plan:
     jobs: int = 4
     stop: threading.Event = field(default_factory=threading.Event)   # Ctrl-C
     baseline: Baseline | None = None      # what the clean run showed, once it has run
+    started: set[str] = field(default_factory=set)   # scenarios whose host run has begun
 
     @property
     def profile(self) -> str:
@@ -72,10 +74,25 @@ class HostStartError(OSError):
     """The host program could not be started at all."""
 
 
+#: how long a host program has to end after SIGTERM before its process group is killed
+TERM_GRACE_S = 2.0
+
+
 def _stop(proc: subprocess.Popen) -> None:
-    with contextlib.suppress(ProcessLookupError):
-        os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
+    """End the host program and everything it started (its process group): SIGTERM, then
+    SIGKILL for what is still there after a grace period. A signal to the suite meanwhile
+    waits until the host is gone, so that nothing is left behind."""
+    with Interrupts.held():
+        for sig, grace in ((signal.SIGTERM, TERM_GRACE_S), (signal.SIGKILL, None)):
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, sig)
+            try:
+                proc.wait(grace)
+                break
+            except subprocess.TimeoutExpired:
+                continue
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)     # what the host left in its group
 
 
 def run_once(plan: Plan, fault: Fault, port: HostPort, *,
@@ -121,15 +138,13 @@ def _launched_run(relay: Relay, plan: Plan, port: HostPort,
     proc: subprocess.Popen | None = None
     with tempfile.TemporaryFile() as log:
         try:
-            # Ctrl-C waits until the host is known, so that it is stopped, never orphaned
-            old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-            try:
-                proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
-                                        stderr=subprocess.STDOUT, start_new_session=True)
-            except OSError as err:
-                raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
-            finally:
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)
+            # a signal waits until the host is known, so that it is stopped, never orphaned
+            with Interrupts.held():
+                try:
+                    proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
+                                            stderr=subprocess.STDOUT, start_new_session=True)
+                except OSError as err:
+                    raise HostStartError(f"cannot start {argv[0]!r}: {err}") from err
             ended = relay.serve(lambda: proc.poll() is not None or plan.stop.is_set(),
                                 plan.host_timeout, limit)
         finally:
@@ -179,6 +194,7 @@ def launched(plan: Plan, on_result: Callable[[HostResult], None]) -> None:
     """Every scenario of ``plan`` with its host program started for each: the clean run,
     then the others side by side; ``on_result`` gets them in scenario order."""
     def run(sc: Scenario, fault: Fault, limit: float) -> Outcome:
+        plan.started.add(sc.id)
         port = open_port(plan.port, plan.baud)
         try:
             return run_once(plan, fault, port, limit=limit)
@@ -238,6 +254,7 @@ def attended(plan: Plan, on_result: Callable[[HostResult], None], console: TextI
                   f"  Start the host's job on {port.name} now. When it has ended, type "
                   "`done` (it finished), `failed` (it reported an error or gave up) or "
                   "`hung` (it stopped answering), then Enter.", file=console, flush=True)
+            plan.started.add(sc.id)
             out = run_once(plan, made, port, done=lambda: _operator(operator, gone))
             if sc.name == "clean":
                 plan.baseline = baseline_of(out)
@@ -262,6 +279,21 @@ def _operator(stream: TextIO, state: dict[str, bool]) -> int | None:
     return OPERATOR.get(word, 1)
 
 
+@contextlib.contextmanager
+def stopping_signals() -> Iterator[None]:
+    """SIGTERM and SIGHUP (a CI job's timeout, a closed terminal) stop a certification as
+    Ctrl-C does: every host program is stopped and the reports are written."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.signal(sig, signal.default_int_handler) for sig in STOPPING}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
 def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
             console: TextIO | None = None, operator: TextIO | None = None) -> RunResult:
     run = RunResult(run_id, targets=[plan.target], settings="host")
@@ -276,14 +308,26 @@ def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
         on_result(r)
 
     try:
-        if plan.command is None:
-            assert console is not None and operator is not None
-            attended(plan, keep, console, operator)
-        else:
-            launched(plan, keep)
+        with stopping_signals():
+            if plan.command is None:
+                assert console is not None and operator is not None
+                attended(plan, keep, console, operator)
+            else:
+                launched(plan, keep)
     except KeyboardInterrupt:
         plan.stop.set()
         run.interrupted = True
+        done = {r.id for r in results}
+        for sc in plan.scenarios:
+            if sc.id in done:
+                continue
+            running = sc.id in plan.started
+            r = oracle.skipped(sc, COULD_NOT_TEST, "interrupted by a signal: the host "
+                               "program was stopped, the scenario not judged" if running else
+                               "not run: the certification was interrupted by a signal",
+                               plan.profile, plan.target)
+            r.interrupted = running
+            results.append(r)
     run.results = list(results)
     run.seconds = time.monotonic() - start
     run.frames = sum(r.frames for r in results)

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import json
 import os
+import select
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -46,23 +49,44 @@ def test_the_scenario_list(capsys):
     assert "2.host.clean" in out and "8.host.lost-answer.vector" in out
 
 
+def running(pid: int) -> bool:
+    """Whether ``pid`` is a live process (a zombie waiting for PID 1 to reap it is not)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except FileNotFoundError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
 @pytest.mark.pty
-def test_ctrl_c_stops_every_host_and_says_so(tmp_path):
-    """SIGINT while hosts run: they are stopped, what finished is reported, exit 1."""
-    pids = tmp_path / "pids"
-    host = tmp_path / "host.sh"          # a host that never ends, and says who it is
-    host.write_text(f"#!/bin/sh\necho $$ >> {pids}\nexec sleep 60\n")
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP],
+                         ids=["SIGINT", "SIGTERM", "SIGHUP"])
+def test_a_signal_stops_every_host_and_writes_the_reports(tmp_path, sig):
+    """A signal while the host runs (one that ignores SIGTERM and starts a child): the
+    host's whole process group is gone, the reports are written with the interrupted
+    scenario, and the exit status is 1, within a few seconds."""
+    fifo = tmp_path / "started"
+    os.mkfifo(fifo)
+    host = tmp_path / "host.sh"
+    host.write_text(f"#!/bin/sh\ntrap '' TERM\nsleep 60 &\necho $$ $! > {fifo}\nwait\n")
     host.chmod(0o755)
+    reader = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)
     proc = subprocess.Popen(
         [sys.executable, "-m", "conformance", "host", "--profile", "GVE84-100",
-         "--no-reports", "--host-timeout", "30", "--", str(host), "{port}"],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    deadline = time.monotonic() + 20
-    while not (pids.exists() and pids.read_text().strip()) and time.monotonic() < deadline:
-        time.sleep(0.05)               # wait for the host to have started
-    proc.send_signal(signal.SIGINT)
+         "--report-dir", str(tmp_path / "reports"), "--host-timeout", "30", "--",
+         str(host), "{port}"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        assert select.select([reader], [], [], 20)[0], "the host never started"
+        pids = [int(p) for p in os.read(reader, 100).split()]
+    finally:
+        os.close(reader)
+    signalled = time.monotonic()
+    proc.send_signal(sig)
     out, _ = proc.communicate(timeout=30)
-    assert proc.returncode == 1 and "interrupted by Ctrl-C" in out and "Traceback" not in out
-    for pid in map(int, pids.read_text().split()):
-        with pytest.raises(ProcessLookupError):
-            os.kill(pid, 0)              # the host is gone
+    assert time.monotonic() - signalled < 10
+    assert proc.returncode == 1 and "interrupted" in out and "Traceback" not in out, out
+    assert not [pid for pid in pids if running(pid)], "the host or its child is still there"
+    (folder,) = (tmp_path / "reports").iterdir()
+    report = json.loads((folder / "results.json").read_text())
+    assert report["interrupted"] is True
+    assert [r["id"] for r in report["results"] if r["interrupted"]] == ["2.host.clean"]
