@@ -176,11 +176,18 @@ def main(argv: list[str] | None = None) -> int:
               f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted",
               flush=True)
     if not run.results:
-        run.results.append(agreement_result(
-            profile=target.profile.name, target=target.info.spec, examples=budget.used,
-            frames=budget.frames, seconds=budget.elapsed))
+        r = agreement_result(profile=target.profile.name, target=target.info.spec,
+                             examples=budget.used, frames=budget.frames,
+                             seconds=budget.elapsed)
+        if run.interrupted:
+            # a search cut short by a signal has not shown that the target agrees
+            r.verdict, r.interrupted = COULD_NOT_TEST, True
+            r.notes = [f"interrupted by a signal after {budget.used} sequences: H and D "
+                       "sent, the search not finished"]
+        run.results.append(r)
     run.frames, run.seconds = budget.frames, budget.elapsed
     print(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
-          f"{counted(run)}", flush=True)
+          f"{counted(run)}"
+          + (" (interrupted by a signal: H and D sent)" if run.interrupted else ""), flush=True)
     status = end(run, None if args.no_reports else args.report_dir)
     return 1 if run.problems else status

@@ -15,6 +15,7 @@ from conformance.diff.gvt import steps_of
 from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME
 from conformance.link.framing import readable
+from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
 from conformance.targets import SessionError, TargetError
 from gve_fixtures.transcript import UNIT, TranscriptError, load
@@ -46,16 +47,20 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     recorded = [r for r in t.records if r.direction == UNIT]
-    session = target.begin()
+    interrupts = Interrupts()
+    session = target.begin(interrupts)
     ask_first(args, target)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     try:
-        outcome = pair.run(steps)
+        with interrupts.catching():
+            outcome = pair.run(steps)
     except (TargetNotResponding, SessionError) as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         session.emergency_stop()
+        print(f"{PROG}: interrupted by a signal: H and D sent, the replay not finished",
+              file=sys.stderr)
         return 1
     finally:
         if session.real:

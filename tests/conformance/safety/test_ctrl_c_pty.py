@@ -50,8 +50,17 @@ def in_machine(n: int) -> Callable[[int, bytes], bool]:
     return trigger
 
 
+#: the main suite's command line against the proxy's port and a report folder
+SUITE = ["--target", "serial:{port}", "--profile", "GVE84-100", "--allow-destructive",
+         "--max-travel", "500", "--yes", "--report-dir", "{reports}", *CASES]
+#: diff's, searching long enough for any trigger to fire
+DIFF = ["diff", "--target", "serial:{port}", "--profile", "GVE84-100", "--allow-destructive",
+        "--max-travel", "500", "--yes", "--report-dir", "{reports}", "--seconds", "60"]
+
+
 def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool], *, sig: int = signal.SIGINT,
-               after_s: float = 0.0, drop: bool = False) -> tuple[list[bytes], int, dict]:
+               after_s: float = 0.0, drop: bool = False, command: list[str] = SUITE
+               ) -> tuple[list[bytes], int, dict]:
     """The run, signalled ``after_s`` after the frame ``trigger`` picks (at once: while it
     is in flight). ``drop``: that frame's answer is lost, so the link waits for a quiet
     line before its next frame and the signal lands inside that wait."""
@@ -89,11 +98,9 @@ def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool], *, sig: int = si
     with unit_behind_proxy("--model", "GVE84-100", "--eeprom", str(image),
                            on_frame=on_frame, transform=lose_one) as (emu, proxy):
         emu.control("in 1 FF")
-        proc.append(subprocess.Popen(
-            [sys.executable, "-m", "conformance", "--target", f"serial:{proxy.path}",
-             "--profile", "GVE84-100", "--allow-destructive", "--max-travel", "500", "--yes",
-             "--report-dir", str(tmp_path / "reports"), *CASES],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE))
+        argv = [a.format(port=proxy.path, reports=tmp_path / "reports") for a in command]
+        proc.append(subprocess.Popen([sys.executable, "-m", "conformance", *argv],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE))
         out, err = proc[0].communicate(timeout=120)
         state = emu.state()
     assert signalled, f"the trigger never fired\n{out.decode()}\n{err.decode()}"
@@ -104,9 +111,11 @@ def ctrl_c_run(tmp_path, trigger: Callable[[int, bytes], bool], *, sig: int = si
     assert state["physical"] == stopped[0], "the axes moved after H"
     assert image.read_bytes() == bytes(data), "EEPROM not as found"
     assert state["status"][:6] == ["00"] * 6
+    assert (tmp_path / "reports").exists(), out.decode() + err.decode()
     (folder,) = [p for p in (tmp_path / "reports").iterdir() if not p.name.startswith(".")]
     report = json.loads((folder / "results.json").read_text())
     assert report["interrupted"] is True and proc[0].returncode != 0
+    assert b"PASS" not in out.splitlines()[-2], out.decode()   # the verdicts' line
     return after, pressed[0], report
 
 
@@ -143,3 +152,15 @@ def test_a_signal_inside_the_quiet_line_wait_sends_nothing_before_h(tmp_path, si
     trigger = in_machine(3) if where == "machine" else counting(rb"!0EW", 1)
     after, _, report = ctrl_c_run(tmp_path, trigger, sig=sig, after_s=1.0, drop=True)
     assert after[0].startswith(b"!0H") and report["interrupted"] is True
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("drop", [False, True], ids=["in-flight", "quiet-wait"])
+def test_a_signal_during_diff_sends_h_then_d_first(tmp_path, sig, drop):
+    """diff's search: a signal while a frame is in flight, or (its answer lost) inside the
+    wait for a quiet line: H and D are the next frames, the search stops, nothing says
+    PASS."""
+    after, _, report = ctrl_c_run(tmp_path, counting(rb"!0(L|C)", 20), sig=sig,
+                                  after_s=1.0 if drop else 0.0, drop=drop, command=DIFF)
+    assert after[0].startswith(b"!0H")
+    assert [r["verdict"] for r in report["results"]] != ["PASS"]
