@@ -5,6 +5,7 @@ so that the next run, or another bench, tries them first."""
 from __future__ import annotations
 
 import os
+import re
 import secrets
 import tempfile
 from collections.abc import Iterator
@@ -126,6 +127,11 @@ def _check(where: str) -> None:
     if where.startswith(REDIS_SCHEMES):
         _redis_client(where)
         return
+    if not where.strip():
+        raise ValueError("an empty name: give a directory, redis://HOST:PORT/N or none")
+    if re.match(r"[A-Za-z][A-Za-z0-9+.-]*://", where):
+        raise ValueError(f"{where}: unknown scheme (a directory, "
+                         f"{', '.join(s + '...' for s in REDIS_SCHEMES)} or none)")
     # created when the first failing example is saved: a run that fails nothing leaves
     # no folder behind
     path = Path(where).absolute()

@@ -8,14 +8,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import NoReturn
 
 from conformance.cli.ending import counted, end, new_run_id
 from conformance.cli.unit import ask_before_motion
+from conformance.cli.usage import Parser, UsageError, one_line, positive, seconds, writable_folder
 from conformance.diff.engine import Budget, Finding, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.gvt import transcript, write
-from conformance.diff.results import agreement_result, finding_result
+from conformance.diff.results import agreement_result, finding_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
@@ -31,21 +31,6 @@ PROG = "gve-conformance diff"
 DEFAULT_EXAMPLES = 2000
 
 
-class UsageError(Exception):
-    """A mistake on the command line: one line, exit status 2, nothing sent."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
-
-
-def one_line(err: BaseException) -> str:
-    """An error as one line for the user (a KeyError's text without its quotes)."""
-    text = err.args[0] if err.args and isinstance(err.args[0], str) else str(err)
-    return (text.splitlines() or [type(err).__name__])[0]
-
-
 def common(ap: argparse.ArgumentParser) -> None:
     """The options diff and replay share."""
     ap.add_argument("--target", required=True,
@@ -55,18 +40,18 @@ def common(ap: argparse.ArgumentParser) -> None:
                     "embedded emulator)")
     ap.add_argument("--allow-destructive", action="store_true",
                     help="also J, W and EEPROM writes (real units: backed up and restored)")
-    ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
+    ap.add_argument("--max-travel", type=positive, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in full steps per axis")
     ap.add_argument("--yes", action="store_true",
                     help="real units: move without asking first (unattended benches)")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
     common(ap)
-    ap.add_argument("--examples", type=int, metavar="N",
+    ap.add_argument("--examples", type=positive, metavar="N",
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
-    ap.add_argument("--seconds", type=float, metavar="S", help="search for S seconds")
+    ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
     ap.add_argument("--seed", type=int, default=0, help="the search's seed (default 0)")
     ap.add_argument("--no-probes", action="store_true",
                     help="draw sequences only (the written probes, run first by default, "
@@ -75,10 +60,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--no-reports", action="store_true",
                     help="write no reports (the transcripts are printed instead)")
     args = ap.parse_args(argv)
-    if args.examples is not None and args.examples < 1:
-        raise UsageError("--examples must be at least 1")
-    if args.seconds is not None and args.seconds <= 0:
-        raise UsageError("--seconds must be positive")
+    if not args.no_reports:
+        writable_folder(args.report_dir)
     return args
 
 
@@ -175,7 +158,12 @@ def main(argv: list[str] | None = None) -> int:
               f"target {readable(d.target.answer) or '(none)'} / reference "
               f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted",
               flush=True)
-    if not run.results:
+    agreed = not run.results
+    if pair.target.rig_lost:
+        run.results.append(rig_lost_result(profile=target.profile.name,
+                                           target=target.info.spec, why=pair.target.rig_lost))
+        print(f"{COULD_NOT_TEST}: input steps: {pair.target.rig_lost}", flush=True)
+    if agreed:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames,
                              seconds=budget.elapsed)

@@ -17,7 +17,9 @@ import fnmatch
 import sys
 
 from conformance.cli.ending import counted, end, new_run_id, progress
+from conformance.cli.usage import Parser, UsageError, positive, seconds, writable_folder
 from conformance.host.certify import HostStartError, Plan, certify
+from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
 from conformance.runner import CaseResult
@@ -25,32 +27,23 @@ from conformance.verdict import ORDER, PASS, grade
 from gve_fixtures.profile import ProfileError
 
 
-class Usage(Exception):
-    """A usage error: one line on stderr, exit status 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:     # one line, no usage dump, no traceback
-        raise Usage(message)
-
-
 def parse_args(argv: list[str]) -> argparse.Namespace:
     command: list[str] = []
     if "--" in argv:
         at = argv.index("--")
         argv, command = argv[:at], argv[at + 1:]
-    ap = _Parser(prog="gve-conformance host", description=__doc__.splitlines()[0])
+    ap = Parser(prog="gve-conformance host", description=__doc__.splitlines()[0])
     ap.add_argument("--profile", help="the unit played to the host, at its default address")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable; instead of --profile)")
     ap.add_argument("--scenarios", action="append", default=[], metavar="GLOB",
                     help="run only these scenarios (the clean run always runs)")
-    ap.add_argument("--baud", type=int, help="the line's baud rate (default: the profile's)")
-    ap.add_argument("--host-timeout", type=float, default=5.0, metavar="S",
+    ap.add_argument("--baud", type=positive, help="the line's baud rate (default: the profile's)")
+    ap.add_argument("--host-timeout", type=seconds, default=5.0, metavar="S",
                     help="a host silent this long without exiting hangs (default 5)")
     ap.add_argument("--port", default="pty",
                     help="pty (default), tcp:HOST:PORT, or a serial device path")
-    ap.add_argument("--jobs", type=int, default=4,
+    ap.add_argument("--jobs", type=positive, default=4,
                     help="scenarios run side by side (launched, pty or tcp port 0)")
     ap.add_argument("--strict", action="store_true",
                     help="the host claims the project's decisions: [D] rules FAIL too")
@@ -65,24 +58,27 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
 
 def plan_of(args: argparse.Namespace) -> Plan:
     if bool(args.profile) == bool(args.unit):
-        raise Usage("give --profile, or --unit MODEL@ADDRESS (repeatable)")
+        raise UsageError("give --profile, or --unit MODEL@ADDRESS (repeatable)")
     try:
         units = load_units(args.unit or [args.profile])
     except (ValueError, LookupError, ProfileError) as err:
-        raise Usage(str(err).splitlines()[0]) from None
+        raise UsageError(str(err).splitlines()[0]) from None
     baud = args.baud or units[0][0].default_baud
     unsupported = [p.name for p, _ in units if baud not in p.bauds]
     if unsupported:
-        raise Usage(f"--baud {baud}: the {', '.join(unsupported)} does not run at it "
+        raise UsageError(f"--baud {baud}: the {', '.join(unsupported)} does not run at it "
                     f"(it runs at {', '.join(map(str, units[0][0].bauds))})")
-    if args.host_timeout <= 0 or args.jobs < 1:
-        raise Usage("--host-timeout and --jobs take positive numbers")
+    if args.port != "pty":
+        try:                    # a port that cannot be opened is a usage error, not a run
+            open_port(args.port, baud).close()
+        except ValueError as err:
+            raise UsageError(str(err)) from None
     if args.command and not any("{port}" in a for a in args.command):
-        raise Usage("the host command must name the port as {port}")
+        raise UsageError("the host command must name the port as {port}")
     unmatched = [p for p in args.scenarios if not any(
         fnmatch.fnmatchcase(s.name, p) or fnmatch.fnmatchcase(s.id, p) for s in SCENARIOS)]
     if unmatched:
-        raise Usage(f"no scenario matches {' '.join(unmatched)} (see --list)")
+        raise UsageError(f"no scenario matches {' '.join(unmatched)} (see --list)")
     scenarios = select(args.scenarios)
     return Plan(units, baud, scenarios, args.command, args.port, args.host_timeout,
                 args.strict, args.jobs)
@@ -96,7 +92,9 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{sc.id:32} {sc.title}")
             return 0
         plan = plan_of(args)
-    except Usage as err:
+        if not args.no_reports:
+            writable_folder(args.report_dir)
+    except UsageError as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
     def worst(r: CaseResult) -> str | None:

@@ -16,12 +16,12 @@ micro-stepping shows only there). Hypothesis machines run with the ``mutation`` 
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
+from conformance.cli.usage import Parser, UsageError, positive
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
@@ -113,27 +113,29 @@ def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool]) -> Hunt:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="gve-conformance mutation",
-                                 description=__doc__.splitlines()[0])
+    ap = Parser(prog="gve-conformance mutation", description=__doc__.splitlines()[0])
     ap.add_argument("--profile", action="append", default=[],
                     help="hunt on this profile only (repeatable; default: every profile)")
     ap.add_argument("--mutant", action="append", default=[], metavar="NAME",
                     help="only this mutant (repeatable; default: every one)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", type=int, default=1, help="mutants hunted in parallel")
+    ap.add_argument("--jobs", type=positive, default=1, help="mutants hunted in parallel")
     ap.add_argument("--sweep", action="store_true",
                     help="also run the rest of the catalogue against each mutant (one "
                          "profile per family), failing on any ERROR")
-    args = ap.parse_args(argv)
+    try:
+        args = ap.parse_args(argv)
+    except UsageError as err:
+        print(f"gve-conformance mutation: {err}", file=sys.stderr)
+        return 2
     from conformance.targets import emu
     from gve_fixtures.profile import available_profiles
     known = emu.mutants()
     wrong = [m for m in args.mutant if m not in known]
     wrong += [p for p in args.profile if p not in available_profiles()]
-    if wrong or args.jobs < 1:
-        print(f"gve-conformance mutation: unknown {', '.join(wrong) or '--jobs'}",
-              file=sys.stderr)
+    if wrong:
+        print(f"gve-conformance mutation: unknown {', '.join(wrong)}", file=sys.stderr)
         return 2
     names = args.mutant or sorted(known)
     jobs = [(m, args.profile or None, args.cases or None, args.sweep) for m in names]

@@ -5,11 +5,10 @@ and the one recorded. Exit status 1 while the sides disagree, 0 when they agree.
 
 from __future__ import annotations
 
-import argparse
 import sys
-from typing import NoReturn
 
-from conformance.cli.diff import UsageError, ask_first, common, one_line, targets
+from conformance.cli.diff import ask_first, common, targets
+from conformance.cli.usage import Parser, UsageError, one_line
 from conformance.diff.engine import Pair
 from conformance.diff.gvt import steps_of
 from conformance.diff.sides import Side
@@ -23,13 +22,8 @@ from gve_fixtures.transcript import UNIT, TranscriptError, load
 PROG = "gve-conformance replay"
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
-
-
 def main(argv: list[str] | None = None) -> int:
-    ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
     ap.add_argument("file", help="a .gvt transcript")
     common(ap)
     try:
@@ -72,8 +66,9 @@ def main(argv: list[str] | None = None) -> int:
         if rec.step.kind not in (FRAME, FILL) or rec.target is None:
             print(f"  = {rec.step}")
             continue
-        was = b"".join(next(answers).data for _ in range(rec.reference.answer.count(b"\r"))) \
-            if rec.step.answer else b""
+        # a transcript may record fewer answers than the reference gives (a fill's)
+        was = b"".join(r.data for _, r in zip(range(rec.reference.answer.count(b"\r")),
+                                             answers, strict=False)) if rec.step.answer else b""
         print(f"  > {readable(rec.target.sent):28} target {readable(rec.target.answer) or '-':16}"
               f" reference {readable(rec.reference.answer) or '-':16}"
               f" recorded {readable(was) or '-'}")

@@ -10,18 +10,17 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import tempfile
 import time
 import uuid
 from contextlib import ExitStack
 from pathlib import Path
-from typing import NoReturn
 
 from serial import SerialException
 
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
 from conformance.cli.unit import ask_before_motion, confirmed, record_identities, resolve
+from conformance.cli.usage import Parser, UsageError, positive, run_id, writable_folder
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
@@ -35,17 +34,8 @@ from gve_fixtures.profile import available_profiles
 PROG = "gve-conformance"
 
 
-class UsageError(Exception):
-    """A mistake on the command line: one line, exit status 2, nothing sent."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
-
-
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = _Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
     ap.add_argument("--target", action="append", default=[],
                     help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
                          "tcp:HOST:PORT, exec:COMMAND (a simulator it starts, docs/rig.md); "
@@ -69,7 +59,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--seed", type=int, metavar="N",
                     help="the Hypothesis machines' seed: the same N replays the same examples "
                          "(default: a fresh one, printed; none for derandomized settings)")
-    ap.add_argument("--max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
+    ap.add_argument("--max-travel", type=positive, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in full steps per axis either side "
                          "of where the run began (default %(default)s)")
     ap.add_argument("--allow-destructive", action="store_true",
@@ -77,9 +67,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                          "restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
-    ap.add_argument("--run-id", metavar="NAME",
+    ap.add_argument("--run-id", type=run_id, metavar="NAME",
                     help="the report folder's name (default: date, time and a random tag)")
-    ap.add_argument("--jobs", "-j", type=int, default=1, metavar="N",
+    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
                     help="run the targets in N parallel processes: one report per target "
                          "under reports/<run id>/ and a summary across them")
     ap.add_argument("--hypothesis-db", metavar="DIR|redis://HOST:PORT/N|none",
@@ -165,10 +155,8 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
         print(format_coverage(report, args.coverage))
         # a gate for CI: a rule no case can fail is a defect of the suite
         return 1 if any(pc.uncovered for pc in report) else 0
-    if args.jobs < 1:
-        raise UsageError("--jobs must be 1 or more")
     if not args.no_reports:
-        _check_writable(Path(args.report_dir))
+        writable_folder(args.report_dir)
     with ExitStack() as run_scope:
         try:
             run_scope.enter_context(example_database(example_database_of(args)))
@@ -296,14 +284,6 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     except (ValueError, LookupError, OSError, SerialException) as err:
         raise UsageError(str(err).strip("'\"")) from None
 
-
-def _check_writable(folder: Path) -> None:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
-            pass
-    except OSError as err:
-        raise UsageError(f"cannot write reports to {folder}: {err.strerror or err}") from None
 
 
 def _preflight(targets: list[Target]) -> None:

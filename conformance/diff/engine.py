@@ -132,10 +132,10 @@ class Pair:
             if step.kind == INPUT:
                 if self.target.has_rig and self.reference.has_rig:
                     self._retimed("input", None)
-                    self.target.set_input(step.port, step.value)
-                    self.reference.set_input(step.port, step.value)
-                    out.records.append(Record(step, place=place))
-                    earlier.add("input")
+                    if (self.target.set_input(step.port, step.value)
+                            and self.reference.set_input(step.port, step.value)):
+                        out.records.append(Record(step, place=place))
+                        earlier.add("input")
                 continue
             command = command_of(step.body)
             times = step.times if step.kind == FILL else 1

@@ -6,12 +6,13 @@ comment, waits, rig inputs and filled queues as actions; and back into steps for
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from conformance.diff.engine import Finding, Record
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from conformance.link.framing import HostFramer, readable
-from gve_fixtures.transcript import ACTION, HOST, UNIT, Transcript, unescape
+from gve_fixtures.transcript import ACTION, HOST, UNIT, Transcript, TranscriptError, unescape
 from gve_fixtures.transcript import Record as Line
 
 
@@ -112,7 +113,7 @@ def steps_of(t: Transcript) -> list[Step]:
             if (j + 1 < len(records) and records[j].direction == ACTION
                     and records[j].action[0] == "wait" and records[j + 1].direction == HOST
                     and not data.endswith(b"\r")):
-                stall = (len(data), float(records[j].action[1]))
+                stall = (len(data), _wait(records[j].action).seconds)
                 data += records[j + 1].data
                 j += 2
             lines = 0
@@ -123,17 +124,48 @@ def steps_of(t: Transcript) -> list[Step]:
                               stall=stall, raw=data))
             i = j
             continue
-        if r.direction == ACTION:
-            words = r.action
-            if words[0] == "wait":
-                steps.append(Step(WAIT, seconds=float(words[1])))
-            elif words[0] == "input":
-                steps.append(Step(INPUT, port=int(words[1]), value=int(words[2], 16)))
-            elif words[0] == "fill":
-                data = unescape(words[2])
-                steps.append(Step(FILL, _body(data), times=int(words[1]), raw=data))
+        if r.direction == ACTION and r.action[0] in _ACTIONS:
+            steps.append(_action(r.action))
         i += 1
     return steps
+
+
+#: the longest `= wait` replayed, and the most frames one `= fill` sends
+LONGEST_WAIT = 3600.0
+LARGEST_FILL = 100_000
+
+
+def _wait(words: list[str]) -> Step:
+    seconds = float(words[1])
+    if not math.isfinite(seconds) or not 0 <= seconds <= LONGEST_WAIT:
+        raise ValueError(f"give 0 to {LONGEST_WAIT:g} seconds")
+    return Step(WAIT, seconds=seconds)
+
+
+def _input(words: list[str]) -> Step:
+    port, value = int(words[1]), int(words[2], 16)
+    if not (0 <= port <= 99 and 0 <= value <= 0xFF):
+        raise ValueError("give a port number and a byte in hex (00..FF)")
+    return Step(INPUT, port=port, value=value)
+
+
+def _fill(words: list[str]) -> Step:
+    times, data = int(words[1]), unescape(words[2])
+    if not 1 <= times <= LARGEST_FILL:
+        raise ValueError(f"give 1 to {LARGEST_FILL} frames")
+    return Step(FILL, _body(data), times=times, raw=data)
+
+
+#: the actions a replay performs (the others, e.g. a log's `= fault`, are notes)
+_ACTIONS = {"wait": _wait, "input": _input, "fill": _fill}
+
+
+def _action(words: list[str]) -> Step:
+    try:
+        return _ACTIONS[words[0]](words)
+    except (ValueError, IndexError) as err:
+        why = str(err) if isinstance(err, ValueError) and "give" in str(err) else "malformed"
+        raise TranscriptError(f"= {' '.join(words)}: {why}") from None
 
 
 def _body(data: bytes) -> str:

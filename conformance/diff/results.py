@@ -10,7 +10,7 @@ import re
 from conformance.diff.engine import Finding
 from conformance.link.framing import readable
 from conformance.runner import CaseResult
-from conformance.verdict import PASS
+from conformance.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures.rules import load_rules
 
 
@@ -52,4 +52,13 @@ def agreement_result(*, profile: str, target: str, examples: int, frames: int,
     r.checks = [{"ok": True, "what": f"{examples} sequences, {frames} frames: every answer "
                  "alike", "observed": "", "expected": "", "tag": "M", "rule": ""}]
     r.frames, r.seconds = frames, seconds
+    return r
+
+
+def rig_lost_result(*, profile: str, target: str, why: str) -> CaseResult:
+    """The rig's input steps, left out once the target's rig stopped answering."""
+    r = CaseResult("diff.search.rig-inputs", "diff", "inputs set by the rig are answered "
+                   "as the reference answers them", "M", "gve-conformance diff", profile,
+                   target, COULD_NOT_TEST)
+    r.notes = [f"input steps not tested: {why}"]
     return r

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from conformance.case import CouldNotTest
 from conformance.link.framing import HostFramer, Response, parse_response
 from conformance.link.link import MARGIN, Link
 from conformance.targets import Session, Target
@@ -46,6 +47,8 @@ class Side:
         self.session = session
         self.link: Link | None = None
         self._origin = 0
+        #: why the rig stopped answering (its input steps are left out from then on)
+        self.rig_lost: str | None = None
 
     @property
     def virtual(self) -> bool:
@@ -53,7 +56,7 @@ class Side:
 
     @property
     def has_rig(self) -> bool:
-        return self.link is not None and self.link.rig is not None
+        return self.link is not None and self.link.rig is not None and self.rig_lost is None
 
     def open(self) -> Link:
         """A link in the known state for a new example: on the emulator a fresh unit (and
@@ -112,8 +115,15 @@ class Side:
     def wait(self, seconds: float) -> bytes:
         return self.link.wait(seconds)
 
-    def set_input(self, port: int, value: int) -> None:
-        self.link.rig.set_input(port, value)
+    def set_input(self, port: int, value: int) -> bool:
+        """Set a rig input; False (and the rig lost) when the rig does not do it: a rig
+        that does not answer is a rig that is not there."""
+        try:
+            self.link.rig.set_input(port, value)
+        except CouldNotTest as err:
+            self.rig_lost = str(err)
+            return False
+        return True
 
     def close_example(self) -> None:
         """Take what is still on its way (an answer after the last frame); on a real unit

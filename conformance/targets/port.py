@@ -108,10 +108,11 @@ def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel:
     if mutant is not None:
         raise TargetError(f"--mutant plants a bug in the embedded emulator; {spec} is not one"
                           + (f" ({mutant_hint})" if mutant_hint else ""))
-    if max_travel <= 0:
-        raise TargetError(f"--max-travel {max_travel}: the envelope needs a positive "
-                          "number of full steps")
-    return load_profile(profile)
+    p = load_profile(profile)
+    if not 0 < max_travel <= p.vector_range:
+        raise TargetError(f"--max-travel {max_travel}: the envelope is 1 to "
+                          f"{p.vector_range} full steps on the {p.name} (its vector range)")
+    return p
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,

@@ -39,12 +39,16 @@ class HostPort(Protocol):
 
 
 def open_port(spec: str, baud: int) -> HostPort:
-    """``pty`` (a new pseudo-terminal), ``tcp:HOST:PORT`` or a device path."""
-    if spec == "pty":
-        return pty.PtyPort(baud)
-    if spec.startswith("tcp:"):
-        host, _, port = spec[4:].rpartition(":")
-        if not port.isdigit():
-            raise ValueError(f"--port {spec!r}: expected tcp:HOST:PORT")
-        return tcp.TcpPort(host or "127.0.0.1", int(port))
-    return device.DevicePort(spec, baud)
+    """``pty`` (a new pseudo-terminal), ``tcp:HOST:PORT`` or a device path; a
+    ValueError with one line when it cannot be opened."""
+    try:
+        if spec == "pty":
+            return pty.PtyPort(baud)
+        if spec.startswith("tcp:"):
+            host, _, port = spec[4:].rpartition(":")
+            if not port.isdigit() or not 0 <= int(port) <= 65535:
+                raise ValueError(f"--port {spec!r}: expected tcp:HOST:PORT, PORT 0..65535")
+            return tcp.TcpPort(host or "127.0.0.1", int(port))
+        return device.DevicePort(spec, baud)
+    except OSError as err:
+        raise ValueError(f"--port {spec}: {err.strerror or err}") from None
