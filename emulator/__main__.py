@@ -1,11 +1,15 @@
-"""`python -m emulator` / `gve-emulator`: emulated units on a pseudo-terminal or TCP port.
+"""`python -m emulator` / `gve-emulator`: emulated units on a pseudo-terminal or TCP port,
+or in co-simulation on standard input and output.
 
     python -m emulator --model GVE114-500 --pty       # prints the pty's path first
     python -m emulator --unit GVE54@1 --unit GVE84-100@0 --tcp 127.0.0.1:5114
+    python -m emulator --model GVE84-100 --cosim      # prints `cosim 1` first
 
 Serves in real time until SIGINT/SIGTERM (or `quit` on the control channel: standard
 input, one command a line: `in 1 7F`, `switch Y -1500`, `power-on`, `state`, `quit`;
-docs/rig.md). A usage error is one line on stderr and exit status 2.
+docs/rig.md). With --cosim the line runs in virtual time, its clock moved only by the
+commands on standard input (docs/cosim.md), until `quit` or the end of that input. A
+usage error is one line on stderr and exit status 2.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import sys
 from typing import NoReturn
 
 from emulator.link.clock import RealClock
+from emulator.link.cosim import serve_cosim
 from emulator.link.line import Line
 from emulator.link.server import (
     PtyHost,
@@ -73,8 +78,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     where = ap.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", action="store_true", help="serve on a new pseudo-terminal")
     where.add_argument("--tcp", metavar="HOST:PORT", help="serve raw bytes on a TCP port")
+    where.add_argument("--cosim", action="store_true",
+                       help="co-simulation in virtual time on standard input and output "
+                       "(docs/cosim.md)")
     ap.add_argument("--baud", type=_positive, default=None,
-                    help="pace bytes at this rate (default: delivered at once)")
+                    help="pace bytes at this rate (default: delivered at once; with "
+                    "--cosim the profile's rate until `baud N`)")
     ap.add_argument("--eeprom", metavar="FILE", help="EEPROM image (kept across restarts)")
     ap.add_argument("--log", metavar="FILE", help="write a transcript of the wire")
     ap.add_argument("--watchdog-ms", type=_positive, default=None)
@@ -84,8 +93,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return ap.parse_args(argv)
 
 
-def build(argv: list[str] | None) -> tuple[Line, PtyHost | TcpHost]:
-    """The line and where it is served; every usage problem raises UsageError."""
+def build(argv: list[str] | None) -> tuple[Line, PtyHost | TcpHost | None]:
+    """The line and where it is served (None: co-simulation on standard input and
+    output); every usage problem raises UsageError."""
     args = parse_args(argv)
     try:
         units = [parse_unit(u) for u in args.unit]
@@ -95,6 +105,8 @@ def build(argv: list[str] | None) -> tuple[Line, PtyHost | TcpHost]:
                         eeprom=args.eeprom, mutant=args.mutant, stepper=args.stepper,
                         log=args.log)
         built = spec.build_units()
+        if args.cosim:
+            return Line(built, spec.line_baud(built), log=args.log), None
         place = tcp_address(args.tcp) if args.tcp else None
         line = Line(built, spec.line_baud(built), clock=RealClock(), log=args.log,
                     paced=args.baud is not None)
@@ -113,6 +125,8 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
+    if host is None:
+        return _cosim(line)
     try:
         say(host.name)
     except StdoutGone:
@@ -123,6 +137,17 @@ def main(argv: list[str] | None = None) -> int:
         serve(line, host, control_fd())
     except StdoutGone:
         silence_stdout()                  # the reader went away: end quietly
+    finally:
+        if line.log is not None:
+            line.log.close()
+    return 0
+
+
+def _cosim(line: Line) -> int:
+    try:
+        serve_cosim(line)
+    except StdoutGone:
+        silence_stdout()                  # the driver went away: end quietly
     finally:
         if line.log is not None:
             line.log.close()

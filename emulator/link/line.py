@@ -218,6 +218,32 @@ class Line:
             else:
                 self.advance_to(t)
 
+    def take_timed(self) -> list[tuple[int, bytes]]:
+        """Every byte complete by now and not taken yet, in runs: (the instant the run's
+        first byte is complete, its bytes), each next byte of a run ``byte_ns`` later
+        (the co-simulation's ``rx`` lines, docs/cosim.md)."""
+        now, rx, out = self.now, self._rx, []
+        while rx and rx[0][0] <= now:
+            chunk = rx[0]
+            first, data, taken = chunk
+            ready = self._ready(first, data, now)
+            if ready > taken:
+                out.append((first + taken * self.byte_ns, data[taken:ready]))
+                chunk[2] = ready
+            if ready < len(data):
+                break
+            rx.popleft()
+        return out
+
+    def next_byte_at(self, value: bytes) -> int | None:
+        """The instant the next unread byte ``value`` is complete (None: none is on its
+        way)."""
+        for first, data, taken in self._rx:
+            k = data.find(value, taken)
+            if k >= 0:
+                return first + k * self.byte_ns
+        return None
+
     def take_ready(self) -> bytes:
         """Real time: every byte due by now (the server writes them to its port)."""
         self._settle(self.now)

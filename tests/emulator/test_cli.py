@@ -27,7 +27,8 @@ def run(*args: str) -> subprocess.CompletedProcess:
     (["--watchdog-ms", "0", "--pty"], "above 0"),
     (["--mutant", "nosuch", "--pty"], "invalid choice"),
     (["--unit", "GVE114-500@0", "--unit", "GVE84-100@7", "--pty"], "two units answer address 7"),
-    (["--model", "GVE84-100"], "one of the arguments --pty --tcp is required"),
+    (["--model", "GVE84-100"], "one of the arguments --pty --tcp --cosim is required"),
+    (["--cosim", "--pty"], "not allowed with argument"),
 ])
 def test_usage_errors_are_one_line_and_exit_2(args: list[str], says: str) -> None:
     done = run(*args)
