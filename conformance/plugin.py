@@ -41,8 +41,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                 help="the profile a serial/tcp/exec target behaves as")
     g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
     g.addoption("--gve-settings", default=None,
-                help="Hypothesis settings profile (default: ci on the emulator, hardware on "
-                     "serial/tcp/exec targets)")
+                help="Hypothesis settings profile (default: ci in virtual time, the "
+                     "emulator's or a co-simulator's; hardware on serial/tcp/exec targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
     g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",

@@ -74,9 +74,9 @@ class RunResult:
 
 
 def settings_for(target: Target, chosen: str | None) -> str:
-    """The Hypothesis settings on ``target``: as chosen, else `hardware` on real units
-    (no shrinking in real time) and `ci` on the emulator."""
-    return chosen or ("ci" if target.info.kind == "emu" else "hardware")
+    """The Hypothesis settings on ``target``: as chosen, else `ci` in virtual time (the
+    emulator, a co-simulator) and `hardware` on real units (no shrinking in real time)."""
+    return chosen or ("ci" if target.info.virtual_time else "hardware")
 
 
 def _result(case: Case, target: Target, verdict: str = PASS) -> CaseResult:

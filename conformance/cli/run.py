@@ -54,8 +54,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
     ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
-                    help="Hypothesis settings profile (default: ci on the emulator, "
-                         "hardware on serial/tcp/exec targets)")
+                    help="Hypothesis settings profile (default: ci in virtual time, the "
+                         "emulator's or a co-simulator's; hardware on serial/tcp/exec "
+                         "targets)")
     ap.add_argument("--seed", type=int, metavar="N",
                     help="the Hypothesis machines' seed: the same N replays the same examples "
                          "(default: a fresh one, printed; none for derandomized settings)")
@@ -299,8 +300,8 @@ def _preflight(targets: list[Target]) -> None:
 def _settings_line(targets: list[Target], chosen: str | None) -> str:
     if chosen:
         return chosen
-    kinds = {t.info.kind == "emu" for t in targets}
-    parts = (["ci on the emulator"] if True in kinds else []) + \
+    kinds = {t.info.virtual_time for t in targets}
+    parts = (["ci in virtual time"] if True in kinds else []) + \
         (["hardware on real units (no shrinking in real time)"] if False in kinds else [])
     return ", ".join(parts) + " (--settings to choose)"
 

@@ -1,13 +1,16 @@
 """``exec:COMMAND``: a program the suite starts itself — a firmware clone's simulator, or
-the emulator (``exec:python -m emulator --pty``) — judged in real time as a real unit.
+the emulator (``exec:python -m emulator --pty``) — judged as a real unit.
 
 The program prints where its serial port is on its first line (docs/rig.md: a pty path,
 ``socket://HOST:PORT``, ``HOST:PORT`` or ``tcp HOST:PORT``); the port is opened as
-port.py opens any other. When it answers `state` on its standard input with a JSON
-object within a second, the control channel is the run's test rig (rig.py) and rig cases
-run; otherwise they are COULD-NOT-TEST. The program is stopped when the target is closed
-(at the end of the run, also after Ctrl-C once the session has halted the unit), and a
-program that ends during the run makes the target not responding at once.
+port.py opens any other, in real time. When it answers `state` on its standard input with
+a JSON object within a second, the control channel is the run's test rig (rig.py) and
+rig cases run; otherwise they are COULD-NOT-TEST. A first line ``cosim 1`` instead hands
+the program's clock to the suite (docs/cosim.md, cosim.py): the unit runs in virtual
+time, the rig's commands part of the same protocol. The program is stopped when the
+target is closed (at the end of the run, also after Ctrl-C once the session has halted
+the unit), and a program that ends during the run makes the target not responding at
+once.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from typing import NoReturn
 
 from conformance.case import TargetInfo
 from conformance.targets.base import Target, TargetError
+from conformance.targets.cosim import VERSION, CosimLine, CosimPort, ProtocolBroken, announced
 from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
@@ -52,7 +56,12 @@ class ProcessTarget(PortTarget):
 
     def _open(self):
         if self._port is None:
-            url = self._start()
+            first = self._start()
+            version = announced(first)
+            if version is not None:
+                self._port = self._cosim(version)
+                return self._port
+            url = self._serve_port(first)
             try:
                 self._port = TargetPort(open_port(url, self.baud, self.info.spec),
                                          self.program)
@@ -66,7 +75,7 @@ class ProcessTarget(PortTarget):
         raise TargetError(f"{self.info.spec}: {why}")
 
     def _start(self) -> str:
-        """Start the program, find its port and its rig; the port's URL."""
+        """Start the program; its first line."""
         try:
             self.program = program = Program(list(self.command))
         except ProgramError as err:
@@ -78,25 +87,50 @@ class ProcessTarget(PortTarget):
             self._fail(f"the program printed no port: {program.ended()}" if not program.alive
                        else f"the program printed no port within {FIRST_LINE_SECONDS:g} s"
                        + (f" (stderr: {tail})" if tail else ""))
+        return first
+
+    def _serve_port(self, first: str) -> str:
+        """The port the first line names and the rig on standard input; the port's URL."""
         url = port_url(first)
         if url is None:
             self._fail(f"the program's first line {first[:200]!r} is not a port (a pty "
-                       "path, socket://HOST:PORT or HOST:PORT)")
-        self.rig = ControlRig.detect(program, self.address, self._restarted)
-        self.info = replace(self.info, has_rig=self.rig is not None)
+                       "path, socket://HOST:PORT or HOST:PORT) nor cosim 1")
+        self.rig = ControlRig.detect(self.program, self.address, self._restarted)
+        self._found_rig(virtual=False)
+        return url
+
+    def _cosim(self, version: int) -> CosimPort:
+        """The co-simulation's line and port, its rig when `state` answers one. A
+        simulator that breaks the protocol here leaves the line broken: the run's first
+        frame finds it so (a FAIL), nothing is refused before the run."""
+        if version != VERSION:
+            self._fail(f"the program speaks co-simulation version {version}; this suite "
+                       f"speaks version {VERSION} (docs/cosim.md)")
+        program = self.program
+        program.keep_every_line()
+        line = CosimLine(program, self.baud)
+        try:
+            self.rig = ControlRig.found_in(line.start(), line.ask, self.address,
+                                           self._restarted)
+        except ProtocolBroken:
+            self.rig = None
+        self._found_rig(virtual=True)
+        return CosimPort(line)
+
+    def _found_rig(self, *, virtual: bool) -> None:
+        self.info = replace(self.info, has_rig=self.rig is not None, virtual_time=virtual)
         named = self.rig.found.get("profile") if self.rig else None
         if named in available_profiles() and named != self.profile.name:
             self._fail(f"--profile {self.profile.name} contradicts the program, whose rig "
                        f"says it behaves as {named}")
-        return url
 
     def _restarted(self) -> None:
         """The rig cycled the power: the guard books it as a restart (J)."""
         self.session.guard.restarted()
 
     def connect(self, address: int | None):
-        port, baud, virtual, _ = super().connect(address)
-        return port, baud, virtual, self.rig
+        port, baud, _, _ = super().connect(address)
+        return port, baud, self.info.virtual_time, self.rig
 
     def _stop(self) -> None:
         if self.program is not None:

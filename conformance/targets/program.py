@@ -27,6 +27,8 @@ QUIT_SECONDS = 2.0
 TERM_SECONDS = 2.0
 #: lines of standard output held for a reader that does not take them
 HELD_LINES = 1000
+#: a line longer than this comes in pieces of this length (garbage stays bounded)
+LINE_LIMIT = 1 << 20
 
 _RUNNING: set[Program] = set()
 
@@ -49,7 +51,8 @@ class Program:
             self._stderr.close()
             reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
             raise ProgramError(f"cannot start {command[0]!r}: {reason}") from None
-        self._lines: queue.Queue[str | None] = queue.Queue(HELD_LINES)
+        self._lines: queue.Queue[str | None] = queue.Queue()
+        self._keep = False            # every line kept for its reader (keep_every_line)
         self._eof = False
         _RUNNING.add(self)
         threading.Thread(target=self._read, name=f"exec-{self.process.pid}",
@@ -57,16 +60,20 @@ class Program:
 
     def _read(self) -> None:
         """Standard output, line by line, until its end (then None); lines beyond
-        HELD_LINES that nobody takes are dropped, so the program never blocks on it."""
+        HELD_LINES that nobody takes are dropped, so the program never blocks on it
+        (unless every line is kept); a line longer than LINE_LIMIT comes in pieces."""
         assert self.process.stdout is not None
         with contextlib.suppress(OSError, ValueError):       # closed by stop()
-            for raw in self.process.stdout:
-                text = raw.decode("utf-8", "replace").rstrip("\r\n")
-                with contextlib.suppress(queue.Full):
-                    self._lines.put_nowait(text)
-        with contextlib.suppress(queue.Full):
-            self._lines.put_nowait(None)
+            while raw := self.process.stdout.readline(LINE_LIMIT):
+                if self._keep or self._lines.qsize() < HELD_LINES:
+                    self._lines.put(raw.decode("utf-8", "replace").rstrip("\r\n"))
+        self._lines.put(None)
         self._eof = True
+
+    def keep_every_line(self) -> None:
+        """From now on no line is dropped: each is a reply its reader waits for (a
+        co-simulator's, docs/cosim.md)."""
+        self._keep = True
 
     # -- what it says ---------------------------------------------------------------------
     def line(self, timeout: float) -> str | None:

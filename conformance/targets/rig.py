@@ -1,5 +1,6 @@
 """The test rig of an ``exec:`` target: docs/rig.md's control channel, spoken over the
-program's standard input (commands) and standard output (one reply a line).
+program's standard input (commands) and standard output (one reply a line), or as part
+of the co-simulation protocol (docs/cosim.md), whose client asks the commands for it.
 
 It offers what the suite uses of a rig (``link.rig``): ``set_input``, ``set_switch``,
 ``power_on``, ``outputs``, ``spindle``, ``state``. What the channel cannot give is not
@@ -19,6 +20,9 @@ from conformance.case import CouldNotTest
 from conformance.link.safety import TargetNotResponding
 from conformance.targets.program import Program
 
+#: asks one command and gives its reply line (raising when there is none)
+Ask = Callable[[str], str]
+
 #: how long `state` may take to answer when the suite asks whether there is a rig
 DETECT_SECONDS = 1.0
 #: how long any later command may take to answer
@@ -35,12 +39,27 @@ def _object(reply: str | None) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
+def over_program(program: Program) -> Ask:
+    """Commands on a program's standard input, its reply the next line it prints (lines
+    that arrived before are not a reply): no reply in time makes the case COULD-NOT-TEST,
+    a program that ended makes the target not responding."""
+    def ask(command: str) -> str:
+        program.discard()
+        reply = program.line(REPLY_SECONDS) if program.send(command) else None
+        if reply is None:
+            if not program.alive or program.wait(0.5):
+                raise TargetNotResponding(program.ended())
+            raise CouldNotTest(f"the rig did not answer {command!r} within {REPLY_SECONDS:g} s")
+        return reply
+    return ask
+
+
 class ControlRig:
     """The rig over a running program's control channel (see the module's docstring)."""
 
-    def __init__(self, program: Program, found: dict, address: int,
+    def __init__(self, ask: Ask, found: dict, address: int,
                  on_power_on: Callable[[], None] = lambda: None) -> None:
-        self.program = program
+        self.ask = ask
         self.address = address
         self.on_power_on = on_power_on
         # a simulator of several units answers `state` per address: then every command
@@ -59,16 +78,19 @@ class ControlRig:
         if not program.send("state"):
             return None
         found = _object(program.line(DETECT_SECONDS))
-        return None if found is None else cls(program, found, address, on_power_on)
+        return None if found is None else cls(over_program(program), found, address,
+                                               on_power_on)
+
+    @classmethod
+    def found_in(cls, reply: str, ask: Ask, address: int,
+                 on_power_on: Callable[[], None] = lambda: None) -> ControlRig | None:
+        """The rig, when ``reply`` (to `state`) is a JSON object; else None (no rig)."""
+        found = _object(reply)
+        return None if found is None else cls(ask, found, address, on_power_on)
 
     # -- the channel ---------------------------------------------------------------------------
     def _ask(self, command: str) -> str:
-        self.program.discard()              # lines nobody asked for are not a reply
-        reply = self.program.line(REPLY_SECONDS) if self.program.send(command) else None
-        if reply is None:
-            if not self.program.alive or self.program.wait(0.5):
-                raise TargetNotResponding(self.program.ended())
-            raise CouldNotTest(f"the rig did not answer {command!r} within {REPLY_SECONDS:g} s")
+        reply = self.ask(command)
         if reply.startswith("error"):
             raise CouldNotTest(f"the rig refused {command!r}: {reply}")
         return reply

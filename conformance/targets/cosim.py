@@ -1,0 +1,351 @@
+"""The co-simulation protocol's client (docs/cosim.md): a program that prints ``cosim 1``
+as its first line hands its clock to the suite, which drives it on the program's
+standard input and output. The suite speaks the text protocol only (the simulator is
+somebody else's; the emulator is one more such program).
+
+:class:`CosimLine` is the line as a virtual-time link sees the embedded emulator's
+(``now``, ``advance``, ``advance_to``; reads that wait in virtual time), and
+:class:`CosimPort` the pyserial port on it that links write and read. A write is sent
+with the next operation (``tx HEX T`` when that is a read: one exchange per frame).
+
+Every reply is checked as it comes: a simulator that breaks the protocol — no reply or
+no ``now`` within :data:`REPLY_SECONDS`, time going backwards, a byte stamped before the
+command began or after its ``now``, a clock that overshoots or stops short, an
+``error:`` where the clock was to move, a line that is none of the replies — is
+:class:`ProtocolBroken` (the target not responding, saying what it sent), and so is every
+later use of the line: the run's cases FAIL or are COULD-NOT-TEST, never an ERROR.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import NoReturn, Protocol
+
+from conformance.link.safety import TargetNotResponding
+
+VERSION = 1
+SECOND = 1_000_000_000
+CR = b"\r"
+#: wall-clock seconds within which every reply must be complete
+REPLY_SECONDS = 10.0
+#: the most virtual time one command asks for (a slow simulator answers each in time)
+STEP_NS = SECOND
+#: the most bytes one reply may report
+REPLY_BYTES = 1 << 20
+#: a read without a timeout waits at most this long in virtual time
+LONGEST_WAIT_NS = 3600 * SECOND
+
+
+class ProtocolBroken(TargetNotResponding):
+    """The co-simulator broke the protocol: the target is gone, saying how."""
+
+
+class Channel(Protocol):
+    """The program's side (conformance.targets.program.Program)."""
+
+    @property
+    def alive(self) -> bool: ...
+
+    def send(self, text: str) -> bool: ...
+
+    def line(self, timeout: float) -> str | None: ...
+
+    def wait(self, seconds: float) -> bool: ...
+
+    def ended(self) -> str: ...
+
+
+def announced(first: str) -> int | None:
+    """The protocol version a program's first line announces (None: not ``cosim N``)."""
+    words = first.split()
+    if len(words) == 2 and words[0] == "cosim" and words[1].isdigit():
+        return int(words[1])
+    return None
+
+
+def byte_ns(baud: int) -> int:
+    return round(10 * SECOND / baud)
+
+
+class CosimLine:
+    """The simulator's line, driven in virtual time (see the module's docstring)."""
+
+    def __init__(self, program: Channel, baud: int) -> None:
+        self.program = program
+        self.baud = baud
+        self.byte_ns = byte_ns(baud)
+        self.now = 0                          # the simulator's clock, as it last said
+        self._rx = bytearray()                # bytes to the host, not read yet
+        self._tx: tuple[bytes, int] | None = None   # a write not sent yet, and its start
+        self.broken = ""
+
+    # -- the channel -------------------------------------------------------------------------
+    def _break(self, why: str) -> NoReturn:
+        self.broken = self.broken or f"the co-simulator broke the protocol: {why}"
+        raise ProtocolBroken(self.broken)
+
+    def _usable(self) -> None:
+        if self.broken:
+            raise ProtocolBroken(self.broken)
+
+    def _send(self, command: str) -> None:
+        if not self.program.send(command):
+            self._ended(command)
+
+    def _ended(self, command: str) -> NoReturn:
+        self.program.wait(1.0)
+        ended = self.program.ended()
+        self.broken = (f"the target's program ended: {ended}" if ended else
+                       f"the co-simulator stopped reading its input at {command!r}")
+        raise ProtocolBroken(self.broken)
+
+    def _reply(self, command: str, deadline: float, said: str) -> str:
+        text = self.program.line(max(0.0, deadline - time.monotonic()))
+        if text is None:
+            if not self.program.alive or self.program.wait(0.2):
+                self._ended(command)
+            self._break(f"no reply to {command!r} within {REPLY_SECONDS:g} s" if not said
+                        else f"after {command!r} it sent {said[:120]!r} and then nothing "
+                        f"within {REPLY_SECONDS:g} s (no `now`)")
+        return text
+
+    def start(self) -> str:
+        """The line at the target's rate (`baud N`), then the reply to `state`: the
+        rig's state, or an ``error:`` line when it has none."""
+        self._send(f"baud {self.baud}")
+        reply = self._reply(f"baud {self.baud}", time.monotonic() + REPLY_SECONDS, "")
+        if reply.strip() != "ok":
+            self._break(f"it answered 'baud {self.baud}' with {reply[:120]!r}, not ok")
+        return self.ask("state")
+
+    def ask(self, command: str) -> str:
+        """A rig command (docs/rig.md) at the current instant: its one reply line."""
+        self._flush()
+        self._usable()
+        self._send(command)
+        return self._reply(command, time.monotonic() + REPLY_SECONDS, "")
+
+    def next_event(self) -> int | None:
+        """The instant the simulator says something next happens (None: nothing is
+        due until the host sends or the rig acts)."""
+        reply = self.ask("next")
+        words = reply.split()
+        if len(words) == 2 and words[0] == "next" and words[1] == "none":
+            return None
+        if len(words) == 2 and words[0] == "next" and words[1].isdigit():
+            return int(words[1])
+        self._break(f"it answered 'next' with {reply[:120]!r}, not next T or next none")
+
+    # -- the clock -----------------------------------------------------------------------------
+    def _move(self, command: str, start: int, end: int, goal: int) -> bool:
+        """Send ``command`` (tx or until), which runs the clock from ``start``: through
+        the host's bytes to ``end``, then on to ``goal`` unless a CR reached the host by
+        ``end``, stopping at the first CR after ``end``. Takes the reply's bytes; True
+        when a CR ended it (or came during the bytes)."""
+        self._send(command)
+        deadline = time.monotonic() + REPLY_SECONDS
+        b, last, got = self.byte_ns, start, 0
+        cr_sent = False                       # a CR reached the host by `end`
+        stop: int | None = None               # the CR after `end` where the clock stops
+        said = ""
+        while True:
+            said = self._reply(command, deadline, said)
+            words = said.split()
+            if len(words) == 3 and words[0] == "rx":
+                t, data = _rx(words)
+                if t is None or not data:
+                    self._break(f"it answered {command!r} with {said[:120]!r}: not rx T HEX")
+                if t <= start:
+                    self._break(f"after {command!r} it sent {said[:120]!r}: a byte stamped "
+                                f"{t}, not after the instant {start} the command began "
+                                "(a byte in the past)")
+                if t < last:
+                    self._break(f"after {command!r} it sent {said[:120]!r}: stamped {t}, "
+                                f"before the byte it sent before ({last})")
+                for i, value in enumerate(data):
+                    at = t + i * b
+                    if stop is not None or (cr_sent and at > end):
+                        self._break(f"after {command!r} it sent {said[:120]!r}: a byte at "
+                                    f"{at}, after the CR at "
+                                    f"{stop if stop is not None else end} where the clock "
+                                    "was to stop")
+                    if value == CR[0]:
+                        if at <= end:
+                            cr_sent = True
+                        else:
+                            stop = at
+                last = t + (len(data) - 1) * b
+                got += len(data)
+                if got > REPLY_BYTES:
+                    self._break(f"it answered {command!r} with more than {REPLY_BYTES} bytes")
+                self._rx += data
+            elif len(words) == 2 and words[0] == "now":
+                if not words[1].isdigit():
+                    self._break(f"it answered {command!r} with {said[:120]!r}: not now T")
+                self._arrived(command, said, int(words[1]), start, end, goal, last,
+                              end if cr_sent else stop if stop is not None else goal)
+                return cr_sent or stop is not None
+            elif said.startswith("error"):
+                self._break(f"it refused {command!r}: {said[:200]}")
+            else:
+                self._break(f"it answered {command!r} with {said[:120]!r}: not rx T HEX "
+                            "or now T")
+
+    def _arrived(self, command: str, said: str, now: int, start: int, end: int, goal: int,
+                 last: int, expected: int) -> None:
+        """``now`` must be where the command was to take the clock."""
+        if now < start:
+            self._break(f"after {command!r} it sent {said!r}: time went backwards "
+                        f"(it was {start})")
+        if now < last:
+            self._break(f"after {command!r} it sent {said!r}: before the last byte it sent "
+                        f"({last}), a byte in the future")
+        if now > goal:
+            self._break(f"after {command!r} it sent {said!r}: past the instant {goal} "
+                        "it was asked for")
+        if now != expected:
+            self._break(f"after {command!r} it sent {said!r}, where the clock had to stop "
+                        f"at {expected}" + (" (the end of the host's bytes)" if expected ==
+                                            end and end > start else ""))
+        self.now = now
+
+    def _step(self, t: int) -> bool:
+        """One command toward the instant ``t`` (the write not sent yet first): True when
+        it stopped at a CR to the host."""
+        self._usable()
+        if self._tx is not None:
+            data, start = self._tx
+            self._tx = None
+            end = self.now
+            goal = min(max(t, end), end + STEP_NS)
+            command = f"tx {data.hex().upper()}" + (f" {goal}" if goal > end else "")
+            return self._move(command, start, end, goal)
+        goal = min(t, self.now + STEP_NS)
+        return self._move(f"until {goal}", self.now, self.now, goal)
+
+    def _flush(self) -> None:
+        """Send the write not sent yet (its clock to the end of its bytes)."""
+        if self._tx is not None:
+            self._step(self.now)
+
+    def advance_to(self, t: int) -> None:
+        """Let virtual time pass up to the instant ``t``."""
+        self._flush()
+        while self.now < t:
+            self._step(t)
+
+    def advance(self, seconds: float) -> None:
+        self.advance_to(self.now + round(seconds * SECOND))
+
+    def run_until_idle(self, max_seconds: float = 3600.0) -> bool:
+        """Advance from event to event until none is due; False if ``max_seconds`` ran
+        out first."""
+        limit = self.now + round(max_seconds * SECOND)
+        while (due := self.next_event()) is not None:
+            if due > limit:
+                self.advance_to(limit)
+                return False
+            self.advance_to(due)
+        return True
+
+    # -- the host's side -----------------------------------------------------------------------
+    def write(self, data: bytes) -> int:
+        """The host's bytes, one byte time each from now: the clock moves to their end
+        (sent with the next operation)."""
+        self._flush()
+        self._usable()
+        if data:
+            self._tx = (bytes(data), self.now)
+            self.now += len(data) * self.byte_ns
+        return len(data)
+
+    def _take(self, size: int, terminator: bytes | None) -> bytes:
+        end = min(size, len(self._rx))
+        if terminator:
+            k = self._rx.find(terminator, 0, end)
+            if k >= 0:
+                end = k + len(terminator)
+        out = bytes(self._rx[:end])
+        del self._rx[:end]
+        return out
+
+    def read(self, size: int, timeout: float | None, terminator: bytes | None = None) -> bytes:
+        """Up to ``size`` bytes (stopping after ``terminator``), waiting at most
+        ``timeout`` seconds of virtual time: the clock stops when the terminator is there
+        (a CR, as every answer ends) or at the timeout."""
+        deadline = self.now + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
+        out = bytearray(self._take(size, terminator))
+        while len(out) < size and not (terminator and out.endswith(terminator)):
+            if self._tx is None and self.now >= deadline:
+                break
+            self._step(deadline)
+            out += self._take(size - len(out), terminator)
+        return bytes(out)
+
+    @property
+    def in_waiting(self) -> int:
+        self._flush()
+        return len(self._rx)
+
+    def discard_received(self) -> None:
+        self._flush()
+        self._rx.clear()
+
+    def set_baud(self, baud: int) -> None:
+        reply = self.ask(f"baud {baud}")
+        if reply.strip() != "ok":
+            self._break(f"it answered 'baud {baud}' with {reply[:120]!r}, not ok")
+        self.baud, self.byte_ns = baud, byte_ns(baud)
+
+
+def _rx(words: list[str]) -> tuple[int | None, bytes]:
+    if not words[1].isdigit():
+        return None, b""
+    try:
+        data = bytes.fromhex(words[2])
+    except ValueError:
+        return None, b""
+    return int(words[1]), data if len(words[2]) == 2 * len(data) else b""
+
+
+class CosimPort:
+    """The port a link writes and reads: pyserial's interface on a :class:`CosimLine`
+    (``.line`` gives the clock, as the embedded emulator's port does)."""
+
+    def __init__(self, line: CosimLine, timeout: float | None = 0.5) -> None:
+        self.line = line
+        self.timeout = timeout
+        self.is_open = True
+
+    @property
+    def baudrate(self) -> int:
+        return self.line.baud
+
+    @baudrate.setter
+    def baudrate(self, baud: int) -> None:
+        self.line.set_baud(baud)
+
+    def write(self, data: bytes) -> int:
+        return self.line.write(bytes(data))
+
+    def read(self, size: int = 1) -> bytes:
+        return self.line.read(size, self.timeout)
+
+    def read_until(self, expected: bytes = b"\n", size: int | None = None) -> bytes:
+        return self.line.read(size or 1 << 30, self.timeout, expected)
+
+    @property
+    def in_waiting(self) -> int:
+        return self.line.in_waiting
+
+    def reset_input_buffer(self) -> None:
+        self.line.discard_received()
+
+    def reset_output_buffer(self) -> None:
+        """Nothing waits to go out: a write is on the line at once."""
+
+    def flush(self) -> None:
+        self.line._flush()
+
+    def close(self) -> None:
+        self.is_open = False
