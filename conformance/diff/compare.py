@@ -10,8 +10,8 @@ In virtual time on both sides everything is exact. With a target in real time, p
 read while moving may differ by the band of ``conformance/motion/tolerance.py`` (the
 fastest rate the reference can have stepped at, times the width of the windows in which
 the two frames were processed, plus a step of placement); at rest they must be equal.
-The index (`@`) is compared from where each side's example began (a real unit's index is
-not reset by the known state).
+The index (`@`) is compared from where each side's example began (the index of a real
+unit or a co-simulator is not reset by the known state), in virtual time too.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ def difference(command: str, target: Exchange, reference: Exchange, judge: Judge
         if not judge.exact and _positions_close(target, reference, judge, moving):
             return None
         return "position"
-    if command == "@" and not judge.exact and _same_index(ra.values, rb.values, judge):
+    if command == "@" and _same_index(ra.values, rb.values, judge):
         return None
     return "data"
 

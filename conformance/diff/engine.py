@@ -111,7 +111,7 @@ class Pair:
         self._idle_since = 0
         self._latency_ns = self._slack_ns = self._cut_ns = 0
         self._lost = False
-        if not self.exact:
+        if self.target.real:
             self._prelude()
         context_packet = False
         earlier: set[str] = set()
@@ -183,7 +183,8 @@ class Pair:
         return out
 
     def _prelude(self) -> None:
-        """A real unit's index is not reset by the known state: read both, compare from
+        """A unit that lives on between examples (a real one, a co-simulator) is not
+        reset by the known state: its index is read on both sides and compared from
         there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
         reference, a fresh unit, first stands a while: the real one's last motion ended
         long ago (a vector right away would otherwise wait the dwell T on one side only),
@@ -201,7 +202,7 @@ class Pair:
             except AssertionError:
                 indexes.append(0)
             side.link.send("SR0")
-        self.judge = Judge(False, self.judge.rate, (indexes[0] - indexes[1]) % 256)
+        self.judge = Judge(self.exact, self.judge.rate, (indexes[0] - indexes[1]) % 256)
 
     def _same_eeprom(self) -> None:
         """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
@@ -237,7 +238,7 @@ class Pair:
             out.refused.append(f"{step}: {err}")
             return None
         except TargetNotResponding as err:
-            if not self.target.virtual:
+            if self.target.real:       # a fresh unit's silence ends only its example
                 raise
             rec.target = Exchange(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)

@@ -3,10 +3,10 @@ through the run's session (its guard judges every one before it goes out), and t
 clock the two sides share.
 
 The target leads; the reference follows it in time. When both are in virtual time
-(the embedded emulator against a mutant of itself) each step starts on both at the
-same instant: the one behind is advanced to the other (exact). When the target runs in
-real time, the reference (virtual) is advanced, before each step, to the instant the
-target has reached since the example began.
+(the embedded emulator against a mutant of itself, or a co-simulator) each step starts
+on both at the same instant: the one behind is advanced to the other (exact). When the
+target runs in real time, the reference (virtual) is advanced, before each step, to the
+instant the target has reached since the example began.
 """
 
 from __future__ import annotations
@@ -53,6 +53,12 @@ class Side:
     @property
     def virtual(self) -> bool:
         return self.target.info.virtual_time
+
+    @property
+    def real(self) -> bool:
+        """A unit that lives on between examples (its session's known state, not a
+        fresh unit): a real one, or a co-simulator."""
+        return self.session is not None and self.session.real
 
     @property
     def has_rig(self) -> bool:

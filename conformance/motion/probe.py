@@ -61,7 +61,8 @@ class Probe:
         self.scale = 1 if p.microstep is None else p.microstep.factors[p.microstep.reset_mode]
         # the state a case starts from: a fresh emulated unit, or a real one put into the
         # known state (docs/suite.md), whose VL cannot always be set back to the reset's
-        vl = r.VL if self.link.virtual or "VL" not in p.commands else known_axis_limits(p)
+        fresh = ctx.target.kind == "emu"
+        vl = r.VL if fresh or "VL" not in p.commands else known_axis_limits(p)
         self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T, "VK": r.VK,
                       "VL": tuple(vl)}
         self.events: list[Event] = []

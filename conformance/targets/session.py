@@ -143,7 +143,7 @@ class Session:
         port, baud, virtual, rig = self.target.connect(address)
         link = Link(port, self.guard, address=self.target.address if address is None else address,
                     baud=baud, virtual=virtual, rig=rig)
-        if self._link is not None and not virtual:
+        if self._link is not None and self.real:       # the same unit: its mode too
             link.checksums = self._link.checksums
         self._link = link
         return link
@@ -419,10 +419,12 @@ class Session:
     def after_case(self) -> None:
         """EEPROM bytes a case wrote are put back as soon as it ends, so that no later
         case meets them (e.g. 06 turning the GVE114's hand wheel on after a J); the end
-        of the run verifies every byte again."""
+        of the run verifies every byte again. The unit is stopped first: a case (or a
+        diff sequence) may leave it moving, and a moving unit refuses EEPROM writes."""
         if not (self.real and self.guard.eeprom_written) or self.failed:
             return
         with self._own_link() as link:
+            self._stop(link)
             self._eeprom_back(link, sorted(self.guard.eeprom_written))
 
     def _eeprom_back(self, link: Link, addresses: list[int]) -> list[str]:
