@@ -1,0 +1,187 @@
+"""exec: targets that co-simulate (docs/cosim.md): the program that prints `cosim 1` runs
+in virtual time, the suite driving its clock over the text protocol; the emulator as such
+a program answers as in process; and a simulator that breaks the protocol — silence, no
+`now`, time going backwards, a byte stamped in the past or the future, a clock that
+overshoots or stops short, garbage, an error where the clock was to move, a program that
+dies — is the target's FAIL naming what it sent, within a bounded time, never an
+ERROR."""
+
+from __future__ import annotations
+
+import shlex
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.runner import run
+from conformance.targets import TargetError, parse_target
+from conformance.targets import cosim as cosim_module
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+
+EMULATOR = [sys.executable, "-m", "emulator", "--cosim"]
+
+#: a co-simulator of a unit that never answers, which breaks the protocol in one way
+#: (argv[1]) at its second tx or until; before that it keeps the clock as it should
+BROKEN = r"""
+import sys, time
+mode, moves, now = sys.argv[1], 0, 0
+print("cosim 1", flush=True)
+for line in sys.stdin:
+    w = line.split()
+    if not w:
+        continue
+    if w[0] == "quit":
+        break
+    if mode == "silence":
+        continue
+    if w[0] not in ("tx", "until"):
+        print("ok" if w[0] == "baud" else "error: no rig", flush=True)
+        continue
+    start = now
+    end = now + (len(w[1]) // 2 * 86806 if w[0] == "tx" else 0)
+    goal = int(w[-1]) if len(w) == (3 if w[0] == "tx" else 2) else end
+    moves += 1
+    if moves < 2 or mode == "none":
+        now = goal
+        print(f"now {now}", flush=True)
+        continue
+    if mode == "dies":
+        print("the simulator gave up", file=sys.stderr, flush=True)
+        sys.exit(3)
+    out = {
+        "no-now": [f"rx {goal} 310D"],
+        "backwards": [f"now {start - 1000}"],
+        "past": [f"rx {start} 30", f"now {goal}"],
+        "future": [f"rx {goal + 1000} 30", f"now {goal}"],
+        "overshoot": [f"now {goal + 1}"],
+        "short": [f"now {goal - 1}"],
+        "garbage": ["hello there"],
+        "error": ["error: the clock is broken"],
+        "after-cr": [f"rx {goal - 2000} 0D", f"rx {goal - 1000} 30", f"now {goal}"],
+    }[mode]
+    now = goal
+    print("\n".join(out), flush=True)
+    if mode == "no-now":
+        time.sleep(60)
+"""
+
+#: what each break's FAIL says
+SAYS = {
+    "silence": "no reply to 'baud 115200' within",
+    "no-now": "and then nothing within",
+    "backwards": "time went backwards",
+    "past": "a byte in the past",
+    "future": "a byte in the future",
+    "overshoot": "past the instant",
+    "short": "where the clock had to stop",
+    "garbage": "'hello there': not rx T HEX or now T",
+    "error": "it refused",
+    "after-cr": "after the CR",
+    "dies": "exited with status 3 (stderr: the simulator gave up)",
+}
+
+
+def broken(mode: str):
+    target = parse_target("exec:" + shlex.join([sys.executable, "-c", BROKEN, mode]),
+                          profile="GVE84-100")
+    target.preflight()
+    return target
+
+
+@pytest.fixture
+def quick(monkeypatch):
+    monkeypatch.setattr(cosim_module, "REPLY_SECONDS", 0.5)
+    monkeypatch.setattr("conformance.targets.program.QUIT_SECONDS", 0.3)
+    monkeypatch.setattr("conformance.targets.program.TERM_SECONDS", 0.3)
+
+
+def test_the_emulator_as_a_co_simulator_runs_in_virtual_time_with_its_rig():
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100",
+                          allow_destructive=True)
+    target.preflight()
+    assert target.info.virtual_time and target.info.has_rig and target.info.kind == "exec"
+    cases = ["5.errors.ok", "10.2.measured.cruise-at-v", "10.cmd.output.port",
+             "10.3.inputs.physical-across-restart", "11.golden.g7-reset-state"]
+    start = time.monotonic()
+    result = run([target], select(cases))
+    assert {r.id: r.verdict for r in result.results} == {c: PASS for c in cases}, [
+        (r.id, r.notes, r.failed_checks) for r in result.results]
+    assert time.monotonic() - start < 10, "virtual time: the waits take no wall time"
+    assert result.problems == [] and target.program is None
+    session = result.sessions[target.info.spec]
+    assert session["real"] and session["restored"], "the session's restorations ran"
+
+
+def test_the_motion_is_judged_exactly():
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    result = run([target], select(["10.2.measured.cruise-at-v"]))
+    (r,) = result.results
+    readings = [c["what"] for c in r.checks if " PF at " in c["what"]]
+    assert r.verdict == PASS and len(readings) > 3
+    assert all("(±0 step(s) over a window of 0.000 ms)" in what for what in readings)
+
+
+def test_a_mutant_through_the_protocol_fails_its_case():
+    target = parse_target("exec:" + shlex.join([*EMULATOR, "--mutant", "velocity-ignored"]),
+                          profile="GVE84-100")
+    target.preflight()
+    result = run([target], select(["10.2.measured.cruise-at-v"]))
+    assert [r.verdict for r in result.results] == [FAIL]
+
+
+def test_the_envelope_and_the_destructive_guard_apply():
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    result = run([target], select(["10.2.measured.max-rate", "11.golden.g9-eeprom-relay"]))
+    notes = {r.id: (r.verdict, r.notes) for r in result.results}
+    assert notes["10.2.measured.max-rate"][0] == COULD_NOT_TEST
+    assert "envelope" in notes["10.2.measured.max-rate"][1][0]
+    assert notes["11.golden.g9-eeprom-relay"] == (
+        COULD_NOT_TEST, ["destructive: needs --allow-destructive"])
+
+
+def test_a_protocol_version_the_suite_does_not_speak_is_refused_before_anything():
+    target = parse_target("exec:" + shlex.join([sys.executable, "-c", "print('cosim 2')"]),
+                          profile="GVE84-100")
+    with pytest.raises(TargetError, match="speaks co-simulation version 2; this suite "
+                                          "speaks version 1"):
+        target.preflight()
+
+
+def test_a_simulator_that_keeps_the_protocol_but_never_answers_is_not_responding(quick):
+    result = run([broken("none")], select(["5.errors.ok", "5.errors.unknown"]))
+    first = result.results[0]
+    assert first.verdict == FAIL and "frames unanswered" in first.failed_checks[0]["what"]
+
+
+@pytest.mark.parametrize("mode", sorted(SAYS))
+def test_a_simulator_that_breaks_the_protocol_fails_saying_what_it_sent(quick, mode):
+    target = broken(mode)
+    assert target.info.virtual_time
+    start = time.monotonic()
+    result = run([target], select(["5.errors.ok", "5.errors.unknown", "6.checksum.*"]))
+    took = time.monotonic() - start
+    verdicts = [r.verdict for r in result.results]
+    assert verdicts[0] == FAIL and set(verdicts[1:]) == {COULD_NOT_TEST}, verdicts
+    assert ERROR not in verdicts
+    why = result.results[0].failed_checks[0]["what"]
+    assert SAYS[mode] in why, why
+    assert mode in ("silence", "dies") or "the co-simulator broke the protocol" in why
+    assert any("restorations stopped" in p for p in result.problems)
+    assert took < 5, f"{took:.1f} s"
+    assert target.program is None
+
+
+def test_the_command_line_says_fail_and_exits_1():
+    command = "exec:" + shlex.join([sys.executable, "-c", BROKEN, "garbage"])
+    done = subprocess.run([sys.executable, "-m", "conformance", "--target", command,
+                           "--profile", "GVE84-100", "--yes", "--no-reports",
+                           "--cases", "5.errors.*"], capture_output=True, text=True,
+                          timeout=120, stdin=subprocess.DEVNULL)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "FAIL" in done.stdout and "'hello there'" in done.stdout
+    assert "Traceback" not in done.stdout + done.stderr

@@ -1,0 +1,159 @@
+"""The emulator's side of the co-simulation protocol (docs/cosim.md): in process, the
+commands move the line's clock exactly as the in-process `gve://` line would (tx to the
+end of the bytes, until stopping at a CR to the host), every byte reported once with
+its instant; malformed commands are one `error:` line and change nothing; and
+`python -m emulator --cosim` speaks it on standard input and output, with several
+units on one line too."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+
+import pytest
+import serial
+
+import emulator  # noqa: F401  (registers gve://)
+from emulator.link.control import Quit
+from emulator.link.cosim import Cosim, serve_cosim
+from emulator.link.line import Line, byte_time
+from emulator.link.url import LineSpec
+
+BAUD = 115200
+B = byte_time(BAUD)
+
+
+def cosim(model: str = "GVE84-100") -> Cosim:
+    spec = LineSpec(units=[(model, None)])
+    return Cosim(Line(spec.build_units(), BAUD))
+
+
+def rx(replies: list[str]) -> bytes:
+    """The bytes of a reply's rx lines, checked to be one byte time apart in a line."""
+    out = b""
+    for reply in replies:
+        word, t, data = reply.split()
+        assert word == "rx" and int(t) > 0
+        out += bytes.fromhex(data)
+    return out
+
+
+def test_tx_runs_the_clock_to_the_end_of_the_bytes_and_until_stops_at_the_cr():
+    c = cosim()
+    assert c.handle("tx 21303F0D") == [f"now {4 * B}"]         # the answer is on its way
+    *got, now = c.handle("until 1000000000")
+    reference = serial.serial_for_url("gve://?model=GVE84-100", timeout=1)
+    reference.write(b"!0?\r")
+    answer = reference.read_until(b"\r")
+    assert rx(got) == answer and now == f"now {reference.line.now}"
+    assert int(got[0].split()[1]) == 5 * B, "the first byte is complete one byte time on"
+    assert c.handle("until 1000000000") == ["now 1000000000"]  # nothing more: on to T
+
+
+def test_tx_with_an_instant_reads_the_answer_in_one_exchange():
+    c = cosim()
+    *got, now = c.handle("tx 21303F0D 1000000000")
+    reference = serial.serial_for_url("gve://?model=GVE84-100", timeout=1)
+    reference.write(b"!0?\r")
+    assert rx(got) == reference.read_until(b"\r")
+    assert now == f"now {reference.line.now}"
+
+
+def test_answers_completed_during_the_bytes_end_tx_there_whatever_the_instant():
+    c = cosim()
+    frames = b"!0SR0\r!0SR1\r"
+    *got, now = c.handle(f"tx {frames.hex()} 1000000000")
+    assert rx(got) == b"0,00\r"                  # SR0's answer, complete during SR1
+    assert now == f"now {len(frames) * B}"        # the clock stops at the bytes' end
+    *rest, _ = c.handle("until 1000000000")
+    assert rx(rest) == b"0,00\r"
+
+
+def test_deferred_answers_and_events_on_the_way():
+    """H answers when the axes have stopped: until stops at that answer's CR."""
+    c = cosim()
+    c.handle("tx " + b"!0V1000\r".hex() + " 100000000")
+    c.handle("tx " + b"!0L5000,0,0\r".hex() + " 100000000")
+    c.handle("until 500000000")
+    c.handle("tx " + b"!0H\r".hex())
+    *got, now = c.handle("until 9000000000")
+    assert rx(got) == b"8\r"
+    assert 500_000_000 < int(now.split()[1]) < 9_000_000_000
+    assert c.handle("next") == ["next none"]
+
+
+def test_next_names_what_is_due():
+    c = cosim()
+    c.handle("tx 21303F0D")
+    assert c.handle("next") == [f"next {5 * B}"]
+
+
+@pytest.mark.parametrize("text", ["tx", "tx 2", "tx ZZ", "tx 21 22 23", "until", "until -5",
+                                  "until 1.5", "until 0 0", "next 1", "baud 0", "baud x",
+                                  "fly", "tx 210D 1"])
+def test_malformed_commands_are_one_error_line_and_change_nothing(text):
+    c = cosim()
+    c.handle("until 1000")
+    assert len(c.handle(text)) == 1 and c.handle(text)[0].startswith("error: ")
+    assert c.line.now == 1000
+
+
+def test_time_does_not_go_back():
+    c = cosim()
+    c.handle("until 5000")
+    assert c.handle("until 4999")[0].startswith("error: until 4999: before now")
+
+
+def test_baud_changes_the_byte_time():
+    c = cosim()
+    assert c.handle("baud 9600") == ["ok"]
+    assert c.handle("tx 21303F0D") == [f"now {4 * byte_time(9600)}"]
+
+
+def test_the_rig_s_commands_are_there_and_quit_ends():
+    c = cosim()
+    assert c.handle("in 1 FE") == ["ok"]
+    assert json.loads(c.handle("state")[0])["inputs"]["1"] == "FE"
+    assert c.handle("help")[0].startswith("commands: tx HEX [T] | until T")
+    assert c.handle("") == []
+    with pytest.raises(Quit):
+        c.handle("quit")
+
+
+def test_serve_cosim_announces_the_version_and_ends_at_the_end_of_input():
+    out = io.StringIO()
+    spec = LineSpec(units=[("GVE84-100", None)])
+    serve_cosim(Line(spec.build_units(), BAUD), io.BytesIO(b"until 7\n\nnext\n"), out)
+    assert out.getvalue() == "cosim 1\nnow 7\nnext none\n"
+
+
+def test_a_line_that_is_too_long_is_refused():
+    out = io.StringIO()
+    spec = LineSpec(units=[("GVE84-100", None)])
+    serve_cosim(Line(spec.build_units(), BAUD), io.BytesIO(b"x" * 70000 + b"\nuntil 3\n"), out)
+    lines = out.getvalue().splitlines()
+    assert lines[1].startswith("error: a command line longer than") and lines[2] == "now 3"
+
+
+def test_python_m_emulator_cosim_with_several_units(tmp_path):
+    log = tmp_path / "wire.gvt"
+    commands = ("tx " + b"!1?\r".hex() + " 1000000000\nstate\nstate @1\nquit\n")
+    done = subprocess.run([sys.executable, "-m", "emulator", "--unit", "GVE54@1", "--unit",
+                           "GVE84-100@0", "--cosim", "--log", str(log)], input=commands,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stderr == ""
+    lines = done.stdout.splitlines()
+    assert lines[0] == "cosim 1"
+    answer = rx([x for x in lines if x.startswith("rx ")])
+    assert answer.startswith(b"0,") and answer.endswith(b"\r")
+    both, one = (json.loads(x) for x in lines if x.startswith("{"))
+    assert set(both) == {"0", "1"} and one["profile"] == "GVE54"
+    assert "!1?" in log.read_text()
+
+
+def test_python_m_emulator_cosim_ends_quietly_when_its_input_ends():
+    done = subprocess.run([sys.executable, "-m", "emulator", "--cosim"], input="",
+                          capture_output=True, text=True, timeout=60)
+    assert (done.returncode, done.stdout, done.stderr) == (0, "cosim 1\n", "")
