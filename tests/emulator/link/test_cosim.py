@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import serial
@@ -157,3 +159,25 @@ def test_python_m_emulator_cosim_ends_quietly_when_its_input_ends():
     done = subprocess.run([sys.executable, "-m", "emulator", "--cosim"], input="",
                           capture_output=True, text=True, timeout=60)
     assert (done.returncode, done.stdout, done.stderr) == (0, "cosim 1\n", "")
+
+
+def test_the_session_in_docs_cosim_md_is_the_emulator_s():
+    """The example session of docs/cosim.md, command by command, answered as written
+    (the shortened `state` line by its beginning)."""
+    doc = (Path(__file__).resolve().parents[3] / "docs" / "cosim.md").read_text()
+    block = doc.split("## A session", 1)[1].split("```")[1]
+    lines = [re.split(r"\s{3,}", x.strip())[0] for x in block.splitlines() if x.strip()]
+    assert lines[0] == "cosim 1"
+    commands = [x[2:] for x in lines if x.startswith("> ")]
+    expected = [x for x in lines[1:] if not x.startswith("> ")]
+    done = subprocess.run([sys.executable, "-m", "emulator", "--model", "GVE84-100",
+                           "--cosim"], input="\n".join(commands) + "\n",
+                          capture_output=True, text=True, timeout=60)
+    got = done.stdout.splitlines()
+    assert got[0] == "cosim 1" and len(got[1:]) == len(expected), got
+    for want, have in zip(expected, got[1:], strict=True):
+        if want.endswith(", ...}"):              # the keys shown, as shown
+            shown = json.loads(want.replace(", ...}", "}"))
+            assert {k: json.loads(have)[k] for k in shown} == shown
+        else:
+            assert have == want
