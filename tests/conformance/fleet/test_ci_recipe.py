@@ -58,10 +58,29 @@ def test_the_shell_job_runs_an_exec_simulator_and_publishes(tmp_path):
         os.kill(int(pidfile.read_text()), 0)
 
 
+def test_the_shell_job_runs_a_co_simulator_in_virtual_time_and_publishes(tmp_path):
+    env = {**environment(0, "", "5.errors.*"), "GVE_COSIM": f"{EMULATOR} --cosim",
+           "GVE_DIFF_SECONDS": "2"}
+    done = run_recipe(["settings", "run-cosim", "publish"], tmp_path, env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "PASSED" in done.stdout and "diff: exec:" in done.stdout
+    assert len(published(tmp_path).findall("./testsuite/testcase")) > 0
+    assert list((tmp_path / "artifacts" / "gve-diff").glob("*/results.json"))
+
+
+def test_a_co_simulator_s_failure_fails_the_job(tmp_path):
+    env = {**environment(0, "", "10.2.measured.cruise-at-v"),
+           "GVE_COSIM": f"{EMULATOR} --cosim --mutant velocity-ignored",
+           "GVE_DIFF_SECONDS": "2"}
+    done = run_recipe(["settings", "run-cosim", "publish"], tmp_path, env)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert (tmp_path / "artifacts" / "gve-report" / "report.html").is_file()
+
+
 def test_the_github_workflow_runs_the_shell_job_s_commands():
     recipe = blocks()
-    workflow = commands(recipe["github"])
-    for step in ("install", "run-exec"):
+    workflow = [line.removesuffix(" || status=$?") for line in commands(recipe["github"])]
+    for step in ("install", "run-exec", "run-cosim"):
         for line in commands(recipe[step]):
             if line.startswith(("python3 -m venv", ". ", "status=")):
                 continue        # the workflow's Python is set up by actions/setup-python
