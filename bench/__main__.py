@@ -1,6 +1,6 @@
 """Run every benchmark: `python -m bench`."""
 
-from bench import bench_diff, bench_emulator, bench_host, bench_stepper
+from bench import bench_cosim, bench_diff, bench_emulator, bench_host, bench_stepper
 
 if __name__ == "__main__":
     bench_emulator.main()
@@ -10,3 +10,5 @@ if __name__ == "__main__":
     bench_host.main([])
     print()
     bench_diff.main([])
+    print()
+    bench_cosim.main([])

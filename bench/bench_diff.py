@@ -1,6 +1,9 @@
 """The differential fuzzer in process: the emulator against a mutant of itself (and
 against itself), frames per second with the search's own overhead (drawing, shrinking),
-and the time 10,000 frames take as a ratio of the issue's 10 s budget (below 1: met).
+and the time 10,000 frames take as a ratio of the issue's 10 s budget (below 1: met);
+then the same search through a co-simulator (`exec:` of `python -m emulator --cosim`,
+docs/cosim.md: virtual time over the text protocol, the unit's known state before each
+sequence), its sequences per second and their ratio to the in-process figure.
 
     python -m bench.bench_diff [--frames N]
 """
@@ -8,6 +11,8 @@ and the time 10,000 frames take as a ratio of the issue's 10 s budget (below 1: 
 from __future__ import annotations
 
 import argparse
+import shlex
+import sys
 
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
@@ -18,10 +23,31 @@ BUDGET_FRAMES = 10_000
 BUDGET_SECONDS = 10.0
 
 
-def frames_per_second(mutant: str | None, frames: int) -> tuple[float, int]:
-    spec = "emu:GVE84-100" + (f"?mutant={mutant}" if mutant else "")
-    target, reference = parse_target(spec), parse_target("emu:GVE84-100")
-    pair = Pair(Side(target), Side(reference), target.profile)
+def cosim_spec(mutant: str | None) -> str:
+    return "exec:" + shlex.join([sys.executable, "-m", "emulator", "--model", "GVE84-100",
+                                 "--cosim", *(["--mutant", mutant] if mutant else [])])
+
+
+def frames_per_second(mutant: str | None, frames: int, *, cosim: bool = False
+                      ) -> tuple[float, float, int]:
+    """(frames/s, sequences/s, findings) of searches that send ``frames`` frames."""
+    reference = parse_target("emu:GVE84-100")
+    if cosim:
+        target = parse_target(cosim_spec(mutant), profile="GVE84-100", allow_destructive=True)
+        target.preflight()
+        side = Side(target, target.begin())
+    else:
+        target = parse_target("emu:GVE84-100" + (f"?mutant={mutant}" if mutant else ""))
+        side = Side(target)
+    try:
+        return _search(Pair(side, Side(reference), target.profile), frames)
+    finally:
+        if cosim:
+            target.session.finish()
+            target.close()
+
+
+def _search(pair: Pair, frames: int) -> tuple[float, float, int]:
     budget = Budget(examples=None)
     total = 0.0
     found = 0
@@ -34,7 +60,7 @@ def frames_per_second(mutant: str | None, frames: int) -> tuple[float, int]:
         found += len(search(pair, Options(destructive=True, rig=True), budget,
                             seed=budget.used, with_probes=first))
     total = budget.elapsed
-    return budget.frames / total, found
+    return budget.frames / total, budget.used / total, found
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -42,12 +68,21 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--frames", type=int, default=BUDGET_FRAMES)
     args = ap.parse_args(argv)
     print("differential fuzzer, in process (GVE84-100, virtual time on both sides)")
+    in_process = {}
     for mutant in (None, "velocity-ignored"):
-        rate, found = frames_per_second(mutant, args.frames)
+        rate, sequences, found = frames_per_second(mutant, args.frames)
+        in_process[mutant] = sequences
         ten_k = BUDGET_FRAMES / rate
-        print(f"  against {mutant or 'itself':18} {rate:8.0f} frames/s  "
-              f"10,000 frames in {ten_k:5.2f} s = {ten_k / BUDGET_SECONDS:4.2f} x the 10 s "
-              f"budget  ({found} finding(s))")
+        print(f"  against {mutant or 'itself':18} {rate:8.0f} frames/s {sequences:6.1f} "
+              f"sequences/s  10,000 frames in {ten_k:5.2f} s = "
+              f"{ten_k / BUDGET_SECONDS:4.2f} x the 10 s budget  ({found} finding(s))")
+    print("through a co-simulator (python -m emulator --cosim, exec:, the reference in "
+          "process)")
+    for mutant in (None, "velocity-ignored"):
+        rate, sequences, found = frames_per_second(mutant, args.frames, cosim=True)
+        print(f"  against {mutant or 'itself':18} {rate:8.0f} frames/s {sequences:6.1f} "
+              f"sequences/s = {sequences / in_process[mutant]:4.2f} x in process  "
+              f"({found} finding(s))")
 
 
 if __name__ == "__main__":
