@@ -18,7 +18,9 @@ later use of the line: the run's cases FAIL or are COULD-NOT-TEST, never an ERRO
 
 from __future__ import annotations
 
+import contextlib
 import time
+from collections.abc import Iterator
 from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
@@ -92,6 +94,22 @@ class CosimLine:
         if not self.program.send(command):
             self._ended(command)
 
+    @contextlib.contextmanager
+    def _exchange(self, command: str) -> Iterator[None]:
+        """One command and its whole reply; a reply left half read (a third Ctrl-C,
+        an error of the suite) would be taken for the next command's: the line is broken
+        from then on, saying so."""
+        self._usable()
+        done = False
+        try:
+            self._send(command)
+            yield
+            done = True
+        finally:
+            if not done and not self.broken:
+                self.broken = (f"the exchange {command!r} was cut off before its reply was "
+                               "read: the co-simulation cannot go on")
+
     def _ended(self, command: str) -> NoReturn:
         self.program.wait(1.0)
         ended = self.program.ended()
@@ -112,8 +130,9 @@ class CosimLine:
     def start(self) -> str:
         """The line at the target's rate (`baud N`), then the reply to `state`: the
         rig's state, or an ``error:`` line when it has none."""
-        self._send(f"baud {self.baud}")
-        reply = self._reply(f"baud {self.baud}", time.monotonic() + REPLY_SECONDS, "")
+        command = f"baud {self.baud}"
+        with self._exchange(command):
+            reply = self._reply(command, time.monotonic() + REPLY_SECONDS, "")
         if reply.strip() != "ok":
             self._break(f"it answered 'baud {self.baud}' with {reply[:120]!r}, not ok")
         return self.ask("state")
@@ -121,9 +140,8 @@ class CosimLine:
     def ask(self, command: str) -> str:
         """A rig command (docs/rig.md) at the current instant: its one reply line."""
         self._flush()
-        self._usable()
-        self._send(command)
-        return self._reply(command, time.monotonic() + REPLY_SECONDS, "")
+        with self._exchange(command):
+            return self._reply(command, time.monotonic() + REPLY_SECONDS, "")
 
     def next_event(self) -> int | None:
         """The instant the simulator says something next happens (None: nothing is
@@ -142,7 +160,11 @@ class CosimLine:
         the host's bytes to ``end``, then on to ``goal`` unless a CR reached the host by
         ``end``, stopping at the first CR after ``end``. Takes the reply's bytes; True
         when a CR ended it (or came during the bytes)."""
-        self._send(command)
+        with self._exchange(command):
+            return self._moved(command, start, end, goal)
+
+    def _moved(self, command: str, start: int, end: int, goal: int) -> bool:
+        """The reply to ``command`` (see :meth:`_move`)."""
         deadline = time.monotonic() + REPLY_SECONDS
         b, last, got = self.byte_ns, start, 0
         cr_sent = False                       # a CR reached the host by `end`

@@ -185,3 +185,30 @@ def test_the_command_line_says_fail_and_exits_1():
     assert done.returncode == 1, done.stdout + done.stderr
     assert "FAIL" in done.stdout and "'hello there'" in done.stdout
     assert "Traceback" not in done.stdout + done.stderr
+
+
+class Interrupting:
+    """A channel whose first reply never comes: the wait for it is interrupted."""
+
+    alive = True
+
+    def send(self, text: str) -> bool:
+        return True
+
+    def line(self, timeout: float) -> str | None:
+        raise KeyboardInterrupt
+
+    def wait(self, seconds: float) -> bool:
+        return False
+
+    def ended(self) -> str:
+        return ""
+
+
+def test_an_exchange_cut_off_before_its_reply_leaves_the_line_broken_not_misread():
+    line = cosim_module.CosimLine(Interrupting(), 115200)
+    line.write(b"!0?\r")
+    with pytest.raises(KeyboardInterrupt):
+        line.read(100, 1.0, b"\r")
+    with pytest.raises(cosim_module.ProtocolBroken, match="was cut off before its reply"):
+        line.ask("state")
