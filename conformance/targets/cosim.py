@@ -145,8 +145,11 @@ class CosimLine:
 
     def next_event(self) -> int | None:
         """The instant the simulator says something next happens (None: nothing is
-        due until the host sends or the rig acts)."""
+        due until the host sends or the rig acts); LookupError when it does not tell
+        (`next` is optional, docs/cosim.md)."""
         reply = self.ask("next")
+        if reply.startswith("error"):
+            raise LookupError(f"the co-simulator does not tell its next event: {reply[:120]}")
         words = reply.split()
         if len(words) == 2 and words[0] == "next" and words[1] == "none":
             return None

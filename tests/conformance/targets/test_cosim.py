@@ -212,3 +212,38 @@ def test_an_exchange_cut_off_before_its_reply_leaves_the_line_broken_not_misread
         line.read(100, 1.0, b"\r")
     with pytest.raises(cosim_module.ProtocolBroken, match="was cut off before its reply"):
         line.ask("state")
+
+
+def test_next_and_run_until_idle_through_the_client():
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        line = port.line
+        assert line.next_event() is None
+        port.write(b"!0V1000\r")
+        assert port.read_until(b"\r") == b"0\r"
+        port.write(b"!0L3000,0,0\r")
+        assert port.read_until(b"\r") == b"0\r"
+        assert line.next_event() > line.now
+        assert line.run_until_idle() and line.next_event() is None
+        assert line.now > 3 * cosim_module.SECOND, "3000 steps at 1000/s"
+    finally:
+        target.close()
+
+
+def test_a_simulator_that_does_not_tell_its_next_event_says_so():
+    line = cosim_module.CosimLine(Replies(["error: no"]), 115200)
+    with pytest.raises(LookupError, match="does not tell its next event"):
+        line.next_event()
+    assert not line.broken
+
+
+class Replies(Interrupting):
+    """A channel that replies these lines in turn."""
+
+    def __init__(self, replies: list[str]) -> None:
+        self.replies = list(replies)
+
+    def line(self, timeout: float) -> str | None:
+        return self.replies.pop(0) if self.replies else None
