@@ -116,10 +116,10 @@ def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel:
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
+          max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     url, q = locate(kind, rest)
     p = real_profile(spec, profile, mutant, max_travel)
     baud = _number(q, "baud", p.default_baud, spec, 1, 10_000_000)
     address = _number(q, "address", p.address, spec, 0, 7)
-    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
+    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)
     return PortTarget(info, p, address, baud, url)
