@@ -49,6 +49,7 @@ class RunMeta:
     full_logs: bool = False
     operator_steps: bool = False            # a technician was asked for hand steps
     confirmed: str = ""                     # how motion was allowed: "asked", "--yes", ""
+    strict: bool = False                    # --strict: a NON-STRICT verdict counts as failed
     targets: list[TargetMeta] = field(default_factory=list)
     # the spec's rules the selected cases can fail, per profile: {profile, covered, total,
     # sections: [{section, covered (a count), uncovered (rule IDs)}]}
@@ -73,6 +74,7 @@ class RunMeta:
                 "--exclude": " ".join(self.exclude) or "none",
                 "--full-logs": self.full_logs,
                 "--operator": self.operator_steps,
+                "--strict": self.strict,
                 "motion confirmed": self.confirmed or "not asked"}
 
     def to_dict(self) -> dict:
