@@ -29,7 +29,7 @@ from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import FAILED, ORDER, overall
-from gve_fixtures.profile import available_profiles
+from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"
 
@@ -154,6 +154,8 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
+        except ProfileError as err:
+            raise UsageError(str(err)) from None
         except LookupError as err:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
