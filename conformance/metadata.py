@@ -51,7 +51,6 @@ class RunMeta:
     strict: bool = False                    # --strict: third-party targets graded strictly
     operator_steps: bool = False            # a technician was asked for hand steps
     confirmed: str = ""                     # how motion was allowed: "asked", "--yes", ""
-    strict: bool = False                    # --strict: a NON-STRICT verdict counts as failed
     targets: list[TargetMeta] = field(default_factory=list)
     # the spec's rules the selected cases can fail, per profile: {profile, covered, total,
     # sections: [{section, covered (a count), uncovered (rule IDs)}]}
@@ -77,7 +76,6 @@ class RunMeta:
                 "--full-logs": self.full_logs,
                 "--strict": self.strict,
                 "--operator": self.operator_steps,
-                "--strict": self.strict,
                 "motion confirmed": self.confirmed or "not asked"}
 
     def to_dict(self) -> dict:
