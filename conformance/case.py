@@ -105,6 +105,9 @@ class TargetInfo:
     has_rig: bool
     allow_destructive: bool
     max_travel: int
+    #: graded by the project's decisions: a failed `[D]` check FAILs (the reference
+    #: emulator; another target only when the run says --strict)
+    strict: bool = False
 
 
 @dataclass

@@ -27,6 +27,7 @@ class TargetMeta:
     processor_id: str = ""                  # the unit's answer to `Q`
     envelope: int | None = None             # steps per axis from the start (real units)
     excursion: list[int] | None = None      # the largest |travel| per axis seen in the run
+    graded: str = ""                        # "strict" or "by the tags" (docs/suite.md)
 
 
 @dataclass
@@ -47,6 +48,7 @@ class RunMeta:
     cases: list[str] = field(default_factory=list)      # --cases globs (empty: all)
     exclude: list[str] = field(default_factory=list)
     full_logs: bool = False
+    strict: bool = False                    # --strict: third-party targets graded strictly
     operator_steps: bool = False            # a technician was asked for hand steps
     confirmed: str = ""                     # how motion was allowed: "asked", "--yes", ""
     targets: list[TargetMeta] = field(default_factory=list)
@@ -72,6 +74,7 @@ class RunMeta:
                 "--cases": " ".join(self.cases) or "all",
                 "--exclude": " ".join(self.exclude) or "none",
                 "--full-logs": self.full_logs,
+                "--strict": self.strict,
                 "--operator": self.operator_steps,
                 "motion confirmed": self.confirmed or "not asked"}
 

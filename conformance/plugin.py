@@ -45,6 +45,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      "emulator's or a co-simulator's; hardware on serial/tcp/exec targets)")
     g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
     g.addoption("--gve-allow-destructive", action="store_true")
+    g.addoption("--gve-strict", action="store_true",
+                help="grade a serial/tcp/exec target by the project's decisions too: a "
+                "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
+                "always is)")
     g.addoption("--gve-hypothesis-db", default=None, metavar="DIR|redis://HOST:PORT/N|none",
                 help="where the machines keep failing examples, tried first on the next run "
                      f"(default: {settings_profiles.DEFAULT_DATABASE}/ in the rootdir)")
@@ -151,7 +155,8 @@ def pytest_configure(config: pytest.Config) -> None:
         for spec in specs:
             target = parse_target(spec, profile=config.getoption("--gve-profile"),
                                   allow_destructive=config.getoption("--gve-allow-destructive"),
-                                  max_travel=config.getoption("--gve-max-travel"))
+                                  max_travel=config.getoption("--gve-max-travel"),
+                                  strict=config.getoption("--gve-strict"))
             if not worker:
                 target.preflight()
             if controller:

@@ -150,7 +150,7 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
         if ended:
             _after_case(session, ctx)
     result.seconds = time.perf_counter() - start
-    verdicts += [grade(c.tag, profile.implements_decisions) for c in ctx.checks if not c.ok]
+    verdicts += [grade(c.tag, target.info.strict) for c in ctx.checks if not c.ok]
     if not verdicts and not ctx.checks:
         verdicts.append(ERROR)
         ctx.note("the case recorded no check: a case that cannot fail is a defect")

@@ -15,12 +15,13 @@ ORDER = (ERROR, FAIL, NON_STRICT, INFO, COULD_NOT_TEST, MISSING, PASS)
 TAGS = ("M", "M-ex", "D", "D-info", "always")
 
 
-def grade(tag: str, implements_decisions: bool) -> str:
-    """The verdict of one failed check carrying ``tag``."""
+def grade(tag: str, strict: bool) -> str:
+    """The verdict of one failed check carrying ``tag`` on a target graded ``strict``ly
+    (the reference emulator, or a target run with --strict) or by the tags alone."""
     if tag in ("M", "M-ex", "always"):
         return FAIL
     if tag == "D":
-        return FAIL if implements_decisions else NON_STRICT
+        return FAIL if strict else NON_STRICT
     if tag == "D-info":
         return INFO
     raise ValueError(f"unknown tag {tag!r}")

@@ -44,6 +44,9 @@ def common(ap: argparse.ArgumentParser) -> None:
                     help="real units: the motion envelope in full steps per axis")
     ap.add_argument("--yes", action="store_true",
                     help="real units: move without asking first (unattended benches)")
+    ap.add_argument("--strict", action="store_true",
+                    help="grade the target by the project's decisions too: a [D] "
+                         "difference FAILs instead of NON-STRICT")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -68,7 +71,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 def targets(args: argparse.Namespace) -> tuple[Target, Target]:
     """The target and its reference, checked before anything is sent."""
     target = parse_target(args.target, profile=args.profile,
-                          allow_destructive=args.allow_destructive, max_travel=args.max_travel)
+                          allow_destructive=args.allow_destructive, max_travel=args.max_travel,
+                          strict=args.strict)
     against = args.against or f"emu:{target.profile.name}"
     reference = parse_target(against)
     if reference.info.kind != "emu":

@@ -1,7 +1,12 @@
 """`gve-conformance ports`: the serial ports of this machine (pyserial's ``list_ports``:
 device, description, hardware id), so that a technician finds the unit's port. With
 ``--probe`` each port is also asked ``?`` at the profiles' baud rates and the unit that
-answers is named; ``--glob`` adds ports the system does not list (a pty, a symlink)."""
+answers is named; ``--glob`` adds ports the system does not list (a pty, a symlink).
+
+The probe asks ``?`` and nothing else (framed as the suite frames it, once more with a
+checksum when the unit answers that it wants one). A port another program holds (locked,
+or ``TIOCEXCL``) is skipped untouched and said so; every port probed gets its terminal
+settings back as they were found."""
 
 from __future__ import annotations
 
@@ -17,7 +22,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     ap.add_argument("--glob", action="append", default=[], metavar="PATTERN",
                     help="also list devices matching PATTERN (e.g. '/dev/pts/*')")
     ap.add_argument("--probe", action="store_true",
-                    help="ask each port `?` (only `?`: it moves nothing) and show who answers")
+                    help="ask each port `?` at the profiles' baud rates (only `?`, again with "
+                         "a checksum if the unit wants one: it moves nothing) and show who "
+                         "answers; ports held by another program are skipped, each port's "
+                         "settings restored")
     return ap.parse_args(argv)
 
 
@@ -46,8 +54,7 @@ def main(argv: list[str]) -> int:
     for device, description, hwid in ports:
         line = f"{device:{width}}  {description}  [{hwid}]"
         if args.probe:
-            answer = probe(device)
-            line += f"  -> {answer}" if answer else "  -> no GVE unit answered"
+            line += f"  -> {probe(device)}"
         print(line, flush=True)
     return 0
 

@@ -29,7 +29,7 @@ from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdict import FAILED, ORDER, overall
-from gve_fixtures.profile import available_profiles
+from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"
 
@@ -67,6 +67,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="real units: allow J, W and EEPROM writes (EEPROM backed up and "
                          "restored)")
     ap.add_argument("--mutant", help="emulator targets: plant this deliberate bug")
+    ap.add_argument("--strict", action="store_true",
+                    help="grade a serial/tcp/exec target by the project's decisions too: a "
+                         "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
+                         "always is)")
     ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
     ap.add_argument("--run-id", type=run_id, metavar="NAME",
                     help="the report folder's name (default: date, time and a random tag)")
@@ -151,6 +155,8 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
         profiles = [args.profile] if args.profile else None
         try:
             report = coverage(profiles, role=args.coverage, cases=cases)
+        except ProfileError as err:
+            raise UsageError(str(err)) from None
         except LookupError as err:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
@@ -234,11 +240,12 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how:
                    settings=_settings_line(targets, args.settings), seed=seed,
                    mutant=args.mutant, destructive=args.allow_destructive,
                    max_travel=args.max_travel, cases=args.cases, exclude=args.exclude,
-                   full_logs=args.full_logs)
+                   full_logs=args.full_logs, strict=args.strict)
     for target, chosen in zip(targets, how, strict=True):
         t = meta.target(target.info.spec)
         t.kind, t.profile, t.profile_chosen = target.info.kind, target.profile.name, chosen
         t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+        t.graded = "strict" if target.info.strict else "by the tags"
     meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
                                         for s in d["sections"]]}
                      for d in (pc.as_dict() for pc in coverage(
@@ -280,7 +287,8 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
         chosen = [resolve(s, args.profile if named else None, args.variant, console)
                   for s, named in specs]
         return [parse_target(s, profile=p, allow_destructive=args.allow_destructive,
-                             max_travel=args.max_travel, mutant=args.mutant)
+                             max_travel=args.max_travel, mutant=args.mutant,
+                             strict=args.strict)
                 for s, p, _ in chosen], [how for _, _, how in chosen]
     except (ValueError, LookupError, OSError, SerialException) as err:
         raise UsageError(str(err).strip("'\"")) from None

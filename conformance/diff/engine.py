@@ -155,7 +155,7 @@ class Pair:
                                      rec.reference, frozenset(context), frozenset(earlier))
                     d.rule = label(command, kind, context, earlier,
                                    _code(rec.reference), _code(rec.target))
-                    d.verdict, d.tag = verdict_of(d.rule, self.profile.implements_decisions)
+                    d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
                     out.disagreement = d
                     return self._end(out)
                 if i == 0:             # a fill's later vectors join the first: no dwell

@@ -83,9 +83,9 @@ def label(command: str, kind: str, context: set[str], earlier: set[str],
     return None
 
 
-def verdict_of(rule: str | None, implements_decisions: bool) -> tuple[str, str]:
+def verdict_of(rule: str | None, strict: bool) -> tuple[str, str]:
     """(verdict, tag) of a disagreement touching ``rule``."""
     if rule is None:
         return INFO, "D-info"
     tag = load_rules()[rule].tag
-    return grade(tag, implements_decisions), tag
+    return grade(tag, strict), tag

@@ -300,6 +300,7 @@ def certify(plan: Plan, run_id: str, on_result: Callable[[HostResult], None],
     # a certification's evidence is its wire log both ways with the faults marked on it:
     # every scenario keeps it whole, passing or not
     run.meta.started, run.meta.full_logs = now_iso(), True
+    run.meta.strict = plan.strict
     start = time.monotonic()
     results: list[HostResult] = []
 

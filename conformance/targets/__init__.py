@@ -19,9 +19,12 @@ SCHEMES = {"emu": emu, "serial": port, "tcp": port, "exec": process}
 
 
 def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bool = False,
-                 max_travel: int = DEFAULT_MAX_TRAVEL, mutant: str | None = None) -> Target:
+                 max_travel: int = DEFAULT_MAX_TRAVEL, mutant: str | None = None,
+                 strict: bool = False) -> Target:
     """A target from its command-line text (``emu:GVE84-100``, ``serial:/dev/ttyUSB0``...).
-    Raises TargetError (or LookupError for an unknown profile) with one line to show."""
+    ``strict``: grade a target that is not the reference emulator by the project's
+    decisions too (the reference always is). Raises TargetError (or LookupError for an
+    unknown profile) with one line to show."""
     kind, _, rest = spec.partition(":")
     module = SCHEMES.get(kind)
     if module is None:
@@ -29,4 +32,4 @@ def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bo
                           "serial:PATH?baud=&address=, tcp:HOST:PORT, or exec:COMMAND")
     return module.parse(kind, rest, spec=spec, profile=profile,
                         allow_destructive=allow_destructive, max_travel=max_travel,
-                        mutant=mutant)
+                        mutant=mutant, strict=strict)

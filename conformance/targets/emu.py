@@ -39,7 +39,7 @@ class EmuTarget(Target):
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
+          max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     parts = urlsplit("x://h/" + rest)
     name = parts.path.lstrip("/") or "GVE84-100"
     q = parse_qs(parts.query)
@@ -48,5 +48,6 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
     if profile is not None and load_profile(profile).name != p.name:
         raise TargetError(f"--profile {profile} contradicts the target {spec} "
                           f"(the emulator behaves as {p.name})")
-    info = TargetInfo("emu", spec, True, True, True, max_travel)
+    # the reference implements every decision: graded strictly, its mutants too
+    info = TargetInfo("emu", spec, True, True, True, max_travel, strict=True)
     return EmuTarget(info, p, p.address, p.default_baud, spec, mutant)

@@ -1,5 +1,5 @@
 """Who is on the line (issue 12 item 1): ask a unit `?` and `Q` — two questions that move
-nothing — and pick its profile for ``--profile auto``.
+nothing — and pick its profile for ``--profile auto``; ``ports --probe`` asks `?` alone.
 
 The family comes from the firmware string: a profile whose `?` answer is exactly that
 string, else the family its leading name gives (``IP84 v3 …`` → GVE84). The variant
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import serial
 
+from conformance.link.exclusive import LeftAlone, open_serial, settings_kept
 from conformance.link.framing import frame, parse_response
 from conformance.targets.base import Target
 from gve_fixtures.profile import Profile, available_profiles, load_profile
@@ -64,15 +65,17 @@ def _ask(port: serial.SerialBase, address: int, body: str) -> str | None:
 
 
 def ask(url: str, address: int, rates: list[int],
-        open_port: Callable[..., serial.SerialBase] = serial.serial_for_url
-        ) -> Identity | None:
-    """The unit's identity at the first rate where it answers `?`, or None."""
+        open_port: Callable[..., serial.SerialBase] = open_serial, *,
+        processor_id: bool = True) -> Identity | None:
+    """The unit's identity at the first rate where it answers `?`, or None; its `Q`
+    asked too unless ``processor_id`` is False (then "")."""
     for baud in rates:
         port = open_port(url, baudrate=baud, timeout=ANSWER_SECONDS)
         try:
             version = _ask(port, address, "?")
             if version is not None:
-                return Identity(version, _ask(port, address, "Q") or "", baud)
+                found = _ask(port, address, "Q") if processor_id else None
+                return Identity(version, found or "", baud)
         finally:
             port.close()
     return None
@@ -124,17 +127,21 @@ def choose(identity: Identity, variant: str | None = None,
     raise ValueError(f"--variant {variant}: a {family} is one of {choices}")
 
 
-def probe(url: str, address: int = 0) -> str | None:
-    """One line about the unit at ``url`` (for `gve-conformance ports --probe`)."""
+def probe(url: str, address: int = 0) -> str:
+    """What `gve-conformance ports --probe` says of the port at ``url``: the unit that
+    answers `?` (asked nothing else), no answer, or why the port was skipped untouched
+    (another program holds it; not a terminal). Its settings are put back afterwards."""
     try:
-        identity = ask(url, address, bauds())
+        with settings_kept(url):
+            identity = ask(url, address, bauds(), processor_id=False)
+    except LeftAlone as err:
+        return f"skipped: {err}"
     except (serial.SerialException, OSError, ValueError):
-        return None
+        return "no GVE unit answered"
     if identity is None:
-        return None
+        return "no GVE unit answered"
     family = family_of(identity.version) or "unknown family"
-    return (f"{family}: ? {identity.version!r}, Q {identity.processor_id!r} "
-            f"at {identity.baud} baud, address {address}")
+    return f"{family}: ? {identity.version!r} at {identity.baud} baud, address {address}"
 
 
 def of_target(target: Target) -> Identity | None:

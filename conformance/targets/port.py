@@ -10,6 +10,7 @@ from urllib.parse import parse_qs, urlencode, urlsplit
 import serial
 
 from conformance.case import TargetInfo
+from conformance.link.exclusive import open_serial
 from conformance.targets.base import Target, TargetError
 from conformance.targets.targetport import TargetPort
 from gve_fixtures.profile import Profile, available_profiles, load_profile
@@ -49,10 +50,11 @@ def _host_port(where: str) -> str:
 
 
 def open_port(url: str, baud: int, spec: str) -> serial.SerialBase:
-    """The pyserial port at ``url`` (a path, or a URL such as ``socket://host:port``);
-    TargetError with one line when it cannot be opened."""
+    """The pyserial port at ``url`` (a path, held alone while the run has it open, or a
+    URL such as ``socket://host:port``); TargetError with one line when it cannot be
+    opened (another program holds it, among others)."""
     try:
-        return serial.serial_for_url(url, baudrate=baud, timeout=0.5)
+        return open_serial(url, baudrate=baud, timeout=0.5)
     except (serial.SerialException, OSError, ValueError) as err:
         raise TargetError(f"{spec}: cannot open {url}: {_reason(err)}") from None
 
@@ -116,10 +118,10 @@ def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel:
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
+          max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     url, q = locate(kind, rest)
     p = real_profile(spec, profile, mutant, max_travel)
     baud = _number(q, "baud", p.default_baud, spec, 1, 10_000_000)
     address = _number(q, "address", p.address, spec, 0, 7)
-    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
+    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)
     return PortTarget(info, p, address, baud, url)

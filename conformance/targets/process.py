@@ -143,7 +143,7 @@ class ProcessTarget(PortTarget):
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
-          max_travel: int, mutant: str | None) -> Target:
+          max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     try:
         command = shlex.split(rest)
     except ValueError as err:
@@ -153,5 +153,5 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
                           "(exec:'./clone-sim --pty')")
     p = real_profile(spec, profile, mutant, max_travel,
                      "put --mutant NAME in the command when it is the emulator")
-    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel)
+    info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)
     return ProcessTarget(info, p, p.address, p.default_baud, spec, command=tuple(command))

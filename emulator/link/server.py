@@ -33,6 +33,8 @@ OUTPUT_LIMIT = 1 << 16
 #: a control line longer than this without its newline is refused
 CONTROL_LIMIT = 1 << 16
 READ_SIZE = 1 << 16
+#: reads of a connected host's bytes before a newcomer is turned away
+CHECK_READS = 16
 _ERRORS = select.POLLERR | select.POLLHUP | select.POLLNVAL
 
 
@@ -148,7 +150,10 @@ class PtyHost(Host):
 
 
 class TcpHost(Host):
-    """One host at a time on a TCP port; others are turned away while it is connected."""
+    """One host at a time on a TCP port; others are turned away while it is connected.
+    Whether it still is, is asked before a newcomer is turned away: a host that closed
+    and at once connected again is served, though poll told of the new connection
+    before the old one's end."""
 
     def __init__(self, host: str, port: int) -> None:
         self.listener = socket.create_server((host, port), reuse_port=False)
@@ -174,7 +179,7 @@ class TcpHost(Host):
         if fd == self.listener.fileno():
             with contextlib.suppress(BlockingIOError, InterruptedError):
                 conn, _ = self.listener.accept()
-                if self.conn is not None:
+                if self._connected(line, poll):
                     conn.close()
                     return
                 conn.setblocking(False)
@@ -200,6 +205,24 @@ class TcpHost(Host):
         if events & select.POLLOUT:
             self.out.flush(conn.send)
             poll.modify(conn, self._events())
+
+    def _connected(self, line: Line, poll: select.poll) -> bool:
+        """Whether a host is still connected, the bytes it sent taken first (up to
+        :data:`CHECK_READS` reads: one that keeps sending is there)."""
+        for _ in range(CHECK_READS):
+            if self.conn is None:
+                return False
+            try:
+                data = self.conn.recv(READ_SIZE)
+            except (BlockingIOError, InterruptedError):
+                return True
+            except OSError:
+                data = b""
+            if data == b"":
+                self._drop(poll)
+                return False
+            line.write(data)
+        return True
 
     def send(self, data: bytes, poll: select.poll) -> None:
         if self.conn is None:

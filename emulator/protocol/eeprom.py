@@ -1,6 +1,10 @@
 """The unit's EEPROM (spec 10.6): 256 bytes, optionally backed by an image file.
 
-The image survives J and power cycles. Every write replaces the file atomically: the
+The image survives J and power cycles. The file given must be an image: a regular file
+of exactly the EEPROM's size, or absent (then it is created with the defaults); anything
+else — a FIFO, a device, a directory, a file of another size — is refused before it is
+opened (:class:`EepromPlaceError`), so that nothing waits on a FIFO, reads a device
+without end, or cuts a file that was never an image. Every write replaces the file atomically: the
 new image goes to ``<image>.tmp`` next to it (flushed and fsynced) and is renamed over
 the image, with the signals that could interrupt it held back meanwhile, so a write
 leaves either the old or the new image and no temporary file. A place where the image
@@ -12,6 +16,7 @@ from __future__ import annotations
 
 import os
 import signal
+import stat
 import sys
 from pathlib import Path
 
@@ -31,13 +36,37 @@ class Eeprom:
         if self.path is None:
             return
         try:
-            if self.path.exists():
-                stored = self.path.read_bytes()
-                self.data[: len(stored)] = stored[: len(self.data)]
-            self._replace(self._temporary(), probe=True)
+            found = self._image()
+            if found is not None:
+                self.data[:] = found
+            self._replace(self._temporary(), probe=found is not None)
         except OSError as err:
-            raise EepromPlaceError(
-                f"cannot keep the EEPROM image in {self.path}: {err.strerror or err}") from None
+            raise self._refused(f"{err.strerror or err}") from None
+
+    def _image(self) -> bytes | None:
+        """The image the file holds (None: there is no file), looked at with ``stat``
+        before it is opened; EepromPlaceError when the file is no image."""
+        assert self.path is not None
+        try:
+            found = os.stat(self.path)
+        except FileNotFoundError:
+            return None
+        size = len(self.data)
+        if not stat.S_ISREG(found.st_mode):
+            raise self._refused(f"{_kind(found.st_mode)}, not an image file")
+        if found.st_size != size:
+            raise self._refused(f"{found.st_size} bytes, an image is {size}")
+        fd = os.open(self.path, os.O_RDONLY | os.O_NONBLOCK)   # never waits, even if
+        try:                                                   # swapped meanwhile
+            stored = os.read(fd, size + 1)
+        finally:
+            os.close(fd)
+        if len(stored) != size:
+            raise self._refused(f"it changed while read, an image is {size} bytes")
+        return stored
+
+    def _refused(self, why: str) -> EepromPlaceError:
+        return EepromPlaceError(f"cannot keep the EEPROM image in {self.path}: {why}")
 
     def read(self, address: int, size: int = 1) -> bytes:
         return bytes(self.data[address:address + size])
@@ -77,3 +106,14 @@ class Eeprom:
                 tmp.unlink(missing_ok=True)      # gone already after the rename
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+def _kind(mode: int) -> str:
+    """What a file that is no regular file is (for the refusal)."""
+    if stat.S_ISDIR(mode):
+        return "a directory"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "a socket" if stat.S_ISSOCK(mode) else "a special file"

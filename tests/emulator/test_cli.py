@@ -3,11 +3,15 @@ status 2, before it serves anything, never with a traceback (issue 8 item 9)."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+from gve_fixtures.profile import load_profile
+from tests.emulator.process import Emulator
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
@@ -47,6 +51,54 @@ def test_an_eeprom_place_that_cannot_be_written_is_refused(tmp_path: Path) -> No
         lines = done.stderr.splitlines()
         assert len(lines) == 1 and "cannot keep the EEPROM image" in lines[0], lines
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file"]
+
+
+def _fifo(place: Path) -> Path:
+    os.mkfifo(place / "fifo")                 # opened for reading, it would wait forever
+    return place / "fifo"
+
+
+def _sized(size: int):
+    def make(place: Path) -> Path:
+        (place / f"{size}.eeprom").write_bytes(bytes(size))
+        return place / f"{size}.eeprom"
+    return make
+
+
+#: what --eeprom may not be, and what the refusal says it is
+NO_IMAGES = {
+    "a FIFO": (_fifo, "a FIFO, not an image file"),
+    "a device": (lambda _: Path("/dev/zero"), "a device, not an image file"),
+    "a directory": (lambda place: place, "a directory, not an image file"),
+    **{f"{size} bytes": (_sized(size), f"{size} bytes, an image is 256")
+       for size in (0, 10, 300, 10 * 1024 * 1024)},
+}
+
+
+@pytest.mark.parametrize("what", list(NO_IMAGES))
+def test_an_eeprom_file_that_is_no_image_is_refused_before_the_port(tmp_path: Path,
+                                                                     what: str) -> None:
+    make, says = NO_IMAGES[what]
+    image = make(tmp_path)
+    size = image.stat().st_size if image.is_file() else None
+    done = run("--pty", "--eeprom", str(image))          # bounded: run's timeout
+    assert done.returncode == 2 and done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0] == (f"gve-emulator: cannot keep the EEPROM image "
+                                            f"in {image}: {says}"), lines
+    if size is not None:
+        assert image.stat().st_size == size               # left as it was
+
+
+def test_an_absent_eeprom_image_is_created_and_an_image_is_taken(tmp_path: Path) -> None:
+    image = tmp_path / "unit.eeprom"
+    for _ in range(2):                                    # absent, then the image made
+        emu = Emulator("--model", "GVE84-100", "--pty", "--eeprom", str(image))
+        try:
+            assert emu.first.startswith("/dev/") and "time_ns" in emu.state()   # serving
+            assert image.read_bytes() == load_profile("GVE84-100").eeprom.image()
+        finally:
+            assert emu.stop() == 0
 
 
 def test_a_port_in_use_is_refused() -> None:

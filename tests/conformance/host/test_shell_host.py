@@ -7,6 +7,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from junitparser import Failure, JUnitXml, Properties
 
 from conformance.verdict import FAIL, NON_STRICT, PASS
 from tests.conformance.host.run import certify, failing_rules, verdicts
@@ -37,3 +38,20 @@ def test_a_shell_host_in_lower_case_fails(tmp_path):
     print(clean["verdict"], failing_rules(clean))
     assert status == 1 and clean["verdict"] == FAIL
     assert "5.code.unknown" in failing_rules(clean)
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_the_junit_file_tells_a_ci_the_non_strict_verdict(tmp_path, strict):
+    certify(tmp_path, "GVE84-100", command=[SCRIPT, "{port}"], scenarios=("lost-answer.vector",),
+            options=("--strict",) if strict else ())
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir()]
+    (suite,) = JUnitXml.fromfile(str(folder / "junit.xml"))
+    (lost,) = [c for c in suite if c.name.startswith("8.host.lost-answer.vector")]
+    verdict = {p.name: p.value for p in lost.child(Properties)}["verdict"]
+    if strict:      # the host claims the project's decisions: the [D] rule FAILs
+        (failure,) = lost.result
+        assert isinstance(failure, Failure) and verdict == FAIL
+        assert failure.message.startswith("FAIL 8.recovery.finishes: ")
+    else:
+        assert lost.is_passed and verdict == NON_STRICT
+        assert lost.system_out.startswith("NON-STRICT 8.recovery.finishes: ")

@@ -5,7 +5,10 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as ET
 
+import pytest
+
 from conformance.cli import main
+from gve_fixtures.profile import load_profile
 
 
 def test_a_run_writes_three_reports(tmp_path, capsys):
@@ -62,3 +65,22 @@ def test_emu_all_means_every_profile(capsys):
 def test_an_unknown_profile_is_explained(capsys):
     assert main(["--target", "emu:GVE99", "--no-reports"]) == 2
     assert "GVE99" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", [
+    ["--target", "emu:GVE84-100", "--no-reports"],
+    ["--target", "serial:/dev/null", "--profile", "{file}", "--no-reports"],
+    ["--coverage"],
+    ["diff", "--target", "emu:GVE84-100", "--no-reports"],
+    ["host", "--profile", "GVE84-100", "--no-reports", "--", "true", "{port}"],
+])
+def test_a_misspelt_profile_key_stops_every_command_in_one_line(argv, tmp_path, monkeypatch,
+                                                               capsys):
+    text = load_profile("GVE84-100").path.read_text()
+    path = tmp_path / "GVE84-100.toml"       # overrides the shipped one (GVE_PROFILE_PATH)
+    path.write_text(text.replace("watchdog_ms =", "watchdog_mss =", 1))
+    monkeypatch.setenv("GVE_PROFILE_PATH", str(tmp_path))
+    assert main([a.replace("{file}", str(path)) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.endswith(
+        f"{path}: unknown key 'link.watchdog_mss' (did you mean 'link.watchdog_ms'?)\n")

@@ -69,9 +69,16 @@ def test_unit_bytes_that_cannot_be_read_fail_the_case_never_error(target, index)
         r.failed_checks[0]["what"]
 
 
-def test_d_is_non_strict_on_a_unit_that_does_not_implement_the_decisions(target):
-    target.profile = dataclasses.replace(target.profile, implements_decisions=False)
+def test_d_is_non_strict_on_a_target_not_graded_strictly(target):
+    target.info = dataclasses.replace(target.info, strict=False)
     assert run_case(_toy(_fails, "D"), target).verdict == NON_STRICT
+
+
+def test_d_fails_on_the_reference_emulator_and_on_a_target_run_with_strict(target):
+    assert target.info.strict and run_case(_toy(_fails, "D"), target).verdict == FAIL
+    real = parse_target("tcp:localhost:1", profile="GVE84-100", strict=True)
+    assert real.info.strict
+    assert not parse_target("tcp:localhost:1", profile="GVE84-100").info.strict
 
 
 def test_profile_filters_come_before_running(target):

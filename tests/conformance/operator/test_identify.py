@@ -1,6 +1,6 @@
 """--profile auto over a pty: every emulated profile is recognised from its answers to
 ? and Q (the variant from --variant where the answer does not say it, or asked on a
-terminal); gve-conformance ports lists and probes a pty-backed port."""
+terminal); gve-conformance ports lists and probes a pty-backed port (`?` alone)."""
 
 from __future__ import annotations
 
@@ -79,8 +79,9 @@ def test_ports_lists_and_probes_a_pty_backed_port(unit, capsys, tmp_path, monkey
     monkeypatch.setattr(ports.list_ports, "comports", lambda include_links: [])
     link = tmp_path / "ttyUSB-bench"
     link.symlink_to(unit.path)                        # as udev names an adapter
-    (tmp_path / "ttyUSB-nothing").write_text("")      # a device where no unit answers
+    (tmp_path / "ttyUSB-nothing").write_text("")      # no device: nothing written to it
     assert main(["ports", "--glob", str(tmp_path / "tty*"), "--probe"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert "GVE54: ? 'Ip54v3 21.12.2007', Q '25020304' at 115200 baud" in out[0]
-    assert out[1].endswith("-> no GVE unit answered")
+    assert out[0].endswith("-> GVE54: ? 'Ip54v3 21.12.2007' at 115200 baud, address 0")
+    assert out[1].endswith("-> skipped: not a serial device")
+    assert (tmp_path / "ttyUSB-nothing").read_text() == ""

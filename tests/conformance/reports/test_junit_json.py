@@ -1,10 +1,14 @@
 """JUnit XML and JSON: the run's metadata and verdict, per-testcase properties that
-show NON-STRICT and INFO, well-formed whatever the unit sent."""
+show NON-STRICT and INFO, well-formed whatever the unit sent; what a CI's JUnit reader
+(junitparser here) makes of NON-STRICT, INFO and COULD-NOT-TEST, with and without
+--strict."""
 
 from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
+
+from junitparser import Failure, JUnitXml, Properties, Skipped
 
 from conformance.reports import to_json, write_junit, write_reports
 from conformance.verdict import FAILED
@@ -55,3 +59,49 @@ def test_json_has_the_same_metadata_and_the_overall_verdict(tmp_path, no_plots):
     failing = next(r for r in data["results"] if r["id"] == "6.toy.fails")
     assert failing["wire_log"][-1] == f"< {HOSTILE}"       # JSON escapes by itself
     assert to_json(toy_run(full_logs=True))["results"][0]["wire_log_lines"] == 100
+
+
+def _read(run, path):
+    """The JUnit file of ``run`` as a CI reads it: its one suite, its cases by name."""
+    (suite,) = JUnitXml.fromfile(str(write_junit(run, path)))
+    return suite, {case.name: case for case in suite}
+
+
+def _case_props(case) -> dict[str, str]:
+    return {p.name: p.value for p in case.child(Properties) or ()}
+
+
+def test_a_ci_reader_sees_non_strict_and_info_pass_and_say_so(tmp_path):
+    suite, cases = _read(toy_run(), tmp_path / "junit.xml")
+    lenient, informs = cases["8.toy.lenient[GVE84-100]"], cases["9.toy.informs[GVE84-100]"]
+    assert lenient.is_passed and informs.is_passed
+    assert _case_props(lenient)["verdict"] == "NON-STRICT"
+    # the first line of the output names the verdict and the rule the check judges
+    assert lenient.system_out.splitlines()[0] == (
+        "NON-STRICT 8.repeat.answer: [D] > repeats the last frame "
+        "(observed '5', expected '0')")
+    assert informs.system_out.startswith("INFO 10.3.st6.free: [D-info] ST6 free bits")
+    counts = {p.name: p.value for p in suite.properties() if p.name.startswith("count ")}
+    assert counts == {"count PASS": "2", "count MISSING": "0", "count COULD-NOT-TEST": "1",
+                      "count INFO": "1", "count NON-STRICT": "1", "count FAIL": "1",
+                      "count ERROR": "0"}
+    assert (suite.tests, suite.failures, suite.errors, suite.skipped) == (6, 1, 0, 1)
+
+
+def test_could_not_test_is_skipped_with_its_reason(tmp_path):
+    _, cases = _read(toy_run(), tmp_path / "junit.xml")
+    hand = cases["10.3.toy.needs-a-hand[GVE84-100]"]
+    (skipped,) = hand.result
+    assert isinstance(skipped, Skipped) and skipped.message == (
+        "COULD-NOT-TEST 10.3.toy.needs-a-hand: nobody grounded IN0 (X limit)")
+
+
+def test_under_strict_non_strict_is_a_failure_and_info_still_passes(tmp_path):
+    suite, cases = _read(toy_run(strict=True), tmp_path / "junit.xml")
+    lenient = cases["8.toy.lenient[GVE84-100]"]
+    (failure,) = lenient.result
+    assert isinstance(failure, Failure) and failure.type == "NON-STRICT"
+    assert failure.message.startswith("NON-STRICT 8.repeat.answer: [D]")
+    assert cases["9.toy.informs[GVE84-100]"].is_passed
+    assert suite.failures == 2            # the FAIL and the NON-STRICT
+    assert {p.name: p.value for p in suite.properties()}["--strict"] == "True"

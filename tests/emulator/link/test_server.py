@@ -61,6 +61,23 @@ def test_an_endless_frame_costs_no_memory_and_is_answered_4() -> None:
         assert emu.stop() == 0
 
 
+def test_a_host_that_closes_and_connects_again_at_once_is_served() -> None:
+    emu = Emulator("--model", "GVE84-100", "--tcp", "127.0.0.1:0")
+    where = tuple(emu.first.split()[1].rsplit(":", 1))
+    deadline = time.monotonic() + 60
+    try:
+        for i in range(200):
+            sock = socket.create_connection(where, 10)
+            try:
+                sock.sendall(b"!0?\r")
+                assert read_answer(sock) == b"0,IP84 v3 27.1.2010\r", f"cycle {i}"
+            finally:
+                sock.close()
+        assert time.monotonic() < deadline
+    finally:
+        assert emu.stop() == 0
+
+
 def test_a_host_that_stops_reading_stops_neither_the_unit_nor_the_control_channel() -> None:
     emu = Emulator("--model", "GVE84-100", "--pty")
     port = serial.Serial(emu.first, 115200, timeout=5, write_timeout=5)

@@ -1,0 +1,71 @@
+"""`gve-conformance ports --probe` disturbs nobody: a port another program holds
+(TIOCEXCL, a lock) gets no byte and keeps its settings, and says
+why it was skipped; a free port gets `?` only and its settings back."""
+
+from __future__ import annotations
+
+import fcntl
+import termios
+
+import pytest
+
+from conformance.cli import main, ports
+from tests.conformance.link.test_exclusive import pending, pty  # noqa: F401  (fixture)
+
+
+@pytest.fixture(autouse=True)
+def only_globbed(monkeypatch):
+    """The machine's own ports left out: the probe sees the test's pty alone."""
+    monkeypatch.setattr(ports.list_ports, "comports", lambda include_links: [])
+
+
+def probe(path: str, capsys) -> str:
+    assert main(["ports", "--glob", path, "--probe"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 1 and out[0].startswith(path)
+    return out[0]
+
+
+def cooked(fd: int) -> list:
+    """Settings no probe would leave: canonical, echoing, 9600 baud, 7E1."""
+    attrs = termios.tcgetattr(fd)
+    attrs[2] = (attrs[2] & ~termios.CSIZE) | termios.CS7 | termios.PARENB
+    attrs[3] |= termios.ICANON | termios.ECHO
+    attrs[4] = attrs[5] = termios.B9600
+    termios.tcsetattr(fd, termios.TCSANOW, attrs)
+    return termios.tcgetattr(fd)
+
+
+def test_a_port_held_with_tiocexcl_is_skipped_untouched(pty, capsys):  # noqa: F811
+    master, slave, path = pty
+    settings = cooked(slave)
+    fcntl.ioctl(slave, termios.TIOCEXCL)
+    line = probe(path, capsys)
+    assert line.endswith("-> skipped: another program holds it exclusively (TIOCEXCL)")
+    assert pending(master) == b""
+    assert termios.tcgetattr(slave) == settings
+
+
+def test_a_port_another_run_has_locked_is_skipped_untouched(pty, capsys):  # noqa: F811
+    master, slave, path = pty
+    settings = cooked(slave)
+    fcntl.flock(slave, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    assert "-> skipped: another program holds it locked" in probe(path, capsys)
+    assert pending(master) == b""
+    assert termios.tcgetattr(slave) == settings
+
+
+def test_a_free_port_is_asked_only_and_gets_its_settings_back(pty, capsys):  # noqa: F811
+    master, slave, path = pty
+    settings = cooked(slave)
+    assert probe(path, capsys).endswith("-> no GVE unit answered")
+    assert termios.tcgetattr(slave) == settings
+    sent = pending(master)
+    assert sent and set(sent.split(b"\r")) == {b"!0?", b""}       # `?` at each rate
+
+
+def test_what_is_no_serial_device_is_skipped(tmp_path, capsys):
+    plain = tmp_path / "ttyUSB-file"
+    plain.write_text("")
+    assert probe(str(plain), capsys).endswith("-> skipped: not a serial device")
+    assert plain.read_text() == ""
