@@ -247,3 +247,15 @@ class Replies(Interrupting):
 
     def line(self, timeout: float) -> str | None:
         return self.replies.pop(0) if self.replies else None
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_a_co_simulator_is_graded_as_a_target_other_than_the_reference(strict):
+    """Strict (a failed [D] check FAILs) only when the run says --strict: the clock is
+    the suite's, the firmware somebody else's."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100", strict=strict)
+    target.preflight()
+    try:
+        assert target.info.virtual_time and target.info.strict is strict
+    finally:
+        target.close()
