@@ -95,6 +95,7 @@ class ProcessTarget(PortTarget):
         if url is None:
             self._fail(f"the program's first line {first[:200]!r} is not a port (a pty "
                        "path, socket://HOST:PORT or HOST:PORT) nor cosim 1")
+        self.program.read_in_background()              # it never blocks on its output
         self.rig = ControlRig.detect(self.program, self.address, self._restarted)
         self._found_rig(virtual=False)
         return url
@@ -106,9 +107,7 @@ class ProcessTarget(PortTarget):
         if version != VERSION:
             self._fail(f"the program speaks co-simulation version {version}; this suite "
                        f"speaks version {VERSION} (docs/cosim.md)")
-        program = self.program
-        program.keep_every_line()
-        line = CosimLine(program, self.baud)
+        line = CosimLine(self.program, self.baud)     # its replies read as they are due
         try:
             self.rig = ControlRig.found_in(line.start(), line.ask, self.address,
                                            self._restarted)

@@ -1,7 +1,9 @@
 """The program behind an ``exec:`` target: started in a process group of its own (so
 that Ctrl-C on the terminal reaches the suite alone, which halts the unit before the
-program is stopped), its standard output read line by line, its standard input written
-line by line, its standard error kept for the one line that says why it failed.
+program is stopped), its standard output read line by line (when asked for, or by a
+thread in the background once :meth:`Program.read_in_background` is called), its
+standard input written line by line, its standard error kept for the one line that says
+why it failed.
 
 Stopping it (:meth:`Program.stop`) asks first (``quit`` on standard input, docs/rig.md),
 then terminates and finally kills its whole process group, each with a bounded wait, and
@@ -15,6 +17,7 @@ import atexit
 import contextlib
 import os
 import queue
+import select
 import shlex
 import signal
 import subprocess
@@ -51,34 +54,62 @@ class Program:
             self._stderr.close()
             reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
             raise ProgramError(f"cannot start {command[0]!r}: {reason}") from None
+        self._fd = self.process.stdout.fileno()     # read with os.read only, unbuffered
+        self._pending = bytearray()                 # bytes read, not yet a whole line
         self._lines: queue.Queue[str | None] = queue.Queue()
-        self._keep = False            # every line kept for its reader (keep_every_line)
+        self._background = False
         self._eof = False
         _RUNNING.add(self)
-        threading.Thread(target=self._read, name=f"exec-{self.process.pid}",
-                         daemon=True).start()
-
-    def _read(self) -> None:
-        """Standard output, line by line, until its end (then None); lines beyond
-        HELD_LINES that nobody takes are dropped, so the program never blocks on it
-        (unless every line is kept); a line longer than LINE_LIMIT comes in pieces."""
-        assert self.process.stdout is not None
-        with contextlib.suppress(OSError, ValueError):       # closed by stop()
-            while raw := self.process.stdout.readline(LINE_LIMIT):
-                if self._keep or self._lines.qsize() < HELD_LINES:
-                    self._lines.put(raw.decode("utf-8", "replace").rstrip("\r\n"))
-        self._lines.put(None)
-        self._eof = True
-
-    def keep_every_line(self) -> None:
-        """From now on no line is dropped: each is a reply its reader waits for (a
-        co-simulator's, docs/cosim.md)."""
-        self._keep = True
 
     # -- what it says ---------------------------------------------------------------------
+    def _take(self, timeout: float | None) -> str | None:
+        """The next line read from standard output itself, waiting up to ``timeout``
+        seconds (None: until one comes); None when none came or the output ended. A line
+        longer than LINE_LIMIT comes in pieces."""
+        end = None if timeout is None else time.monotonic() + timeout
+        while True:
+            k = self._pending.find(b"\n")
+            if k >= 0 or len(self._pending) >= LINE_LIMIT or (self._eof and self._pending):
+                k = min(len(self._pending), LINE_LIMIT) if k < 0 else k
+                raw = bytes(self._pending[:k])
+                del self._pending[:k + 1]
+                return raw.decode("utf-8", "replace").rstrip("\r")
+            if self._eof:
+                return None
+            left = None if end is None else max(0.0, end - time.monotonic())
+            try:
+                ready = select.select([self._fd], [], [], left)[0]
+                data = os.read(self._fd, 1 << 16) if ready else None
+            except (OSError, ValueError):              # closed by stop()
+                data = b""
+            if data is None:
+                return None
+            if not data:
+                self._eof = True
+            self._pending += data
+
+    def read_in_background(self) -> None:
+        """From now on a thread reads standard output as it comes, so that the program
+        never blocks on it: lines beyond HELD_LINES that nobody takes are dropped (a
+        simulator in real time, whose output is its rig's replies and what else it
+        prints). Until then lines are read when asked for, none dropped (a
+        co-simulator's replies, docs/cosim.md)."""
+        if not self._background:
+            self._background = True
+            threading.Thread(target=self._read, name=f"exec-{self.process.pid}",
+                             daemon=True).start()
+
+    def _read(self) -> None:
+        while (text := self._take(None)) is not None:
+            if self._lines.qsize() < HELD_LINES:
+                self._lines.put(text)
+        self._lines.put(None)
+
     def line(self, timeout: float) -> str | None:
         """The next line of standard output within ``timeout`` seconds (None: none came,
         or the output ended)."""
+        if not self._background:
+            return self._take(timeout)
         if self._eof and self._lines.empty():
             return None
         try:
@@ -90,10 +121,15 @@ class Program:
         """The lines already printed and not taken (dropped)."""
         out = []
         while True:
-            try:
-                text = self._lines.get_nowait()
-            except queue.Empty:
-                return out
+            if not self._background:
+                text = self._take(0.0)
+                if text is None:
+                    return out
+            else:
+                try:
+                    text = self._lines.get_nowait()
+                except queue.Empty:
+                    return out
             if text is not None:
                 out.append(text)
 

@@ -34,7 +34,6 @@ def example():
     program = Program([sys.executable, str(EXAMPLE)])
     try:
         assert program.line(10) == "cosim 1"
-        program.keep_every_line()
         line = CosimLine(program, 115200)
         assert line.start().startswith("error:"), "the example has no rig"
         yield CosimPort(line, timeout=30.0)
