@@ -62,6 +62,15 @@ class Case:
 
 REGISTRY: dict[str, Case] = {}
 
+#: how a tag grades: M and M-ex alike (a golden example is a manual's statement too)
+GRADES = {"M": "M", "M-ex": "M", "D": "D", "D-info": "D-info"}
+
+
+def mixed(case: Case) -> bool:
+    """Whether the case's rules grade differently, so each check must name its rule."""
+    known = load_rules()
+    return len({GRADES[known[r].tag] for r in case.rules}) > 1
+
 
 def case(id: str, *, rule: str | None = None, tag: str | None = None, source: str | None = None,
          requires: tuple[str, ...] = (), absent: tuple[str, ...] = (),
@@ -79,10 +88,14 @@ def case(id: str, *, rule: str | None = None, tag: str | None = None, source: st
         raise ValueError(f"{id}: name its rules, or give rule, tag and source")
     first = known[rules[0]] if rules else None
     rule = first.text if rule is None else rule
+    if tag is not None and tag not in TAGS:
+        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
+    graded = {GRADES[known[r].tag] for r in rules}
+    if tag is not None and rules and GRADES[tag] not in graded:
+        raise ValueError(f"{id}: declared tag {tag} contradicts its rules, tagged "
+                         f"{', '.join(sorted({known[r].tag for r in rules}))}")
     tag = first.tag if tag is None else tag
     source = first.source if source is None else source
-    if tag not in TAGS:
-        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)
@@ -161,6 +174,10 @@ class CaseContext:
                              f"not list in its rules")
         if rule is None and len(self.case.rules) == 1:
             rule = self.case.rules[0]
+        if rule is None and tag is None and self.case.rules and mixed(self.case):
+            # the case's tag would grade a [D] point as [M] or the other way round
+            raise ValueError(f"{self.case.id}: a check ({what!r}) must name its rule: the "
+                             "case's rules carry different tags")
         graded = tag or (load_rules()[rule].tag if rule else self.case.tag)
         self.checks.append(Check(bool(ok), what,
                                  "" if observed is None else str(observed),

@@ -88,7 +88,8 @@ def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
                       expected=expected, tag=tag, rule=rule)
 
 
-def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:
+def fill_queue(ctx: CaseContext, count: int | None = None, *,
+               rule: str | None = None) -> bool:
     """Setup: stop the unit (H, so INTA = 1 and vectors wait in the queue [D 10.1]) and
     queue ``count`` (default: the buffer's size) one-step vectors going back and forth,
     so that a real unit's axes stay within the envelope. Returns whether every vector
@@ -98,7 +99,7 @@ def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:
     for i in range(ctx.profile.buffer if count is None else count):
         r = ctx.link.send("C" + vector(ctx, 1 if i % 2 == 0 else -1))
         if not ctx.expect(r is not None and r.code == 0, f"vector {i + 1} is accepted",
-                          observed=show(r), expected="code 0"):
+                          observed=show(r), expected="code 0", rule=rule):
             return False
     return True
 

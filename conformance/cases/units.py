@@ -84,7 +84,8 @@ def absent(ctx: CaseContext) -> None:
       tag="D", source="spec 1 [D]",
       rule="? answers 0,<the profile's firmware string>")
 def version(ctx: CaseContext) -> None:
-    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string")
+    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string",
+            rule="1.profile.version")
 
 
 @case("9.reset.state",
@@ -110,11 +111,11 @@ def after_j(ctx: CaseContext) -> None:
     setup(ctx, "SW2,2B")
     setup(ctx, "L" + vector(ctx, 16))
     link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
-    answers(ctx, link.send("J"), "0", "J → 0")
+    answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5)
-    answers(ctx, link.send("SR2"), "0,00", "ST2 reset", tag="M")
-    answers(ctx, link.send("@"), "0,1", "the index restarted at 0")
-    ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", tag="M")
+    answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
+    answers(ctx, link.send("@"), "0,1", "the index restarted at 0", rule="8.index.answer")
+    ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", rule="9.reset.state")
 
 
 @case("10.6.eeprom.round-trip",
@@ -165,9 +166,12 @@ def microstep(ctx: CaseContext) -> None:
       rule="!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate")
 def spindle(ctx: CaseContext) -> None:
     link = ctx.link
-    answers(ctx, link.send("V300", address=7), "0", "!7V300")
-    ctx.expect(link.rig.spindle() == 300, "spindle 300", observed=link.rig.spindle())
-    ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs())
-    answers(ctx, link.send("V0", address=7), "0", "!7V0")
-    ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs())
-    code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors", tag="D")
+    speed = "12.spindle.speed"
+    answers(ctx, link.send("V300", address=7), "0", "!7V300", rule=speed)
+    ctx.expect(link.rig.spindle() == 300, "spindle 300", observed=link.rig.spindle(),
+               rule=speed)
+    ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs(), rule=speed)
+    answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)
+    ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
+    code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors",
+         rule="12.spindle.commands")
