@@ -9,7 +9,6 @@ from dataclasses import dataclass, field
 
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import ERROR, FAIL, NON_STRICT, ORDER, grade
-from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
 
 #: the verdicts the list shows, worst first
@@ -30,23 +29,25 @@ class Failure:
     runs: list[CaseResult] = field(default_factory=list)   # the case's runs it stands for
 
 
-def _implements_decisions(profile: str) -> bool:
+def _graded(tag: str, strict: bool | None) -> str | None:
+    """The verdict a failed check with ``tag`` gives (``strict`` None: not known, only a
+    verdict every grading agrees on)."""
     try:
-        return load_profile(profile).implements_decisions
-    except (LookupError, ValueError, OSError):
-        return True
+        if strict is None:
+            lenient, strictly = grade(tag, False), grade(tag, True)
+            return strictly if strictly == lenient else None
+        return grade(tag, strict)
+    except ValueError:
+        return None
 
 
-def deciding_check(r: CaseResult) -> dict | None:
-    """The first failed check graded as the case's verdict (else its first failed one)."""
+def deciding_check(r: CaseResult, strict: bool | None = None) -> dict | None:
+    """The first failed check graded as the case's verdict (else its first failed one);
+    ``strict``: how the case's target was graded (None: not known)."""
     failed = r.failed_checks
-    decisions = _implements_decisions(r.profile)
     for c in failed:
-        try:
-            if grade(c["tag"], decisions) == r.verdict:
-                return c
-        except ValueError:
-            continue
+        if _graded(c["tag"], strict) == r.verdict:
+            return c
     return failed[0] if failed else None
 
 
@@ -61,8 +62,8 @@ def _why_not_run(r: CaseResult) -> str:
     return f"{lines[0]} … {lines[-1].strip()}"
 
 
-def failure_of(r: CaseResult) -> Failure:
-    c = deciding_check(r)
+def failure_of(r: CaseResult, strict: bool | None = None) -> Failure:
+    c = deciding_check(r, strict)
     if c is None:
         return Failure(r.id, r.verdict, _why_not_run(r), rule=r.rule, runs=[r])
     rule_id = c.get("rule") or ""
@@ -75,11 +76,13 @@ def failure_of(r: CaseResult) -> Failure:
 def failures(run: RunResult) -> list[Failure]:
     """The failing cases, worst verdict first, then in case order; the same case failing
     the same way on several profiles once."""
+    graded = {t.spec: {"strict": True, "by the tags": False}.get(t.graded)
+              for t in run.meta.targets}
     out: dict[tuple, Failure] = {}
     for r in run.results:
         if r.verdict not in LISTED:
             continue
-        f = failure_of(r)
+        f = failure_of(r, graded.get(r.target))
         key = (f.id, f.verdict, f.what, f.observed, f.expected)
         if key in out:
             out[key].runs.append(r)

@@ -144,3 +144,20 @@ def test_plain_headers_and_the_state_as_found_and_as_left_in_view(no_plots):
                   "PROBLEM: EEPROM 07 not put back",
                   "emu:GVE84-100: the embedded emulator — every case ran on a fresh unit"):
         assert shown in state, shown
+
+
+@pytest.mark.parametrize(("graded", "shown"), [("by the tags", "an M check"),
+                                               ("strict", "a D check"), ("", "an M check")])
+def test_the_check_shown_is_the_one_that_gave_the_verdict(graded, shown, no_plots):
+    """Graded by the tags a failed [D] check is NON-STRICT: a FAIL is the [M] check's;
+    graded strictly the first failed check FAILs the case."""
+    run = toy_run()
+    run.meta.target("emu:GVE84-100").graded = graded
+    run.results = [result("10.toy.both", FAIL, checks=[
+        {"ok": False, "what": "a D check", "observed": "1", "expected": "0", "tag": "D",
+         "rule": ""},
+        {"ok": False, "what": "an M check", "observed": "2", "expected": "0", "tag": "M",
+         "rule": ""}])]
+    page = render_html(run)
+    failed = page[page.index("id='failed'"):page.index("</section>")]
+    assert f"<td>{shown}</td>" in failed
