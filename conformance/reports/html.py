@@ -71,7 +71,8 @@ def _failed(run: RunResult) -> list[str]:
     untested = [f"{counts[v]} {v}" for v in _UNJUDGED if counts.get(v)]
     if not found and not untested:
         return []
-    out = [f"<section id='failed'><h2>What failed ({len(found)})</h2>"]
+    out = [f"<section id='failed'><h2>What failed ({len(found)})</h2>" if found else
+           "<section id='failed'><h2>What failed: no case</h2>"]
     if found:
         out.append("<table class='failed'><tr><th>case</th><th>what failed</th>"
                    "<th>observed</th><th>expected</th><th>rule</th></tr>")
@@ -84,8 +85,6 @@ def _failed(run: RunResult) -> list[str]:
                        f"<td>{h(f.what)}</td><td>{h(f.observed)}</td><td>{h(f.expected)}</td>"
                        f"<td>{h(rule)}</td></tr>")
         out.append("</table>")
-    else:
-        out.append("<p>No case failed.</p>")
     if untested:
         out.append(f"<p class='why'>Not judged: {h(', '.join(untested))} (each says why on "
                    "its line under Cases).</p>")
