@@ -209,12 +209,17 @@ class CaseContext:
 
     def trace(self, name: str, *, samples: list[tuple[float, list[int]]],
               model: list[tuple[float, list[int]]], tolerance: dict[str, float],
-              params: dict[str, Any]) -> None:
+              params: dict[str, Any], faults: list[dict] | None = None) -> None:
         """Record a motion trace for the reports: ``samples`` as read from the target
         (seconds since the motion's origin, positions per axis), ``model`` the spec
         model's positions at those or denser instants, ``tolerance`` the band the check
-        used (``seconds``, ``steps``), ``params`` the parameters (A, V, B, T, XM...)."""
+        used (``seconds``, ``steps``), ``params`` the parameters (A, V, B, T, XM...),
+        ``faults`` what the checks found wrong, to be marked on the picture: an instant
+        (``{"kind": "instant", "what", "observed": t, "expected": [t_lo, t_hi],
+        "expected_what"}``) or a reading (``{"kind": "position", "t", "axis",
+        "observed": steps, "expected": [lo, hi]}``)."""
         self.traces.append({"name": name,
                             "samples": [[float(t), [int(p) for p in ps]] for t, ps in samples],
                             "model": [[float(t), [int(p) for p in ps]] for t, ps in model],
-                            "tolerance": dict(tolerance), "params": dict(params)})
+                            "tolerance": dict(tolerance), "params": dict(params),
+                            **({"faults": list(faults)} if faults else {})})
