@@ -148,6 +148,8 @@ class CaseContext:
     _link: Link | None = None
     seed: int | None = None      # the run's seed for the Hypothesis machines (None: settings)
     operator: Any = None         # conformance.operator.Hands: hand steps (rig or technician)
+    #: what the case measured of the unit's readings once (e.g. whether @ counts itself)
+    measured: dict[Any, Any] = field(default_factory=dict)
 
     @property
     def link(self) -> Link:

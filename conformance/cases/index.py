@@ -37,7 +37,7 @@ def queries(ctx: CaseContext) -> None:
     link.send("V1000")
     link.send("@")
     link.send(">", lines=2)
-    index_moved(ctx, before, 1, "only V1000 counted")
+    index_moved(ctx, before, 1, "only V1000 counted", queries=True)
 
 
 @case("8.index.modulo-256",
@@ -94,15 +94,11 @@ def not_again(ctx: CaseContext) -> None:
       rule="A lost response is recovered with @ and > without executing the vector twice")
 def lost_response(ctx: CaseContext) -> None:
     link = ctx.link
-    before = link.send("@")
+    before = index(ctx)
     link.inject("unit", "drop")
     lost = link.send("L" + vector(ctx, 9))
     ctx.require(lost is None, "the injected loss did not happen")
-    after = link.send("@")
-    ctx.expect(before is not None and after is not None and
-               after.dec() == (before.dec() + 1) % 256,
-               "the index shows the command arrived", observed=after, expected="index + 1",
-               rule="8.index.counts")
+    index_moved(ctx, before, 1, "the index shows the command arrived", rule="8.index.counts")
     r = link.send(">", lines=2)
     answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer",
             rule="8.repeat.answer")

@@ -38,6 +38,11 @@ class UnitMachine(RuleBasedStateMachine):
         # a real unit is not fresh: start the bookkeeping from where it is
         self.model.committed = self.position()
         self.model.index = self.index()
+        # whether @ counts itself is a reading the manuals leave open [D]: measured
+        again = self.index()
+        if again == (self.model.index + 1) % 256:
+            self.model.uncounted = ()
+        self.model.index = again
 
     def send(self, body: str, **kw) -> Response | None:
         r = self.link.send(body, **kw)
@@ -59,6 +64,7 @@ class UnitMachine(RuleBasedStateMachine):
     def index(self) -> int:
         r = self.link.send("@")
         holds(r is not None and r.code == 0 and r.values, "8.index.answer", f"@ answered {r}")
+        self.model.frame_arrived("@")
         return r.dec()
 
     def position(self) -> list[int]:

@@ -63,6 +63,7 @@ class PacketMachine(UnitMachine):
     @rule()
     def breaker(self) -> None:
         r = self.link.send("@")
+        self.model.frame_arrived("@")
         holds(r is not None and r.code == 0, "7.packet.breakers",
               f"@ inside a packet answered {r}")
         self.model.packet = None

@@ -201,6 +201,8 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
         if dev.mutant.active("go-without-inta"):
             return []
         raise CommandError(ErrorCode.NOTHING_TO_GO, "G with INTA = 0")
+    if dev.readings.active("go-nothing-queued") and not dev.motion.queued(t):
+        raise CommandError(ErrorCode.NOTHING_TO_GO, "G with nothing queued")
     s.status[6] &= ~(INTA | INTCOM)
     s.status[4] = s.status[5] = 0
     dev.motion.resume(t)

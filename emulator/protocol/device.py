@@ -18,6 +18,8 @@ from emulator.mutants import Mutant
 from emulator.protocol.eeprom import Eeprom
 from emulator.protocol.params import CommandError
 from emulator.protocol.state import FREE, INTA, RUN, STOP, DeviceState, reset_state
+from emulator.readings import NONE as NO_READINGS
+from emulator.readings import Readings
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -28,9 +30,11 @@ UNCONNECTED = {0: 0xFF, 1: 0xFF, 2: 0xFF}
 
 class Device:
     def __init__(self, profile: Profile, *, mutant: Mutant, eeprom_path: str | Path | None = None,
-                 stepper: str | None = None, origin: int = 0) -> None:
+                 stepper: str | None = None, origin: int = 0,
+                 readings: Readings = NO_READINGS) -> None:
         self.profile = profile
         self.mutant = mutant
+        self.readings = readings
         self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
