@@ -71,7 +71,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 def targets(args: argparse.Namespace) -> tuple[Target, Target]:
     """The target and its reference, checked before anything is sent (a real unit that
     would have to ask before moving where nobody can answer is refused here)."""
-    unattended([args.target], args.yes, Console())
     target = parse_target(args.target, profile=args.profile,
                           allow_destructive=args.allow_destructive, max_travel=args.max_travel,
                           strict=args.strict)
@@ -85,6 +84,7 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
                          f"target as {target.profile.name}")
     target.preflight()
     reference.preflight()
+    unattended([target, reference], args.yes, Console())
     return target, reference
 
 

@@ -25,6 +25,7 @@ from conformance.cli.unit import (
     record_identities,
     resolve,
     unattended,
+    unattended_specs,
 )
 from conformance.cli.usage import Parser, UsageError, positive, run_id, writable_folder
 from conformance.coverage import coverage, format_coverage
@@ -179,12 +180,15 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
 
 def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     console = Console()
-    unattended(args.target, args.yes, console)
+    if args.profile == "auto":       # asking a unit on a port who it is sends `?` and `Q`
+        unattended_specs([t for t in args.target if t.startswith(("serial:", "tcp:"))],
+                         args.yes, console)
     try:
         targets, how = _targets(args, console)
     except KeyboardInterrupt:
         raise UsageError("interrupted before the run, nothing was sent") from None
     _preflight(targets)
+    unattended(targets, args.yes, console)
     run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
     seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
     meta = _meta(args, argv, targets, how, cases, seed, console)

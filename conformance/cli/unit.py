@@ -96,10 +96,22 @@ def confirmed(targets: list[Target], meta: RunMeta, console: Console) -> bool:
     return not real or confirm_motion(console, lines)
 
 
-def unattended(specs: list[str], yes: bool, console: Console) -> None:
+def unattended(targets: list[Target], yes: bool, console: Console) -> None:
     """Refuse, before anything is sent, a run on a real unit that must ask before its
     first move (no ``--yes``) where nobody can answer (standard input not a terminal):
-    UsageError, exit status 2. The embedded emulator (``emu:``) needs no question."""
+    the targets are closed, UsageError (exit status 2). The embedded emulator needs no
+    question. ``--profile auto``, which asks the unit who it is, checks the specs first
+    with :func:`unattended_specs`."""
+    try:
+        unattended_specs([t.info.spec for t in targets if t.info.kind != "emu"], yes, console)
+    except UsageError:
+        for t in targets:
+            t.close()
+        raise
+
+
+def unattended_specs(specs: list[str], yes: bool, console: Console) -> None:
+    """:func:`unattended` for target specs not yet opened."""
     real = [s for s in specs if s.partition(":")[0] != "emu"]
     if real and not yes and not console.interactive:
         raise UsageError(CANNOT_ASK)
