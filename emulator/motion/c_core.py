@@ -1,16 +1,26 @@
 """The C stepper core behind the Motion interface (interface.py).
 
-Raises ImportError when the compiled module ``emulator.motion._stepper_c`` is missing
-(the emulator then uses the Python twin). Behaves exactly like python_twin.PythonMotion;
-KEEP returns the same save structure, so the unit treats both cores alike.
+Raises ImportError when the compiled module ``emulator.motion._stepper_c`` is missing,
+or older than its sources and not rebuildable here (rebuild.py): the emulator then uses
+the Python twin. Behaves exactly like python_twin.PythonMotion; KEEP returns the same
+save structure, so the unit treats both cores alike.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from emulator.motion._stepper_c import ffi, lib  # ImportError when not built
-from emulator.motion.interface import Deviation, KeepSave, MotionFlags, Vector
+from emulator.motion.rebuild import ensure_fresh
+
+ensure_fresh()   # ImportError for a stale build that cannot be rebuilt
+
+from emulator.motion._stepper_c import ffi, lib  # noqa: E402  (ImportError when not built)
+from emulator.motion.interface import (  # noqa: E402
+    Deviation,
+    KeepSave,
+    MotionFlags,
+    Vector,
+)
 
 AXES = 4
 
