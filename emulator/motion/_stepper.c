@@ -328,12 +328,13 @@ void st_position(stepper *m, int64_t t, int64_t *out) {
     position_now(m, out);
 }
 
-void st_flags(stepper *m, int64_t t, int *busy, int *moving, int *stopping, int *halted) {
+int st_flags(stepper *m, int64_t t) {
     st_advance(m, t);
-    *stopping = m->halted && m->stop_end > m->now;
-    *busy = m->qlen > 0;
-    *moving = (*busy && !m->halted) || *stopping;
-    *halted = m->halted;
+    int stopping = m->halted && m->stop_end > m->now;
+    int busy = m->qlen > 0;
+    int moving = (busy && !m->halted) || stopping;
+    return (busy ? ST_BUSY : 0) | (moving ? ST_MOVING : 0) | (stopping ? ST_STOPPING : 0)
+        | (m->halted ? ST_HALTED : 0);
 }
 
 int64_t st_queued(stepper *m, int64_t t) {
@@ -341,27 +342,39 @@ int64_t st_queued(stepper *m, int64_t t) {
     return (i64)m->qlen;
 }
 
-/* the executed pieces, then the planned future up to t1 (played on a ghost) */
-typedef struct { piece_t *p; size_t n; } timeline_t;
+/* The executed pieces, then the planned future up to t1 (played on a ghost): read in
+ * place (the history ring, the ghost's, the head's remaining plan), never copied. */
+typedef struct {
+    const stepper *m;
+    stepper *g;
+    piece_t tail;
+    size_t n;
+} timeline_t;
 
 static int timeline(stepper *m, i64 t1, timeline_t *tl) {
     stepper *g = ghost(m);
     if (!g) return -1;
     st_advance(g, t1);
-    size_t total = m->hlen + g->hlen + 1;
-    tl->p = malloc(total * sizeof(piece_t));
-    if (!tl->p) { st_free(g); return -1; }
-    size_t n = 0;
-    for (size_t i = 0; i < m->hlen; i++) tl->p[n++] = m->hist[(m->hhead + i) % m->hcap];
-    for (size_t i = 0; i < g->hlen; i++) tl->p[n++] = g->hist[(g->hhead + i) % g->hcap];
+    tl->m = m;
+    tl->g = g;
+    tl->n = m->hlen + g->hlen;
     if (g->qlen && head(g)->has_plan && head(g)->nseg > 0) {
         entry_t *e = head(g);
-        make_piece(&tl->p[n++], g->base, e, e->done, entry_steps(e, NEVER), g->axes);
+        make_piece(&tl->tail, g->base, e, e->done, entry_steps(e, NEVER), g->axes);
+        tl->n++;
     }
-    tl->n = n;
-    st_free(g);
     return 0;
 }
+
+static const piece_t *timeline_piece(const timeline_t *tl, size_t i) {
+    const stepper *m = tl->m, *g = tl->g;
+    if (i < m->hlen) return &m->hist[(m->hhead + i) % m->hcap];
+    i -= m->hlen;
+    if (i < g->hlen) return &g->hist[(g->hhead + i) % g->hcap];
+    return &tl->tail;
+}
+
+static void timeline_free(timeline_t *tl) { st_free(tl->g); }
 
 static i64 piece_instant(const piece_t *p, i64 k) {
     for (int i = 0; i < p->nseg; i++) {
@@ -386,7 +399,7 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
     if (timeline(m, NEVER, &tl)) return -1;
     int found = 0;
     for (size_t i = 0; i < tl.n && !found; i++) {
-        const piece_t *p = &tl.p[i];
+        const piece_t *p = timeline_piece(&tl, i);
         i64 d = p->steps[axis];
         i128 c = (i128)value - p->base[axis];
         if (d == 0 || c == 0 || ((c > 0) != (d > 0)) || abs128(c) > abs128(d)) continue;
@@ -396,34 +409,63 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
             if (t >= m->now) { *out = t; found = 1; }
         }
     }
-    free(tl.p);
+    timeline_free(&tl);
     return found;
+}
+
+/* Steps first..last of a piece: their instants and masks. The plan's segments follow
+ * each other over the steps, so they are walked in order; each axis's count at the step
+ * before is carried from one step to the next. */
+static void piece_train(const piece_t *p, int axes, i64 first, i64 last, i64 *times,
+                        uint8_t *masks) {
+    i64 before[ST_AXES];
+    uint8_t sign = 0;
+    for (int a = 0; a < axes; a++) {
+        before[a] = axis_count(first - 1, p->steps[a], p->n);
+        if (p->steps[a] < 0) sign |= (uint8_t)(1 << (4 + a));
+    }
+    i64 k = first;
+    for (int i = 0; i < p->nseg && k <= last; i++) {
+        const seg_t *s = &p->plan[i];
+        for (i64 top = min64(last, s->k0 + s->length); k <= top; k++) {
+            uint8_t mask = 0;
+            for (int a = 0; a < axes; a++) {
+                i64 c = axis_count(k, p->steps[a], p->n);
+                if (c != before[a]) mask |= (uint8_t)(1 << a);
+                before[a] = c;
+            }
+            *times++ = seg_step_instant(s, k - s->k0);
+            *masks++ = mask | (sign & (uint8_t)(mask << 4));
+        }
+    }
+}
+
+/* the steps of a piece in the train [t0, t1): first..last (none when last < first) */
+static void piece_range(const piece_t *p, i64 t0, i64 t1, i64 *first, i64 *last) {
+    *first = max64(p->k_from, plan_steps(p, t0 - 1)) + 1;
+    *last = min64(p->k_to, plan_steps(p, t1 - 1));
 }
 
 int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
                   int64_t cap) {
     timeline_t tl;
     if (timeline(m, t1, &tl)) return -1;
-    i64 count = 0;
+    i64 count = 0, first, last;
     for (size_t i = 0; i < tl.n; i++) {
-        const piece_t *p = &tl.p[i];
-        i64 first = max64(p->k_from, plan_steps(p, t0 - 1)) + 1;
-        i64 last = min64(p->k_to, plan_steps(p, t1 - 1));
-        for (i64 k = first; k <= last; k++) {
-            if (count < cap) {
-                uint8_t mask = 0;
-                for (int a = 0; a < m->axes; a++) {
-                    i64 d = p->steps[a];
-                    if (axis_count(k, d, p->n) != axis_count(k - 1, d, p->n))
-                        mask |= (uint8_t)((1 << a) | ((d < 0) << (4 + a)));
-                }
-                times[count] = piece_instant(p, k);
-                masks[count] = mask;
-            }
-            count++;
+        piece_range(timeline_piece(&tl, i), t0, t1, &first, &last);
+        if (last >= first) count += last - first + 1;
+    }
+    if (count <= cap) {
+        i64 at = 0;
+        for (size_t i = 0; i < tl.n; i++) {
+            const piece_t *p = timeline_piece(&tl, i);
+            piece_range(p, t0, t1, &first, &last);
+            if (last < first) continue;
+            piece_train(p, m->axes, first, last, times + at, masks + at);
+            at += last - first + 1;
         }
     }
-    free(tl.p);
+    timeline_free(&tl);
     return count;
 }
 
@@ -599,11 +641,11 @@ void st_physical(stepper *m, int64_t t, int64_t *out) {
     for (int i = 0; i < m->axes; i++) out[i] += m->offset[i];
 }
 
-void st_excursion(stepper *m, int64_t t, int64_t *lo, int64_t *hi) {
+void st_excursion(stepper *m, int64_t t, int64_t *out) {
     i64 here[ST_AXES];
     st_position(m, t, here);
     visit(m, here);
-    for (int i = 0; i < m->axes; i++) { lo[i] = m->lo[i]; hi[i] = m->hi[i]; }
+    for (int i = 0; i < m->axes; i++) { out[i] = m->lo[i]; out[ST_AXES + i] = m->hi[i]; }
 }
 
 void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel) {
