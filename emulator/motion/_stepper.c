@@ -507,6 +507,12 @@ int st_push(stepper *m, const st_vector *v, int64_t t) {
     return 0;
 }
 
+int64_t st_push_many(stepper *m, const st_timed_vector *v, int64_t n) {
+    for (int64_t i = 0; i < n; i++)
+        if (st_push(m, &v[i].v, v[i].t)) return i;
+    return n;
+}
+
 int64_t st_halt(stepper *m, int64_t t) {
     i64 here[ST_AXES];
     st_position(m, t, here);

@@ -43,6 +43,13 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out);
 int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
                   int64_t cap);
 int st_push(stepper *m, const st_vector *v, int64_t t);
+/* pushes in a batch: each vector at its instant, in order, as st_push one by one;
+ * returns how many were pushed (fewer: out of memory) */
+typedef struct {
+    int64_t t;
+    st_vector v;
+} st_timed_vector;
+int64_t st_push_many(stepper *m, const st_timed_vector *v, int64_t n);
 int64_t st_halt(stepper *m, int64_t t);
 void st_resume(stepper *m, int64_t t);
 void st_clear(stepper *m, int64_t t);
