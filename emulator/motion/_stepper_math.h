@@ -1,6 +1,6 @@
-/* The stepper's exact arithmetic (arith.py) and segments (segment.py), for the C core
- * (_stepper.c) and any other C that must compute exactly as it does.
- * docs/motion-model.md is the spec.
+/* The stepper's exact arithmetic (arith.py) and segments (segment.py), shared by the
+ * C core (_stepper.c) and the benchmark's bare reference loop (_reference.c) so that
+ * both run the same code. docs/motion-model.md is the spec.
  *
  * Every quantity is an integer; products are computed in 128 bits so the results equal
  * the Python twin's (unbounded integers) bit for bit. The only floating point is the

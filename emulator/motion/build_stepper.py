@@ -23,9 +23,9 @@ if TYPE_CHECKING:
 HERE = Path(__file__).resolve().parent
 MODULE = "emulator.motion._stepper_c"
 #: the headers whose declarations the module exposes (cffi's cdef)
-HEADERS = ("_stepper.h",)
-#: the C files compiled into the module
-C_FILES = ("_stepper.c",)
+HEADERS = ("_stepper.h", "_reference.h")
+#: the C files compiled into the module (the core, the benchmark's reference loop)
+C_FILES = ("_stepper.c", "_reference.c")
 #: every file the module is built from: a change to any of them makes a build stale
 SOURCES = (*HEADERS, "_stepper_math.h", *C_FILES, "build_stepper.py")
 #: precedes the sources' digest in the compiled module
