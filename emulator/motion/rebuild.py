@@ -5,7 +5,9 @@ its C helper. A stale module that cannot be rebuilt (no compiler, a read-only
 installation) is refused with ImportError, and the emulator uses the Python twin: it
 never runs C code that its sources no longer describe.
 
-A missing module is left missing (an installation without a compiler uses the twin).
+A missing module is left missing (an installation without a compiler uses the twin),
+and a module whose sources are not all beside it is taken as built (there is nothing
+to be stale against).
 Processes that find the same stale module at once rebuild it once: the rebuild holds
 a lock, and the new module replaces the old one in a single rename.
 """
@@ -48,8 +50,12 @@ def built_digest(module: Path) -> str | None:
 
 
 def is_fresh(module: Path, directory: Path = HERE) -> bool:
-    """Whether ``module`` was built from the sources now in ``directory``."""
-    return built_digest(module) == source_digest(directory)
+    """Whether ``module`` was built from the sources now in ``directory`` (or those are
+    not all there to say otherwise)."""
+    try:
+        return built_digest(module) == source_digest(directory)
+    except OSError:
+        return True
 
 
 def ensure_fresh(module: Path | None = None, directory: Path = HERE) -> None:

@@ -1,7 +1,8 @@
 """The C core is never older than its sources: a build carries their digest, a changed
 source makes the module stale and it is rebuilt into what the sources now say; a stale
-module that cannot be rebuilt is refused, never loaded. Each test works on a copy of
-the sources and of the built module in a temporary folder."""
+module that cannot be rebuilt is refused, never loaded; a module without its sources
+beside it is taken as built. Each test works on a copy of the sources and of the built
+module in a temporary folder."""
 
 from __future__ import annotations
 
@@ -90,3 +91,11 @@ def test_a_stale_module_that_cannot_be_rebuilt_is_refused(copy, monkeypatch):
         ensure_fresh(module, folder)
     assert built_digest(module) == old and not is_fresh(module, folder)
     assert sorted(p.name for p in folder.iterdir()) == sorted([*SOURCES, module.name])
+
+
+def test_a_module_without_its_sources_is_taken_as_built(copy):
+    folder, module = copy
+    (folder / "_stepper.c").unlink()
+    before = module.stat().st_mtime_ns
+    ensure_fresh(module, folder)
+    assert is_fresh(module, folder) and module.stat().st_mtime_ns == before
