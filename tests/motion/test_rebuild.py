@@ -99,3 +99,16 @@ def test_a_module_without_its_sources_is_taken_as_built(copy):
     before = module.stat().st_mtime_ns
     ensure_fresh(module, folder)
     assert is_fresh(module, folder) and module.stat().st_mtime_ns == before
+
+
+def test_processes_finding_it_stale_at_once_rebuild_it_once(copy):
+    folder, module = copy
+    add_probe(folder)
+    code = ("import sys; from pathlib import Path; from emulator.motion.rebuild import "
+            "ensure_fresh; ensure_fresh(Path(sys.argv[1]), Path(sys.argv[2]))")
+    procs = [subprocess.Popen([sys.executable, "-c", code, str(module), str(folder)],
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    errs = [p.communicate(timeout=120)[1] for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], errs
+    assert sum("rebuilding it" in err for err in errs) == 1, errs
+    assert is_fresh(module, folder)
