@@ -34,7 +34,23 @@ def range_ends(ctx: CaseContext) -> None:
     scale = step_factor(ctx)
     start = position(ctx)
     ctx.require(start is not None, "PF did not answer with positions")
-    # each axis at each end, its neighbours at the other: every reading tells them apart
+    # first the moves, each ending on an end and coming back: read while the vector may
+    # still run as far as the guard knows (PF until it shows the end), so that a unit
+    # whose counters wrap is not taken for one whose axes went elsewhere, and the axes
+    # come back whatever it reads
+    near = [hi - RUN_IN, lo + RUN_IN, hi - RUN_IN]
+    for axis, value in zip(shown, near, strict=True):
+        _set(ctx, axis, value, 0, "10.cmd.set-axis")
+    for d, there, what in (((RUN_IN, -RUN_IN, RUN_IN), [hi, lo, hi], "a move counted up to "
+                            "the ends"), ((-RUN_IN, RUN_IN, -RUN_IN), near, "and back")):
+        setup(ctx, "L" + vector(ctx, *d))
+        want = [v * scale for v in there]
+        r = ctx.link.poll("PF", lambda r, want=want: r.code == 0 and r.values == [
+            str(v) for v in want], 5.0, every=0.02)
+        got = r.decs() if r is not None else position(ctx)
+        ctx.expect(r is not None, what, observed=got, expected=want, rule="10.cmd.positions")
+    _settle(ctx)
+    # then each axis at each end, its neighbours at the other: every reading tells them apart
     for ends in ((hi, lo, hi), (lo, hi, lo)):
         for axis, value in zip(shown, ends, strict=True):
             _set(ctx, axis, value, 0, "10.cmd.set-axis")
@@ -46,16 +62,6 @@ def range_ends(ctx: CaseContext) -> None:
     if "NA" in p.commands:                   # the A counter: set and refused, not read
         for value, want in ((hi, 0), (hi + 1, 5), (lo, 0), (lo - 1, 5), (0, 0)):
             _set(ctx, "A", value, want, "10.cmd.set-axis" if want == 0 else "5.code.range")
-    # moves that end on the ends: the counters count up to them
-    ends = [hi - RUN_IN, lo + RUN_IN, hi - RUN_IN]
-    for axis, value in zip(shown, ends, strict=True):
-        _set(ctx, axis, value, 0, "10.cmd.set-axis")
-    setup(ctx, "L" + vector(ctx, RUN_IN, -RUN_IN, RUN_IN))
-    _settle(ctx)
-    _reads(ctx, [hi * scale, lo * scale, hi * scale], "a move counted up to the ends")
-    setup(ctx, "L" + vector(ctx, -RUN_IN, RUN_IN, -RUN_IN))
-    _settle(ctx)
-    _reads(ctx, [v * scale for v in ends], "and back from them")
     # back where the case began
     for axis, value in zip(shown, start, strict=True):
         _set(ctx, axis, value // scale, 0, "10.cmd.set-axis")
