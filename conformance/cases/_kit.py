@@ -131,3 +131,10 @@ def position(ctx: CaseContext) -> list[int] | None:
     if r is None or r.code != 0 or len(r.values) < 3:
         return None
     return r.decs()
+
+
+def step_factor(ctx: CaseContext) -> int:
+    """Counter units per commanded step in the micro-step mode a case starts in (the
+    reset's: GVE54 MF, one sixteenth; 1 where there is no micro-stepping)."""
+    m = ctx.profile.microstep
+    return 1 if m is None else m.factors[m.reset_mode]

@@ -51,6 +51,8 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_vectors_to_mpg()
     room = dev.profile.buffer - (1 if dev.mutant.active("queue-one-short") else 0)
     if dev.motion.queued(t) >= room:
+        if dev.mutant.active("refused-vector-queued"):
+            dev.push(steps, True, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "the CONT buffer is full")
     dev.push(steps, True, t)
     return []

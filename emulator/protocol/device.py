@@ -109,6 +109,8 @@ class Device:
         if self.mutant.active("position-ignores-microstep"):
             f = self.factor()
             return tuple(int(x / f) for x in here)
+        if self.mutant.active("narrow-counters"):
+            return tuple((x + (1 << 23)) % (1 << 24) - (1 << 23) for x in here)
         return here
 
     # -- vectors ------------------------------------------------------------------------
@@ -221,6 +223,10 @@ class Device:
         return None
 
     # -- EEPROM -----------------------------------------------------------------------------
+    def eeprom_cell(self, address: int) -> int:
+        """The byte ER and EW reach at ``address``: every one of the 256."""
+        return address & 0x7F if self.mutant.active("eeprom-7-bit-address") else address
+
     def write_eeprom(self, address: int, data: bytes, t: int) -> None:
         self.refuse_while_moving(t)
         if not self.mutant.active("eeprom-write-lost"):
