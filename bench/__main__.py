@@ -5,7 +5,7 @@ from bench import bench_cosim, bench_diff, bench_emulator, bench_host, bench_ste
 if __name__ == "__main__":
     bench_emulator.main()
     print()
-    bench_stepper.main()
+    bench_stepper.main([])
     print()
     bench_host.main([])
     print()

@@ -62,6 +62,15 @@ class Case:
 
 REGISTRY: dict[str, Case] = {}
 
+#: how a tag grades: M and M-ex alike (a golden example is a manual's statement too)
+GRADES = {"M": "M", "M-ex": "M", "D": "D", "D-info": "D-info"}
+
+
+def mixed(case: Case) -> bool:
+    """Whether the case's rules grade differently, so each check must name its rule."""
+    known = load_rules()
+    return len({GRADES[known[r].tag] for r in case.rules}) > 1
+
 
 def case(id: str, *, rule: str | None = None, tag: str | None = None, source: str | None = None,
          requires: tuple[str, ...] = (), absent: tuple[str, ...] = (),
@@ -79,10 +88,14 @@ def case(id: str, *, rule: str | None = None, tag: str | None = None, source: st
         raise ValueError(f"{id}: name its rules, or give rule, tag and source")
     first = known[rules[0]] if rules else None
     rule = first.text if rule is None else rule
+    if tag is not None and tag not in TAGS:
+        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
+    graded = {GRADES[known[r].tag] for r in rules}
+    if tag is not None and rules and GRADES[tag] not in graded:
+        raise ValueError(f"{id}: declared tag {tag} contradicts its rules, tagged "
+                         f"{', '.join(sorted({known[r].tag for r in rules}))}")
     tag = first.tag if tag is None else tag
     source = first.source if source is None else source
-    if tag not in TAGS:
-        raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)
@@ -135,6 +148,8 @@ class CaseContext:
     _link: Link | None = None
     seed: int | None = None      # the run's seed for the Hypothesis machines (None: settings)
     operator: Any = None         # conformance.operator.Hands: hand steps (rig or technician)
+    #: what the case measured of the unit's readings once (e.g. whether @ counts itself)
+    measured: dict[Any, Any] = field(default_factory=dict)
 
     @property
     def link(self) -> Link:
@@ -161,6 +176,10 @@ class CaseContext:
                              f"not list in its rules")
         if rule is None and len(self.case.rules) == 1:
             rule = self.case.rules[0]
+        if rule is None and tag is None and self.case.rules and mixed(self.case):
+            # the case's tag would grade a [D] point as [M] or the other way round
+            raise ValueError(f"{self.case.id}: a check ({what!r}) must name its rule: the "
+                             "case's rules carry different tags")
         graded = tag or (load_rules()[rule].tag if rule else self.case.tag)
         self.checks.append(Check(bool(ok), what,
                                  "" if observed is None else str(observed),
@@ -192,12 +211,17 @@ class CaseContext:
 
     def trace(self, name: str, *, samples: list[tuple[float, list[int]]],
               model: list[tuple[float, list[int]]], tolerance: dict[str, float],
-              params: dict[str, Any]) -> None:
+              params: dict[str, Any], faults: list[dict] | None = None) -> None:
         """Record a motion trace for the reports: ``samples`` as read from the target
         (seconds since the motion's origin, positions per axis), ``model`` the spec
         model's positions at those or denser instants, ``tolerance`` the band the check
-        used (``seconds``, ``steps``), ``params`` the parameters (A, V, B, T, XM...)."""
+        used (``seconds``, ``steps``), ``params`` the parameters (A, V, B, T, XM...),
+        ``faults`` what the checks found wrong, to be marked on the picture: an instant
+        (``{"kind": "instant", "what", "observed": t, "expected": [t_lo, t_hi],
+        "expected_what"}``) or a reading (``{"kind": "position", "t", "axis",
+        "observed": steps, "expected": [lo, hi]}``)."""
         self.traces.append({"name": name,
                             "samples": [[float(t), [int(p) for p in ps]] for t, ps in samples],
                             "model": [[float(t), [int(p) for p in ps]] for t, ps in model],
-                            "tolerance": dict(tolerance), "params": dict(params)})
+                            "tolerance": dict(tolerance), "params": dict(params),
+                            **({"faults": list(faults)} if faults else {})})

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import datetime
 import platform as _platform
+import shlex
 import socket
 from dataclasses import asdict, dataclass, field
 from importlib import metadata as _dist
@@ -52,6 +53,10 @@ class RunMeta:
     operator_steps: bool = False            # a technician was asked for hand steps
     confirmed: str = ""                     # how motion was allowed: "asked", "--yes", ""
     targets: list[TargetMeta] = field(default_factory=list)
+    # a host certification: the host program as given after `--` (empty: attended) and
+    # the certification's own options in force (they replace the suite's flags)
+    host_command: list[str] = field(default_factory=list)
+    host_flags: dict[str, object] = field(default_factory=dict)
     # the spec's rules the selected cases can fail, per profile: {profile, covered, total,
     # sections: [{section, covered (a count), uncovered (rule IDs)}]}
     coverage: list[dict] = field(default_factory=list)
@@ -65,7 +70,11 @@ class RunMeta:
         return self.targets[-1]
 
     def flags(self) -> dict[str, object]:
-        """The flags that shaped the run, by their command-line names."""
+        """The flags that shaped the run, by their command-line names (a host
+        certification's: the host command and the certification's options)."""
+        if self.host_flags:
+            return {"host command": shlex.join(self.host_command) or "attended",
+                    **self.host_flags}
         return {"--settings": self.settings,
                 "--seed": "derandomized" if self.seed is None else self.seed,
                 "--mutant": self.mutant or "none",

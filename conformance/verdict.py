@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Protocol
+
+from conformance.untested import grouped
+
 PASS = "PASS"
 NON_STRICT = "NON-STRICT"
 FAIL = "FAIL"
@@ -43,20 +48,57 @@ PASSED = "PASSED"
 FAILED = "FAILED"
 #: verdicts that judged the target (the others say why it could not be judged)
 JUDGED = (PASS, NON_STRICT, INFO)
+#: verdicts of what was not tested (their reasons: conformance/untested.toml)
+UNTESTED = (COULD_NOT_TEST, MISSING)
+#: the judged verdicts as the last line counts them: what failed, then what passed
+LINE_ORDER = (ERROR, FAIL, PASS, NON_STRICT, INFO)
 
 
-def overall(verdicts: list[str], interrupted: bool = False, problems: list[str] = ()
-            ) -> tuple[str, str]:
-    """PASSED or FAILED for a run's case verdicts, with the reason in a few words. A run
-    that judged nothing has not passed: a broken or silent target never earns a PASS;
-    nor has one that left something of a unit unrestored (``problems``)."""
-    bad = [v for v in ORDER if failing(v) and v in verdicts]
-    if bad:
-        return FAILED, " and ".join(f"{verdicts.count(v)} {v}" for v in bad)
+class Result(Protocol):
+    verdict: str
+    notes: list[str]
+
+
+def counted(verdicts: Sequence[str], among: Sequence[str] = ORDER) -> str:
+    """``120 PASS, 8 NON-STRICT``: the verdicts of ``among`` present, worst first."""
+    return ", ".join(f"{verdicts.count(v)} {v}" for v in among if v in verdicts)
+
+
+def not_tested(results: Sequence[Result]) -> str:
+    """``not tested: 12 of 149 (9 need a rig, 3 beyond the envelope)``, or
+    ``everything tested``."""
+    groups = grouped(results, UNTESTED)
+    if not groups:
+        return f"everything tested ({len(results)})"
+    n = sum(groups.values())
+    return (f"not tested: {n} of {len(results)} ("
+            + ", ".join(f"{k} {phrase}" for phrase, k in groups.items()) + ")")
+
+
+def overall(results: Sequence[Result], interrupted: bool = False,
+            problems: Sequence[str] = ()) -> tuple[str, str]:
+    """PASSED or FAILED for a run's results, with what was judged and what was not
+    tested and why: ``PASSED``, ``120 PASS, 8 NON-STRICT; not tested: 12 of 149 (9 need
+    a rig, 3 beyond the envelope)``. PASSED only when nothing FAILed or ERRed. A run that
+    judged nothing has not passed: a broken or silent target never earns a PASS; nor has
+    one that left something of a unit unrestored (``problems``) or was interrupted."""
+    verdicts = [r.verdict for r in results]
+    tested = counted(verdicts, LINE_ORDER) or "nothing judged"
+    tail = f"{tested}; {not_tested(results)}"
+    if any(failing(v) for v in verdicts):
+        return FAILED, tail
     if problems:
-        return FAILED, f"{len(problems)} problem(s) restoring the unit: {problems[0]}"
+        return FAILED, (f"{len(problems)} problem(s) restoring the unit: {problems[0]}; "
+                        + tail)
     if interrupted:
-        return FAILED, "interrupted before every case had run"
+        return FAILED, f"interrupted before every case had run; {tail}"
     if not any(v in JUDGED for v in verdicts):
-        return FAILED, "no case could judge the target"
-    return PASSED, "no case failed"
+        return FAILED, f"no case could judge the target; {tail}"
+    return PASSED, tail
+
+
+def last_line(results: Sequence[Result], interrupted: bool = False,
+              problems: Sequence[str] = ()) -> str:
+    """The last line of every command: ``PASSED — ...`` or ``FAILED — ...``."""
+    verdict, reason = overall(results, interrupted, problems)
+    return f"{verdict} — {reason}"

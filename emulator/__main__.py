@@ -32,6 +32,7 @@ from emulator.link.server import (
 )
 from emulator.link.url import DEFAULT_MODEL, LineSpec, parse_address, parse_unit, positive
 from emulator.mutants import MUTANTS
+from emulator.readings import READINGS
 
 PROG = "gve-emulator"
 
@@ -89,6 +90,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--watchdog-ms", type=_positive, default=None)
     ap.add_argument("--mutant", choices=sorted(MUTANTS), metavar="NAME",
                     help="plant one deliberate bug (emulator/mutants.py)")
+    ap.add_argument("--reading", action="append", default=[], choices=sorted(READINGS),
+                    metavar="NAME", help="take another reading of a point the manuals leave "
+                    "open (emulator/readings.py; repeatable)")
     ap.add_argument("--stepper", choices=["c", "python"], default=None)
     return ap.parse_args(argv)
 
@@ -103,7 +107,7 @@ def build(argv: list[str] | None) -> tuple[Line, PtyHost | TcpHost | None]:
             units = [(args.model or DEFAULT_MODEL, args.address)]
         spec = LineSpec(units=units, baud=args.baud, watchdog_ms=args.watchdog_ms,
                         eeprom=args.eeprom, mutant=args.mutant, stepper=args.stepper,
-                        log=args.log)
+                        log=args.log, readings=tuple(args.reading))
         built = spec.build_units()
         if args.cosim:
             return Line(built, spec.line_baud(built), log=args.log), None

@@ -43,8 +43,12 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "go-without-inta": ("5, 10.4", "G with INTA = 0 answers 0 instead of 6", "10.4"),
     "line-while-busy": ("10.1", "L is accepted while vectors are queued or running", "10.1"),
     "queue-one-short": ("10.1", "the CONT buffer refuses one vector before it is full", "10.1"),
+    "refused-vector-queued": ("10.1", "a C answered 1 (no room) still enters the queue",
+                              "10.1"),
     "packet-partial-commit": ("7", "a failing packet still commits its valid members", "7"),
     "packet-count-ignored": ("7", "*E commits although the member count differs", "7"),
+    "failed-packet-keeps-b": ("7", "a packet that fails still sets the B of its B members",
+                              "7"),
     "index-skips-refused": ("8", "frames answered with an error do not advance the index",
                             "8"),
     "index-counts-queries": ("8", "@ and > advance the index", "8"),
@@ -59,6 +63,10 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "status-word-masked": ("10.3", "SW stores only the bits with an input behind them", "10.3"),
     "interrupt-ignored": ("10.3", "an enabled active input does not stop the motion", "10.3"),
     "eeprom-write-lost": ("10.6", "EW answers 0 but does not change the byte", "10.6"),
+    "eeprom-7-bit-address": ("10.6", "ER and EW decode 7 address bits: 80..FF are 00..7F "
+                             "again", "10.6"),
+    "narrow-counters": ("10", "the position counters are 24 bits wide: P and PF wrap "
+                        "beyond ±8388607", "10"),
     "position-ignores-microstep": ("10.7", "GVE54 positions are reported in commanded steps",
                                    "10.7"),
     # the eleven interaction errors of the emulator issue

@@ -2,6 +2,7 @@
 
 from conformance.cases import (  # noqa: F401
     checksum,
+    counters,
     eeprom,
     errors,
     families,
@@ -15,6 +16,7 @@ from conformance.cases import (  # noqa: F401
     packet,
     params,
     reference,
+    refusals,
     status,
     units,
 )

@@ -69,9 +69,28 @@ def fresh_reset(ctx: CaseContext) -> None:
     ctx.link.wait(2.5)
 
 
+def queries_counted(ctx: CaseContext, address: int | None = None) -> bool:
+    """Whether the unit's ``@`` advances its own index: the manuals leave what counts
+    open (8.index.queries-uncounted [D]), so a case measures it once (two ``@`` in a
+    row) and judges only the frames it sent."""
+    key = ("queries-counted", address, id(ctx.link))
+    if key not in ctx.measured:
+        a, b = _read_index(ctx, address), _read_index(ctx, address)
+        ctx.measured[key] = a is not None and b == (a + 1) % 256
+    return ctx.measured[key]
+
+
+def _read_index(ctx: CaseContext, address: int | None) -> int | None:
+    r = ctx.link.send("@", address=address)
+    if r is None or r.code != 0:
+        return None
+    return r.dec()
+
+
 def index(ctx: CaseContext, address: int | None = None) -> int | None:
     """The index as ``@`` reads it (at ``address``; default the link's): on a real unit
     it is wherever the unit's use left it, so cases judge how far it moves."""
+    queries_counted(ctx, address)
     r = ctx.link.send("@", address=address)
     if r is None or r.code != 0:
         return None
@@ -80,15 +99,19 @@ def index(ctx: CaseContext, address: int | None = None) -> int | None:
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,
                 tag: str | None = None, rule: str | None = None,
-                address: int | None = None) -> bool:
-    """Expect the index to have advanced by ``frames`` since ``before`` (spec 8)."""
+                address: int | None = None, queries: bool = False) -> bool:
+    """Expect the index to have advanced by ``frames`` since ``before`` (spec 8), the
+    reading ``@`` itself not counted on a unit whose ``@`` counts (``queries``: the
+    check judges that very point, so nothing is taken off)."""
+    counted = queries_counted(ctx, address) and not queries
     after = index(ctx, address)
-    expected = None if before is None else (before + frames) % 256
+    expected = None if before is None else (before + frames + counted) % 256
     return ctx.expect(after is not None and after == expected, what, observed=after,
                       expected=expected, tag=tag, rule=rule)
 
 
-def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:
+def fill_queue(ctx: CaseContext, count: int | None = None, *,
+               rule: str | None = None) -> bool:
     """Setup: stop the unit (H, so INTA = 1 and vectors wait in the queue [D 10.1]) and
     queue ``count`` (default: the buffer's size) one-step vectors going back and forth,
     so that a real unit's axes stay within the envelope. Returns whether every vector
@@ -98,7 +121,7 @@ def fill_queue(ctx: CaseContext, count: int | None = None) -> bool:
     for i in range(ctx.profile.buffer if count is None else count):
         r = ctx.link.send("C" + vector(ctx, 1 if i % 2 == 0 else -1))
         if not ctx.expect(r is not None and r.code == 0, f"vector {i + 1} is accepted",
-                          observed=show(r), expected="code 0"):
+                          observed=show(r), expected="code 0", rule=rule):
             return False
     return True
 
@@ -108,3 +131,10 @@ def position(ctx: CaseContext) -> list[int] | None:
     if r is None or r.code != 0 or len(r.values) < 3:
         return None
     return r.decs()
+
+
+def step_factor(ctx: CaseContext) -> int:
+    """Counter units per commanded step in the micro-step mode a case starts in (the
+    reset's: GVE54 MF, one sixteenth; 1 where there is no micro-stepping)."""
+    m = ctx.profile.microstep
+    return 1 if m is None else m.factors[m.reset_mode]

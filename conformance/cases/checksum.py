@@ -33,12 +33,12 @@ def command_summed(ctx: CaseContext) -> None:
 def bad_sum(ctx: CaseContext) -> None:
     setup(ctx, "%+", checksum=False)
     r = ctx.link.send("SW0,0F", checksum="00")
-    code(ctx, r, 4, "a wrong checksum → 4")
+    code(ctx, r, 4, "a wrong checksum → 4", rule="6.checksum.bad-refused")
     ctx.expect(r is not None and bool(r.checksum_ok), "the error carries a checksum",
-               observed=r, expected="4,60")
+               observed=r, expected="4,60", rule="6.checksum.bad-refused")
     r = ctx.link.send("SR0")
     ctx.expect(r is not None and r.values[:1] == ["00"], "the refused frame was not executed",
-               observed=r, expected="0,00,XX", tag="M")
+               observed=r, expected="0,00,XX", rule="4.response.failed-not-executed")
 
 
 @case("6.checksum.missing-sum-rejected",

@@ -5,7 +5,7 @@ while moving) and what a restart resets and what it does not."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, setup, vector
+from conformance.cases._kit import answers, code, setup, show, vector
 
 #: bytes no profile gives a default to (spec 10.6)
 UNWRITTEN = (0x00, 0x20, 0x7F, 0xFF)
@@ -104,3 +104,38 @@ def restart(ctx: CaseContext) -> None:
         answers(ctx, link.send("SR0", checksum=False), "0,00",
                 "checksums are off after J: a frame without one is executed",
                 rule="6.checksum.off-after-reset")
+
+
+#: the two patterns: each address's byte differs from every other address's, and the
+#: second pass flips every bit of the first
+PATTERNS = (0x5A, 0xA5)
+
+
+@case("10.6.eeprom.every-address", destructive=True,
+      rules=("10.cmd.eeprom-bytes", "10.6.eeprom.defaults"))
+def every_address(ctx: CaseContext) -> None:
+    link = ctx.link
+    size = ctx.profile.eeprom.size
+    for key in PATTERNS:
+        refused = []
+        for address in range(size):
+            r = link.send("EW%02X,%02X" % (address, address ^ key))
+            if r is None or r.code != 0:
+                refused.append(f"EW{address:02X} → {show(r)}")
+        ctx.expect(not refused, f"EW writes every address (byte = address XOR {key:02X})",
+                   observed="; ".join(refused) or "every one answered 0",
+                   expected="0 each time", rule="10.cmd.eeprom-bytes")
+        wrong = []
+        for address in range(size):
+            r = link.send("ER%02X" % address)
+            want = "0,%02X" % (address ^ key)
+            if r is None or r.raw != want.encode() + b"\r":
+                wrong.append(f"ER{address:02X} → {show(r)} (wrote {address ^ key:02X})")
+        ctx.expect(not wrong, f"ER reads back each address's own byte ({key:02X} pattern)",
+                   observed="; ".join(wrong[:8]) + (f" … {len(wrong)} in all" if wrong else "")
+                   or "every byte as written",
+                   expected="0,<address XOR %02X> at each address" % key,
+                   rule="10.cmd.eeprom-bytes")
+    code(ctx, link.send("EW%X,00" % size), 5, f"{size} bytes: EW{size:X} is out of range",
+         rule="10.6.eeprom.defaults")
+    code(ctx, link.send("ER%X" % size), 5, f"and ER{size:X}", rule="10.6.eeprom.defaults")

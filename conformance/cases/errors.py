@@ -38,8 +38,10 @@ def unknown(ctx: CaseContext) -> None:
       tag="M-ex", source="M84 12.6 (G4e)",
       rule="A parameter out of range answers 5 (!0SW8,F1 → 5)")
 def out_of_range(ctx: CaseContext) -> None:
-    for body in ("SW8,F1", "T25", "A0", "SR7"):
-        code(ctx, ctx.link.send(body), 5, f"{body} → 5")
+    # A0: the accelerations' range is our reading [D]; the others the manual's
+    for body, rule in (("SW8,F1", "5.code.range"), ("T25", "10.cmd.modal"),
+                       ("A0", "10.cmd.accel-range"), ("SR7", "10.cmd.status-words")):
+        code(ctx, ctx.link.send(body), 5, f"{body} → 5", rule=rule)
 
 
 @case("5.errors.go-without-inta",
@@ -58,8 +60,9 @@ def busy(ctx: CaseContext) -> None:
     setup(ctx, "V1000")
     setup(ctx, "C" + vector(ctx, 1500))      # 1.5 s at V1000: moving for every probe
     ctx.link.wait(0.3)
-    for body in ("D", "K", "R", "N"):
-        code(ctx, ctx.link.send(body), 7, f"{body} while moving → 7")
+    for body, rule in (("D", "5.code.busy-moving"), ("K", "5.code.busy-moving"),
+                       ("R", "5.code.busy-moving"), ("N", "5.code.busy-run")):
+        code(ctx, ctx.link.send(body), 7, f"{body} while moving → 7", rule=rule)
     ctx.link.send("H")
 
 
@@ -69,7 +72,8 @@ def busy(ctx: CaseContext) -> None:
       rule="N is refused (7) while interrupted vectors still hold RUN = 1")
 def n_run(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
-    code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True)
+    code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True,
+         rule="5.code.busy-run")
 
 
 @case("5.errors.refused-not-executed",

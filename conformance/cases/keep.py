@@ -23,12 +23,18 @@ SRC = "M84 12.5.8; M114 13.6.9; M54"
       rule="K saves the queue and ST4..ST6 and clears them; R brings them back")
 def saves(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
-    answers(ctx, ctx.link.send("K"), "0", "K clears INTA")
-    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared after K")
-    answers(ctx, ctx.link.send("R"), "8", "R restores INTA", tag="D")
+    r = ctx.link.send("K")
+    code(ctx, r, 0, "K is accepted", rule="10.5.keep.saves")
+    ctx.expect(r is not None and not r.inta, "K's answer shows INTA cleared",
+               observed=show(r), expected="0", rule="4.response.inta-after-command")
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared after K", rule="10.5.keep.saves")
+    r = ctx.link.send("R")
+    code(ctx, r, 0, "R is accepted", rule="10.5.restore.exact")
+    ctx.expect(r is not None and r.inta, "R's answer shows the INTA it restored",
+               observed=show(r), expected="8", rule="4.response.inta-after-command")
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 as saved",
-               observed=show(r), expected="8,D0")
+               observed=show(r), expected="8,D0", rule="10.5.restore.exact")
 
 
 @case("10.5.keep.partial-vector",
@@ -57,8 +63,10 @@ def partial(ctx: CaseContext) -> None:
 def single_l(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     setup(ctx, "K")
-    code(ctx, ctx.link.send("C" + vector(ctx, 10)), 4, "C after K → 4")
-    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 0, "L after K → 0", tag="M")
+    code(ctx, ctx.link.send("C" + vector(ctx, 10)), 4, "C after K → 4",
+         rule="10.5.keep.c-refused")
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 0, "L after K → 0",
+         rule="10.5.keep.single-l")
 
 
 @case("10.5.keep.refused-while-moving",

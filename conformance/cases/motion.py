@@ -64,7 +64,7 @@ def targets(ctx: CaseContext) -> None:
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
     expected = [sum(m[i] for m in moves) for i in range(3)]
     ctx.expect(position(ctx) == expected, "the sum of the vectors",
-               observed=position(ctx), expected=expected)
+               observed=position(ctx), expected=expected, rule="10.1.queue.relative")
     ctx.step_train("the step train of the three vectors")
 
 

@@ -23,10 +23,10 @@ def _packet(ctx: CaseContext, members: list[str], count: int):
       rule="*E<n> commits every member in order and answers code,k")
 def commits(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
-    answers(ctx, r, "0,3", "a good packet → 0,3")
+    answers(ctx, r, "0,3", "a good packet → 0,3", rule="7.packet.exchange")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
     ctx.expect(position(ctx) == [10, 20, 0], "both vectors ran", observed=position(ctx),
-               expected=[10, 20, 0])
+               expected=[10, 20, 0], rule="7.packet.exchange")
 
 
 @case("7.packet.count-mismatch",
@@ -35,9 +35,10 @@ def commits(ctx: CaseContext) -> None:
       rule="k ≠ n: nothing is committed and *E answers 2,k")
 def count(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
-    answers(ctx, r, "2,2", "2 members, *E3 → 2,2")
+    answers(ctx, r, "2,2", "2 members, *E3 → 2,2", rule="5.code.watchdog")
     ctx.link.wait(1.0)
-    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", tag="always")
+    # members committed as they arrive are another reading of the manual's packet [D]
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", rule="7.packet.all-or-nothing")
 
 
 @case("7.packet.invalid-member",
@@ -49,7 +50,7 @@ def invalid(ctx: CaseContext) -> None:
     answers(ctx, r, "4,3", "V inside a packet → 4,3")
     ctx.link.wait(1.0)
     ctx.expect(position(ctx) == [0, 0, 0], "no member was committed", observed=position(ctx),
-               expected=[0, 0, 0], tag="always")
+               expected=[0, 0, 0], rule="7.packet.all-or-nothing")
 
 
 @case("7.packet.out-of-range-member",
@@ -66,15 +67,15 @@ def out_of_range(ctx: CaseContext) -> None:
       tag="D", source=RULE, requires=("*S",),
       rule="A packet that does not fit the queue answers 1 and commits nothing")
 def no_room(ctx: CaseContext) -> None:
-    if not fill_queue(ctx, ctx.profile.buffer - 1):
+    if not fill_queue(ctx, ctx.profile.buffer - 1, rule="5.code.queue-full"):
         return
     r = _packet(ctx, ["C" + vector(ctx, 1), "C" + vector(ctx, -1)], 2)
     ctx.expect(r is not None and (r.code, r.values) == (1, ["2"]),
                "2 vectors into 1 free place → 1,2 (9,2 while INTA)", observed=r,
-               expected="9,2")
+               expected="9,2", rule="7.packet.codes")
     r = ctx.link.send("F")
     ctx.expect(r is not None and r.values == ["D0"], "the queue is not full (nothing added)",
-               observed=r, expected="8,D0")
+               observed=r, expected="8,D0", rule="7.packet.all-or-nothing")
     ctx.link.send("D")
 
 
@@ -95,8 +96,9 @@ def breakers(ctx: CaseContext) -> None:
     before = index(ctx)
     link.send("*S", answer=False)
     link.send("C" + vector(ctx, 10), answer=False)
-    index_moved(ctx, before, 2, "@ inside a packet is answered (*S and the member counted)")
-    answers(ctx, link.send("*E1"), "4,0", "the packet was discarded")
+    index_moved(ctx, before, 2, "@ inside a packet is answered (*S and the member counted)",
+                rule="8.index.counts")
+    answers(ctx, link.send("*E1"), "4,0", "the packet was discarded", rule="7.packet.breakers")
 
 
 @case("7.packet.with-checksums",

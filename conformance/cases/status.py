@@ -16,7 +16,7 @@ def all_bits(ctx: CaseContext) -> None:
         ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {show(r)}")
         r = ctx.link.send(f"SR{n}")
         ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
-                   observed=show(r), expected=value)
+                   observed=show(r), expected=value, rule="10.3.status.all-bits")
 
 
 @case("10.3.status.run-bit",
@@ -37,7 +37,8 @@ def run_bit(ctx: CaseContext) -> None:
       tag="D", source="spec 10.3 [D]",
       rule="Input ports read FF with nothing connected")
 def inputs(ctx: CaseContext) -> None:
-    answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected")
+    answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected",
+            rule="10.3.inputs.idle-level")
 
 
 @case("10.3.interrupt.stops-motion",
@@ -53,10 +54,11 @@ def interrupt(ctx: CaseContext) -> None:
     link.wait(1.0)
     here = position(ctx)
     link.wait(0.5)
-    ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here)
+    ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here,
+               rule="10.3.inputs.interrupt")
     r = link.send("SR4")
     ctx.expect(r is not None and r.inta and r.values[:1] == ["01"], "ST4 bit 0, INTA",
-               observed=show(r), expected="8,01")
+               observed=show(r), expected="8,01", rule="10.3.status.meaning")
 
 
 @case("10.3.interrupt.polarity",
@@ -68,11 +70,11 @@ def polarity(ctx: CaseContext) -> None:
     setup(ctx, "SW2,01")                 # IN0 active at log. 1: unconnected = active
     r = link.send("SW0,01")
     ctx.expect(r is not None and r.code == 0 and r.inta, "enabling it interrupts at once",
-               observed=show(r), expected="8")
+               observed=show(r), expected="8", rule="4.response.inta-level")
     r = link.send("SR4")
     ctx.expect(r is not None and r.inta and r.values[:1] == ["01"],
                "an unconnected input with polarity 1 interrupts at once", observed=show(r),
-               expected="8,01")
+               expected="8,01", rule="10.3.inputs.polarity")
 
 
 @case("10.3.flags.f-command",
@@ -80,5 +82,5 @@ def polarity(ctx: CaseContext) -> None:
       tag="M", source="M84 12.5.11",
       rule="F answers ST6 with bit 5 = queue full")
 def f_idle(ctx: CaseContext) -> None:
-    answers(ctx, ctx.link.send("F"), "0,00", "F when idle")
-    code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", tag="D")
+    answers(ctx, ctx.link.send("F"), "0,00", "F when idle", rule="10.cmd.flags")
+    code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", rule="3.params.none-expected")

@@ -17,6 +17,9 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "ports": ("conformance.cli.ports", "the serial ports of this machine, to find the unit's"),
     "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
                  "with the catalogue until a case FAILs it"),
+    "fairness": ("conformance.cli.fairness", "the fairness score: the catalogue against "
+                 "every reading the emulator can take of what the manuals leave open; no "
+                 "case may FAIL one"),
     "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
     "diff": ("conformance.cli.diff", "differential fuzzing: the target against the emulator, "
              "each disagreement shrunk to a transcript"),

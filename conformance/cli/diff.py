@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from conformance.cli.ending import counted, end, new_run_id
-from conformance.cli.unit import ask_before_motion
+from conformance.cli.unit import ask_before_motion, unattended
 from conformance.cli.usage import Parser, UsageError, one_line, positive, seconds, writable_folder
 from conformance.diff.engine import Budget, Finding, Pair, search
 from conformance.diff.grammar import Options
@@ -69,7 +69,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def targets(args: argparse.Namespace) -> tuple[Target, Target]:
-    """The target and its reference, checked before anything is sent."""
+    """The target and its reference, checked before anything is sent (a real unit that
+    would have to ask before moving where nobody can answer is refused here)."""
     target = parse_target(args.target, profile=args.profile,
                           allow_destructive=args.allow_destructive, max_travel=args.max_travel,
                           strict=args.strict)
@@ -83,6 +84,7 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
                          f"target as {target.profile.name}")
     target.preflight()
     reference.preflight()
+    unattended([target, reference], args.yes, Console())
     return target, reference
 
 
@@ -181,5 +183,4 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
           f"{counted(run)}"
           + (" (interrupted by a signal: H and D sent)" if run.interrupted else ""), flush=True)
-    status = end(run, None if args.no_reports else args.report_dir)
-    return 1 if run.problems else status
+    return end(run, None if args.no_reports else args.report_dir)

@@ -1,6 +1,6 @@
 """What every job of `gve-conformance` prints and how it ends: a run's ID, one line per
 result as it comes, the verdicts counted, the reports written, the exit status (0 when
-nothing FAILs or ERRs and nobody pressed Ctrl-C, else 1)."""
+the verdict line says PASSED, else 1)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from pathlib import Path
 
 from conformance.reports import write_reports
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ORDER, PASS, failing
+from conformance.verdict import ORDER, PASS, PASSED, last_line, overall
 
 
 def new_run_id() -> str:
@@ -38,9 +38,12 @@ def counted(result: RunResult) -> str:
 
 
 def end(result: RunResult, report_dir: str | Path | None) -> int:
-    """Write the reports (unless ``report_dir`` is None) and say where; the exit status."""
+    """Write the reports (unless ``report_dir`` is None) and say where, then the verdict
+    line (what was judged, what was not tested and why); the exit status: 1 unless
+    PASSED."""
     if report_dir is not None:
         folder = write_reports(result, report_dir)
         print(f"reports: {folder}/junit.xml, results.json, report.html")
-    bad = any(failing(r.verdict) for r in result.results)
-    return 1 if bad or result.interrupted else 0
+    print(last_line(result.results, result.interrupted, result.problems), flush=True)
+    verdict, _ = overall(result.results, result.interrupted, result.problems)
+    return 0 if verdict == PASSED else 1

@@ -24,7 +24,7 @@ from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
 from conformance.runner import CaseResult
 from conformance.verdict import ORDER, PASS, grade
-from gve_fixtures.profile import ProfileError
+from gve_fixtures.profile import Profile, ProfileError
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -47,6 +47,11 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                     help="scenarios run side by side (launched, pty or tcp port 0)")
     ap.add_argument("--strict", action="store_true",
                     help="the host claims the project's decisions: [D] rules FAIL too")
+    ap.add_argument("--expect-motion", action="append", default=[],
+                    metavar="[ADDRESS:]X,Y,...",
+                    help="the full steps each axis travels in the host's job (the sum of "
+                         "its vectors' lengths): the clean run must execute exactly that "
+                         "(2.link.host-drives); per unit, default its first")
     ap.add_argument("--report-dir", default="reports")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the scenarios and exit")
@@ -81,12 +86,49 @@ def plan_of(args: argparse.Namespace) -> Plan:
         raise UsageError(f"no scenario matches {' '.join(unmatched)} (see --list)")
     scenarios = select(args.scenarios)
     return Plan(units, baud, scenarios, args.command, args.port, args.host_timeout,
-                args.strict, args.jobs)
+                args.strict, args.jobs, expect_motion_of(args.expect_motion, units))
+
+
+def expect_motion_of(given: list[str], units: list[tuple[Profile, int]]
+                     ) -> dict[int, tuple[int, ...]] | None:
+    """``--expect-motion [ADDRESS:]X,Y,...`` per unit on the line, or None."""
+    out: dict[int, tuple[int, ...]] = {}
+    axes = {address: profile.axes for profile, address in units}
+    for text in given:
+        where, _, steps = text.rpartition(":")
+        try:
+            address = int(where) if where else units[0][1]
+            travel = tuple(int(v) for v in steps.split(","))
+        except ValueError:
+            raise UsageError(f"--expect-motion {text}: give [ADDRESS:]X,Y,... in whole "
+                             "full steps, e.g. 1000,500,0") from None
+        if address not in axes:
+            raise UsageError(f"--expect-motion {text}: no unit at address {address} "
+                             f"(the line has {', '.join(map(str, axes))})")
+        if len(travel) > len(axes[address]) or any(v < 0 for v in travel):
+            raise UsageError(f"--expect-motion {text}: at most {len(axes[address])} "
+                             f"travels ({', '.join(axes[address])}), none negative")
+        if address in out:
+            raise UsageError(f"--expect-motion: unit {address} given twice")
+        out[address] = travel
+    return out or None
+
+
+def flags_of(args: argparse.Namespace, plan: Plan) -> dict[str, object]:
+    """The options in force for a certification, by their command-line names."""
+    return {"--profile" if args.profile else "--unit": plan.profile,
+            "--baud": plan.baud, "--port": plan.port,
+            "--scenarios": " ".join(args.scenarios) or "all",
+            "--host-timeout": plan.host_timeout, "--jobs": plan.jobs,
+            "--strict": plan.strict,
+            "--expect-motion": " ".join(args.expect_motion) or "none (not judged)",
+            "wire logs": "whole, every scenario"}
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        args = parse_args(list(sys.argv[1:] if argv is None else argv))
+        args = parse_args(argv)
         if args.list:
             for sc in SCENARIOS:
                 print(f"{sc.id:32} {sc.title}")
@@ -111,6 +153,9 @@ def main(argv: list[str] | None = None) -> int:
     except (HostStartError, ValueError) as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
+    result.meta.command = ["host", *argv]
+    result.meta.host_command = list(args.command or [])
+    result.meta.host_flags = flags_of(args, plan)
     print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
           f"{' (interrupted by a signal: the hosts were stopped)' if result.interrupted else ''}")
     clean = next((r for r in result.results if r.id.endswith(".clean")), None)

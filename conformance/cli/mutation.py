@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
+from conformance.cli.pool import workers
 from conformance.cli.usage import Parser, UsageError, positive
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
     jobs = [(m, args.profile or None, args.cases or None, args.sweep) for m in names]
     start = time.perf_counter()
     results = []
-    with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else _Serial() as pool:
+    with workers(args.jobs) as pool:
         for h in pool.map(_hunt, jobs):
             results.append(h)
             _show(h)
@@ -166,18 +166,6 @@ def _show(h: Hunt) -> None:
     for e in h.clean_fails:
         print(f"        not counted: {e} fails the clean emulator too", flush=True)
 
-
-class _Serial:
-    """One job: no worker processes."""
-
-    def __enter__(self) -> _Serial:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        return None
-
-    def map(self, fn, items):
-        return map(fn, items)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 """`gve-conformance replay FILE --target ...`: replay a transcript `diff` wrote (or any
 transcript) on a target and its reference alike, frame by frame, and say whether the
 disagreement is still there: each frame with the target's answer, the reference's now
-and the one recorded. Exit status 1 while the sides disagree, 0 when they agree."""
+and the one recorded, then one verdict line (PASS, FAIL..., COULD-NOT-TEST). Exit status
+0 when the sides agree on every frame, 1 while they disagree or when the transcript
+could not be replayed whole, 2 for a usage error."""
 
 from __future__ import annotations
 
@@ -10,14 +12,14 @@ import sys
 from conformance.cli.diff import ask_first, common, targets
 from conformance.cli.usage import Parser, UsageError, one_line
 from conformance.diff.engine import Pair
-from conformance.diff.gvt import steps_of
+from conformance.diff.gvt import expected_of, steps_of
+from conformance.diff.replayed import Verdict, frame_lines, header, verdict
 from conformance.diff.sides import Side
-from conformance.diff.steps import FILL, FRAME
-from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
 from conformance.targets import SessionError, TargetError
-from gve_fixtures.transcript import UNIT, TranscriptError, load
+from conformance.verdict import FAIL
+from gve_fixtures.transcript import TranscriptError, load
 
 PROG = "gve-conformance replay"
 
@@ -40,46 +42,34 @@ def main(argv: list[str] | None = None) -> int:
             OSError) as err:
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
-    recorded = [r for r in t.records if r.direction == UNIT]
+    expected = expected_of(t)
     interrupts = Interrupts()
     session = target.begin(interrupts)
     ask_first(args, target)
+    for line in header(args.file, target.info.spec, reference.info.spec, target.profile.name,
+                       t.meta):
+        print(line, flush=True)
     pair = Pair(Side(target, session), Side(reference), target.profile)
+    outcome = None
     try:
         with interrupts.catching():
             outcome = pair.run(steps)
-    except (TargetNotResponding, SessionError) as err:
-        print(f"{PROG}: {err}", file=sys.stderr)
-        return 1
+        result = verdict(outcome, steps, t.meta)
+    except TargetNotResponding as err:
+        result = Verdict(FAIL, f"{FAIL}: the target stopped answering ({err}); nothing "
+                         "after it was compared", 1)
+    except SessionError as err:
+        result = Verdict.could_not_test(f"the session on the target could not go on ({err})")
     except KeyboardInterrupt:
         session.emergency_stop()
-        print(f"{PROG}: interrupted by a signal: H and D sent, the replay not finished",
-              file=sys.stderr)
-        return 1
+        result = Verdict.could_not_test("interrupted by a signal: H and D sent, the replay "
+                                        "not finished")
     finally:
         if session.real:
             session.finish()
         target.close()
-    print(f"replay {args.file}: {target.info.spec} against {reference.info.spec}")
-    answers = iter(recorded)
-    for rec in outcome.records:
-        if rec.step.kind not in (FRAME, FILL) or rec.target is None:
-            print(f"  = {rec.step}")
-            continue
-        # a transcript may record fewer answers than the reference gives (a fill's)
-        was = b"".join(r.data for _, r in zip(range(rec.reference.answer.count(b"\r")),
-                                             answers, strict=False)) if rec.step.answer else b""
-        print(f"  > {readable(rec.target.sent):28} target {readable(rec.target.answer) or '-':16}"
-              f" reference {readable(rec.reference.answer) or '-':16}"
-              f" recorded {readable(was) or '-'}")
-    d = outcome.disagreement
-    for note in outcome.refused:
-        print(f"  not sent (the guard): {note}")
-    if d is None:
-        print("no disagreement: the target answers as the reference does")
-        return 0
-    print(f"the disagreement is still there: {readable(d.target.sent)} target "
-          f"{readable(d.target.answer) or '(none)'}, reference "
-          f"{readable(d.reference.answer) or '(none)'} ({d.kind}); "
-          f"{d.verdict} {d.rule or '(no known rule)'}")
-    return 1
+    if outcome is not None:
+        for line in frame_lines(outcome, steps, expected):
+            print(line)
+    print(result.line, flush=True)
+    return result.status

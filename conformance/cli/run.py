@@ -19,7 +19,14 @@ from serial import SerialException
 
 from conformance.catalogue import select
 from conformance.cli.progress import Progress
-from conformance.cli.unit import ask_before_motion, confirmed, record_identities, resolve
+from conformance.cli.unit import (
+    ask_before_motion,
+    confirmed,
+    record_identities,
+    resolve,
+    unattended,
+    unattended_specs,
+)
 from conformance.cli.usage import Parser, UsageError, positive, run_id, writable_folder
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
@@ -28,7 +35,7 @@ from conformance.reports import write_junit, write_reports
 from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import FAILED, ORDER, overall
+from conformance.verdict import FAILED, ORDER, last_line, overall
 from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"
@@ -174,11 +181,15 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
 
 def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     console = Console()
+    if args.profile == "auto":       # asking a unit on a port who it is sends `?` and `Q`
+        unattended_specs([t for t in args.target if t.startswith(("serial:", "tcp:"))],
+                         args.yes, console)
     try:
         targets, how = _targets(args, console)
     except KeyboardInterrupt:
         raise UsageError("interrupted before the run, nothing was sent") from None
     _preflight(targets)
+    unattended(targets, args.yes, console)
     run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
     seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
     meta = _meta(args, argv, targets, how, cases, seed, console)
@@ -214,9 +225,8 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
         _say(f"reports: {folder}/report.html, results.json, junit.xml")
     if args.junitxml:
         _say(f"JUnit XML: {write_junit(result, args.junitxml)}")
-    verdict, reason = overall([r.verdict for r in result.results], result.interrupted,
-                              result.problems)
-    _say(f"{verdict}: {reason}")
+    verdict, _ = overall(result.results, result.interrupted, result.problems)
+    _say(last_line(result.results, result.interrupted, result.problems))
     return 1 if verdict == FAILED else 0
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from conformance.cli.usage import UsageError
 from conformance.metadata import RunMeta
 from conformance.operator import Console, confirm_motion
 from conformance.targets import Target
@@ -14,6 +15,9 @@ from conformance.targets.port import locate
 from gve_fixtures.profile import Profile
 
 AUTO = "auto"
+#: why a run that must ask before moving stops before sending anything
+CANNOT_ASK = ("motion needs a yes and nobody can answer here (no terminal): give --yes on "
+              "an unattended bench")
 
 
 def _ask_variant(console: Console):
@@ -90,3 +94,24 @@ def confirmed(targets: list[Target], meta: RunMeta, console: Console) -> bool:
     lines = [line for t in real for line in _what_moves(
         t, meta.target(t.info.spec).version, meta.target(t.info.spec).processor_id)]
     return not real or confirm_motion(console, lines)
+
+
+def unattended(targets: list[Target], yes: bool, console: Console) -> None:
+    """Refuse, before anything is sent, a run on a real unit that must ask before its
+    first move (no ``--yes``) where nobody can answer (standard input not a terminal):
+    the targets are closed, UsageError (exit status 2). The embedded emulator needs no
+    question. ``--profile auto``, which asks the unit who it is, checks the specs first
+    with :func:`unattended_specs`."""
+    try:
+        unattended_specs([t.info.spec for t in targets if t.info.kind != "emu"], yes, console)
+    except UsageError:
+        for t in targets:
+            t.close()
+        raise
+
+
+def unattended_specs(specs: list[str], yes: bool, console: Console) -> None:
+    """:func:`unattended` for target specs not yet opened."""
+    real = [s for s in specs if s.partition(":")[0] != "emu"]
+    if real and not yes and not console.interactive:
+        raise UsageError(CANNOT_ASK)

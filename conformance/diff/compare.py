@@ -69,6 +69,21 @@ def difference(command: str, target: Exchange, reference: Exchange, judge: Judge
     return "data"
 
 
+def alike_because(command: str, target: Exchange, reference: Exchange, judge: Judge,
+                  *, moving: bool = False) -> str:
+    """Why two answers :func:`difference` found alike are alike ("" when their bytes are
+    the same): what a replay prints beside two answers that differ in their bytes."""
+    if target.answer == reference.answer:
+        return ""
+    if command == "@":
+        return (f"the same index, counted from where each side began (offset "
+                f"{judge.index_offset})")
+    limit = band(target, reference, judge, moving)
+    when = "read while the axes may have moved" if moving else \
+        "read after a frame that changed the motion's course"
+    return f"within ±{limit} step(s), {when}"
+
+
 def _repeats_position(ra, rb) -> bool:
     """Both `>` answers repeat the same position read: its values were taken while the
     axes may have moved, and are compared as that read was (the first line is the frame

@@ -21,7 +21,7 @@ from hypothesis.errors import Flaky, NoSuchExample
 from hypothesis.internal.conjecture import providers
 from hypothesis.internal.constants_ast import Constants
 
-from conformance.diff.compare import Judge, difference
+from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.labels import command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
@@ -52,6 +52,9 @@ class Record:
     reference: Exchange | None = None
     repeat: int = 0                      # FILL: frames of it before this one
     place: int = 0                       # the step's place in its sequence
+    #: answers whose bytes differ but were judged alike: why (the timing band, the index
+    #: counted from each side's start); "" when the bytes are the same
+    alike: str = ""
 
 
 @dataclass
@@ -235,7 +238,8 @@ class Pair:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
                                               stall=step.stall, body=step.body)
         except SafetyStop as err:
-            out.refused.append(f"{step}: {err}")
+            why = str(err)
+            out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")
             return None
         except TargetNotResponding as err:
             if self.target.real:       # a fresh unit's silence ends only its example
@@ -264,7 +268,10 @@ class Pair:
                 moving = self._moving_near(rec) if command != ">" else True
         late = self._cut_ns + (self._slack_ns if moving else 0)
         judge = replace(self.judge, rate=self._ceiling.rate * self._factor, slack_ns=late)
-        return difference(command, rec.target, rec.reference, judge, moving=moving)
+        kind = difference(command, rec.target, rec.reference, judge, moving=moving)
+        if kind is None:
+            rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)
+        return kind
 
     def _retimed(self, command: str, rec: Record | None) -> None:
         """Real time: the reference acts on a frame when the target's exchange began, the

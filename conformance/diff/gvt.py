@@ -101,7 +101,17 @@ def write(path: str | Path, t: Transcript) -> Path:
 def steps_of(t: Transcript) -> list[Step]:
     """The steps a transcript replays: each frame's bytes exactly, an answer due when
     `<` records follow it (as many lines as there are), waits, inputs, fills."""
-    steps: list[Step] = []
+    return [step for step, _ in _parsed(t)]
+
+
+def expected_of(t: Transcript) -> list[bytes]:
+    """Step by step (as :func:`steps_of`), the answer the transcript expects: its `<`
+    records after the frame, joined (empty for an action, a fill included)."""
+    return [answer for _, answer in _parsed(t)]
+
+
+def _parsed(t: Transcript) -> list[tuple[Step, bytes]]:
+    steps: list[tuple[Step, bytes]] = []
     records = t.records
     i = 0
     while i < len(records):
@@ -116,16 +126,17 @@ def steps_of(t: Transcript) -> list[Step]:
                 stall = (len(data), _wait(records[j].action).seconds)
                 data += records[j + 1].data
                 j += 2
-            lines = 0
+            answer = []
             while j < len(records) and records[j].direction == UNIT:
-                lines += 1
+                answer.append(records[j].data)
                 j += 1
-            steps.append(Step(FRAME, _body(data), answer=lines > 0, lines=max(lines, 1),
-                              stall=stall, raw=data))
+            steps.append((Step(FRAME, _body(data), answer=bool(answer),
+                               lines=max(len(answer), 1), stall=stall, raw=data),
+                          b"".join(answer)))
             i = j
             continue
         if r.direction == ACTION and r.action[0] in _ACTIONS:
-            steps.append(_action(r.action))
+            steps.append((_action(r.action), b""))
         i += 1
     return steps
 

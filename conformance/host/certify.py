@@ -53,6 +53,8 @@ class Plan:
     host_timeout: float = 5.0
     strict: bool = False
     jobs: int = 4
+    #: address -> the full steps per axis the clean run must travel (--expect-motion)
+    expect_motion: dict[int, tuple[int, ...]] | None = None
     stop: threading.Event = field(default_factory=threading.Event)   # Ctrl-C
     baseline: Baseline | None = None      # what the clean run showed, once it has run
     started: set[str] = field(default_factory=set)   # scenarios whose host run has begun
@@ -177,7 +179,7 @@ def grade(plan: Plan, sc: Scenario, out: Outcome) -> HostResult:
     line = LineFacts(out.views, units, plan.baud, out.recording.origin, out.exit_code)
     g = oracle.Grader(sc, plan.strict)
     oracle.wire_checks(g, judge(out.recording, line))
-    oracle.motion_checks(g, out, plan.baseline)
+    oracle.motion_checks(g, out, plan.baseline, plan.expect_motion)
     if sc.name == "interrupt":
         oracle.interrupt_checks(g, out.recording)
     return oracle.result(g, out, plan.profile, plan.target)

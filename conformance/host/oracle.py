@@ -132,12 +132,44 @@ def wire_checks(g: Grader, j: Judgement) -> None:
     g.notes += j.notes
 
 
-def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None) -> None:
+def travel(steps: list[Step], axes: int) -> tuple[int, ...]:
+    """The full steps each axis travelled in the executed vectors ``steps`` (the sum of
+    their lengths, whatever the direction)."""
+    out = [0] * axes
+    for s in steps:
+        if s.kind in VECTORS:
+            for i, v in enumerate(s.values[:axes]):
+                out[i] += abs(int(v))
+    return tuple(out)
+
+
+def driven_checks(g: Grader, out: Outcome, expect: dict[int, tuple[int, ...]] | None
+                  ) -> None:
+    """The clean run shows a host that drives its units: it sends frames, and the units
+    execute the motion its job claims (``expect``: the travel per axis per address)."""
+    n = len(out.recording.exchanges)
+    g.check(n > 0, "2.link.host-drives", "the host sends its units frames on the clean "
+            "line", f"{n} frame(s)", "always")
+    for address, want in (expect or {}).items():
+        view = next((v for v in out.views if v.address == address), None)
+        axes = view.profile.axes if view is not None else ""
+        got = travel(list(view.executed), len(axes)) if view is not None else ()
+        want = tuple(want) + (0,) * (len(axes) - len(want))
+        shown = ", ".join(f"{a} {s}" for a, s in zip(axes, got, strict=False))
+        g.check(got == want, "2.link.host-drives", f"unit {address} executes the motion "
+                "the job claims (--expect-motion "
+                + ",".join(map(str, want)) + ")",
+                f"it travelled {shown or 'nothing'} full steps", "always")
+
+
+def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None,
+                  expect: dict[int, tuple[int, ...]] | None = None) -> None:
     sc = g.scenario
     finished = out.ended in ("exited", "operator") and out.exit_code == 0
     if sc.name == "clean":
         g.check(finished, "8.recovery.finishes", "the host finishes its own job on a "
                 "clean line", _ending(out), "always")
+        driven_checks(g, out, expect)
         return
     hung = out.ended in ("silent", "limit")
     g.check(not hung, "8.recovery.finishes", "the host finishes or gives up after the "
@@ -218,6 +250,7 @@ HOST_CHECKS: dict[str, Callable] = {
     **WIRE_CHECKS,
     "8.recovery.exactly-once": motion_checks,
     "8.recovery.finishes": motion_checks,
+    "2.link.host-drives": driven_checks,
     "4.response.inta-bit": interrupt_checks,
 }
 

@@ -8,8 +8,26 @@ from conformance.link.framing import Response
 from conformance.model.unit import ModelUnit
 
 
+class Broken(AssertionError):
+    """A machine's invariant that failed, with the rule it checks: graded by that
+    rule's tag, as a directed case's check is."""
+
+    def __init__(self, rule: str, message: str) -> None:
+        super().__init__(message)
+        self.rule = rule
+
+
+def holds(ok: object, rule: str, message: str) -> None:
+    """Assert ``ok`` as a check of ``rule`` (Broken when it fails)."""
+    if not ok:
+        raise Broken(rule, message)
+
+
 class UnitMachine(RuleBasedStateMachine):
     ctx = None      # set by run_machine
+    #: the rule the index invariant checks (a machine whose frames include what only our
+    #: reading counts names that reading's rule)
+    INDEX_RULE = "8.index.counts"
 
     def __init__(self) -> None:
         super().__init__()
@@ -20,6 +38,11 @@ class UnitMachine(RuleBasedStateMachine):
         # a real unit is not fresh: start the bookkeeping from where it is
         self.model.committed = self.position()
         self.model.index = self.index()
+        # whether @ counts itself is a reading the manuals leave open [D]: measured
+        again = self.index()
+        if again == (self.model.index + 1) % 256:
+            self.model.uncounted = ()
+        self.model.index = again
 
     def send(self, body: str, **kw) -> Response | None:
         r = self.link.send(body, **kw)
@@ -34,23 +57,25 @@ class UnitMachine(RuleBasedStateMachine):
     def idle(self) -> None:
         r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120)
         self.model.frame_arrived("L")
-        assert r is not None, "the unit never became idle"
+        holds(r is not None, "10.1.queue.wait-idiom", "the unit never became idle")
         # the polls counted too: resynchronize with what the unit says the index is
         self.model.index = self.index()
 
     def index(self) -> int:
         r = self.link.send("@")
-        assert r is not None and r.code == 0 and r.values, f"@ answered {r}"
+        holds(r is not None and r.code == 0 and r.values, "8.index.answer", f"@ answered {r}")
+        self.model.frame_arrived("@")
         return r.dec()
 
     def position(self) -> list[int]:
         r = self.link.send("PF")
         self.model.frame_arrived("P")
-        assert r is not None and r.code == 0, f"PF answered {r}"
+        holds(r is not None and r.code == 0, "10.cmd.positions", f"PF answered {r}")
         return r.decs()
 
     @invariant()
     def index_is_the_models(self) -> None:
         if self.model.packet is None:
             got = self.index()
-            assert got == self.model.index, f"index {got}, model {self.model.index}"
+            holds(got == self.model.index, self.INDEX_RULE,
+                  f"index {got}, model {self.model.index}")

@@ -7,10 +7,11 @@ from hypothesis import strategies as st
 from hypothesis.stateful import rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine
+from conformance.machines.base import UnitMachine, holds
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import St6
 
-RUN, INTA = 0x40, 0x80
+RUN, INTA = St6.RUN, St6.INTA
 
 
 def expected_code(body: str, moving: bool, run: bool, inta: bool) -> int:
@@ -28,13 +29,22 @@ def expected_code(body: str, moving: bool, run: bool, inta: bool) -> int:
     return table[body]
 
 
+#: the rule each code checks; a probe whose code is our reading names that reading
+CODE_RULE = {0: "5.code.ok", 1: "10.1.queue.wait-idiom", 3: "5.code.unknown",
+             4: "5.code.syntax", 5: "5.code.range", 6: "5.code.nothing-to-go",
+             7: "5.code.busy-moving"}
+CODE_RULES = {"V+1": "3.params.decimal", "A0": "10.cmd.accel-range", "N": "5.code.busy-run"}
+
+
 class ErrorMachine(UnitMachine):
     def observe(self) -> tuple[bool, bool, bool]:
         r = self.link.send("SR6")
         self.model.frame_arrived("S")
-        assert r is not None and r.code == 0 and r.values, f"SR6 answered {r}"
+        holds(r is not None and r.code == 0 and r.values, "10.cmd.status-words",
+              f"SR6 answered {r}")
         st6 = r.hex()
-        assert r.inta == bool(st6 & INTA), f"the INTA bit of {r.text} disagrees with ST6"
+        holds(r.inta == bool(st6 & INTA), "4.response.inta-bit",
+              f"the INTA bit of {r.text} disagrees with ST6")
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
         return (run and not inta) or bool(st6 & 0x01), run, inta
 
@@ -44,13 +54,14 @@ class ErrorMachine(UnitMachine):
             return
         r = self.link.send(f"C{steps},0,0")
         self.model.frame_arrived("C")
-        assert r is not None and r.code in (0, 1), f"C answered {r}"
+        holds(r is not None and r.code in (0, 1), "10.1.queue.cont-buffer", f"C answered {r}")
 
     @rule()
     def halt(self) -> None:
         r = self.link.send("H")
         self.model.frame_arrived("H")
-        assert r is not None and r.code == 0 and r.inta, f"H answered {r}"
+        holds(r is not None and r.code == 0 and r.inta, "4.response.inta-bit",
+              f"H answered {r}")
 
     @rule(seconds=st.sampled_from([0.01, 0.3, 1.5]))
     def wait(self, seconds: float) -> None:
@@ -65,17 +76,27 @@ class ErrorMachine(UnitMachine):
         r = self.link.send(body)
         self.model.frame_arrived(body[:1])
         want = expected_code(body, moving, run, inta)
-        assert r is not None, f"{body} got no answer"
-        assert r.code == want, f"{body} (moving={moving}, RUN={run}, INTA={inta}): " \
-                               f"code {r.code}, expected {want}"
+        holds(r is not None, "5.code.ok", f"{body} got no answer")
+        # G with INTA = 1 and nothing pending may answer 6 as well (spec 5, both readings)
+        allowed = {want} | ({6} if body == "G" and inta and not run else set())
+        holds(r.code in allowed, CODE_RULES.get(body, CODE_RULE.get(want, "5.code.ok")),
+              f"{body} (moving={moving}, RUN={run}, INTA={inta}): code {r.code}, "
+              f"expected {want}")
         after = {"G": False, "D": False}.get(body, inta) if r.code == 0 else inta
-        assert r.inta == after, f"{body}: INTA bit {r.inta}, expected {after}"
+        if r.code == 6 and inta:
+            self.link.send("D")             # nothing started: clear INTA the manual's way
+            self.model.frame_arrived("D")
+            after = r.inta
+        holds(r.inta == after, "4.response.inta-after-command",
+              f"{body}: INTA bit {r.inta}, expected {after}")
 
 
 @case("5.machine.error-codes",
       rules=("5.code.nothing-to-go", "5.code.busy-moving", "5.code.busy-run", "5.code.unknown",
              "5.code.syntax", "5.code.range", "4.response.inta-bit",
-             "4.response.inta-after-command"),
+             "4.response.inta-after-command", "5.code.ok", "3.params.decimal",
+             "10.cmd.accel-range", "10.1.queue.wait-idiom", "10.1.queue.cont-buffer",
+             "10.cmd.status-words"),
       tag="M", source="M84 12.6; spec 4, 5",
       rule="Each error code arises exactly in its states, with the INTA bit of ST6")
 def error_machine(ctx: CaseContext) -> None:

@@ -74,7 +74,10 @@ class KeepMachine(UnitMachine):
     @rule()
     def go(self) -> None:
         r = self.link.send("G")
-        assert r is not None and r.code == 0, f"G answered {r}"
+        # with nothing left to run, 6 ("for Go, nothing to start") is allowed too (spec 5)
+        assert r is not None and r.code in (0, 6), f"G answered {r}"
+        if r.code == 6:
+            self.link.send("D")
         self.halted = False
 
     def teardown(self) -> None:
@@ -82,7 +85,9 @@ class KeepMachine(UnitMachine):
             self.link.send("R")
             self.halted = True
         if self.halted:
-            self.link.send("G")
+            r = self.link.send("G")
+            if r is not None and r.code == 6:
+                self.link.send("D")
         self.idle()
         got = self.position()
         assert got == self.model.committed, f"position {got}, expected {self.model.committed}"

@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine
+from conformance.machines.base import UnitMachine, holds
 from conformance.machines.runner import run_machine
 
 # member frame -> (kind, code it fails the packet with, steps it commits)
@@ -24,7 +24,7 @@ class PacketMachine(UnitMachine):
     def mode(self, summed: bool) -> None:
         if summed:
             r = self.send("%+", checksum=False)
-            assert r is not None and r.code == 0
+            holds(r is not None and r.code == 0, "6.checksum.mode-commands", f"%+ answered {r}")
             self.model.checksums = True
 
     @rule()
@@ -50,9 +50,9 @@ class PacketMachine(UnitMachine):
         expected = self.model.end_packet(n, self.model.buffer)
         r = self.send(f"*E{n}")
         self.pending = []
-        assert r is not None, "*E got no answer"
-        assert (r.code, r.values) == (expected[0], [str(expected[1])]), (
-            f"*E{n}: {r.text}, expected {expected[0]},{expected[1]}")
+        holds(r is not None, "7.packet.exchange", "*E got no answer")
+        holds((r.code, r.values) == (expected[0], [str(expected[1])]), "7.packet.codes",
+              f"*E{n}: {r.text}, expected {expected[0]},{expected[1]}")
         if expected[0] == 0:
             for body in members:
                 steps = MEMBERS[body][2]
@@ -63,7 +63,9 @@ class PacketMachine(UnitMachine):
     @rule()
     def breaker(self) -> None:
         r = self.link.send("@")
-        assert r is not None and r.code == 0, f"@ inside a packet answered {r}"
+        self.model.frame_arrived("@")
+        holds(r is not None and r.code == 0, "7.packet.breakers",
+              f"@ inside a packet answered {r}")
         self.model.packet = None
         self.pending = []
 
@@ -71,7 +73,8 @@ class PacketMachine(UnitMachine):
         if self.model.packet is None:
             self.idle()
             got = self.position()
-            assert got == self.model.committed, f"position {got}, committed {self.model.committed}"
+            holds(got == self.model.committed, "7.packet.all-or-nothing",
+                  f"position {got}, committed {self.model.committed}")
 
 
 @case("7.machine.packets",

@@ -7,8 +7,10 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine
+from conformance.machines.base import UnitMachine, holds
 from conformance.machines.runner import run_machine
+
+WAITING = "10.1.queue.wait-for-go"
 
 
 class QueueMachine(UnitMachine):
@@ -23,69 +25,74 @@ class QueueMachine(UnitMachine):
     def interrupted(self) -> None:
         # vectors wait in the queue while INTA = 1 [D 10.1]: the queue length is ours
         r = self.send("H")
-        assert r is not None and r.inta, f"H answered {r}"
+        holds(r is not None and r.inta, "4.response.inta-bit", f"H answered {r}")
 
     @rule(count=st.integers(1, 40))
     def queue(self, count: int) -> None:
         for i in range(count):
             r = self.send("C" + ("1,0,0" if i % 2 == 0 else "-1,0,0"))
             full = self.queued >= self.model.buffer
-            assert r is not None and r.code == (1 if full else 0), (
-                f"C with {self.queued} queued of {self.model.buffer}: {r}")
+            # the count of queued vectors rests on their waiting while INTA = 1 [D]
+            holds(r is not None and r.code == (1 if full else 0), WAITING,
+                  f"C with {self.queued} queued of {self.model.buffer}: {r}")
             if not full:
                 self.queued += 1
 
     @rule()
     def wait_idiom(self) -> None:
         r = self.send("L0,0,0")
-        assert r is not None and r.code == (1 if self.queued else 0), f"L0,0,0: {r}"
+        holds(r is not None and r.code == (1 if self.queued else 0), WAITING, f"L0,0,0: {r}")
         if r.code == 0:
             self.queued += 1            # accepted while INTA = 1: it waits for G [D 10.1]
 
     @rule()
     def delete(self) -> None:
         r = self.send("D")
-        assert r is not None and r.code == 0, f"D answered {r}"
+        holds(r is not None and r.code == 0, "5.code.ok", f"D answered {r}")
         self.queued = 0
         self.status.update({4: 0, 5: 0})    # D clears ST4..ST6 (spec 10.4)
         r = self.send("H")                  # interrupted again, so vectors stay queued
-        assert r is not None and r.inta
+        holds(r is not None and r.inta, "4.response.inta-bit", f"H answered {r}")
 
     @rule(n=st.sampled_from([3, 4, 5]), value=st.integers(0, 255))
     def status_word(self, n: int, value: int) -> None:
         r = self.send("SW%d,%02X" % (n, value))
-        assert r is not None and r.code == 0, f"SW{n} answered {r}"
+        holds(r is not None and r.code == 0, "10.cmd.status-words", f"SW{n} answered {r}")
         self.status[n] = value
         r = self.send(f"SR{n}")
-        assert r is not None and r.values == ["%02X" % value], f"SR{n}: {r}"
+        holds(r is not None and r.values == ["%02X" % value], "10.cmd.status-words",
+              f"SR{n}: {r}")
 
     @rule(address=st.integers(0x40, 0x47), value=st.integers(0, 255))
     def eeprom_write(self, address: int, value: int) -> None:
         r = self.send("EW%02X,%02X" % (address, value))
-        assert r is not None and r.code == 0, f"EW answered {r}"
+        holds(r is not None and r.code == 0, "10.cmd.eeprom-bytes", f"EW answered {r}")
         self.eeprom[address] = value
 
     def flags(self) -> None:
         r = self.send("F")
-        assert r is not None and r.code == 0 and r.values, f"F answered {r}"
+        holds(r is not None and r.code == 0 and r.values, "10.cmd.flags", f"F answered {r}")
         full = 0x20 if self.queued >= self.model.buffer else 0
         run = 0x40 if self.queued else 0
-        assert r.hex() & 0x60 == full | run, f"F = {r.values[0]}, " \
-            f"{self.queued} of {self.model.buffer} queued"
+        holds(r.hex() & 0x60 == full | run, WAITING,
+              f"F = {r.values[0]}, {self.queued} of {self.model.buffer} queued")
 
     def teardown(self) -> None:
         self.flags()
         for address, value in self.eeprom.items():
             r = self.send("ER%02X" % address)
-            assert r is not None and r.values == ["%02X" % value], f"ER{address:02X}: {r}"
+            holds(r is not None and r.values == ["%02X" % value], "10.cmd.eeprom-bytes",
+                  f"ER{address:02X}: {r}")
         for n, value in self.status.items():
             r = self.send(f"SR{n}")
-            assert r is not None and r.values == ["%02X" % value], f"SR{n}: {r}"
+            holds(r is not None and r.values == ["%02X" % value], "10.cmd.status-words",
+                  f"SR{n}: {r}")
 
 
 @case("10.machine.queue-status-eeprom",
       rules=("10.1.queue.cont-buffer", "10.1.queue.wait-idiom", "10.cmd.flags",
-             "10.cmd.status-words", "10.cmd.eeprom-bytes", "10.1.queue.wait-for-go"),
+             "10.cmd.status-words", "10.cmd.eeprom-bytes", "10.1.queue.wait-for-go",
+             "4.response.inta-bit", "5.code.ok"),
       tag="M", source="M84 12.5.2, 12.5.11, 11",
       destructive=True,
       rule="The queue's room, L0,0,0, F, status words and EEPROM bytes keep their rules")

@@ -21,11 +21,14 @@ class ModelUnit:
     inta: bool = False
     packet: list[tuple[str, int]] | None = None     # (member kind, its code)
     committed: list[int] = field(default_factory=lambda: [0, 0, 0])
+    #: frames that do not advance the index: @ and > by our reading [D]; a unit whose @
+    #: counts itself (measured by the machines) has none
+    uncounted: tuple[str, ...] = UNCOUNTED
 
     # -- section 8 ------------------------------------------------------------------------
     def frame_arrived(self, name: str, checksum_ok: bool = True) -> None:
         """A complete frame for the unit arrived (spec 8: counted unless @/> or a bad sum)."""
-        if checksum_ok and name not in UNCOUNTED:
+        if checksum_ok and name not in self.uncounted:
             self.index = (self.index + 1) % 256
 
     # -- section 6 ------------------------------------------------------------------------

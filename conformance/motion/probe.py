@@ -2,7 +2,8 @@
 unit processed them, the motion they cause is booked in the suite's model, positions are
 read with ``PF``, and at the end every reading is judged against the model at its
 instant, within the tolerance of :mod:`conformance.motion.tolerance` (printed with each
-check), and the whole is recorded as a trace for the reports.
+check in real time; in virtual time it is exact and not printed), and the whole is
+recorded as a trace for the reports, with what failed marked on it.
 
 The probe interprets the frames it sends as the unit must (spec 10): modal parameters
 (``V A B $ T VK VN VL M``) are captured by the vectors accepted after them, ``XM XA XU
@@ -21,6 +22,7 @@ from conformance.motion.arith import SECOND
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
+    Tolerance,
     Window,
     answer_window,
     late_window,
@@ -215,12 +217,13 @@ class Probe:
 
     def judge(self) -> bool:
         """Judge every reading taken after the first event, and the instant each H
-        answered; record the trace."""
+        answered; record the trace, with the faults marked on it."""
         (model, rests), variants = self.model(), self._variants()
         virtual = self.link.virtual
         t0 = self.events[0].window.lo if self.events else self.readings[0].window.lo
         spread = sum(e.window.hi - e.window.lo for e in self.events)
         ok_all = True
+        faults: list[dict] = []
         widest = tolerance(Window(0, spread), virtual=virtual)
         halts = [e for e in self.events if e.kind == "halt"]
         for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
@@ -229,11 +232,17 @@ class Probe:
             hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
             a = e.answer
             tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual)
-            ok_all &= self.ctx.expect(
+            ok = self.ctx.expect(
                 lo <= a.hi and a.lo <= hi,
-                f"{self.name}: H answered when the motion came to rest ({tol})",
+                f"{self.name}: H answered when the motion came to rest{_within(tol)}",
                 observed=f"answer at {(a.lo - t0) / 1e6:.3f} ms",
                 expected=f"at rest at {(rest - t0) / 1e6:.3f} ms", rule=self.rule)
+            ok_all &= ok
+            if not ok:
+                faults.append({"kind": "instant", "what": "H answered",
+                               "observed": (a.lo - t0) / SECOND,
+                               "expected": [(lo - t0) / SECOND, (hi - t0) / SECOND],
+                               "expected_what": "at rest"})
         for reading in self.readings:
             w = reading.window
             if w.hi < t0:
@@ -247,12 +256,18 @@ class Probe:
                         for b0, b1 in band]
             ok_all &= self.ctx.expect(
                 ok, f"{self.name}: PF at {(w.lo - t0) / 1e6:.3f} ms"
-                f"{' ' + reading.label if reading.label else ''} ({tol})",
+                f"{' ' + reading.label if reading.label else ''}{_within(tol)}",
                 observed=got, expected=expected, rule=self.rule)
-        self._trace(model, t0, widest)
+            if not ok:
+                t = ((w.lo + w.hi) / 2 - t0) / SECOND
+                faults += [{"kind": "position", "t": t, "axis": i, "observed": g,
+                            "expected": [b0, b1]}
+                           for i, (g, (b0, b1)) in enumerate(zip(got, band, strict=True))
+                           if not b0 <= g <= b1]
+        self._trace(model, t0, widest, faults)
         return ok_all
 
-    def _trace(self, model: MotionModel, t0: int, tol) -> None:
+    def _trace(self, model: MotionModel, t0: int, tol, faults: list[dict]) -> None:
         end = max(r.window.hi for r in self.readings)
         end = max(end, model.rest)
         step = max(1, (end - t0) // TRACE_POINTS)
@@ -263,7 +278,12 @@ class Probe:
                        samples=[((r.window.lo + r.window.hi) / 2 / SECOND - t0 / SECOND,
                                  r.positions) for r in self.readings if r.window.hi >= t0],
                        model=[((t - t0) / SECOND, model.position(t)) for t in instants],
-                       tolerance=tol.as_dict(), params=dict(self.params))
+                       tolerance=tol.as_dict(), params=dict(self.params), faults=faults)
+
+
+def _within(tol: Tolerance) -> str:
+    """The band a check used, for its text; none in virtual time, where it is exact."""
+    return "" if tol.exact else f" ({tol})"
 
 
 def _split(body: str) -> tuple[str, str]:

@@ -9,7 +9,7 @@ from conformance.verdict import overall
 def run_verdict(run: RunResult, target: str | None = None) -> tuple[str, str]:
     """PASSED or FAILED, and why, for the whole run or for ``target`` alone."""
     if target is None:
-        return overall([r.verdict for r in run.results], run.interrupted, run.problems)
+        return overall(run.results, run.interrupted, run.problems)
     session = run.sessions.get(target) or {}
-    return overall([r.verdict for r in run.results if r.target == target], run.interrupted,
+    return overall([r for r in run.results if r.target == target], run.interrupted,
                    session.get("problems", []))

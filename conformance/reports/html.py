@@ -1,8 +1,9 @@
-"""One self-contained HTML page (issue 12 items 4-6): the banner PASSED/FAILED, the
-run's metadata and the units' identity, a chart and a matrix of verdicts by spec section
-(cells link to the cases), filters (a little inline script: works offline), and per case
-its checks, pictures of its motion, notes and wire log. No external assets; every text
-from a unit goes through :func:`html_text`."""
+"""One self-contained HTML page (issue 12 items 4-6): the banner PASSED/FAILED and, right
+under it, what failed (each failing case with the check that failed it, linked to the
+case); then the run's metadata, the units (as found and as left), a chart and a matrix of
+verdicts by spec section (cells link to the cases), filters (a little inline script:
+works offline), and per case its checks, pictures of its motion (the fault marked), notes
+and wire log. No external assets; every text from a unit goes through :func:`html_text`."""
 
 from __future__ import annotations
 
@@ -11,9 +12,11 @@ from importlib import resources
 
 import conformance.reports.plots as plots
 from conformance.reports.banner import run_verdict
+from conformance.reports.failures import failures
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import html_text as h
+from conformance.reports.units import state_section, units_table
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS
 
@@ -21,6 +24,8 @@ from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PAS
 _OPEN = (FAIL, ERROR)
 #: verdicts whose reason (the first note) shows on the case's line
 _WHY = (COULD_NOT_TEST, MISSING, ERROR)
+#: verdicts that say the target could not be judged (counted under the failures)
+_UNJUDGED = (COULD_NOT_TEST,)
 
 
 def _asset(name: str) -> str:
@@ -39,44 +44,51 @@ def _header(run: RunResult) -> list[str]:
     verdict, reason = run_verdict(run)
     m = run.meta
     counts = run.counts()
-    out = [f"<div class='banner {verdict}'>{verdict}</div> <span class='why'>{h(reason)}"
-           f"{' (interrupted by Ctrl-C)' if run.interrupted else ''}</span>",
-           *([f"<ul class='FAIL'>{''.join(f'<li>PROBLEM: {h(p)}</li>' for p in run.problems)}"
-              "</ul>"] if run.problems else []),
-           f"<h1>gve-conformance run {h(run.run_id)}</h1>",
-           "<p>" + " ".join(f"<span class='{h(v)}'>{h(v)}: {counts[v]}</span>"
-                            for v in ORDER if v in counts)
-           + f" — {len(run.results)} case runs in {run.seconds:.1f} s, {run.frames} frames</p>",
-           "<table class='meta'>" + _rows([
-               ("started", m.started), ("finished", m.finished),
-               ("operator", m.operator or "(not given: --operator-name)"),
-               ("suite version", m.suite_version),
-               ("host", f"{m.host} ({m.platform}, Python {m.python})"),
-               ("command", " ".join(["gve-conformance", *m.command])),
-               *((flag, value) for flag, value in m.flags().items())]) + "</table>",
-           "<h2>Units</h2><table><tr><th>target</th><th>profile</th><th>version (?)</th>"
-           "<th>processor id (Q)</th><th>envelope (steps per axis)</th>"
-           "<th>largest excursion</th><th>verdict</th></tr>"]
-    for target in run.targets:
-        t = m.target(target)
-        v, why = run_verdict(run, target)
-        out.append(
-            f"<tr><td>{h(target)}</td><td>{h(t.profile)}"
-            f"{' (' + h(t.profile_chosen) + ')' if t.profile_chosen else ''}</td>"
-            f"<td>{h(t.version)}</td><td>{h(t.processor_id)}</td>"
-            f"<td>{h('±' + str(t.envelope) if t.envelope is not None else 'not enforced')}</td>"
-            f"<td>{h(t.excursion if t.excursion is not None else '')}</td>"
-            f"<td class='{v}'>{v}: {h(why)}</td></tr>")
-    out.append("</table>")
-    for target, s in run.sessions.items():
-        done = [*(f"found {k} {v}" for k, v in s.get("found", {}).items()),
-                *(f"restored: {r}" for r in s.get("restored", [])),
-                *(f"reset: {r}" for r in s.get("reset", [])),
-                *(f"PROBLEM: {p}" for p in s.get("problems", []))]
-        if done:
-            out.append(f"<details><summary>{h(target)}: the unit as found and as left "
-                       f"({len(done)})</summary><ul>"
-                       + "".join(f"<li>{h(d)}</li>" for d in done) + "</ul></details>")
+    return [f"<div class='banner {verdict}'>{verdict}</div> <span class='why'>{h(reason)}"
+            f"{' (interrupted by Ctrl-C)' if run.interrupted else ''}</span>",
+            *([f"<ul class='FAIL'>{''.join(f'<li>PROBLEM: {h(p)}</li>' for p in run.problems)}"
+               "</ul>"] if run.problems else []),
+            *_failed(run),
+            f"<h1>gve-conformance run {h(run.run_id)}</h1>",
+            "<p>" + " ".join(f"<span class='{h(v)}'>{h(v)}: {counts[v]}</span>"
+                             for v in ORDER if v in counts)
+            + f" — {len(run.results)} case runs in {run.seconds:.1f} s, {run.frames} frames</p>",
+            "<table class='meta'>" + _rows([
+                ("started", m.started), ("finished", m.finished),
+                ("operator", m.operator or "(not given: --operator-name)"),
+                ("suite version", m.suite_version),
+                ("host", f"{m.host} ({m.platform}, Python {m.python})"),
+                ("command", " ".join(["gve-conformance", *m.command])),
+                *((flag, value) for flag, value in m.flags().items())]) + "</table>",
+            *units_table(run), *state_section(run)]
+
+
+def _failed(run: RunResult) -> list[str]:
+    """The failing cases, right under the banner: each with the check that failed it,
+    linked to the case below."""
+    found = failures(run)
+    counts = run.counts()
+    untested = [f"{counts[v]} {v}" for v in _UNJUDGED if counts.get(v)]
+    if not found and not untested:
+        return []
+    out = [f"<section id='failed'><h2>What failed ({len(found)})</h2>" if found else
+           "<section id='failed'><h2>What failed: no case</h2>"]
+    if found:
+        out.append("<table class='failed'><tr><th>case</th><th>what failed</th>"
+                   "<th>observed</th><th>expected</th><th>rule</th></tr>")
+        for f in found:
+            profiles = h(f.runs[0].profile) if len(f.runs) == 1 else ", ".join(
+                f"<a href='#{h(_anchor(r))}'>{h(r.profile)}</a>" for r in f.runs)
+            rule = f"{f.rule_id}: {f.rule}" if f.rule_id else f.rule
+            out.append(f"<tr class='{h(f.verdict)}'><td><a href='#{h(_anchor(f.runs[0]))}'>"
+                       f"<b>{h(f.verdict)}</b> {h(f.id)}</a> [{profiles}]</td>"
+                       f"<td>{h(f.what)}</td><td>{h(f.observed)}</td><td>{h(f.expected)}</td>"
+                       f"<td>{h(rule)}</td></tr>")
+        out.append("</table>")
+    if untested:
+        out.append(f"<p class='why'>Not judged: {h(', '.join(untested))} (each says why on "
+                   "its line under Cases).</p>")
+    out.append("</section>")
     return out
 
 

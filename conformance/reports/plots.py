@@ -6,7 +6,9 @@ plots are off.
 - :func:`verdict_chart`: per spec section, a bar of its case verdicts.
 - :func:`trace_chart`: a motion trace (``CaseResult.traces``) — position and rate
   against time as sampled from the target, over the spec's model, with the tolerance
-  band the check used.
+  band the check used (none in virtual time, where it is zero) and the trace's faults
+  marked: the instant observed against the instant expected, a wrong reading against
+  the positions admitted there.
 - :func:`step_train_chart`: the pulses per axis of the emulator's stepper core.
 """
 
@@ -27,6 +29,8 @@ MAX_PULSES = 120
 COLOURS = {"PASS": "#6cc35a", "NON-STRICT": "#e5b935", "FAIL": "#d9483b",
            "ERROR": "#8b1e14", "INFO": "#6f93d8", "MISSING": "#bbbbbb",
            "COULD-NOT-TEST": "#8d8d8d"}
+#: how opaque the tolerance band is drawn
+BAND_ALPHA = 0.15
 _AXIS_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
 
 
@@ -128,18 +132,29 @@ def _band(t: np.ndarray, model_t: np.ndarray, model: np.ndarray, seconds: float,
     return shifted.min(axis=0) - steps, shifted.max(axis=0) + steps
 
 
+def band_text(seconds: float, steps: float) -> str:
+    """The tolerance band for a caption; none where it is zero (virtual time: exact)."""
+    if not seconds and not steps:
+        return ""
+    return f"band: ±{seconds * 1e3:.3f} ms, ±{steps:g} step(s)"
+
+
 def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
-    """Position (and ``rate``) against time: the target's samples over the model."""
+    """Position (and ``rate``) against time: the target's samples over the model, the
+    tolerance band around it (where it has a width) and the trace's faults marked."""
     if not available():
         return None
     st, sp = _columns(_thin(trace.get("samples") or []))
     mt, mp = _columns(trace.get("model") or [])
     tol = trace.get("tolerance") or {}
     seconds, steps = float(tol.get("seconds", 0.0)), float(tol.get("steps", 0.0))
+    faults = trace.get("faults") or []
     names = trace.get("axes") or ["X", "Y", "Z", "A"]
     width = max(sp.shape[1] if sp.size else 0, mp.shape[1] if mp.size else 0)
-    moving = [i for i in range(width)
-              if (sp.size and np.ptp(sp[:, i]) > 0) or (mp.size and np.ptp(mp[:, i]) > 0)]
+    moving = sorted({i for i in range(width)
+                     if (sp.size and np.ptp(sp[:, i]) > 0) or (mp.size and np.ptp(mp[:, i]) > 0)}
+                    | {f["axis"] for f in faults if f.get("kind") == "position"
+                       and f["axis"] < width})
     height = 4.4 if rate else 2.6
     fig = _figure(7.5, height, {"left": 0.12, "right": 0.98, "top": 1 - 0.3 / height,
                                 "bottom": 0.5 / height, "hspace": 0.12})
@@ -149,8 +164,9 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
         if mp.size:
             grid = np.linspace(mt[0], mt[-1], MAX_POINTS)
             model_i = np.interp(grid, mt, mp[:, i])
-            lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
-            pos_ax.fill_between(grid, lo, hi, color=colour, alpha=0.15, linewidth=0)
+            if seconds or steps:
+                lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
+                pos_ax.fill_between(grid, lo, hi, color=colour, alpha=BAND_ALPHA, linewidth=0)
             pos_ax.plot(grid, model_i, "--", color=colour, linewidth=1, label=f"{name} model")
             if rate_ax is not None:
                 rt, rv = _rate(grid, model_i[:, None])
@@ -161,6 +177,7 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
             if rate_ax is not None:
                 rt, rv = _rate(st, sp[:, i:i + 1])
                 rate_ax.plot(rt, rv[:, 0], "o", color=colour, markersize=3.5)
+    _mark_faults(faults, pos_ax, rate_ax)
     title = trace.get("name", "motion")
     params = trace.get("params") or {}
     if params:
@@ -169,11 +186,52 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
     pos_ax.set_ylabel("position (steps)")
     if rate_ax is not None:
         rate_ax.set_ylabel("rate (steps/s)")
-    (rate_ax or pos_ax).set_xlabel(f"time (s); band: ±{seconds:g} s, ±{steps:g} steps")
+    band = band_text(seconds, steps)
+    (rate_ax or pos_ax).set_xlabel("time (s)" + (f"; {band}" if band else ""))
     pos_ax.legend(fontsize=7, ncols=2)
     for ax in (pos_ax, rate_ax or pos_ax):
         ax.tick_params(labelsize=8)
     return _svg(fig, key)
+
+
+#: how a fault is drawn: what the unit did in the verdict's red, what the spec wants black
+_OBSERVED, _EXPECTED = COLOURS["FAIL"], "#000000"
+
+
+def _mark_faults(faults: list[dict], pos_ax, rate_ax) -> None:
+    """The faults on the picture: a wrong instant as a red line where it happened and a
+    black one (or span) where it should have; a wrong reading ringed in red, the
+    positions the spec admits there in black (a tick, or a bar where the band is wide)."""
+    readings = _thin([f for f in faults if f.get("kind") == "position"])
+    for n, f in enumerate(readings):
+        lo, hi = f["expected"]
+        t, got = f["t"], f["observed"]
+        near = lo if got < lo else hi
+        pos_ax.plot([t, t], [got, near], ":", color=_OBSERVED, linewidth=1)
+        if hi > lo:
+            pos_ax.vlines(t, lo, hi, color=_EXPECTED, linewidth=2.5,
+                          label="expected there" if n == 0 else None)
+        else:
+            pos_ax.plot([t], [lo], "_", color=_EXPECTED, markersize=10, markeredgewidth=2.5,
+                        label="expected there" if n == 0 else None)
+        pos_ax.plot([t], [got], "o", color=_OBSERVED, markersize=9, markerfacecolor="none",
+                    markeredgewidth=1.6, label="read wrong" if n == 0 else None)
+    for f in (f for f in faults if f.get("kind") == "instant"):
+        lo, hi = f["expected"]
+        for ax in (pos_ax, rate_ax):
+            if ax is None:
+                continue
+            first = ax is pos_ax
+            ax.axvline(f["observed"], color=_OBSERVED, linewidth=1.6,
+                       label=f"{f['what']} {f['observed'] * 1e3:.1f} ms" if first else None)
+            expected = f"{f.get('expected_what', 'expected')} {lo * 1e3:.1f} ms" + (
+                f"..{hi * 1e3:.1f} ms" if hi != lo else "") + " (expected)"
+            if hi > lo:
+                ax.axvspan(lo, hi, color=_EXPECTED, alpha=0.2,
+                           label=expected if first else None)
+            else:
+                ax.axvline(lo, color=_EXPECTED, linewidth=1.6, linestyle=":",
+                           label=expected if first else None)
 
 
 def step_train_chart(pulses: Sequence[tuple[float, int]], axes: Sequence[str], key: str,

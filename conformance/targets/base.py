@@ -29,6 +29,7 @@ class Target:
     baud: int
     url: str
     mutant: str | None = None
+    readings: str = ""              # emu: the emulator's other readings, "A,B"
 
     def __post_init__(self) -> None:
         self._session: Session | None = None

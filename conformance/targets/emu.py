@@ -22,6 +22,13 @@ def mutants() -> dict[str, tuple[str, str]]:
             for name, spec in MUTANTS.items()}
 
 
+def emulator_readings() -> dict[str, tuple[tuple[str, ...], str]]:
+    """The readings the emulator can take: name -> (the rules read otherwise, what it
+    does), from its registry."""
+    from emulator.readings import READINGS
+    return {name: (spec.rules, spec.description) for name, spec in READINGS.items()}
+
+
 class EmuTarget(Target):
     def preflight(self) -> None:
         if self.mutant is not None and self.mutant not in mutants():
@@ -34,6 +41,8 @@ class EmuTarget(Target):
         query = f"model={self.profile.name}&address={address}"
         if self.mutant:
             query += f"&mutant={self.mutant}"
+        if self.readings:
+            query += f"&reading={self.readings}"
         port = serial.serial_for_url(f"gve://?{query}", timeout=0.25)
         return port, port.line.baud, True, port.line
 
@@ -44,10 +53,18 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
     name = parts.path.lstrip("/") or "GVE84-100"
     q = parse_qs(parts.query)
     mutant = q.get("mutant", [mutant])[-1]
+    readings = ",".join(q.get("reading", []))
     p = load_profile(name)
     if profile is not None and load_profile(profile).name != p.name:
         raise TargetError(f"--profile {profile} contradicts the target {spec} "
                           f"(the emulator behaves as {p.name})")
-    # the reference implements every decision: graded strictly, its mutants too
-    info = TargetInfo("emu", spec, True, True, True, max_travel, strict=True)
-    return EmuTarget(info, p, p.address, p.default_baud, spec, mutant)
+    if readings:
+        unknown = sorted(set(readings.split(",")) - set(emulator_readings()))
+        if unknown:
+            raise TargetError(f"unknown reading(s) {', '.join(unknown)} "
+                              f"(known: {', '.join(sorted(emulator_readings()))})")
+    # the reference implements every decision: graded strictly, its mutants too; an
+    # emulator taking other readings is graded as any other unit, by the tags
+    info = TargetInfo("emu", spec, True, True, True, max_travel,
+                      strict=not readings or strict)
+    return EmuTarget(info, p, p.address, p.default_baud, spec, mutant, readings)

@@ -1,7 +1,8 @@
 """`gve://` URLs: which units a line carries, and how (docs/architecture.md, Ways in).
 
 ``gve://?model=GVE84-100&address=0`` or ``gve://?unit=GVE54@1&unit=GVE84-100@0``, with
-``baud``, ``watchdog_ms``, ``eeprom``, ``mutant``, ``stepper``, ``log``, and
+``baud``, ``watchdog_ms``, ``eeprom``, ``mutant``, ``reading`` (``A,B``: readings of
+emulator/readings.py), ``stepper``, ``log``, and
 ``realtime=1`` (the line runs on the wall clock instead of virtual time).
 """
 
@@ -11,6 +12,7 @@ from dataclasses import dataclass, field
 from urllib.parse import parse_qs, urlsplit
 
 from emulator.protocol.unit import Unit
+from emulator.readings import parse_readings
 from gve_fixtures.profile import load_profile
 
 DEFAULT_MODEL = "GVE84-100"
@@ -23,6 +25,7 @@ class LineSpec:
     watchdog_ms: int | None = None
     eeprom: str | None = None
     mutant: str | None = None
+    readings: tuple[str, ...] = ()
     stepper: str | None = None
     log: str | None = None
     realtime: bool = False
@@ -33,7 +36,8 @@ class LineSpec:
         taken: dict[int, str] = {}
         for model, address in self.units or [(DEFAULT_MODEL, None)]:
             unit = Unit(load_profile(model), address, eeprom_path=self.eeprom,
-                        mutant=self.mutant, watchdog_ms=self.watchdog_ms, stepper=self.stepper)
+                        mutant=self.mutant, watchdog_ms=self.watchdog_ms, stepper=self.stepper,
+                        readings=self.readings)
             for a in sorted(unit.addresses):
                 if a in taken:
                     raise ValueError(f"two units answer address {a}: {taken[a]} and "
@@ -74,7 +78,7 @@ def parse_url(url: str) -> LineSpec:
         raise ValueError(f"not a gve:// URL: {url!r}")
     q = parse_qs(parts.query)
     unknown = set(q) - {"model", "address", "unit", "baud", "watchdog_ms", "eeprom",
-                        "mutant", "stepper", "log", "realtime"}
+                        "mutant", "reading", "stepper", "log", "realtime"}
     if unknown:
         raise ValueError(f"unknown gve:// parameter(s): {', '.join(sorted(unknown))}")
 
@@ -92,5 +96,6 @@ def parse_url(url: str) -> LineSpec:
             setattr(spec, key, positive(key, value))
     for key in ("eeprom", "mutant", "stepper", "log"):
         setattr(spec, key, one(key))
+    spec.readings = parse_readings(",".join(q.get("reading", [])))
     spec.realtime = one("realtime") in ("1", "true", "yes")
     return spec

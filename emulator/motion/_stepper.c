@@ -1,26 +1,14 @@
-/* The C stepper core: a faithful port of python_twin.py / segment.py / arith.py.
- *
- * Every quantity is an integer; products are computed in 128 bits so the results equal
- * the Python twin's (unbounded integers) bit for bit. docs/motion-model.md is the spec.
- * The only floating point is the first guess of an integer square root, which is then
- * corrected exactly.
+/* The C stepper core: a faithful port of python_twin.py (its arithmetic and segments,
+ * arith.py and segment.py, are in _stepper_math.h). docs/motion-model.md is the spec.
  */
-#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "_stepper.h"
+#include "_stepper_math.h"
 
-typedef __int128 i128;
-typedef unsigned __int128 u128;
-typedef int64_t i64;
-
-#define SECOND 1000000000LL
-#define NEVER ((i64)((uint64_t)1 << 61))
 #define HISTORY 65536
-#define FWD 0
-#define REV 1
 /* deviations (interface.py Deviation) */
 #define DEV_ZERO_LENGTH_JUNCTION 1
 #define DEV_CONTINUOUS_DWELL 2
@@ -29,57 +17,12 @@ typedef int64_t i64;
 #define DEV_HALT_DEAD 16
 #define DEV_GO_AT_SPEED 32
 
-/* ---- arithmetic (arith.py) ------------------------------------------------------ */
+/* ---- the exported arithmetic (tests, tools) ------------------------------------------ */
 
-static i64 sat(i128 t) { return t < NEVER ? (i64)t : NEVER; }
-static i128 max128(i128 a, i128 b) { return a > b ? a : b; }
-static i128 min128(i128 a, i128 b) { return a < b ? a : b; }
-static i64 max64(i64 a, i64 b) { return a > b ? a : b; }
-static i64 min64(i64 a, i64 b) { return a < b ? a : b; }
-static i128 abs128(i128 a) { return a < 0 ? -a : a; }
+i64 st_acc_time(i64 v, i64 a, i64 m) { return acc_time(v, a, m); }
 
-/* floor division (b > 0), as Python's // */
-static i128 fdiv(i128 a, i128 b) {
-    i128 q = a / b;
-    if ((a % b != 0) && (a < 0)) q -= 1;
-    return q;
-}
-
-u128 st_isqrt(u128 n) {
-    if (n < 2) return n;
-    u128 x = (u128)sqrtl((long double)n);
-    const u128 limit = ((u128)1 << 64) - 1;   /* x*x must not overflow */
-    if (x > limit) x = limit;
-    while (x * x > n) x--;
-    while (x < limit && (x + 1) * (x + 1) <= n) x++;
-    return x;
-}
-
-static i128 isqrt(i128 n) { return n <= 0 ? 0 : (i128)st_isqrt((u128)n); }
-
-static i128 acc_count(i64 v, i64 a, i128 tau) {
-    i128 num = (i128)2 * SECOND * v * tau + (i128)a * tau * tau;
-    return fdiv(num, (i128)2 * SECOND * SECOND);
-}
-
-i64 st_acc_time(i64 v, i64 a, i64 m) {
-    if (m <= 0) return 0;
-    i128 target = (i128)2 * SECOND * SECOND * m;
-    i128 b = (i128)2 * SECOND * v;
-    i128 tau;
-    if (a == 0) {
-        tau = -fdiv(-target, b);
-    } else {
-        u128 disc = (u128)(b * b) + (u128)4 * (u128)a * (u128)target;
-        tau = fdiv((i128)st_isqrt(disc) - b, (i128)2 * a);
-        while (tau > 0 && b * (tau - 1) + (i128)a * (tau - 1) * (tau - 1) >= target) tau--;
-        while (b * tau + (i128)a * tau * tau < target) tau++;
-    }
-    return sat(tau);
-}
-
-/* The exported count (tests, tools): exact for any tau >= 0, saturating at NEVER where
- * the count leaves int64 (the core itself only counts within a segment's duration). */
+/* The count: exact for any tau >= 0, saturating at NEVER where the count leaves int64
+ * (the core itself only counts within a segment's duration). */
 i64 st_acc_count(i64 v, i64 a, i64 tau) {
     if (tau <= 0) return tau == 0 ? 0 : (i64)acc_count(v, a, tau);
     const u128 top = ~(u128)0;
@@ -91,108 +34,7 @@ i64 st_acc_count(i64 v, i64 a, i64 tau) {
 }
 
 uint64_t st_isqrt_u128(uint64_t hi, uint64_t lo) {
-    return (uint64_t)st_isqrt(((u128)hi << 64) | lo);
-}
-
-static i64 axis_count(i64 k, i64 d, i64 n) {
-    if (d == 0 || n == 0) return 0;
-    i128 c = fdiv((i128)2 * k * abs128(d) + n, (i128)2 * n);
-    return (i64)(d > 0 ? c : -c);
-}
-
-static i64 first_step_reaching(i64 c, i64 d, i64 n) {
-    i128 ad = abs128(d);
-    i128 k = -fdiv(-((i128)2 * n * c - n), 2 * ad);
-    return (i64)max128(0, k);
-}
-
-/* ---- segments (segment.py) -------------------------------------------------------- */
-
-static seg_t forward(i64 t0, i64 v, i64 a, i64 length, i64 k0) {
-    seg_t s = {FWD, t0, v, a, length, 0, length, k0, 0, t0, 0};
-    s.end = sat((i128)t0 + st_acc_time(v, a, length));
-    return s;
-}
-
-static seg_t reverse(i64 t0, i64 v, i64 a, i64 total, i64 m0, i64 length, i64 k0) {
-    seg_t s = {REV, t0, v, a, total, m0, length, k0, 0, 0, 0};
-    s.tdec = st_acc_time(v, a, total);
-    s.start = sat((i128)t0 + s.tdec - st_acc_time(v, a, total - m0));
-    s.end = sat((i128)t0 + s.tdec - st_acc_time(v, a, total - m0 - length));
-    return s;
-}
-
-static i64 seg_count(const seg_t *s, i64 t) {
-    if (t < s->start) return 0;
-    if (t >= s->end) return s->length;
-    if (s->kind == FWD) return (i64)min128(s->length, acc_count(s->v, s->a, (i128)t - s->t0));
-    i128 x = (i128)s->tdec - ((i128)t - s->t0);
-    i128 curve = s->total - (acc_count(s->v, s->a, x - 1) + 1);
-    return (i64)min128(max128(curve - s->m0, 0), s->length);
-}
-
-static i64 seg_step_instant(const seg_t *s, i64 j) {
-    if (s->kind == FWD) return sat((i128)s->t0 + st_acc_time(s->v, s->a, j));
-    return sat((i128)s->t0 + s->tdec - st_acc_time(s->v, s->a, s->total - s->m0 - j));
-}
-
-static i64 seg_rate(const seg_t *s, i64 t) {
-    i128 tau = (i128)min64(max64(t, s->start), s->end) - s->t0;
-    if (s->kind == FWD) return (i64)(s->v + fdiv((i128)s->a * tau, SECOND));
-    return (i64)(s->v + fdiv((i128)s->a * max128((i128)s->tdec - tau, 0), SECOND));
-}
-
-typedef struct { int kind; i128 v, acc, length; } piece_spec;
-
-static int plan(i64 t, i64 k0, i64 r, i64 vin, i64 vc, i64 vx, i64 a, seg_t *out) {
-    if (r <= 0) return 0;
-    i128 two_a = (i128)2 * a, R = r, VIN = vin, VC = vc, VX = vx;
-    i128 down = fdiv(VC * VC - VX * VX, two_a);
-    piece_spec p[3];
-    int np = 0;
-    if (vin <= vc) {
-        i128 up = fdiv(VC * VC - VIN * VIN, two_a);
-        if (up + down <= R) {
-            p[0] = (piece_spec){FWD, VIN, a, up};
-            p[1] = (piece_spec){FWD, VC, 0, R - up - down};
-            p[2] = (piece_spec){REV, VX, a, down};
-            np = 3;
-        } else if (VIN * VIN + two_a * R <= VX * VX) {
-            p[0] = (piece_spec){FWD, VIN, a, R};
-            np = 1;
-        } else if (VX * VX + two_a * R <= VIN * VIN) {
-            p[0] = (piece_spec){REV, isqrt(VIN * VIN - two_a * R), a, R};
-            np = 1;
-        } else {
-            i128 peak2 = fdiv(two_a * R + VIN * VIN + VX * VX, 2);
-            up = min128(max128(fdiv(peak2 - VIN * VIN, two_a), 0), R);
-            p[0] = (piece_spec){FWD, VIN, a, up};
-            p[1] = (piece_spec){REV, VX, a, R - up};
-            np = 2;
-        }
-    } else {
-        i128 over = fdiv(VIN * VIN - VC * VC, two_a);
-        if (over + down <= R) {
-            p[0] = (piece_spec){REV, VC, a, over};
-            p[1] = (piece_spec){FWD, VC, 0, R - over - down};
-            p[2] = (piece_spec){REV, VX, a, down};
-            np = 3;
-        } else {
-            p[0] = (piece_spec){REV, max128(VX, isqrt(max128(0, VIN * VIN - two_a * R))), a, R};
-            np = 1;
-        }
-    }
-    int n = 0;
-    for (int i = 0; i < np; i++) {
-        if (p[i].length <= 0) continue;
-        seg_t s = p[i].kind == FWD
-            ? forward(t, (i64)p[i].v, (i64)p[i].acc, (i64)p[i].length, k0)
-            : reverse(t, (i64)p[i].v, (i64)p[i].acc, (i64)p[i].length, 0, (i64)p[i].length, k0);
-        out[n++] = s;
-        t = s.end;
-        k0 += (i64)p[i].length;
-    }
-    return n;
+    return (uint64_t)isqrt_u128(((u128)hi << 64) | lo);
 }
 
 /* ---- the core (python_twin.py) ---------------------------------------------------- */
@@ -486,12 +328,13 @@ void st_position(stepper *m, int64_t t, int64_t *out) {
     position_now(m, out);
 }
 
-void st_flags(stepper *m, int64_t t, int *busy, int *moving, int *stopping, int *halted) {
+int st_flags(stepper *m, int64_t t) {
     st_advance(m, t);
-    *stopping = m->halted && m->stop_end > m->now;
-    *busy = m->qlen > 0;
-    *moving = (*busy && !m->halted) || *stopping;
-    *halted = m->halted;
+    int stopping = m->halted && m->stop_end > m->now;
+    int busy = m->qlen > 0;
+    int moving = (busy && !m->halted) || stopping;
+    return (busy ? ST_BUSY : 0) | (moving ? ST_MOVING : 0) | (stopping ? ST_STOPPING : 0)
+        | (m->halted ? ST_HALTED : 0);
 }
 
 int64_t st_queued(stepper *m, int64_t t) {
@@ -499,27 +342,39 @@ int64_t st_queued(stepper *m, int64_t t) {
     return (i64)m->qlen;
 }
 
-/* the executed pieces, then the planned future up to t1 (played on a ghost) */
-typedef struct { piece_t *p; size_t n; } timeline_t;
+/* The executed pieces, then the planned future up to t1 (played on a ghost): read in
+ * place (the history ring, the ghost's, the head's remaining plan), never copied. */
+typedef struct {
+    const stepper *m;
+    stepper *g;
+    piece_t tail;
+    size_t n;
+} timeline_t;
 
 static int timeline(stepper *m, i64 t1, timeline_t *tl) {
     stepper *g = ghost(m);
     if (!g) return -1;
     st_advance(g, t1);
-    size_t total = m->hlen + g->hlen + 1;
-    tl->p = malloc(total * sizeof(piece_t));
-    if (!tl->p) { st_free(g); return -1; }
-    size_t n = 0;
-    for (size_t i = 0; i < m->hlen; i++) tl->p[n++] = m->hist[(m->hhead + i) % m->hcap];
-    for (size_t i = 0; i < g->hlen; i++) tl->p[n++] = g->hist[(g->hhead + i) % g->hcap];
+    tl->m = m;
+    tl->g = g;
+    tl->n = m->hlen + g->hlen;
     if (g->qlen && head(g)->has_plan && head(g)->nseg > 0) {
         entry_t *e = head(g);
-        make_piece(&tl->p[n++], g->base, e, e->done, entry_steps(e, NEVER), g->axes);
+        make_piece(&tl->tail, g->base, e, e->done, entry_steps(e, NEVER), g->axes);
+        tl->n++;
     }
-    tl->n = n;
-    st_free(g);
     return 0;
 }
+
+static const piece_t *timeline_piece(const timeline_t *tl, size_t i) {
+    const stepper *m = tl->m, *g = tl->g;
+    if (i < m->hlen) return &m->hist[(m->hhead + i) % m->hcap];
+    i -= m->hlen;
+    if (i < g->hlen) return &g->hist[(g->hhead + i) % g->hcap];
+    return &tl->tail;
+}
+
+static void timeline_free(timeline_t *tl) { st_free(tl->g); }
 
 static i64 piece_instant(const piece_t *p, i64 k) {
     for (int i = 0; i < p->nseg; i++) {
@@ -544,7 +399,7 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
     if (timeline(m, NEVER, &tl)) return -1;
     int found = 0;
     for (size_t i = 0; i < tl.n && !found; i++) {
-        const piece_t *p = &tl.p[i];
+        const piece_t *p = timeline_piece(&tl, i);
         i64 d = p->steps[axis];
         i128 c = (i128)value - p->base[axis];
         if (d == 0 || c == 0 || ((c > 0) != (d > 0)) || abs128(c) > abs128(d)) continue;
@@ -554,34 +409,63 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
             if (t >= m->now) { *out = t; found = 1; }
         }
     }
-    free(tl.p);
+    timeline_free(&tl);
     return found;
+}
+
+/* Steps first..last of a piece: their instants and masks. The plan's segments follow
+ * each other over the steps, so they are walked in order; each axis's count at the step
+ * before is carried from one step to the next. */
+static void piece_train(const piece_t *p, int axes, i64 first, i64 last, i64 *times,
+                        uint8_t *masks) {
+    i64 before[ST_AXES];
+    uint8_t sign = 0;
+    for (int a = 0; a < axes; a++) {
+        before[a] = axis_count(first - 1, p->steps[a], p->n);
+        if (p->steps[a] < 0) sign |= (uint8_t)(1 << (4 + a));
+    }
+    i64 k = first;
+    for (int i = 0; i < p->nseg && k <= last; i++) {
+        const seg_t *s = &p->plan[i];
+        for (i64 top = min64(last, s->k0 + s->length); k <= top; k++) {
+            uint8_t mask = 0;
+            for (int a = 0; a < axes; a++) {
+                i64 c = axis_count(k, p->steps[a], p->n);
+                if (c != before[a]) mask |= (uint8_t)(1 << a);
+                before[a] = c;
+            }
+            *times++ = seg_step_instant(s, k - s->k0);
+            *masks++ = mask | (sign & (uint8_t)(mask << 4));
+        }
+    }
+}
+
+/* the steps of a piece in the train [t0, t1): first..last (none when last < first) */
+static void piece_range(const piece_t *p, i64 t0, i64 t1, i64 *first, i64 *last) {
+    *first = max64(p->k_from, plan_steps(p, t0 - 1)) + 1;
+    *last = min64(p->k_to, plan_steps(p, t1 - 1));
 }
 
 int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
                   int64_t cap) {
     timeline_t tl;
     if (timeline(m, t1, &tl)) return -1;
-    i64 count = 0;
+    i64 count = 0, first, last;
     for (size_t i = 0; i < tl.n; i++) {
-        const piece_t *p = &tl.p[i];
-        i64 first = max64(p->k_from, plan_steps(p, t0 - 1)) + 1;
-        i64 last = min64(p->k_to, plan_steps(p, t1 - 1));
-        for (i64 k = first; k <= last; k++) {
-            if (count < cap) {
-                uint8_t mask = 0;
-                for (int a = 0; a < m->axes; a++) {
-                    i64 d = p->steps[a];
-                    if (axis_count(k, d, p->n) != axis_count(k - 1, d, p->n))
-                        mask |= (uint8_t)((1 << a) | ((d < 0) << (4 + a)));
-                }
-                times[count] = piece_instant(p, k);
-                masks[count] = mask;
-            }
-            count++;
+        piece_range(timeline_piece(&tl, i), t0, t1, &first, &last);
+        if (last >= first) count += last - first + 1;
+    }
+    if (count <= cap) {
+        i64 at = 0;
+        for (size_t i = 0; i < tl.n; i++) {
+            const piece_t *p = timeline_piece(&tl, i);
+            piece_range(p, t0, t1, &first, &last);
+            if (last < first) continue;
+            piece_train(p, m->axes, first, last, times + at, masks + at);
+            at += last - first + 1;
         }
     }
-    free(tl.p);
+    timeline_free(&tl);
     return count;
 }
 
@@ -621,6 +505,12 @@ int st_push(stepper *m, const st_vector *v, int64_t t) {
         replan(m, t, 1);
     }
     return 0;
+}
+
+int64_t st_push_many(stepper *m, const st_timed_vector *v, int64_t n) {
+    for (int64_t i = 0; i < n; i++)
+        if (st_push(m, &v[i].v, v[i].t)) return i;
+    return n;
 }
 
 int64_t st_halt(stepper *m, int64_t t) {
@@ -757,11 +647,11 @@ void st_physical(stepper *m, int64_t t, int64_t *out) {
     for (int i = 0; i < m->axes; i++) out[i] += m->offset[i];
 }
 
-void st_excursion(stepper *m, int64_t t, int64_t *lo, int64_t *hi) {
+void st_excursion(stepper *m, int64_t t, int64_t *out) {
     i64 here[ST_AXES];
     st_position(m, t, here);
     visit(m, here);
-    for (int i = 0; i < m->axes; i++) { lo[i] = m->lo[i]; hi[i] = m->hi[i]; }
+    for (int i = 0; i < m->axes; i++) { out[i] = m->lo[i]; out[ST_AXES + i] = m->hi[i]; }
 }
 
 void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel) {

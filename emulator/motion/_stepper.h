@@ -33,12 +33,23 @@ int64_t st_now(stepper *m);
 int st_next_event(stepper *m, int64_t *out);
 int st_drain_instant(stepper *m, int64_t *out);
 void st_position(stepper *m, int64_t t, int64_t *out);
-void st_flags(stepper *m, int64_t t, int *busy, int *moving, int *stopping, int *halted);
+/* the state flags at t (interface.py MotionFlags) as bits */
+enum { ST_BUSY = 1, ST_MOVING = 2, ST_STOPPING = 4, ST_HALTED = 8 };
+int st_flags(stepper *m, int64_t t);
 int64_t st_queued(stepper *m, int64_t t);
 int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out);
+/* the pulse train in [t0, t1): returns its length, and writes its instants and masks
+ * when the length is at most cap (so cap 0 asks for the length alone); -1: no memory */
 int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *masks,
                   int64_t cap);
 int st_push(stepper *m, const st_vector *v, int64_t t);
+/* pushes in a batch: each vector at its instant, in order, as st_push one by one;
+ * returns how many were pushed (fewer: out of memory) */
+typedef struct {
+    int64_t t;
+    st_vector v;
+} st_timed_vector;
+int64_t st_push_many(stepper *m, const st_timed_vector *v, int64_t n);
 int64_t st_halt(stepper *m, int64_t t);
 void st_resume(stepper *m, int64_t t);
 void st_clear(stepper *m, int64_t t);
@@ -52,7 +63,8 @@ void st_set_position(stepper *m, int axis, int64_t value, int64_t t);
 /* the W reference run: the axis moves by delta outside the planner (counter and axis) */
 void st_jump(stepper *m, int axis, int64_t delta, int64_t t);
 void st_physical(stepper *m, int64_t t, int64_t *out);
-void st_excursion(stepper *m, int64_t t, int64_t *lo, int64_t *hi);
+/* the lowest physical positions in out[0..ST_AXES), the highest in out[ST_AXES..2 ST_AXES) */
+void st_excursion(stepper *m, int64_t t, int64_t *out);
 void st_set_velocity(stepper *m, int64_t velocity, int64_t t, int has_accel, int64_t accel);
 void st_scale_velocity(stepper *m, int64_t num, int64_t den, int64_t t, int accel);
 void st_set_multiplier(stepper *m, int64_t percent, int64_t t);

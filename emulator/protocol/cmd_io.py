@@ -32,13 +32,14 @@ def cmd_processor(dev: Device, ses: Session, p: str, t: int) -> Reply:
 # -- EEPROM (spec 10.6) ----------------------------------------------------------------
 
 def cmd_eeprom_read(dev: Device, ses: Session, p: str, t: int) -> Reply:
-    address = within(hexa(p), 0, 0xFF)
+    address = dev.eeprom_cell(within(hexa(p), 0, 0xFF))
     return ["%02X" % dev.eeprom.read(address)[0]]
 
 
 def cmd_eeprom_write(dev: Device, ses: Session, p: str, t: int) -> Reply:
     a, x = (hexa(f) for f in fields(p, (2,)))
-    dev.write_eeprom(within(a, 0, 0xFF), bytes([within(x, 0, 0xFF)]), t)
+    data = bytes([within(x, 0, 0xFF)])
+    dev.write_eeprom(dev.eeprom_cell(within(a, 0, 0xFF)), data, t)
     return []
 
 

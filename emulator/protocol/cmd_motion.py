@@ -51,6 +51,8 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_vectors_to_mpg()
     room = dev.profile.buffer - (1 if dev.mutant.active("queue-one-short") else 0)
     if dev.motion.queued(t) >= room:
+        if dev.mutant.active("refused-vector-queued"):
+            dev.push(steps, True, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "the CONT buffer is full")
     dev.push(steps, True, t)
     return []
@@ -201,6 +203,8 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
         if dev.mutant.active("go-without-inta"):
             return []
         raise CommandError(ErrorCode.NOTHING_TO_GO, "G with INTA = 0")
+    if dev.readings.active("go-nothing-queued") and not dev.motion.queued(t):
+        raise CommandError(ErrorCode.NOTHING_TO_GO, "G with nothing queued")
     s.status[6] &= ~(INTA | INTCOM)
     s.status[4] = s.status[5] = 0
     dev.motion.resume(t)

@@ -81,6 +81,10 @@ def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
             code = ErrorCode.BUSY
         elif dev.motion.queued(t) + vectors > dev.profile.buffer:
             code = ErrorCode.QUEUE_FULL
+    if code and dev.mutant.active("failed-packet-keeps-b"):
+        for m in members:
+            if m.name == "B" and not m.code:
+                dev.state.modal.B = m.value  # type: ignore[assignment]
     if code == ErrorCode.OK or dev.mutant.active("packet-partial-commit"):
         room = dev.profile.buffer - dev.motion.queued(t)
         for m in members:

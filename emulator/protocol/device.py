@@ -18,6 +18,8 @@ from emulator.mutants import Mutant
 from emulator.protocol.eeprom import Eeprom
 from emulator.protocol.params import CommandError
 from emulator.protocol.state import FREE, INTA, RUN, STOP, DeviceState, reset_state
+from emulator.readings import NONE as NO_READINGS
+from emulator.readings import Readings
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -28,9 +30,11 @@ UNCONNECTED = {0: 0xFF, 1: 0xFF, 2: 0xFF}
 
 class Device:
     def __init__(self, profile: Profile, *, mutant: Mutant, eeprom_path: str | Path | None = None,
-                 stepper: str | None = None, origin: int = 0) -> None:
+                 stepper: str | None = None, origin: int = 0,
+                 readings: Readings = NO_READINGS) -> None:
         self.profile = profile
         self.mutant = mutant
+        self.readings = readings
         self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
@@ -105,6 +109,8 @@ class Device:
         if self.mutant.active("position-ignores-microstep"):
             f = self.factor()
             return tuple(int(x / f) for x in here)
+        if self.mutant.active("narrow-counters"):
+            return tuple((x + (1 << 23)) % (1 << 24) - (1 << 23) for x in here)
         return here
 
     # -- vectors ------------------------------------------------------------------------
@@ -217,6 +223,10 @@ class Device:
         return None
 
     # -- EEPROM -----------------------------------------------------------------------------
+    def eeprom_cell(self, address: int) -> int:
+        """The byte ER and EW reach at ``address``: every one of the 256."""
+        return address & 0x7F if self.mutant.active("eeprom-7-bit-address") else address
+
     def write_eeprom(self, address: int, data: bytes, t: int) -> None:
         self.refuse_while_moving(t)
         if not self.mutant.active("eeprom-write-lost"):

@@ -32,11 +32,17 @@ from emulator.protocol.tables import (
     spindle_table,
     split,
 )
+from emulator.readings import Readings
 from gve_fixtures.profile import Profile, load_profile
 from gve_fixtures.protocol import ErrorCode
 
 _HEX = frozenset(b"0123456789ABCDEFabcdef")
 _LONG_DECIMAL = re.compile(r"[0-9]{13}")
+#: a + at the start of a field (the reading plus-sign drops it)
+_PLUS = re.compile(r"(^|,)\+(?=[0-9])")
+_LOWER_HEX = re.compile(r"[a-f]")
+#: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
+_LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 
 
 def _discard(data: bytes, t: int) -> None:
@@ -47,14 +53,15 @@ class Unit:
     def __init__(self, profile: Profile | str | Path, address: int | None = None, *,
                  eeprom_path: str | Path | None = None, mutant: str | None = None,
                  watchdog_ms: int | None = None, stepper: str | None = None,
-                 origin: int = 0) -> None:
+                 origin: int = 0, readings: tuple[str, ...] = ()) -> None:
         if not isinstance(profile, Profile):
             profile = load_profile(profile)
         self.profile = profile
         self.address = profile.address if address is None else address
         self.mutant = Mutant(mutant)
+        self.readings = Readings(frozenset(readings))
         self.device = Device(profile, mutant=self.mutant, eeprom_path=eeprom_path,
-                             stepper=stepper, origin=origin)
+                             stepper=stepper, origin=origin, readings=self.readings)
         self.session = Session(profile.reset.checksums)
         self.tables: dict[int, dict[str, Command]] = {self.address: main_table(profile)}
         if profile.spindle is not None and self.address == 0:
@@ -129,6 +136,9 @@ class Unit:
         self._pending = still
 
     def _watchdog(self, head: bytes, t: int) -> None:
+        if len(head) < 2 and self.readings.active("lone-bang-answered"):
+            self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False)
+            return
         if len(head) < 2 or self._address(head) is None:
             return                                  # only '!' arrived, or not ours
         self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False)
@@ -196,7 +206,8 @@ class Unit:
             text = text.upper()
         name, params = split(text)
         known = COMMANDS.get(name or "", _NONE)
-        if known.counted or self.mutant.active("index-counts-queries"):
+        if known.counted or self.mutant.active("index-counts-queries") \
+                or self.readings.active("queries-counted"):
             ses.count()
         if frame.too_long:                     # a syntax error (spec 3), also as a member
             if ses.packet is not None:
@@ -209,7 +220,9 @@ class Unit:
             ses.packet.append(member(self.device, name if command else None, params))
             return
         if command is None:
-            self._answer(raw, ErrorCode.UNKNOWN, [], t, remember=known.remembered)
+            lacking = self.readings.active("missing-letter-range") and _LACKING.match(name or "")
+            self._answer(raw, ErrorCode.RANGE if lacking else ErrorCode.UNKNOWN, [], t,
+                         remember=known.remembered)
             return
         if command.packet == DISCARD:
             ses.packet = None
@@ -218,7 +231,12 @@ class Unit:
     def _run(self, raw: bytes, command: Command, name: str | None, params: str,
              t: int) -> None:
         act = self.mutant.active
+        reads = self.readings.active
         try:
+            if reads("plus-sign"):
+                params = _PLUS.sub(r"\1", params)
+            if reads("hex-upper-only") and _LOWER_HEX.search(params):
+                raise CommandError(ErrorCode.SYNTAX, "lower-case hex digits")
             if command.bare and params:
                 if not act("params-ignored-on-bare-commands"):
                     raise CommandError(ErrorCode.SYNTAX, "this command takes no parameters")
@@ -228,6 +246,8 @@ class Unit:
             if name == ">" and act("repeat-reexecutes") and self.session.history:
                 self._rerun(self.session.history)
             reply = command.run(self.device, self.session, params, t)
+            if name == "?" and reads("long-version"):
+                reply = [f"{self.profile.version} (c) Gravos (P.Borovsky)"]
         except CommandError as err:
             code = err.code
             if code == ErrorCode.RANGE and act("range-error-code"):

@@ -84,10 +84,30 @@ def test_a_trace_is_kept_with_the_result_as_json(target):
     def body(ctx):
         ctx.trace("toy", samples=[(0.5, [1, 2, 3])], model=[(0.0, [0, 0, 0]), (0.5, [1, 2, 3])],
                   tolerance={"seconds": 0.0, "steps": 0}, params={"V": 1000})
-        ctx.expect(True, "traced")
+        ctx.expect(True, "traced", rule="5.code.ok")
     r = run_case(_toy(body), target)
     assert r.verdict == PASS
     (trace,) = json.loads(json.dumps(r.to_dict()))["traces"]
     assert trace == {"name": "toy", "samples": [[0.5, [1, 2, 3]]],
                      "model": [[0.0, [0, 0, 0]], [0.5, [1, 2, 3]]],
                      "tolerance": {"seconds": 0.0, "steps": 0}, "params": {"V": 1000}}
+
+
+def test_a_check_of_a_case_whose_rules_grade_differently_must_name_its_rule(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(True, "which rule?")), target)
+    assert r.verdict == ERROR and "must name its rule" in r.notes[0]
+
+
+def test_a_declared_tag_that_contradicts_the_rules_is_refused():
+    with pytest.raises(ValueError, match="declared tag D contradicts its rules, tagged M"):
+        case("99.toy.contradicting", rules=("8.index.counts",), tag="D")(lambda ctx: None)
+    assert "99.toy.contradicting" not in REGISTRY
+
+
+def test_a_case_s_tag_is_its_first_rule_s():
+    try:
+        case("99.toy.derived", rules=("8.index.queries-uncounted", "8.index.counts"))(
+            lambda ctx: None)
+        assert REGISTRY["99.toy.derived"].tag == "D"
+    finally:
+        REGISTRY.pop("99.toy.derived", None)

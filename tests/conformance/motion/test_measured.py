@@ -1,6 +1,6 @@
-"""The measured motion cases: exact on the emulator's virtual clock (zero tolerance,
-printed with every check, a trace per scenario), and within the printed tolerance in real
-time over a pseudo-terminal."""
+"""The measured motion cases: exact on the emulator's virtual clock (zero tolerance, so
+none printed with the checks; a trace per scenario), and within the printed tolerance in
+real time over a pseudo-terminal."""
 
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ TOLERANCE = re.compile(r"\(±(\d+) step\(s\) over a window of ([\d.]+) ms\)")
 
 @pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
 def test_virtual_time_judges_every_reading_with_zero_tolerance(profile: str) -> None:
+    """Exact: the band is zero, and a band of zero is not printed."""
     results = run([parse_target(f"emu:{profile}")], select(MEASURED)).results
     assert {r.verdict for r in results} <= {PASS, MISSING}
     ran = [r for r in results if r.verdict == PASS]
@@ -28,8 +29,8 @@ def test_virtual_time_judges_every_reading_with_zero_tolerance(profile: str) -> 
     for r in ran:
         assert r.traces and all(t["tolerance"] == {"seconds": 0.0, "steps": 0} for t in r.traces)
         for c in r.checks:
-            m = TOLERANCE.search(c["what"])
-            assert m and (m.group(1), m.group(2)) == ("0", "0.000"), c["what"]
+            assert ": PF at " in c["what"] or ": H answered " in c["what"], c["what"]
+            assert "step(s)" not in c["what"] and "window" not in c["what"], c["what"]
 
 
 @pytest.mark.slow

@@ -58,7 +58,7 @@ def _mpg_unit(tmp_path) -> list[str]:
 def test_a_problem_makes_the_exit_status_non_zero(tmp_path, capsys):
     with unit_behind_proxy(*_mpg_unit(tmp_path)) as (_, proxy):
         status = main(["--target", f"serial:{proxy.path}", "--profile", "GVE114-500",
-                       "--cases", "5.errors.ok", "--no-reports"])
+                       "--cases", "5.errors.ok", "--no-reports", "--yes"])
     assert status == 1
     assert "PROBLEM" in capsys.readouterr().out
 

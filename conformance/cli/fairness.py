@@ -1,0 +1,124 @@
+"""`gve-conformance fairness`: the fairness score — the whole catalogue against the
+emulator taking each of its readings (the other answers a careful reader of the manuals
+could give where they are silent; emulator/readings.py), one at a time on one profile
+per family and all at once on every profile, graded as any unit is (by the tags). A
+reading is fair when no case FAILs or ERRs and every difference it makes names its
+rule; the score is fair readings / readings, and CI fails below 100 %."""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+
+from conformance.cli.pool import workers
+from conformance.cli.usage import Parser, UsageError, positive
+from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
+
+PROG = "gve-conformance fairness"
+#: one profile per family for the readings one at a time
+FIRST = ("GVE84-100", "GVE54", "GVE114-500")
+ALL = "all"
+
+
+@dataclass
+class Trial:
+    """One reading (or ``all``) on its profiles: what it FAILed and what it changed."""
+
+    reading: str
+    profiles: list[str]
+    unfair: list[str] = field(default_factory=list)       # FAIL, ERROR, an unnamed check
+    differences: list[str] = field(default_factory=list)  # NON-STRICT, INFO with the rule
+    seconds: float = 0.0
+
+    @property
+    def fair(self) -> bool:
+        return not self.unfair
+
+
+def trial(reading: str, readings: list[str], profiles: list[str],
+          include: list[str] | None) -> Trial:
+    """Run the catalogue on ``profiles`` with the emulator taking ``readings``."""
+    from conformance.catalogue import select
+    from conformance.runner import run_case
+    from conformance.targets import parse_target
+    result = Trial(reading, profiles)
+    start = time.perf_counter()
+    for p in profiles:
+        target = parse_target(f"emu:{p}?reading={','.join(readings)}", allow_destructive=True)
+        for c in select(include or None):
+            r = run_case(c, target, "mutation")
+            where = f"{c.id} [{p}]"
+            failed = [ch for ch in r.checks if not ch["ok"]]
+            if r.verdict in (FAIL, ERROR):
+                first = failed[0] if failed else {"what": (r.notes or ["?"])[0][:200]}
+                result.unfair.append(f"{r.verdict} {where}: {first['what']}")
+            elif r.verdict in (NON_STRICT, INFO):
+                unnamed = [ch for ch in failed if not ch.get("rule")]
+                if unnamed:
+                    result.unfair.append(f"{r.verdict} {where}: names no rule: "
+                                         f"{unnamed[0]['what']}")
+                rules = sorted({ch["rule"] for ch in failed if ch.get("rule")})
+                result.differences.append(f"{r.verdict} {where} ({', '.join(rules)})")
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _trial(args: tuple[str, list[str], list[str], list[str] | None]) -> Trial:
+    return trial(*args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from conformance.targets.emu import emulator_readings
+    from gve_fixtures.profile import available_profiles
+    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap.add_argument("--reading", action="append", default=[], metavar="NAME",
+                    help="only this reading (repeatable; default: every one, and all at once)")
+    ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
+                    help="only cases whose ID matches (repeatable)")
+    ap.add_argument("--jobs", type=positive, default=1, help="readings tried in parallel")
+    ap.add_argument("-v", "--verbose", action="store_true",
+                    help="also list every difference each reading made")
+    try:
+        args = ap.parse_args(argv)
+        known = emulator_readings()
+        wrong = [r for r in args.reading if r not in known]
+        if wrong:
+            raise UsageError(f"unknown reading(s) {', '.join(wrong)} "
+                             f"(known: {', '.join(sorted(known))})")
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    names = args.reading or sorted(known)
+    first = [p for p in FIRST if p in available_profiles()]
+    jobs = [(n, [n], first, args.cases or None) for n in names]
+    if not args.reading:
+        jobs.append((ALL, names, available_profiles(), args.cases or None))
+    start = time.perf_counter()
+    trials: list[Trial] = []
+    with workers(args.jobs) as pool:
+        for t in pool.map(_trial, jobs):
+            trials.append(t)
+            _show(t, args.verbose)
+    fair = sum(t.fair for t in trials)
+    score = 100.0 * fair / len(trials) if trials else 100.0
+    print(f"\nfairness score: {fair}/{len(trials)} = {score:.1f} % in "
+          f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
+          f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO")
+    return 0 if fair == len(trials) else 1
+
+
+def _show(t: Trial, verbose: bool) -> None:
+    head = "fair  " if t.fair else "UNFAIR"
+    print(f"{head}  {t.reading:24} {len(t.differences)} difference(s) on "
+          f"{', '.join(t.profiles) if t.reading != ALL else 'every profile'} "
+          f"in {t.seconds:.1f} s", flush=True)
+    for line in t.unfair:
+        print(f"        {line}", flush=True)
+    for line in t.differences if verbose else []:
+        print(f"        {line}", flush=True)
+
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,27 @@
+"""The benchmark's reference for the C core's pulse trains: a bare C loop over one
+vector's steps with the core's own arithmetic (_reference.c), built into the same
+module. Raises ImportError where the C core is not available (c_core.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from emulator.motion.c_core import ffi, lib
+
+
+def reference_pulses(steps: tuple[int, ...], t0: int, cruise: int, accel: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The pulse train of the vector ``steps`` planned from rest to rest from ``t0`` at
+    the cruise rate ``cruise`` and acceleration ``accel``: instants and masks as
+    ``Motion.pulses`` gives them (the C core's train for an L vector with no dwell
+    whose cruise rate is ``cruise``)."""
+    axes = len(steps)
+    c_steps = ffi.new("int64_t[]", list(steps))
+    n = lib.st_reference_pulses(c_steps, axes, t0, cruise, accel, ffi.NULL, ffi.NULL, 0)
+    times = np.empty(n, dtype=np.int64)
+    masks = np.empty(n, dtype=np.uint8)
+    lib.st_reference_pulses(c_steps, axes, t0, cruise, accel,
+                            ffi.from_buffer("int64_t[]", times),
+                            ffi.from_buffer("uint8_t[]", masks), n)
+    return times, masks

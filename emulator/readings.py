@@ -1,0 +1,80 @@
+"""Readings: the other answers a careful reader of the manuals could give where they are
+silent — the fairness twin of :mod:`emulator.mutants`.
+
+A mutant breaks what a manual states and must FAIL; a reading takes another side of a
+`[D]` point (or of a point the spec allows two ways) and must never FAIL a target graded
+by the tags: its differences are NON-STRICT or INFO, each naming its rule. A unit created
+with ``readings=(NAME, ...)`` (``gve://?reading=A,B``, ``--reading NAME`` repeatable,
+``--target emu:GVE84-100?reading=A,B``) takes every reading named, several at once.
+`gve-conformance fairness` runs the catalogue against each reading alone and all at once
+and prints the fairness score (readings without a FAIL / readings).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+
+class ReadingSpec(NamedTuple):
+    rules: tuple[str, ...]   # the rules of fixtures/rules.toml whose silence it reads
+    description: str         # what the unit does instead
+
+
+#: name -> (the rules it reads otherwise, what the unit does)
+READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
+    "plus-sign": (("3.params.decimal",),
+                  "a leading + in a decimal field is taken as the sign it is"),
+    "long-version": (("1.profile.version",),
+                     "? answers the firmware string the manual prints in full, with its "
+                     "copyright (`IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)`)"),
+    "go-nothing-queued": (("5.code.nothing-to-go", "10.4.go.without-inta"),
+                          "G with INTA = 1 and nothing queued answers 6: for Go, nothing "
+                          "to start (spec 5, both readings allowed)"),
+    "missing-letter-range": (("5.code.unknown",),
+                             "an axis, port or register letter the unit lacks (NA on a "
+                             "GVE84, I2) answers 5 instead of 3 (spec 10.4, both allowed)"),
+    "lone-bang-answered": (("3.frame.watchdog-lone-bang",),
+                           "a lone ! left by the watchdog is answered 2, as any unfinished "
+                           "frame"),
+    "hex-upper-only": (("3.params.hex-digits",),
+                       "hex fields take upper-case digits only: a-f is a syntax error (4)"),
+    "queries-counted": (("8.index.queries-uncounted",),
+                        "@ and > advance the index like every other command"),
+}.items()}
+
+
+class UnknownReading(ValueError):
+    pass
+
+
+def parse_readings(text: str | None) -> tuple[str, ...]:
+    """``A,B`` (or None) as reading names, each one known."""
+    names = tuple(n for n in (text or "").split(",") if n)
+    unknown = [n for n in names if n not in READINGS]
+    if unknown:
+        raise UnknownReading(f"unknown reading(s) {', '.join(map(repr, unknown))} "
+                             f"(known: {', '.join(sorted(READINGS))})")
+    return names
+
+
+@dataclass(frozen=True)
+class Readings:
+    """The readings a unit takes (none: the project's decisions). ``active(name)`` is the
+    only question the emulator asks; it raises for a name not in :data:`READINGS` so a
+    typo cannot silently read nothing."""
+
+    names: frozenset[str] = frozenset()
+
+    def __post_init__(self) -> None:
+        parse_readings(",".join(self.names))
+
+    def active(self, name: str) -> bool:
+        if not self.names:
+            return False
+        if name not in READINGS:
+            raise UnknownReading(f"the emulator asks for an unknown reading {name!r}")
+        return name in self.names
+
+
+NONE = Readings()

@@ -1,0 +1,38 @@
+"""`gve-conformance fairness`: a reading is graded as any unit is (by the tags): its
+differences NON-STRICT or INFO naming their rule, never FAIL; the strict reference
+emulator FAILs the same difference; the score line."""
+
+from __future__ import annotations
+
+from conformance.catalogue import select
+from conformance.cli import main
+from conformance.runner import run_case
+from conformance.targets import parse_target
+from conformance.verdict import FAIL, NON_STRICT
+
+
+def test_an_emulator_taking_a_reading_is_graded_by_the_tags():
+    (case,) = select(["3.frame.syntax-errors"])
+    read = parse_target("emu:GVE84-100?reading=plus-sign")
+    assert not read.info.strict
+    r = run_case(case, read)
+    assert r.verdict == NON_STRICT
+    assert {c["rule"] for c in r.checks if not c["ok"]} == {"3.params.decimal"}
+    # the same unit claiming our decisions (--strict) FAILs it
+    strict = parse_target("emu:GVE84-100?reading=plus-sign", strict=True)
+    assert run_case(case, strict).verdict == FAIL
+
+
+def test_the_fairness_score_of_one_reading(capsys):
+    status = main(["fairness", "--reading", "plus-sign", "--cases", "3.frame.*", "-v"])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "fair    plus-sign" in out and "NON-STRICT 3.frame.syntax-errors [GVE84-100]" \
+        " (3.params.decimal)" in out
+    assert "fairness score: 1/1 = 100.0 %" in out
+
+
+def test_an_unknown_reading_is_one_line_and_exit_2(capsys):
+    assert main(["fairness", "--reading", "nosuch"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown reading(s) nosuch" in err

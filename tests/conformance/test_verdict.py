@@ -1,0 +1,60 @@
+"""The run's verdict and its last line: PASSED only when nothing FAILed or ERRed, with
+what was judged and what was not tested, grouped by reason (conformance/untested.toml)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from conformance.untested import OTHER, why
+from conformance.verdict import FAILED, PASSED, last_line, overall
+
+
+@dataclass
+class R:
+    verdict: str
+    notes: list[str] = field(default_factory=list)
+
+
+RIG = R("COULD-NOT-TEST", ["needs a test rig (the emulator's, or an exec: simulator's "
+                           "control channel)"])
+ENVELOPE = R("COULD-NOT-TEST", ["safety stop: L900,0,0: axis X could reach 0..900 full "
+                                "steps from where the run began, beyond the envelope ±500"])
+LACKS = R("MISSING", ["the profile lacks EFW"])
+
+
+def test_passed_says_what_was_judged_and_what_was_not_tested():
+    results = [R("PASS")] * 120 + [R("NON-STRICT")] * 8 + [RIG] * 9 + [ENVELOPE] * 3
+    assert last_line(results) == ("PASSED — 120 PASS, 8 NON-STRICT; not tested: 12 of 140 "
+                                  "(9 need a rig, 3 beyond the envelope)")
+
+
+def test_everything_tested():
+    assert overall([R("PASS"), R("INFO")]) == (PASSED, "1 PASS, 1 INFO; everything tested (2)")
+
+
+def test_a_fail_or_an_error_is_failed_and_still_says_what_was_not_tested():
+    verdict, reason = overall([R("PASS"), R("FAIL"), R("ERROR"), LACKS])
+    assert verdict == FAILED
+    assert reason == "1 ERROR, 1 FAIL, 1 PASS; not tested: 1 of 4 (1 not in the profile)"
+
+
+def test_nothing_judged_is_failed():
+    verdict, reason = overall([RIG, RIG])
+    assert verdict == FAILED and reason.startswith("no case could judge the target; ")
+    assert overall([])[0] == FAILED
+
+
+def test_interrupted_and_problems_are_failed():
+    assert overall([R("PASS")], interrupted=True)[0] == FAILED
+    verdict, reason = overall([R("PASS")], problems=["EEPROM 10 not restored"])
+    assert verdict == FAILED and "EEPROM 10 not restored" in reason
+
+
+def test_reasons_come_from_the_notes():
+    assert why(["safety stop: L5: motion was not confirmed"]) == "motion not confirmed"
+    assert why(["destructive: needs --allow-destructive"]) == \
+        "destructive, need --allow-destructive"
+    assert why(["could not test: needs a hand: ground input IN0 (X reference)"]) == \
+        "need a hand at the unit"
+    assert why(["missing: the profile lacks W"]) == "not in the profile"
+    assert why(["something nobody foresaw"]) == OTHER

@@ -1,0 +1,82 @@
+"""Every reading of emulator/readings.py really reads the manual otherwise: the frame of
+its point answered differently from the clean emulator, as its description says; several
+readings at once; and every name the emulator asks ``active()`` about is registered."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from emulator.protocol.unit import Unit
+from emulator.readings import READINGS, Readings, UnknownReading, parse_readings
+from gve_fixtures.rules import load_rules
+
+EMULATOR = Path(__file__).resolve().parents[1].parent / "emulator"
+
+#: reading -> (frames, the clean emulator's answers, the reading's)
+POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
+    "plus-sign": ([b"!0V+100\r"], b"4\r", b"0\r"),
+    "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
+                     b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
+    "go-nothing-queued": ([b"!0H\r", b"!0G\r"], b"8\r0\r", b"8\rE\r"),
+    "missing-letter-range": ([b"!0NA0\r"], b"3\r", b"5\r"),
+    "lone-bang-answered": ([b"!"], b"", b"2\r"),
+    "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
+    "queries-counted": ([b"!0@\r", b"!0@\r"], b"0,0\r0,0\r", b"0,1\r0,2\r"),
+}
+
+
+def answers(readings: tuple[str, ...], frames: list[bytes]) -> bytes:
+    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart."""
+    unit = Unit("GVE84-100", readings=readings)
+    out: list[bytes] = []
+    unit.emit = lambda data, t: out.append(data)
+    t = 10**9
+    for frame in frames:
+        unit.receive(frame, t, 1000)
+        t += 10**9
+        unit.advance(t)
+    return b"".join(out)
+
+
+def test_every_reading_has_its_point_here():
+    assert set(POINTS) == set(READINGS)
+
+
+@pytest.mark.parametrize("name", sorted(POINTS))
+def test_a_reading_answers_its_point_otherwise(name):
+    frames, clean, read = POINTS[name]
+    assert answers((), frames) == clean
+    assert answers((name,), frames) == read
+
+
+def test_readings_combine():
+    assert answers(("plus-sign", "queries-counted"), [b"!0V+100\r", b"!0@\r"]) == b"0\r0,2\r"
+
+
+def test_every_reading_reads_a_rule_the_manuals_leave_open():
+    rules = load_rules()
+    for name, spec in READINGS.items():
+        assert spec.rules and all(r in rules for r in spec.rules), name
+        # a reading of an [M] point would be a mutant; the spec's two-way points are [D]
+        # in the text of an [M] rule's table (codes 3/5, 6)
+        assert any(rules[r].tag.startswith("D") for r in spec.rules) or name in (
+            "go-nothing-queued", "missing-letter-range"), name
+
+
+def test_an_unknown_reading_is_refused():
+    with pytest.raises(UnknownReading, match="unknown reading"):
+        parse_readings("plus-sign,nosuch")
+    with pytest.raises(UnknownReading):
+        Readings(frozenset({"plus-sign"})).active("nosuch")
+
+
+def test_every_reading_the_emulator_asks_about_is_registered():
+    asked = {a or b for path in EMULATOR.rglob("*.py")
+             for a, b in ASKED.findall(path.read_text())}
+    assert asked == set(READINGS)
+
+
+ASKED = re.compile(r'readings\.active\("([^"]+)"\)|reads\("([^"]+)"\)')
