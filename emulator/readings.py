@@ -41,6 +41,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                        "hex fields take upper-case digits only: a-f is a syntax error (4)"),
     "queries-counted": (("8.index.queries-uncounted",),
                         "@ and > advance the index like every other command"),
+    "eeprom-write-while-moving": (("5.code.busy-eeprom",),
+                                  "EW, EFW and EUW are accepted while the axes move (the "
+                                  "manuals forbid only D, K, R, M, N and W while running)"),
 }.items()}
 
 
