@@ -41,6 +41,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                        "hex fields take upper-case digits only: a-f is a syntax error (4)"),
     "queries-counted": (("8.index.queries-uncounted",),
                         "@ and > advance the index like every other command"),
+    "restore-nothing-kept-refused": (("10.5.restore.pops",),
+                                     "R with nothing saved by K (or a second R) is refused "
+                                     "with 4 and changes nothing: the manual's R restores "
+                                     "what K saved and says nothing of an empty save"),
     "eeprom-write-while-moving": (("5.code.busy-eeprom",),
                                   "EW, EFW and EUW are accepted while the axes move (the "
                                   "manuals forbid only D, K, R, M, N and W while running)"),

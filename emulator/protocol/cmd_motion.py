@@ -238,6 +238,8 @@ def cmd_keep(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_restore(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_while_moving(t)
     s = dev.state
+    if s.saved is None and dev.readings.active("restore-nothing-kept-refused"):
+        raise CommandError(ErrorCode.SYNTAX, "nothing kept to restore")
     saved = s.saved or Saved(EMPTY_SAVE, 0, 0, 0)
     if not dev.mutant.active("restore-keeps-save"):
         s.saved = None                         # a stack of one level: R pops it
