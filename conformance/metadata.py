@@ -29,6 +29,9 @@ class TargetMeta:
     envelope: int | None = None             # steps per axis from the start (real units)
     excursion: list[int] | None = None      # the largest |travel| per axis seen in the run
     graded: str = ""                        # "strict" or "by the tags" (docs/suite.md)
+    #: real time: the line's `?` round trip measured at the start (ms min, median, max)
+    #: and one byte's time at the baud rate
+    line: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass

@@ -280,6 +280,8 @@ def _from_sessions(result: RunResult, meta: RunMeta) -> None:
         if s["identity"]:
             t.version = s["identity"].get("version", t.version)
             t.processor_id = s["identity"].get("processor_id", t.processor_id)
+        if s.get("line"):
+            t.line = s["line"]
         if s["excursion"]:
             t.excursion = [max(abs(lo), abs(hi)) for lo, hi in s["excursion"]]
 

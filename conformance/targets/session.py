@@ -82,6 +82,9 @@ class SessionReport:
     interrupted: bool = False
     not_responding: str = ""
     violations: list[str] = field(default_factory=list)   # answers outside the cases
+    #: the line's round trip measured at the start (`?` exchanges): ms min, median, max,
+    #: and the byte time at the baud rate
+    line: dict[str, float] = field(default_factory=dict)
     wire_log: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
@@ -180,6 +183,7 @@ class Session:
             if r is not None and r.code == 0:
                 self.identity[name] = ",".join(r.values)
         self.report.identity = self.identity
+        self.report.line = _round_trip(link)
         for n in range(6):
             r = link.send(f"SR{n}")
             if _hex_ok(r):
@@ -479,6 +483,21 @@ class Session:
         if self.status:
             self.report.problems.append("status words not verified as found: " + " ".join(
                 f"ST{n}={v:02X}" for n, v in sorted(self.status.items())))
+
+
+#: `?` exchanges that measure the line's round trip at the start of a session
+ROUND_TRIPS = 5
+
+
+def _round_trip(link: Link) -> dict[str, float]:
+    """The round trip of a harmless `?` in ms (min, median, max) and one byte's time at
+    the link's baud rate: what the line adds to every exchange."""
+    trips = sorted((r.received_at - r.sent_at) / 1e6 for r in
+                   (link.send("?") for _ in range(ROUND_TRIPS)) if r is not None)
+    if not trips:
+        return {}
+    return {"min_ms": trips[0], "median_ms": trips[len(trips) // 2], "max_ms": trips[-1],
+            "byte_ms": link.byte_seconds(1) * 1e3}
 
 
 def _hex_ok(r: Response | None) -> bool:

@@ -166,3 +166,12 @@ def test_the_operator_is_asked_once_before_the_first_motion_with_the_identity_kn
     run([unit], select(["1.profile.*", "5.errors.ok", "10.1.*"]))
     assert asked == [("IP84 v3 27.1.2010", [])]       # before any frame that moves
     assert [f for f in unit.frames if moves(f)]
+
+
+def test_the_line_round_trip_is_measured_at_the_start():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    result = run([unit], select(["1.profile.*"]))
+    line = result.sessions[unit.info.spec]["line"]
+    assert line["byte_ms"] == pytest.approx(10 / 115200 * 1e3)
+    # a `?` frame (4 bytes) and its answer take at least their bytes' time
+    assert 4 * line["byte_ms"] < line["min_ms"] <= line["median_ms"] <= line["max_ms"]

@@ -1,0 +1,40 @@
+"""The measured family in real time behind a USB-serial-like relay (16 ms latency timer,
+62-byte chunks, jitter): a correct unit gets no FAIL. Slow: prints the runs and FAILs."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.runner import run
+from conformance.targets import parse_target
+from conformance.verdict import FAIL
+from tests.emulator.process import Emulator
+from tests.usb_relay import UsbRelay
+
+REPEATS = int(os.environ.get("GVE_MEASURED_REPEATS", "20"))
+
+
+@pytest.mark.slow
+@pytest.mark.pty
+@pytest.mark.parametrize("latency_ms", [None, 16])
+def test_measured_family_repeated_gets_no_fail(latency_ms: int | None) -> None:
+    emu = Emulator("--model", "GVE84-100", "--pty")
+    relay = UsbRelay(emu.first, latency_ms=latency_ms, jitter_ms=3) if latency_ms else None
+    failed: dict[str, int] = {}
+    try:
+        path = relay.path if relay else emu.first
+        for _ in range(REPEATS):
+            target = parse_target(f"serial:{path}?baud=115200", profile="GVE84-100",
+                                  allow_destructive=True, max_travel=100_000)
+            for r in run([target], select(["10.*measured*"])).results:
+                if r.verdict == FAIL:
+                    failed[r.id] = failed.get(r.id, 0) + 1
+    finally:
+        if relay:
+            relay.close()
+        emu.stop()
+    print(f"latency {latency_ms} ms: {REPEATS} runs, FAILs {failed}")
+    assert not failed
