@@ -109,7 +109,13 @@ class Pair:
     # -- one example ----------------------------------------------------------------------
     def run(self, steps: list[Step]) -> Outcome:
         out = Outcome()
-        self.target.open()
+        try:
+            self.target.open()
+        except SafetyStop as err:
+            # the known state itself was refused (a minimiser's candidate left the unit
+            # where the guard cannot bring it back): the candidate shows nothing
+            out.refused.append(f"the known state: {err}")
+            return out
         self.reference.open()
         self._idle_since = 0
         self._latency_ns = self._slack_ns = self._cut_ns = 0
