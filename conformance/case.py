@@ -10,16 +10,14 @@ from typing import Any
 
 from conformance.link.link import Link
 from conformance.link.safety import SafetyStop
+from conformance.targetinfo import TargetInfo
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import TAGS
 from gve_fixtures.rules import load_rules
 
 __all__ = ["REGISTRY", "Case", "CaseContext", "Check", "CouldNotTest", "Missing",
            "SafetyStop", "TargetInfo", "case"]
-
-
-class CouldNotTest(Exception):
-    """A precondition failed: the case cannot judge this target."""
 
 
 class Missing(Exception):
@@ -108,19 +106,6 @@ def case(id: str, *, rule: str | None = None, tag: str | None = None, source: st
                             applies, rig, destructive, timing, tuple(rules), hands)
         return func
     return register
-
-
-@dataclass(frozen=True)
-class TargetInfo:
-    kind: str                  # emu, serial, tcp, exec
-    spec: str                  # as given on the command line
-    virtual_time: bool
-    has_rig: bool
-    allow_destructive: bool
-    max_travel: int
-    #: graded by the project's decisions: a failed `[D]` check FAILs (the reference
-    #: emulator; another target only when the run says --strict)
-    strict: bool = False
 
 
 @dataclass

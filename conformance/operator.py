@@ -21,9 +21,9 @@ from typing import TextIO
 
 from tqdm import tqdm
 
-from conformance.case import CouldNotTest
 from conformance.link.interrupts import Interrupted
 from conformance.link.link import Link
+from conformance.verdict import CouldNotTest
 
 #: input ports read FF with nothing connected (spec 10.3: inputs are grounded to act)
 NOTHING_CONNECTED = 0xFF

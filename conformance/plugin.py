@@ -114,7 +114,7 @@ def _xdist_controller(config: pytest.Config) -> bool:
 
 def worker_group(target: Target) -> str | None:
     """The xdist group of a target's items: its port, or None (emu: nothing shared)."""
-    if target.info.kind == "emu":
+    if not target.info.real:
         return None
     # loadgroup reads the group after a node ID's last '@', past its last ']'
     return "gve-port:" + re.sub(r"[@\[\]]", "_", target.url)

@@ -15,6 +15,14 @@ MISSING = "MISSING"
 COULD_NOT_TEST = "COULD-NOT-TEST"
 ERROR = "ERROR"
 
+
+
+class CouldNotTest(Exception):
+    """A precondition failed: the case cannot judge this target (its verdict is
+    COULD-NOT-TEST). Raised below the cases too: by a target's rig, the session's way
+    back, an operator who did not answer."""
+
+
 #: worst first: the verdict of a case is the worst of its checks
 ORDER = (ERROR, FAIL, NON_STRICT, INFO, COULD_NOT_TEST, MISSING, PASS)
 TAGS = ("M", "M-ex", "D", "D-info", "always")

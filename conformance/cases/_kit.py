@@ -61,7 +61,7 @@ def halted_line(ctx: CaseContext, steps: int, seconds: float) -> None:
 def fresh_reset(ctx: CaseContext) -> None:
     """Cases about the state right after a reset: the emulator gives a fresh unit; a real
     unit is restarted with J, which needs --allow-destructive."""
-    if ctx.target.kind == "emu":
+    if not ctx.target.real:
         return
     ctx.require(ctx.target.allow_destructive, "needs a reset (J): run with --allow-destructive")
     r = ctx.link.send("J")

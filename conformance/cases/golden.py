@@ -89,7 +89,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
     as the replay's are (a trailing ``,XX`` both ways) and booked with the answers the
     transcript expects (a pattern: unclear, whichever reaches farther)."""
     address = int(t.meta.get("address", profile.address))
-    guard = Guard(profile, address, enforce=True, max_travel=2**62, allow_destructive=True)
+    guard = Guard(profile, address, max_travel=2**62, allow_destructive=True)
     framer, summed, pending, need = HostFramer(), False, [], 0.0
     for rec in t.records:
         if rec.direction == HOST:

@@ -132,7 +132,7 @@ def busy_halted(ctx: CaseContext) -> None:
     link = ctx.link
     halted_line(ctx, 1000, 0.2)
     answers(ctx, link.send("NX0"), "F", "N<axis> while the halted vector holds RUN → 7")
-    if ctx.target.kind == "emu" and "W" in ctx.profile.commands:   # W: never on real units
+    if not ctx.target.real and "W" in ctx.profile.commands:   # W: never on real units
         answers(ctx, link.send("WX,-10,1000,10,1000"), "F", "W while RUN = 1 → 7")
     here = position(ctx)
     ctx.expect(here is not None and 0 < here[0] < 1000, "the refused commands moved nothing",

@@ -76,7 +76,7 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
                           strict=args.strict)
     against = args.against or f"emu:{target.profile.name}"
     reference = parse_target(against)
-    if reference.info.kind != "emu":
+    if reference.info.real:
         raise UsageError(f"--against {against}: the reference is the embedded emulator "
                          "(emu:PROFILE)")
     if reference.profile.name != target.profile.name:
@@ -91,7 +91,7 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
 def ask_first(args: argparse.Namespace, target: Target) -> None:
     """Real units: the question before the first frame that can move an axis, as the
     suite's run asks it (no terminal and no --yes: nothing moves)."""
-    if target.info.kind != "emu" and not args.yes:
+    if target.info.real and not args.yes:
         target.session.before_motion = ask_before_motion(target, Console(), RunMeta())
 
 

@@ -197,7 +197,7 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
         return _fleet(args, argv, targets, meta, console, run_id)
     if meta.confirmed == "asked":
         for target in targets:
-            if target.info.kind != "emu":
+            if target.info.real:
                 target.session.before_motion = ask_before_motion(target, console, meta)
     _say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
     _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
@@ -254,19 +254,19 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how:
     for target, chosen in zip(targets, how, strict=True):
         t = meta.target(target.info.spec)
         t.kind, t.profile, t.profile_chosen = target.info.kind, target.profile.name, chosen
-        t.envelope = None if target.info.kind == "emu" else target.info.max_travel
+        t.envelope = target.info.max_travel if target.info.real else None
         t.graded = "strict" if target.info.strict else "by the tags"
     meta.coverage = [{**d, "sections": [{**s, "covered": len(s["covered"])}
                                         for s in d["sections"]]}
                      for d in (pc.as_dict() for pc in coverage(
                          sorted({t.profile.name for t in targets}), cases=cases))]
-    real = any(t.info.kind != "emu" for t in targets)
+    real = any(t.info.real for t in targets)
     meta.operator_steps = (real and console.interactive if args.operator is None
                            else args.operator)
     if real:
         meta.confirmed = "--yes" if args.yes else "asked"
     try:
-        record_identities([t for t in targets if t.info.kind == "emu"], meta)
+        record_identities([t for t in targets if not t.info.real], meta)
     except (OSError, SerialException, ValueError) as err:
         raise UsageError(str(err)) from None
     return meta

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from conformance.cli.usage import UsageError
 from conformance.metadata import RunMeta
 from conformance.operator import Console, confirm_motion
+from conformance.targetinfo import EMULATOR, is_emulator_spec
 from conformance.targets import Target
 from conformance.targets.identify import ask, bauds, choose, of_target, variant_of
 from conformance.targets.port import locate
@@ -33,8 +34,8 @@ def resolve(spec: str, profile: str | None, variant: str | None, console: Consol
     serial/tcp unit `?` and `Q` and says what it chose. ValueError when it cannot."""
     kind, _, rest = spec.partition(":")
     if profile != AUTO:
-        return spec, profile, "emulated" if kind == "emu" else "--profile"
-    if kind == "emu":
+        return spec, profile, "emulated" if kind == EMULATOR else "--profile"
+    if kind == EMULATOR:
         return spec, None, "emulated"                 # the emulated unit is its profile
     if kind == "exec":
         raise ValueError(f"{spec}: name the profile the simulator behaves as (--profile "
@@ -90,7 +91,7 @@ def ask_before_motion(target: Target, console: Console, meta: RunMeta
 def confirmed(targets: list[Target], meta: RunMeta, console: Console) -> bool:
     """The same question once for several targets before any of them runs (a fleet,
     whose members have no terminal); the identities are those known so far."""
-    real = [t for t in targets if t.info.kind != "emu"]
+    real = [t for t in targets if t.info.real]
     lines = [line for t in real for line in _what_moves(
         t, meta.target(t.info.spec).version, meta.target(t.info.spec).processor_id)]
     return not real or confirm_motion(console, lines)
@@ -103,7 +104,7 @@ def unattended(targets: list[Target], yes: bool, console: Console) -> None:
     question. ``--profile auto``, which asks the unit who it is, checks the specs first
     with :func:`unattended_specs`."""
     try:
-        unattended_specs([t.info.spec for t in targets if t.info.kind != "emu"], yes, console)
+        unattended_specs([t.info.spec for t in targets if t.info.real], yes, console)
     except UsageError:
         for t in targets:
             t.close()
@@ -112,6 +113,6 @@ def unattended(targets: list[Target], yes: bool, console: Console) -> None:
 
 def unattended_specs(specs: list[str], yes: bool, console: Console) -> None:
     """:func:`unattended` for target specs not yet opened."""
-    real = [s for s in specs if s.partition(":")[0] != "emu"]
+    real = [s for s in specs if not is_emulator_spec(s)]
     if real and not yes and not console.interactive:
         raise UsageError(CANNOT_ASK)

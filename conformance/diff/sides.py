@@ -13,10 +13,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from conformance.case import CouldNotTest
 from conformance.link.framing import HostFramer, Response, parse_response
 from conformance.link.link import MARGIN, Link
+from conformance.link.virtual import line_of
 from conformance.targets import Session, Target
+from conformance.targets.session import EmuSession
+from conformance.verdict import CouldNotTest
 
 #: answers summed after the command whatever the mode before (spec 6, 10 J)
 _MODE_AFTER = {"%+": True, "%-": False, "J": False}
@@ -68,9 +70,9 @@ class Side:
         """A link in the known state for a new example: on the emulator a fresh unit (and
         a session of its own, so one example's silences do not count in the next); on a
         real unit the run's session's known state."""
-        if self.virtual and self.target.info.kind == "emu":
-            self.session = Session(self.target, self.session.interrupts if self.session
-                                   else None)
+        if self.virtual and not self.target.info.real:
+            self.session = EmuSession(self.target, self.session.interrupts if self.session
+                                      else None)
         elif self.session is None:
             self.session = self.target.begin()
         self.link = self.session.open_link()
@@ -81,7 +83,7 @@ class Side:
         """Virtual time: let a fresh unit stand for ``seconds`` and begin the example
         there (a unit with a history: no dwell counted from its power-on)."""
         if self.virtual:
-            self.link.port.line.advance(seconds)
+            line_of(self.link.port).advance(seconds)
             self._origin = self.link.now
 
     @property
@@ -92,7 +94,8 @@ class Side:
     def catch_up(self, t: int) -> None:
         """Virtual time: advance to ``t`` (ns since the example began) if behind."""
         if self.virtual and t > self.now:
-            self.link.port.line.advance_to(self.link.port.line.now + (t - self.now))
+            line = line_of(self.link.port)
+            line.advance_to(line.now + (t - self.now))
 
     def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
                  stall: tuple[int, float] | None = None, body: str | None = None
@@ -137,7 +140,7 @@ class Side:
         next example is fresh)."""
         if self.link is not None:
             self.link.settle(final=True)
-        if self.session is not None and self.session.real:
+        if self.session is not None:
             self.session.after_case()
 
     def write_eeprom(self, image: dict[int, int]) -> None:

@@ -12,6 +12,7 @@ import serial
 from conformance.host.recording import Recording, show
 from conformance.host.unitview import UnitView
 from conformance.link.framing import CR, Response, frame, parse_response
+from conformance.link.virtual import line_of
 from gve_fixtures.protocol import St6
 
 #: how long the motion the host left queued may still run
@@ -45,7 +46,7 @@ def ask(unit: serial.SerialBase, rec: Recording, address: int, body: str,
 def final_state(unit: serial.SerialBase, view: UnitView, rec: Recording) -> Final:
     """Ask the unit; the host is gone, so the line's time may now run ahead of the wall
     clock: waiting for a restart or for the motion takes no real time."""
-    line = unit.line  # type: ignore[attr-defined]
+    line = line_of(unit)
     wait = (view.deaf_until - time.monotonic_ns()) / 1e9
     if wait > 0:
         line.advance(wait + 0.05)     # the unit is restarting: it would hear nothing

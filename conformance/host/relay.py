@@ -36,6 +36,7 @@ from conformance.host.ledger import Ledger
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
+from conformance.link.virtual import line_of
 
 MS = 1_000_000
 SECOND = 1_000_000_000
@@ -67,7 +68,7 @@ class Relay:
     def __init__(self, port: HostPort, unit: serial.SerialBase, views: list[UnitView],
                  fault: Fault, baud: int) -> None:
         self.port, self.unit, self.views, self.fault = port, unit, views, fault
-        self.line = unit.line  # type: ignore[attr-defined]  (the gve:// rig and clock)
+        self.line = line_of(unit)                  # the gve:// rig and clock
         self.ledger = Ledger(views)
         self.units = self.ledger.units
         self.byte_ns = round(10 * SECOND / baud)

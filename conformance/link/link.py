@@ -33,6 +33,7 @@ from conformance.link.framing import (
     readable,
 )
 from conformance.link.safety import Guard
+from conformance.link.virtual import Rig, line_of
 from gve_fixtures.protocol import St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
@@ -51,8 +52,9 @@ _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
-                 virtual: bool = False, rig=None) -> None:
+                 virtual: bool = False, rig: Rig | None = None) -> None:
         self.port = port
+        self.line = line_of(port) if virtual else None   # the clock in virtual time
         self.address = address
         self.baud = baud
         self.virtual = virtual
@@ -71,8 +73,8 @@ class Link:
 
     # -- time ------------------------------------------------------------------------------
     def _clock(self) -> int:
-        if self.virtual:
-            return self.port.line.now
+        if self.line is not None:
+            return self.line.now
         return time.monotonic_ns()
 
     @property
@@ -85,8 +87,8 @@ class Link:
     def wait(self, seconds: float) -> bytes:
         """Let ``seconds`` pass; returns whatever arrived meanwhile."""
         self.guard.check_idle()
-        if self.virtual:
-            self.port.line.advance(seconds)
+        if self.line is not None:
+            self.line.advance(seconds)
             data = self.port.read(self.port.in_waiting)
         else:
             data = self._listen(seconds, stop_early=False)
@@ -111,8 +113,8 @@ class Link:
 
     def _pause(self, seconds: float) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
-        if self.virtual:
-            self.port.line.advance(seconds)
+        if self.line is not None:
+            self.line.advance(seconds)
         else:
             time.sleep(seconds)      # real serial/TCP time: the fault is a pause on the wire
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
+from conformance.link.ledger import EepromLedger
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
@@ -112,27 +113,26 @@ def outcome_of(r: Response | None) -> Outcome:
 
 
 class Guard:
-    """One unit's run-wide guard (see the module's docstring)."""
+    """One real unit's run-wide guard (see the module's docstring). It owns what the run
+    knows of the unit's safety: the envelope, the EEPROM ledger, the run's Ctrl-C."""
 
-    def __init__(self, profile: Profile, address: int, *, enforce: bool, max_travel: int,
+    def __init__(self, profile: Profile, address: int, *, max_travel: int,
                  allow_destructive: bool, interrupts: Interrupts | None = None) -> None:
         self.profile = profile
         self.address = address
-        self.enforce = enforce
         self.max_travel = max_travel
         self.allow_destructive = allow_destructive
         self.interrupts = interrupts or Interrupts()
         micro = profile.microstep
         self.scale = profile.position_scale               # counter units per full step
         self.envelope = Envelope(
-            len(profile.axes), max_travel * self.scale if enforce else INF,
+            len(profile.axes), self._limit(max_travel),
             tuple(micro.factors.values()) if micro else (1,),
             micro.factors[micro.reset_mode] if micro else 1)
         self.addresses = {address} | ({profile.spindle.address} if profile.spindle else set())
         self.packet: list[list[Span]] = []       # C members since *S
         self.packet_open = False
-        self.eeprom_backed: set[int] = set()     # bytes the session holds the originals of
-        self.eeprom_written: set[int] = set()    # bytes a frame sent may have changed
+        self.eeprom = EepromLedger()
         self.before_motion: Callable[[], bool | None] | None = None
         self.motion_confirmed: bool | None = None
         self.silences = 0
@@ -140,6 +140,10 @@ class Guard:
         self.dead = False
         self._own = 0                             # inside the session's own frames
         self._emergency = 0
+
+    def _limit(self, max_travel: int) -> float:
+        """The envelope's reach either side, in counter units."""
+        return max_travel * self.scale
 
     # -- who is sending ----------------------------------------------------------------------
     @contextlib.contextmanager
@@ -175,7 +179,7 @@ class Guard:
     def check(self, body: str, address: int | None = None) -> None:
         """Raise if the frame ``body`` for ``address`` may not be sent now."""
         self.check_idle()
-        if self._emergency or not self.enforce:
+        if self._emergency:
             return
         command = Command.parse(body)
         address = self.address if address is None else address
@@ -212,11 +216,11 @@ class Guard:
         width = _EEPROM_WIDTH.get(command.name)
         if width:
             touched = self._eeprom_bytes(command, width)
-            lost = [a for a in touched if a not in self.eeprom_backed] if touched else [-1]
+            lost = [a for a in touched if not self.eeprom.backed_up(a)] if touched else [-1]
             if lost:
                 shown = "?" if lost == [-1] else " ".join("%02X" % a for a in lost)
                 raise SafetyStop(f"{body}: EEPROM {shown} not backed up, so not written")
-            self.eeprom_written.update(touched)
+            self.eeprom.write(touched)
 
     def _eeprom_bytes(self, command: Command, width: int) -> list[int]:
         start = _number(command.params.split(",")[0], 16)
@@ -264,8 +268,6 @@ class Guard:
     # -- after a frame ------------------------------------------------------------------------
     def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
         """Book the frame ``body`` with its answer (None when none was seen)."""
-        if not self.enforce:
-            return
         address = self.address if address is None else address
         if address not in self.addresses:
             return
@@ -286,9 +288,8 @@ class Guard:
     def restarted(self) -> None:
         """The unit restarted by other means than `J` (a test rig's power cycle): booked
         as a `J` it accepted (counters zeroed, queue and packet gone, the axes stay)."""
-        if self.enforce:
-            self.envelope.discard(Outcome.ACCEPTED, restart=True)
-            self.packet_open = False
+        self.envelope.discard(Outcome.ACCEPTED, restart=True)
+        self.packet_open = False
 
     def _event(self, command: Command, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -426,6 +427,29 @@ class Guard:
     def excursion(self) -> list[tuple[float, float]]:
         """Per axis, the farthest the axis may have gone each way, in full steps."""
         return [(_steps(s.lo, self.scale), _steps(s.hi, self.scale)) for s in self.envelope.seen]
+
+
+class EmulatorGuard(Guard):
+    """The embedded emulator's guard: every link is a fresh unit and nothing outlives the
+    run, so no frame is refused or booked; it still stops the run for Ctrl-C and for a
+    unit that stopped answering."""
+
+    def __init__(self, profile: Profile, address: int,
+                 interrupts: Interrupts | None = None) -> None:
+        super().__init__(profile, address, max_travel=0, allow_destructive=True,
+                         interrupts=interrupts)
+
+    def _limit(self, max_travel: int) -> float:
+        return INF
+
+    def check(self, body: str, address: int | None = None) -> None:
+        self.check_idle()
+
+    def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
+        return None
+
+    def restarted(self) -> None:
+        return None
 
 
 #: commands whose effect needs nothing but the outcome

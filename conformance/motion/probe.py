@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from conformance.case import CaseContext, CouldNotTest
+from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
 from conformance.motion.arith import SECOND
 from conformance.motion.model import MotionModel
@@ -29,7 +30,6 @@ from conformance.motion.tolerance import (
     processing_window,
     tolerance,
 )
-from conformance.targets.session import known_axis_limits
 
 #: dense model points per trace
 TRACE_POINTS = 60
@@ -63,7 +63,7 @@ class Probe:
         self.scale = 1 if p.microstep is None else p.microstep.factors[p.microstep.reset_mode]
         # the state a case starts from: a fresh emulated unit, or a real one put into the
         # known state (docs/suite.md), whose VL cannot always be set back to the reset's
-        fresh = ctx.target.kind == "emu"
+        fresh = not ctx.target.real
         vl = r.VL if fresh or "VL" not in p.commands else known_axis_limits(p)
         self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T, "VK": r.VK,
                       "VL": tuple(vl)}

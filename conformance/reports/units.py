@@ -8,6 +8,7 @@ from __future__ import annotations
 from conformance.reports.banner import run_verdict
 from conformance.reports.text import html_text as h
 from conformance.runner import RunResult
+from conformance.targetinfo import EMULATOR
 
 HEADERS = ("target", "profile", "firmware (`?`)", "processor id (`Q`)",
            "motion envelope (full steps per axis)", "largest excursion (full steps)",
@@ -18,7 +19,7 @@ FRESH_UNIT = "not tracked: every case starts a fresh emulated unit"
 
 def excursion_text(session: dict | None, kind: str) -> str:
     """How far each axis went either way, as ``X -12..+1400, Y +0..+0``."""
-    if kind == "emu":
+    if kind == EMULATOR:
         return FRESH_UNIT
     if not session or not session.get("excursion"):
         return "not measured (the session did not run)"
@@ -33,7 +34,7 @@ def units_table(run: RunResult) -> list[str]:
         t = run.meta.target(target)
         v, why = run_verdict(run, target)
         envelope = (f"±{t.envelope}" if t.envelope is not None else
-                    "none (the emulator: nothing to protect)" if t.kind == "emu"
+                    "none (the emulator: nothing to protect)" if t.kind == EMULATOR
                     else "not enforced")
         chosen = f" ({t.profile_chosen})" if t.profile_chosen else ""
         cells = (target, f"{t.profile}{chosen}", t.version or "(not read)",

@@ -7,6 +7,7 @@ run-wide session (session.py) opens links and keeps the unit safe."""
 
 from __future__ import annotations
 
+from conformance.targetinfo import EMULATOR
 from conformance.targets import emu, port, process
 from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
 from conformance.targets.session import Session, SessionError, SessionReport
@@ -15,7 +16,7 @@ __all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Session", "SessionError", "SessionR
            "Target", "TargetError", "parse_target"]
 
 #: scheme -> the module that parses it (``parse(kind, rest, **options) -> Target``)
-SCHEMES = {"emu": emu, "serial": port, "tcp": port, "exec": process}
+SCHEMES = {EMULATOR: emu, "serial": port, "tcp": port, "exec": process}
 
 
 def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bool = False,

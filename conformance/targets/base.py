@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import serial
 
-from conformance.case import TargetInfo
 from conformance.link.interrupts import Interrupts
 from conformance.link.link import Link
-from conformance.targets.session import Session
+from conformance.targetinfo import TargetInfo
+from conformance.targets.session import Session, open_session
 from gve_fixtures.profile import Profile
 
 DEFAULT_MAX_TRAVEL = 2000
@@ -38,14 +38,14 @@ class Target:
     def session(self) -> Session:
         """The run's session on this target (a new one until :meth:`begin` names one)."""
         if self._session is None:
-            self._session = Session(self)
+            self._session = open_session(self)
         return self._session
 
     def begin(self, interrupts: Interrupts | None = None) -> Session:
         """The session for a run, Ctrl-C shared through ``interrupts``: the one prepared
         before the run (an operator's prompt set, the identity read), else a new one."""
         if self._session is None or self._session.finished:
-            self._session = Session(self, interrupts)
+            self._session = open_session(self, interrupts)
         elif interrupts is not None:
             self._session.share(interrupts)
         return self._session

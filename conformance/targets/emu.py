@@ -8,7 +8,8 @@ from urllib.parse import parse_qs, urlsplit
 
 import serial
 
-from conformance.case import TargetInfo
+from conformance.link.virtual import line_of
+from conformance.targetinfo import EMULATOR, TargetInfo
 from conformance.targets.base import Target, TargetError
 from gve_fixtures.profile import load_profile
 
@@ -44,7 +45,8 @@ class EmuTarget(Target):
         if self.readings:
             query += f"&reading={self.readings}"
         port = serial.serial_for_url(f"gve://?{query}", timeout=0.25)
-        return port, port.line.baud, True, port.line
+        line = line_of(port)
+        return port, line.baud, True, line
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
@@ -65,6 +67,6 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
                               f"(known: {', '.join(sorted(emulator_readings()))})")
     # the reference implements every decision: graded strictly, its mutants too; an
     # emulator taking other readings is graded as any other unit, by the tags
-    info = TargetInfo("emu", spec, True, True, True, max_travel,
+    info = TargetInfo(EMULATOR, spec, True, True, True, max_travel,
                       strict=not readings or strict)
     return EmuTarget(info, p, p.address, p.default_baud, spec, mutant, readings)

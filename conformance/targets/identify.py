@@ -146,7 +146,7 @@ def probe(url: str, address: int = 0) -> str:
 
 def of_target(target: Target) -> Identity | None:
     """What the target answers to `?` and `Q`, for the report (nothing that moves)."""
-    if target.info.kind == "emu":
+    if not target.info.real:
         link = target.open_link()
         version, processor_id = link.send("?"), link.send("Q")
         if version is None or processor_id is None:

@@ -9,10 +9,11 @@ from urllib.parse import parse_qs, urlencode, urlsplit
 
 import serial
 
-from conformance.case import TargetInfo
 from conformance.link.exclusive import open_serial
+from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
 from conformance.targets.targetport import TargetPort
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
@@ -74,7 +75,6 @@ class PortTarget(Target):
 
     def connect(self, address: int | None):
         if address is not None and address != self.address:
-            from conformance.case import CouldNotTest
             raise CouldNotTest(f"needs a unit at address {address}")
         return self._open(), self.baud, False, None
 

@@ -19,7 +19,7 @@ import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
 
-from conformance.case import TargetInfo
+from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
 from conformance.targets.cosim import VERSION, CosimLine, CosimPort, ProtocolBroken, announced
 from conformance.targets.port import PortTarget, open_port, real_profile

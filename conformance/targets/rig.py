@@ -16,9 +16,9 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
-from conformance.case import CouldNotTest
 from conformance.link.safety import TargetNotResponding
 from conformance.targets.program import Program
+from conformance.verdict import CouldNotTest
 
 #: asks one command and gives its reply line (raising when there is none)
 Ask = Callable[[str], str]

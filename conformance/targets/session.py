@@ -1,4 +1,4 @@
-"""The run-wide session on one target (issue 8): one per target per run.
+"""The run-wide session on one target: one per target per run.
 
 It owns what must hold for the whole run on one unit, across links, cases and Hypothesis
 examples:
@@ -17,8 +17,9 @@ examples:
   checksum mode as found, what cannot be read set to the reset state; what could not be
   restored goes into :attr:`report` as a problem.
 
-On the embedded emulator every link is a fresh unit: nothing to protect or restore; the
-session still carries Ctrl-C and the count of unanswered frames.
+On the embedded emulator every link is a fresh unit: nothing to protect or restore; its
+session (:class:`EmuSession`) still carries Ctrl-C and the count of unanswered frames. A
+real unit's (:class:`RealSession`) does all of the above; :func:`open_session` picks one.
 """
 
 from __future__ import annotations
@@ -28,11 +29,13 @@ from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
-from conformance.case import CouldNotTest, TargetInfo
+from conformance.known_state import known_axis_limits
 from conformance.link.framing import HostFramer, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.targetinfo import TargetInfo
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
@@ -49,15 +52,6 @@ class Reachable(Protocol):
 #: status words restored at the end, polarity before causes before enables (an enable
 #: written last finds its polarity and cause already in place)
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
-
-
-def known_axis_limits(profile: Profile) -> tuple[int, ...]:
-    """The VL a unit is put back to: the reset VL (the variant's maximum) where VL's range
-    reaches it, else the top of the range (only J restores more, spec 9, 10)."""
-    if "VL" not in profile.ranges:
-        return tuple(profile.reset.VL)
-    top = profile.range("VL").hi
-    return tuple(min(v, top) for v in profile.reset.VL)
 
 
 class SessionError(Exception):
@@ -92,21 +86,19 @@ class SessionReport:
 
 
 class Session:
+    """What every target's session does: the guard's interface, links, Ctrl-C and the
+    report. The embedded emulator's needs nothing more (:class:`EmuSession`); a real
+    unit's adds the unit as found, the known state and the restorations
+    (:class:`RealSession`)."""
+
+    #: whether the unit outlives a link (and so is guarded, set and restored)
+    real = False
+
     def __init__(self, target: Reachable, interrupts: Interrupts | None = None) -> None:
         self.target = target
         self.profile = target.profile
-        self.interrupts = interrupts or Interrupts()
         info = target.info
-        self.real = info.kind != "emu"
-        self.guard = Guard(self.profile, target.address, enforce=self.real,
-                           max_travel=info.max_travel, allow_destructive=info.allow_destructive,
-                           interrupts=self.interrupts)
-        self.identity: dict[str, str] = {}
-        self.status: dict[int, int] = {}           # ST0..ST5 as found
-        self.checksums: bool | None = None         # the checksum mode as found
-        self.eeprom: dict[int, int] = {}           # EEPROM bytes as found
-        self.counters: dict[int, int] = {}         # position counters as found (PF)
-        self.eeprom_touched: set[int] = set()      # bytes the run wrote (put back since)
+        self.guard = self._guard(info, interrupts or Interrupts())
         self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
                                     self.real, max_travel=info.max_travel if self.real else None)
         self.started = False
@@ -114,9 +106,17 @@ class Session:
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
 
+    def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
+        return EmulatorGuard(self.profile, self.target.address, interrupts)
+
+    @property
+    def interrupts(self) -> Interrupts:
+        """The run's Ctrl-C, held by the guard (which stops every frame after it)."""
+        return self.guard.interrupts
+
     def share(self, interrupts: Interrupts) -> None:
         """Take Ctrl-C from the run's ``interrupts``."""
-        self.interrupts = self.guard.interrupts = interrupts
+        self.guard.interrupts = interrupts
 
     # -- the guard's interface, for frames sent by other means ---------------------------------
     @property
@@ -146,8 +146,6 @@ class Session:
         port, baud, virtual, rig = self.target.connect(address)
         link = Link(port, self.guard, address=self.target.address if address is None else address,
                     baud=baud, virtual=virtual, rig=rig)
-        if self._link is not None and self.real:       # the same unit: its mode too
-            link.checksums = self._link.checksums
         self._link = link
         return link
 
@@ -155,14 +153,8 @@ class Session:
         """A link in the known state (on the emulator: a new unit, at ``address``)."""
         self.start()
         self.guard.check_idle()
-        link = self._new_link(address)
-        if self.real:
-            with self.guard.own_frames():
-                self._known_state(link)
-            link.log.clear()
-        return link
+        return self._new_link(address)
 
-    # -- the unit as found ----------------------------------------------------------------------
     def start(self) -> None:
         """Read the unit as found, before the first case (real units only)."""
         if self.failed:
@@ -170,8 +162,77 @@ class Session:
         if self.started:
             return
         self.started = True
-        if not self.real:
-            return
+        self._as_found()
+
+    def _as_found(self) -> None:
+        """Nothing to read of a fresh unit."""
+
+    def eeprom_as_found(self) -> dict[int, int]:
+        """The EEPROM bytes as the run found them (read now if they were not: reading
+        changes nothing); empty where the unit has no `ER` or every link is a new unit."""
+        return self.guard.eeprom.originals
+
+    def after_case(self) -> None:
+        """What a case changed that outlives it, put back (nothing on a fresh unit)."""
+
+    def emergency_stop(self) -> None:
+        """Ctrl-C: on a real unit `H`, then `D`, before anything else."""
+        self.interrupts.handle()
+
+    def finish(self) -> SessionReport:
+        """Put back what the run changed and say what could not be (once)."""
+        if self.finished:
+            return self.report
+        self.finished = True
+        self._put_back()
+        self.report.interrupted = self.report.interrupted or self.interrupts.stopped
+        return self.report
+
+    def _put_back(self) -> None:
+        """Nothing outlives a fresh unit."""
+
+
+class EmuSession(Session):
+    """The embedded emulator's session: every link a fresh unit."""
+
+
+class RealSession(Session):
+    """A real unit's session (see the module's docstring)."""
+
+    real = True
+
+    def __init__(self, target: Reachable, interrupts: Interrupts | None = None) -> None:
+        super().__init__(target, interrupts)
+        self.identity: dict[str, str] = {}
+        self.status: dict[int, int] = {}           # ST0..ST5 as found
+        self.checksums: bool | None = None         # the checksum mode as found
+        self.counters: dict[int, int] = {}         # position counters as found (PF)
+
+    def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
+        return Guard(self.profile, self.target.address, max_travel=info.max_travel,
+                     allow_destructive=info.allow_destructive, interrupts=interrupts)
+
+    @property
+    def eeprom(self) -> dict[int, int]:
+        """The EEPROM bytes as found (the guard's ledger holds them)."""
+        return self.guard.eeprom.originals
+
+    def _new_link(self, address: int | None = None) -> Link:
+        before = self._link
+        link = super()._new_link(address)
+        if before is not None:                      # the same unit: its mode too
+            link.checksums = before.checksums
+        return link
+
+    def open_link(self, address: int | None = None) -> Link:
+        link = super().open_link(address)
+        with self.guard.own_frames():
+            self._known_state(link)
+        link.log.clear()
+        return link
+
+    # -- the unit as found ----------------------------------------------------------------------
+    def _as_found(self) -> None:
         with self._own_link() as link:
             self._read_as_found(link)
 
@@ -239,21 +300,20 @@ class Session:
             return {}
 
     def eeprom_as_found(self) -> dict[int, int]:
-        """The EEPROM bytes as the run found them (read now if they were not: reading
-        changes nothing); empty where the unit has no `ER`."""
-        if not self.eeprom and self.real and "ER" in self.profile.commands:
+        if not self.eeprom and "ER" in self.profile.commands:
             with self._own_link() as link:
                 self._backup_eeprom(link)
         return self.eeprom
 
     def _backup_eeprom(self, link: Link) -> None:
         """Every byte the run can write, before its first EEPROM write: all of them."""
+        found = {}
         for address in range(self.profile.eeprom.size):
             r = link.send("ER%02X" % address)
             if _hex_ok(r):
-                self.eeprom[address] = r.hex()
-        self.guard.eeprom_backed = set(self.eeprom)
-        missing = self.profile.eeprom.size - len(self.eeprom)
+                found[address] = r.hex()
+        self.guard.eeprom.found(found)
+        missing = self.profile.eeprom.size - len(found)
         if missing:
             self.report.problems.append(f"EEPROM: {missing} bytes could not be read, so "
                                         "they are not written")
@@ -336,8 +396,7 @@ class Session:
 
     # -- Ctrl-C and the end --------------------------------------------------------------------
     def emergency_stop(self) -> None:
-        """Ctrl-C: `H`, then `D`, before anything else (real units)."""
-        if self.real and self._link is not None:
+        if self._link is not None:
             self.report.interrupted = True
             wait = None if self.guard.responding else MARGIN
             try:
@@ -348,12 +407,8 @@ class Session:
                 self.report.problems.append(f"H and D after Ctrl-C not sent: {err}")
         self.interrupts.handle()
 
-    def finish(self) -> SessionReport:
-        """Put back what the run changed and say what could not be (once)."""
-        if self.finished:
-            return self.report
-        self.finished = True
-        if self.real and self.started and not self.failed:     # found moving: untouched
+    def _put_back(self) -> None:
+        if self.started and not self.failed:     # found moving: untouched
             if self.interrupts.pending:
                 self.emergency_stop()
             link = self._new_link()
@@ -369,10 +424,7 @@ class Session:
                 self.report.problems.append(f"restorations stopped: {err}")
                 self._unrestored()
             self._keep_log(link)
-        self.report.interrupted = self.report.interrupted or self.interrupts.stopped
-        if self.real:
-            self.report.excursion = [list(e) for e in self.guard.excursion()]
-        return self.report
+        self.report.excursion = [list(e) for e in self.guard.excursion()]
 
     def _restore(self, link: Link) -> None:
         if not self.guard.responding:
@@ -434,11 +486,11 @@ class Session:
         case meets them (e.g. 06 turning the GVE114's hand wheel on after a J); the end
         of the run verifies every byte again. The unit is stopped first: a case (or a
         diff sequence) may leave it moving, and a moving unit refuses EEPROM writes."""
-        if not (self.real and self.guard.eeprom_written) or self.failed:
+        if not self.guard.eeprom.written or self.failed:
             return
         with self._own_link() as link:
             self._stop(link)
-            self._eeprom_back(link, sorted(self.guard.eeprom_written))
+            self._eeprom_back(link, sorted(self.guard.eeprom.written))
 
     def _eeprom_back(self, link: Link, addresses: list[int]) -> list[str]:
         """Read ``addresses``, write back those that differ from the originals and read
@@ -456,12 +508,11 @@ class Session:
             else:
                 self.report.problems.append(f"EEPROM {address:02X} not restored to {value:02X} "
                                             f"(reads {r})")
-        self.eeprom_touched.update(addresses)
-        self.guard.eeprom_written.clear()
+        self.guard.eeprom.put_back(addresses)
         return changed
 
     def _restore_eeprom(self, link: Link) -> None:
-        if not (self.guard.eeprom_written or self.eeprom_touched):
+        if not self.guard.eeprom.ever_written:
             return
         changed = self._eeprom_back(link, sorted(self.eeprom))
         self.report.restored.append(f"EEPROM: {len(self.eeprom)} bytes verified"
@@ -485,8 +536,8 @@ class Session:
                 "%02X" % v for _, v in sorted(self.status.items())))
 
     def _unrestored(self) -> None:
-        if self.guard.eeprom_written:
-            written = sorted(self.guard.eeprom_written)
+        if self.guard.eeprom.written:
+            written = sorted(self.guard.eeprom.written)
             self.report.problems.append("EEPROM not verified: bytes written by the run: "
                                         + " ".join("%02X" % a for a in written))
         if self.status:
@@ -514,3 +565,6 @@ def _hex_ok(r: Response | None) -> bool:
         len(r.values[0]) == 2 and all(c in "0123456789ABCDEF" for c in r.values[0])
 
 
+def open_session(target: Reachable, interrupts: Interrupts | None = None) -> Session:
+    """The session ``target`` needs: a real unit's, or the embedded emulator's."""
+    return (RealSession if target.info.real else EmuSession)(target, interrupts)

@@ -12,7 +12,7 @@ from gve_fixtures.profile import load_profile
 
 
 def guard(profile: str = "GVE84-100", travel: int = 500) -> Guard:
-    g = Guard(load_profile(profile), 0, enforce=True, max_travel=travel, allow_destructive=True)
+    g = Guard(load_profile(profile), 0, max_travel=travel, allow_destructive=True)
     g.envelope.origin({0: 0, 1: 0, 2: 0})       # the run begins at counters 0
     return g
 

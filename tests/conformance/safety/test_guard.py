@@ -8,13 +8,13 @@ import pytest
 from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.interrupts import Interrupted, Interrupts
-from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
 from gve_fixtures.profile import load_profile
 
 
 def guard(profile: str = "GVE84-100", *, destructive: bool = False, travel: int = 500,
           interrupts: Interrupts | None = None) -> Guard:
-    return Guard(load_profile(profile), 0, enforce=True, max_travel=travel,
+    return Guard(load_profile(profile), 0, max_travel=travel,
                  allow_destructive=destructive, interrupts=interrupts)
 
 
@@ -27,24 +27,24 @@ def test_destructive_frames_need_permission(body):
 
 def test_eeprom_writes_go_only_to_bytes_backed_up():
     g = guard(destructive=True)
-    g.eeprom_backed = {0x30, 0x31, 0x32}
+    g.eeprom.found({0x30: 0, 0x31: 0, 0x32: 0})
     with pytest.raises(SafetyStop, match="EEPROM 33 not backed up"):
         g.check("EFW30,1.5")                # four bytes: 30..33
     g.check("EW31,00")
     with pytest.raises(SafetyStop, match="not backed up"):
         g.check("EWzz,00")                  # which byte? not written
-    assert g.eeprom_written == {0x31}
+    assert g.eeprom.written == {0x31}
 
 
 def test_motion_and_writes_for_another_address_are_refused():
     g = guard(destructive=True)
-    g.eeprom_backed = set(range(256))
+    g.eeprom.found(dict.fromkeys(range(256), 0))
     for body in ("L1,0,0", "G", "EW01,00"):
         with pytest.raises(SafetyStop, match="address 3"):
             g.check(body, 3)
     g.check("V2000", 3)                     # harmless elsewhere
     spindle = guard("GVE114-500", destructive=True)
-    spindle.eeprom_backed = {1}
+    spindle.eeprom.found({1: 0})
     spindle.check("EW01,00", 7)             # the GVE114's own EEPROM, through address 7
 
 
@@ -157,8 +157,7 @@ def test_a_vector_may_be_asked_about_before_it_is_drawn_again():
 
 
 def test_the_emulator_has_no_envelope():
-    g = Guard(load_profile("GVE84-100"), 0, enforce=False, max_travel=500,
-              allow_destructive=False)
+    g = EmulatorGuard(load_profile("GVE84-100"), 0)
     assert g.fits("C2147483647,0,0")
 
 
