@@ -10,6 +10,7 @@ from typing import Any
 
 from conformance.link.link import Link
 from conformance.link.safety import SafetyStop
+from conformance.quoting import as_text
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
@@ -166,9 +167,7 @@ class CaseContext:
             raise ValueError(f"{self.case.id}: a check ({what!r}) must name its rule: the "
                              "case's rules carry different tags")
         graded = tag or (load_rules()[rule].tag if rule else self.case.tag)
-        self.checks.append(Check(bool(ok), what,
-                                 "" if observed is None else str(observed),
-                                 "" if expected is None else str(expected),
+        self.checks.append(Check(bool(ok), what, as_text(observed), as_text(expected),
                                  graded, rule or ""))
         return bool(ok)
 

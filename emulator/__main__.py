@@ -48,6 +48,18 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+class _Version(argparse.Action):
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS,
+                 **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         **kwargs)  # type: ignore[arg-type]
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: object) -> None:
+        from emulator.about import version_text
+        print(version_text(PROG))
+        parser.exit(0)
+
+
 def _address(text: str) -> int:
     try:
         return parse_address(text)
@@ -71,7 +83,11 @@ def tcp_address(text: str) -> tuple[str, int]:
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = Parser(prog=PROG, description=(__doc__ or "").splitlines()[0])
+    ap = Parser(prog=PROG, description=__doc__,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--version", action=_Version,
+                    help="print the version, the C stepper core's state and the Python, "
+                    "then exit")
     ap.add_argument("--model", default=None, help=f"unit profile (default {DEFAULT_MODEL})")
     ap.add_argument("--address", type=_address, default=None, help="the unit's address 0..7")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",

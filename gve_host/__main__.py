@@ -8,7 +8,9 @@ Exit status: 0 the job is done; 1 the unit refused a step or is not where the jo
 from __future__ import annotations
 
 import argparse
+import platform
 import sys
+from importlib.metadata import PackageNotFoundError, version
 
 import serial
 
@@ -17,9 +19,29 @@ from gve_host.bugs import BUGS, Bugs
 from gve_host.driver import Driver, JobFailed
 from gve_host.session import Session, UnitLost
 
+EXAMPLES = """\
+examples:
+  python -m gve_host /dev/ttyUSB0 --job gve_host/jobs/square.job
+  python -m gve_host socket://127.0.0.1:5114 --job gve_host/jobs/square-packets.job --checksums
+  gve-conformance host --profile GVE84-100 -- python -m gve_host {port} --job J.job"""
+
+
+def version_text() -> str:
+    """The reference host drives a unit and runs no stepper core of its own."""
+    try:
+        ours = version("gve-conformance")
+    except PackageNotFoundError:
+        ours = "unknown (not installed)"
+    return (f"gve_host {ours}\nC stepper core: none (a host program: it drives a unit)\n"
+            f"Python {platform.python_version()} ({sys.implementation.name})")
+
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(prog="gve_host", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="gve_host", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=EXAMPLES)
+    ap.add_argument("--version", action="version", version=version_text(),
+                    help="print the version and the Python, then exit")
     ap.add_argument("port", nargs="?", help="device path, pty path or pyserial URL")
     ap.add_argument("--job", help="the job file (see gve_host/jobs/)")
     ap.add_argument("--address", type=int, default=0, choices=range(8), metavar="0..7")

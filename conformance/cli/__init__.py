@@ -3,8 +3,10 @@
     gve-conformance [OPTIONS]              run the suite against targets (cli/run.py)
     gve-conformance SUBCOMMAND [OPTIONS]   one of SUBCOMMANDS below
 
-Each subcommand is one module of this package with ``main(argv) -> int``; it is imported
-only when named, so the default run starts no more than it needs.
+Each subcommand is one module of this package with ``main(argv) -> int`` and a parser of
+its own; it is imported only when named, so the default run starts no more than it
+needs (not argparse subparsers, which would import every job to build its parser, and
+which cannot leave the subcommand out for the default run: docs/decisions.md).
 """
 
 from __future__ import annotations
@@ -12,20 +14,7 @@ from __future__ import annotations
 import importlib
 import sys
 
-#: subcommand -> (module, one line for the help)
-SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "ports": ("conformance.cli.ports", "the serial ports of this machine, to find the unit's"),
-    "mutation": ("conformance.cli.mutation", "the mutation score: every emulator mutant hunted "
-                 "with the catalogue until a case FAILs it"),
-    "fairness": ("conformance.cli.fairness", "the fairness score: the catalogue against "
-                 "every reading the emulator can take of what the manuals leave open; no "
-                 "case may FAIL one"),
-    "host": ("conformance.cli.host", "certify a host program: the suite plays the unit"),
-    "diff": ("conformance.cli.diff", "differential fuzzing: the target against the emulator, "
-             "each disagreement shrunk to a transcript"),
-    "replay": ("conformance.cli.replay", "replay a transcript on a target and the emulator "
-               "alike: is the disagreement still there?"),
-}
+from conformance.cli.commands import SUBCOMMANDS
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -11,7 +11,15 @@ from pathlib import Path
 
 from conformance.cli.ending import counted, end, new_run_id
 from conformance.cli.unit import ask_before_motion, unattended
-from conformance.cli.usage import Parser, UsageError, one_line, positive, seconds, writable_folder
+from conformance.cli.usage import (
+    Parser,
+    UsageError,
+    one_line,
+    positive,
+    seconds,
+    summary,
+    writable_folder,
+)
 from conformance.diff.engine import Budget, Finding, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.gvt import transcript, write
@@ -29,13 +37,19 @@ from conformance.verdict import COULD_NOT_TEST, FAIL
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given
 DEFAULT_EXAMPLES = 2000
+EXAMPLES = (
+    "gve-conformance diff --target emu:GVE84-100?mutant=NAME --examples 500",
+    "gve-conformance diff --target tcp:127.0.0.1:5114 --profile GVE114-500 --seconds 60",
+    "gve-conformance diff --target 'exec:./clone-sim --pty' --profile GVE84-100 --yes",
+    "gve-conformance diff --target serial:/dev/ttyUSB0?baud=115200 --profile GVE54",
+)
 
 
 def common(ap: argparse.ArgumentParser) -> None:
     """The options diff and replay share."""
     ap.add_argument("--target", required=True,
-                    help="emu:PROFILE[?mutant=NAME], serial:PATH?baud=&address=, tcp:HOST:PORT")
-    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp target")
+                    help="the target (forms below)")
+    ap.add_argument("--profile", help="the behaviour expected of a serial/tcp/exec target")
     ap.add_argument("--against", help="the reference: emu:PROFILE (default: the profile's "
                     "embedded emulator)")
     ap.add_argument("--allow-destructive", action="store_true",
@@ -50,7 +64,7 @@ def common(ap: argparse.ArgumentParser) -> None:
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES)
     common(ap)
     ap.add_argument("--examples", type=positive, metavar="N",
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")

@@ -12,7 +12,7 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive
+from conformance.cli.usage import Parser, UsageError, positive, summary
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
 
 PROG = "gve-conformance fairness"
@@ -71,7 +71,9 @@ def _trial(args: tuple[str, list[str], list[str], list[str] | None]) -> Trial:
 def main(argv: list[str] | None = None) -> int:
     from conformance.targets.emu import emulator_readings
     from gve_fixtures.profile import available_profiles
-    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=summary(__doc__), examples=(
+        "gve-conformance fairness --jobs 2",
+        "gve-conformance fairness --reading NAME -v"))
     ap.add_argument("--reading", action="append", default=[], metavar="NAME",
                     help="only this reading (repeatable; default: every one, and all at once)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",

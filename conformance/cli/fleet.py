@@ -35,6 +35,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from conformance.cli.usage import exit_status
 from conformance.targets import Target
 from conformance.verdict import FAILED, ORDER, PASSED
 
@@ -107,7 +108,8 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         (folder / INDEX_HTML).write_text(_index_html(summary), encoding="utf-8")
         print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
     print(f"{summary['verdict']}: {summary['reason']}")
-    return 1 if summary["verdict"] != PASSED else 0
+    return exit_status(summary["verdict"] == PASSED, interrupted or any(
+        row["interrupted"] for row in summary["targets"]))
 
 
 def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -> bool:

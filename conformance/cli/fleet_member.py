@@ -8,6 +8,8 @@ import json
 import sys
 from pathlib import Path
 
+from conformance.cli.usage import INTERRUPTED
+
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
@@ -18,7 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         # only before the run began: a run interrupted halts its unit, reports, returns
         print("interrupted before the run began", file=sys.stderr)
-        return 1
+        return INTERRUPTED
 
 
 if __name__ == "__main__":

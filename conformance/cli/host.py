@@ -17,14 +17,36 @@ import fnmatch
 import sys
 
 from conformance.cli.ending import counted, end, new_run_id, progress
-from conformance.cli.usage import Parser, UsageError, positive, seconds, writable_folder
+from conformance.cli.usage import (
+    Parser,
+    UsageError,
+    positive,
+    seconds,
+    summary,
+    writable_folder,
+)
 from conformance.host.certify import HostStartError, Plan, certify
 from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
+from conformance.quoting import quoted
 from conformance.runner import CaseResult
 from conformance.verdict import ORDER, PASS, grade
 from gve_fixtures.profile import Profile, ProfileError
+
+#: where the played unit is served to the host (--port), for --help
+PORT_FORMS = """\
+ports (--port): the suite plays the unit here, the host opens it ({port} in its command)
+  pty                               a new pseudo-terminal (default)
+  tcp:HOST:PORT                     a raw TCP port (the host opens socket://HOST:PORT;
+                                    port 0 picks a free one)
+  /dev/ttyX                         a serial device, to a host on another machine"""
+EXAMPLES = (
+    "gve-conformance host --profile GVE84-100 -- python -m gve_host {port} "
+    "--job gve_host/jobs/square.job",
+    "gve-conformance host --profile GVE114-500 --port tcp:127.0.0.1:0 -- ./my-host {port}",
+    "gve-conformance host --profile GVE84-100                 # attended: you run the host",
+)
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -32,7 +54,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     if "--" in argv:
         at = argv.index("--")
         argv, command = argv[:at], argv[at + 1:]
-    ap = Parser(prog="gve-conformance host", description=__doc__.splitlines()[0])
+    ap = Parser(prog="gve-conformance host", description=summary(__doc__),
+                epilog=PORT_FORMS, examples=EXAMPLES)
     ap.add_argument("--profile", help="the unit played to the host, at its default address")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable; instead of --profile)")
@@ -55,7 +78,11 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     ap.add_argument("--report-dir", default="reports")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the scenarios and exit")
-    ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
+    loud = ap.add_mutually_exclusive_group()
+    loud.add_argument("-q", "--quiet", action="store_true",
+                      help="print only the last line (the verdict)")
+    loud.add_argument("-v", "--verbose", action="store_true",
+                      help="print a line for every scenario (the default)")
     args = ap.parse_args(argv)
     args.command = command or None
     return args
@@ -144,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:
         failed = sorted((c for c in r.checks if not c["ok"]),
                         key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
         if failed:
-            return f"{failed[0]['what']} ({failed[0]['observed']})"
+            return f"{failed[0]['what']} ({quoted(failed[0]['observed'])})"
         return r.notes[0] if r.verdict != PASS and r.notes else None
 
     try:
@@ -156,13 +183,15 @@ def main(argv: list[str] | None = None) -> int:
     result.meta.command = ["host", *argv]
     result.meta.host_command = list(args.command or [])
     result.meta.host_flags = flags_of(args, plan)
-    print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
-          f"{' (interrupted by a signal: the hosts were stopped)' if result.interrupted else ''}")
-    clean = next((r for r in result.results if r.id.endswith(".clean")), None)
-    if clean is not None:
-        print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the clean "
-              f"line; {result.frames} frames")
-    return end(result, None if args.no_reports else args.report_dir)
+    if not args.quiet:
+        stopped = " (interrupted by a signal: the hosts were stopped)"
+        print(f"\n{len(result.results)} scenarios on {plan.profile}: {counted(result)}"
+              f"{stopped if result.interrupted else ''}")
+        clean = next((r for r in result.results if r.id.endswith(".clean")), None)
+        if clean is not None:
+            print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the "
+                  f"clean line; {result.frames} frames")
+    return end(result, None if args.no_reports else args.report_dir, quiet=args.quiet)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive
+from conformance.cli.usage import Parser, UsageError, positive, summary
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
@@ -113,7 +113,10 @@ def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool]) -> Hunt:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = Parser(prog="gve-conformance mutation", description=__doc__.splitlines()[0])
+    ap = Parser(prog="gve-conformance mutation", description=summary(__doc__), examples=(
+        "gve-conformance mutation --jobs 2",
+        "gve-conformance mutation --mutant NAME --profile GVE84-100",
+        "gve-conformance mutation --sweep --jobs 2"))
     ap.add_argument("--profile", action="append", default=[],
                     help="hunt on this profile only (repeatable; default: every profile)")
     ap.add_argument("--mutant", action="append", default=[], metavar="NAME",

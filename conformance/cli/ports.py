@@ -16,9 +16,14 @@ import sys
 
 from serial.tools import list_ports
 
+from conformance.cli.usage import Parser, UsageError, summary
+
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(prog="gve-conformance ports", description=__doc__.split(".")[0])
+    ap = Parser(prog="gve-conformance ports", description=summary(__doc__), examples=(
+        "gve-conformance ports",
+        "gve-conformance ports --probe                    # who answers `?` on each",
+        "gve-conformance ports --glob '/dev/pts/*' --probe"))
     ap.add_argument("--glob", action="append", default=[], metavar="PATTERN",
                     help="also list devices matching PATTERN (e.g. '/dev/pts/*')")
     ap.add_argument("--probe", action="store_true",
@@ -43,7 +48,11 @@ def found(patterns: list[str]) -> list[tuple[str, str, str]]:
 
 
 def main(argv: list[str]) -> int:
-    args = parse_args(argv)
+    try:
+        args = parse_args(argv)
+    except UsageError as err:
+        print(f"gve-conformance ports: {err}", file=sys.stderr)
+        return 2
     ports = found(args.glob)
     if not ports:
         print("no serial ports found (a USB adapter plugged in? try --glob)")

@@ -3,14 +3,15 @@ transcript) on a target and its reference alike, frame by frame, and say whether
 disagreement is still there: each frame with the target's answer, the reference's now
 and the one recorded, then one verdict line (PASS, FAIL..., COULD-NOT-TEST). Exit status
 0 when the sides agree on every frame, 1 while they disagree or when the transcript
-could not be replayed whole, 2 for a usage error."""
+could not be replayed whole, 2 for a usage error, 130 when a signal stopped it."""
 
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 from conformance.cli.diff import ask_first, common, targets
-from conformance.cli.usage import Parser, UsageError, one_line
+from conformance.cli.usage import INTERRUPTED, Parser, UsageError, one_line, summary
 from conformance.diff.engine import Pair
 from conformance.diff.gvt import expected_of, steps_of
 from conformance.diff.replayed import Verdict, frame_lines, header, verdict
@@ -22,10 +23,15 @@ from conformance.verdict import FAIL
 from gve_fixtures.transcript import TranscriptError, load
 
 PROG = "gve-conformance replay"
+EXAMPLES = (
+    "gve-conformance replay reports/RUN/diff-01.gvt --target emu:GVE84-100",
+    "gve-conformance replay diff-01.gvt --target 'exec:./clone-sim --pty' --yes",
+    "gve-conformance replay diff-01.gvt --target serial:/dev/ttyUSB0 --profile GVE84-100",
+)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES)
     ap.add_argument("file", help="a .gvt transcript")
     common(ap)
     try:
@@ -62,8 +68,8 @@ def main(argv: list[str] | None = None) -> int:
         result = Verdict.could_not_test(f"the session on the target could not go on ({err})")
     except KeyboardInterrupt:
         session.emergency_stop()
-        result = Verdict.could_not_test("interrupted by a signal: H and D sent, the replay "
-                                        "not finished")
+        result = replace(Verdict.could_not_test("interrupted by a signal: H and D sent, the "
+                                                "replay not finished"), status=INTERRUPTED)
     finally:
         if session.real:
             session.finish()

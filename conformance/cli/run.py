@@ -18,6 +18,8 @@ from pathlib import Path
 from serial import SerialException
 
 from conformance.catalogue import select
+from conformance.cli.colour import paint, wanted
+from conformance.cli.commands import subcommands_help
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
     ask_before_motion,
@@ -27,7 +29,16 @@ from conformance.cli.unit import (
     unattended,
     unattended_specs,
 )
-from conformance.cli.usage import Parser, UsageError, positive, run_id, writable_folder
+from conformance.cli.usage import (
+    INTERRUPTED,
+    Parser,
+    UsageError,
+    exit_status,
+    positive,
+    run_id,
+    summary,
+    writable_folder,
+)
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
@@ -39,14 +50,25 @@ from conformance.verdict import FAILED, ORDER, last_line, overall
 from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"
+ABOUT = ("The conformance and fuzz suite for GVE54, GVE84 and GVE114 serial motion "
+         "controllers. With no subcommand (or with `run`) it runs the suite against the "
+         "targets, shows its progress and writes the reports.")
+EXAMPLES = (
+    "gve-conformance                                   # every profile, embedded emulator",
+    "gve-conformance --target serial:/dev/ttyUSB0?baud=115200 --profile auto",
+    "gve-conformance --target tcp:127.0.0.1:5114 --profile GVE114-500 --yes",
+    "gve-conformance --target 'exec:python -m emulator --model GVE84-100 --pty' "
+    "--profile GVE84-100",
+    "gve-conformance --cases '6.*' -v                  # some cases, every line shown",
+)
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = Parser(prog=PROG, description=__doc__.splitlines()[0])
+    ap = Parser(prog=PROG, description=f"{summary(ABOUT)}\n\n{subcommands_help()}",
+                targets=True, examples=EXAMPLES)
     ap.add_argument("--target", action="append", default=[],
-                    help="emu:PROFILE (default: every profile), serial:/dev/X?baud=&address=, "
-                         "tcp:HOST:PORT, exec:COMMAND (a simulator it starts, docs/rig.md); "
-                         "repeatable")
+                    help="where the suite runs (forms below; default: the embedded "
+                         "emulator on every profile); repeatable")
     ap.add_argument("--profile", help="the behaviour expected of a serial/tcp/exec target "
                                       "(with no --target: run the emulator as this profile); "
                                       "'auto': ask the unit (? and Q) and choose")
@@ -98,7 +120,14 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    ap.add_argument("-q", "--quiet", action="store_true", help="print only what is not PASS")
+    loud = ap.add_mutually_exclusive_group()
+    loud.add_argument("-q", "--quiet", action="store_true",
+                      help="print only the last line (the verdict)")
+    loud.add_argument("-v", "--verbose", action="store_true",
+                      help="print a line for every case, on a terminal too")
+    ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
+                    default="auto", help="colour the verdicts: auto (a terminal without "
+                    "NO_COLOR set), always or never (default auto)")
     return ap.parse_args(argv)
 
 
@@ -120,6 +149,9 @@ def execute(args: argparse.Namespace, argv: list[str]) -> int:
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
+    except Stopped as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return INTERRUPTED
     except BrokenPipeError:
         _quiet_stdout()          # `gve-conformance --list | head -1`: end quietly
         return 0
@@ -137,6 +169,10 @@ def _say(text: str = "") -> None:
         print(text, flush=True)
     except BrokenPipeError:
         _quiet_stdout()
+
+
+def _nothing(text: str = "") -> None:
+    """What -q prints of every line but the last."""
 
 
 def example_database_of(args: argparse.Namespace) -> str | None:
@@ -187,7 +223,7 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     try:
         targets, how = _targets(args, console)
     except KeyboardInterrupt:
-        raise UsageError("interrupted before the run, nothing was sent") from None
+        raise Stopped("interrupted before the run, nothing was sent") from None
     _preflight(targets)
     unattended(targets, args.yes, console)
     run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
@@ -199,11 +235,14 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
         for target in targets:
             if target.info.real:
                 target.session.before_motion = ask_before_motion(target, console, meta)
-    _say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
-    _say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
-         "seed: none (derandomized settings draw the same examples every run; --seed N for "
-         "others)")
-    progress = Progress(len(targets) * len(cases), quiet=args.quiet)
+    say = _nothing if args.quiet else _say       # -q: the last line only
+    say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
+    say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
+        "seed: none (derandomized settings draw the same examples every run; --seed N for "
+        "others)")
+    colour = wanted(getattr(args, "color", "auto"), sys.stdout)
+    progress = Progress(len(targets) * len(cases), quiet=args.quiet,
+                        verbose=getattr(args, "verbose", False), colour=colour)
     try:
         result = run(targets, cases, settings_name=args.settings, run_id=run_id,
                      on_result=progress.result, seed=seed,
@@ -215,19 +254,24 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     result.meta = meta
     counts = result.counts()
     summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    _say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
-    _say(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
-         f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
+    say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
+    say(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
+        f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
     for line in _session_lines(result):
-        _say(line)
+        say(line)
     if not args.no_reports:
         folder = write_reports(result, args.report_dir)
-        _say(f"reports: {folder}/report.html, results.json, junit.xml")
+        say(f"reports: {folder}/report.html, results.json, junit.xml")
     if args.junitxml:
-        _say(f"JUnit XML: {write_junit(result, args.junitxml)}")
+        say(f"JUnit XML: {write_junit(result, args.junitxml)}")
     verdict, _ = overall(result.results, result.interrupted, result.problems)
-    _say(last_line(result.results, result.interrupted, result.problems))
-    return 1 if verdict == FAILED else 0
+    line = last_line(result.results, result.interrupted, result.problems)
+    _say(paint(verdict, verdict, colour) + line[len(verdict):])
+    return exit_status(verdict != FAILED, result.interrupted)
+
+
+class Stopped(Exception):
+    """Ctrl-C before the run sent anything: one line, exit status INTERRUPTED."""
 
 
 def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], meta: RunMeta,

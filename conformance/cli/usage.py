@@ -9,20 +9,79 @@ import argparse
 import math
 import re
 import tempfile
+import textwrap
+from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
 #: the longest --seconds / --host-timeout taken: a day (a typo of many zeros is a mistake)
 LONGEST_SECONDS = 86400.0
 _RUN_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 
 
+#: the exit status of a job that a stopping signal (Ctrl-C, SIGTERM, SIGHUP) cut short:
+#: a shell's 128 + SIGINT, whichever of them came (the job handles them alike)
+INTERRUPTED = 130
+
+
+def exit_status(passed: bool, interrupted: bool = False) -> int:
+    """0 for a job that passed, 1 for one that did not, INTERRUPTED for one a signal
+    stopped (whatever it had found by then: the reports say)."""
+    return INTERRUPTED if interrupted else 0 if passed else 1
+
+
 class UsageError(Exception):
     """A mistake on the command line: one line, exit status 2, nothing sent."""
 
 
+#: the targets every subcommand that talks to a unit takes, for its --help
+TARGET_FORMS = """\
+targets (--target):
+  emu:PROFILE[?mutant=NAME]         the embedded emulator, in virtual time (emu:all: every
+                                    profile)
+  serial:PATH[?baud=N&address=A]    a unit on a serial port or pseudo-terminal
+  tcp:HOST:PORT                     a unit or a simulator on a raw TCP port
+  exec:COMMAND                      a simulator the suite starts: it prints its port first,
+                                    its standard input is the test rig (docs/rig.md)"""
+
+
+def summary(doc: str | None) -> str:
+    """A module docstring's first paragraph as one text: whole sentences for --help."""
+    first = (doc or "").strip().split("\n\n")[0]
+    return textwrap.fill(" ".join(first.split()), 88)
+
+
+class _Version(argparse.Action):
+    """``--version``: the version, the C stepper core's state and the Python, read only
+    when asked (the emulator is not imported otherwise)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: Any) -> None:
+        from conformance.targets.emu import version_text
+        print(version_text(parser.prog))
+        parser.exit(0)
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse without the usage dump: its errors become one UsageError line."""
+    """argparse without the usage dump: its errors become one UsageError line. Every
+    parser has ``--version``; ``examples`` (and ``targets``: the target forms) close
+    its --help."""
+
+    def __init__(self, *args: Any, examples: Sequence[str] = (), targets: bool = False,
+                 **kwargs: Any) -> None:
+        tail = ([TARGET_FORMS] if targets else []) + (
+            [kwargs["epilog"]] if kwargs.get("epilog") else []) + (
+            ["examples:\n" + "\n".join(f"  {e}" for e in examples)] if examples else [])
+        if tail:
+            kwargs["epilog"] = "\n\n".join(tail)
+        kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+        super().__init__(*args, **kwargs)
+        self.add_argument("--version", action=_Version,
+                          help="print the version, the C stepper core's state and the "
+                               "Python, then exit")
 
     def error(self, message: str) -> NoReturn:
         raise UsageError(message)

@@ -11,6 +11,7 @@ from collections import Counter
 from importlib import resources
 
 import conformance.reports.plots as plots
+from conformance.quoting import quoted
 from conformance.reports.banner import run_verdict
 from conformance.reports.failures import failures
 from conformance.reports.logs import compact, compact_checks
@@ -82,7 +83,7 @@ def _failed(run: RunResult) -> list[str]:
             rule = f"{f.rule_id}: {f.rule}" if f.rule_id else f.rule
             out.append(f"<tr class='{h(f.verdict)}'><td><a href='#{h(_anchor(f.runs[0]))}'>"
                        f"<b>{h(f.verdict)}</b> {h(f.id)}</a> [{profiles}]</td>"
-                       f"<td>{h(f.what)}</td><td>{h(f.observed)}</td><td>{h(f.expected)}</td>"
+                       f"<td>{h(f.what)}</td><td>{h(quoted(f.observed))}</td><td>{h(quoted(f.expected))}</td>"
                        f"<td>{h(rule)}</td></tr>")
         out.append("</table>")
     if untested:
@@ -189,8 +190,8 @@ def _case(r: CaseResult, full_logs: bool, also: tuple[str, ...] = ()) -> list[st
         out.append("<table><tr><th>ok</th><th>check</th><th>tag</th><th>observed</th>"
                    "<th>expected</th></tr>")
         out += [f"<tr class='{'PASS' if c['ok'] else 'FAIL'}'><td>{'yes' if c['ok'] else 'NO'}"
-                f"</td><td>{h(c['what'])}</td><td>{h(c['tag'])}</td><td>{h(c['observed'])}</td>"
-                f"<td>{h(c['expected'])}</td></tr>"
+                f"</td><td>{h(c['what'])}</td><td>{h(c['tag'])}</td>"
+                f"<td>{h(_cell(c, 'observed'))}</td><td>{h(_cell(c, 'expected'))}</td></tr>"
                 for c in compact_checks(r.checks, r.verdict, full_logs)]
         out.append("</table>")
     out += _pictures(r, full_logs)
@@ -228,3 +229,9 @@ def render_html(run: RunResult, full_logs: bool | None = None) -> str:
         out.append("</section>")
     out.append(f"<script>{_asset('report.js')}</script></body></html>")
     return "\n".join(out)
+
+
+def _cell(check: dict, key: str) -> str:
+    """A check's observed or expected value, quoted as on the console; a passing check
+    with none shows nothing rather than "(nothing)"."""
+    return quoted(check[key]) if check[key] or not check["ok"] else ""

@@ -12,6 +12,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from conformance.quoting import quoted
 from conformance.reports.banner import run_verdict
 from conformance.reports.logs import compact
 from conformance.reports.sections import section_title
@@ -33,7 +34,8 @@ def _deciding(r: CaseResult) -> dict | None:
 def _message(r: CaseResult) -> str:
     c = _deciding(r)
     if c is not None:
-        return f"[{c['tag']}] {c['what']} (observed {c['observed']!r}, expected {c['expected']!r})"
+        return (f"[{c['tag']}] {c['what']} (observed {quoted(c['observed'])}, "
+                f"expected {quoted(c['expected'])})")
     return "; ".join(r.notes)[:500] or r.verdict
 
 

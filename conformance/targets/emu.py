@@ -23,6 +23,12 @@ def mutants() -> dict[str, tuple[str, str]]:
             for name, spec in MUTANTS.items()}
 
 
+def version_text(prog: str) -> str:
+    """``prog --version``: the version, the emulator's C stepper core's state, the Python."""
+    from emulator.about import version_text as text
+    return text(prog)
+
+
 def emulator_readings() -> dict[str, tuple[tuple[str, ...], str]]:
     """The readings the emulator can take: name -> (the rules read otherwise, what it
     does), from its registry."""

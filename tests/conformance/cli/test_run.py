@@ -12,7 +12,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.cli.progress import Progress
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdict import COULD_NOT_TEST, MISSING, PASS
 from tests.conformance.reports.toy import result
 
 #: issue 12 item 6: the default run writes at most this much
@@ -94,10 +94,26 @@ def test_plain_progress_lines_are_numbered_and_say_why():
     assert lines[1].endswith("-- Ground input IN0 (X limit): skipped by the operator")
 
 
-def test_a_terminal_gets_a_progress_bar():
+def test_a_terminal_gets_a_progress_bar_and_only_the_lines_to_read():
     out = io.StringIO()
-    p = Progress(4, stream=out, terminal=True, quiet=True, refresh=0)
-    for _ in range(3):
+    p = Progress(4, stream=out, terminal=True, refresh=0)
+    for _ in range(2):
         p.result(result("1.toy.a", PASS))
+    p.result(result("1.toy.m", MISSING, checks=[], notes=["does not apply to this profile"]))
+    p.result(result("2.toy.b", COULD_NOT_TEST, checks=[], notes=["needs a test rig"]))
     p.close()
-    assert "3/4" in out.getvalue() and "PASS" not in out.getvalue()    # quiet: bar only
+    shown = out.getvalue()
+    assert "3/4" in shown and "COULD-NOT-TEST  2.toy.b" in shown
+    assert "PASS" not in shown and "MISSING" not in shown     # the bar counts those
+    assert shown.endswith("\r\x1b[2K")                       # the bar cleared at the end
+
+
+def test_verbose_shows_every_case_on_a_terminal_and_quiet_none():
+    loud, hushed = io.StringIO(), io.StringIO()
+    for out, flags in ((loud, {"verbose": True}), (hushed, {"quiet": True})):
+        p = Progress(2, stream=out, terminal=True, refresh=0, **flags)
+        p.result(result("1.toy.a", PASS))
+        p.result(result("1.toy.m", MISSING, checks=[], notes=["not in the profile"]))
+        p.close()
+    assert "PASS            1.toy.a" in loud.getvalue() and "MISSING" in loud.getvalue()
+    assert hushed.getvalue() == ""                              # -q: no bar, no line

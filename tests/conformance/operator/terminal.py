@@ -106,5 +106,6 @@ class EmulatedUnit:
 
 
 def suite(*args: str) -> list[str]:
-    """The command line of the suite itself."""
-    return [sys.executable, "-m", "conformance", *args]
+    """The command line of the suite itself, printing every case uncoloured, as the
+    prompts' tests read the case lines between the questions."""
+    return [sys.executable, "-m", "conformance", "-v", "--color", "never", *args]

@@ -79,7 +79,7 @@ def test_a_ci_reader_sees_non_strict_and_info_pass_and_say_so(tmp_path):
     # the first line of the output names the verdict and the rule the check judges
     assert lenient.system_out.splitlines()[0] == (
         "NON-STRICT 8.repeat.answer: [D] > repeats the last frame "
-        "(observed '5', expected '0')")
+        '(observed "5", expected "0")')
     assert informs.system_out.startswith("INFO 10.3.st6.free: [D-info] ST6 free bits")
     counts = {p.name: p.value for p in suite.properties() if p.name.startswith("count ")}
     assert counts == {"count PASS": "2", "count MISSING": "0", "count COULD-NOT-TEST": "1",

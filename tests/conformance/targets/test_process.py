@@ -132,7 +132,7 @@ def test_the_program_is_stopped_after_ctrl_c(tmp_path, stopping):
     finally:
         stop(suite)
     assert "Traceback" not in err, err
-    assert suite.returncode == 1, out + err
+    assert suite.returncode == 130, out + err
     (folder,) = (tmp_path / "reports").iterdir()
     report = json.loads((folder / "results.json").read_text())
     assert report["interrupted"] is True
