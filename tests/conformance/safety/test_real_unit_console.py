@@ -12,6 +12,8 @@ from conformance.cli import main
 from tests.conformance.safety.proxy import unit_behind_proxy
 
 pytestmark = pytest.mark.pty
+from conformance.targets.session import ROUND_TRIPS
+
 pytest_plugins = ["pytester"]
 
 
@@ -44,8 +46,8 @@ def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
     result.assert_outcomes(passed=2)
     assert state["status"][0] == "05" and state["physical"] == [0, 0, 0]
     # one session for the whole pytest run: the unit as found is read once (the checksum
-    # probe and the identity ask ? once each, then five more measure the line's round trip)
-    assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 2 + 5
+    # probe and the identity ask ? once each, then the ones that measure the line's round trip)
+    assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 2 + ROUND_TRIPS
 
 
 def _mpg_unit(tmp_path) -> list[str]:
