@@ -9,10 +9,10 @@ import json
 import pytest
 
 from conformance.cli import main
+from conformance.targets.session import ROUND_TRIPS
 from tests.conformance.safety.proxy import unit_behind_proxy
 
 pytestmark = pytest.mark.pty
-from conformance.targets.session import ROUND_TRIPS
 
 pytest_plugins = ["pytester"]
 
