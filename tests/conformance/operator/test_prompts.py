@@ -89,6 +89,9 @@ def test_a_wrong_action_is_caught_by_the_read_back(unit):
     _step(term, GROUND)
     unit.rig("in 1 FD")                              # IN1 grounded instead of IN0
     term.answer("")
+    term.expect("not verified: I1 reads FD (IN0 should read 0); try again")
+    term.expect(GROUND)                              # asked once more, then given up
+    term.answer("")
     term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
                 "IN0 (the X reference input): not verified, I1 reads FD (IN0 should read 0)")
     assert term.finish() == 0
