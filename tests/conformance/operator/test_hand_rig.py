@@ -26,6 +26,8 @@ from tests.conformance.operator.terminal import EmulatedUnit
 pytestmark = pytest.mark.pty
 
 PROFILE = "GVE84-100"
+#: one profile of each family, for the hand cases' PASS
+FAMILIES = ("GVE54", "GVE84-100", "GVE114-200")
 
 
 class ScriptedOperator(Console):
@@ -56,21 +58,21 @@ class ScriptedOperator(Console):
         return " ".join(str(n) for n in range(8) if not outputs >> n & 1) or "none"
 
 
-def _rig_cases(by_hand: bool) -> list[Case]:
-    profile = load_profile(PROFILE)
+def _rig_cases(by_hand: bool, name: str = PROFILE) -> list[Case]:
+    profile = load_profile(name)
     return [c for id, c in sorted(REGISTRY.items()) if c.rig and c.missing_for(profile) is None
             and (cannot_by_hand(id) is None) == by_hand]
 
 
 @pytest.fixture
-def unit():
-    u = EmulatedUnit(PROFILE)
+def unit(request):
+    u = EmulatedUnit(getattr(request, "param", PROFILE))
     yield u
     u.close()
 
 
 def _run(unit: EmulatedUnit, case: Case, operator: Console | None) -> CaseResult:
-    target = parse_target(f"serial:{unit.path}", profile=PROFILE, allow_destructive=True)
+    target = parse_target(f"serial:{unit.path}", profile=unit.model, allow_destructive=True)
     result = run([target], [case], console=operator)
     assert result.problems == []
     (only,) = result.results
@@ -85,7 +87,9 @@ def test_the_hand_cases_cover_inputs_the_power_and_the_outputs():
     assert not ids & set(wording()["cannot"])
 
 
-@pytest.mark.parametrize("case", _rig_cases(by_hand=True), ids=lambda c: c.id)
+@pytest.mark.parametrize(("unit", "case"),
+                         [(name, c) for name in FAMILIES for c in _rig_cases(True, name)],
+                         indirect=["unit"], ids=lambda x: getattr(x, "id", x))
 def test_every_rig_case_a_hand_can_do_passes_by_hand(unit, case):
     operator = ScriptedOperator(unit)
     r = _run(unit, case, operator)
