@@ -213,3 +213,26 @@ def test_a_step_is_asked_with_halted_vectors_and_no_motion_meanwhile():
     HandRig(lambda: unit, hand).set_input(1, 0xFE)
     assert hand.asked == 1 and "while a hand step is open" in hand.refused
     unit.guard.check("L100,0,0")                  # the prompt answered: motion again
+
+
+class _Eyes(Console):
+    """Answers the outputs question with ``answers``, one after the other."""
+
+    def __init__(self, *answers: str) -> None:
+        super().__init__(stdin=io.StringIO(), stdout=io.StringIO(), interactive=True)
+        self.answers = list(answers)
+
+    def observe(self, step: HandStep) -> str | None:
+        return self.answers.pop(0)
+
+
+def test_the_outputs_are_read_as_the_technician_sees_them():
+    unit = _Unit(st6="00")
+    assert HandRig(lambda: unit, _Eyes("2")).outputs() == 0xFB          # OUT2 on: active low
+    assert HandRig(lambda: unit, _Eyes("0, 7")).outputs() == 0x7E
+    assert HandRig(lambda: unit, _Eyes("none")).outputs() == 0xFF
+    eyes = _Eyes("lots", "9", "2 3")                                     # asked again
+    assert HandRig(lambda: unit, eyes).outputs() == 0xF3
+    assert eyes.stdout.getvalue().count("please answer") == 2
+    with pytest.raises(CouldNotTest, match="reading the outputs: skipped by the operator"):
+        HandRig(lambda: unit, _Eyes("s")).outputs()
