@@ -236,3 +236,18 @@ def test_the_outputs_are_read_as_the_technician_sees_them():
     assert eyes.stdout.getvalue().count("please answer") == 2
     with pytest.raises(CouldNotTest, match="reading the outputs: skipped by the operator"):
         HandRig(lambda: unit, _Eyes("s")).outputs()
+
+
+def test_a_power_cycle_not_done_is_caught_by_the_index(unit):
+    class NoPower(ScriptedOperator):
+        def hand_step(self, step: HandStep) -> bool:
+            if step.kind == "power-on":
+                self.asked.append(step)
+                return True                     # Enter, the power never cycled
+            return super().hand_step(step)
+    operator = NoPower(unit)
+    r = _run(unit, REGISTRY["10.3.inputs.physical-across-restart"], operator)
+    assert r.verdict == COULD_NOT_TEST
+    assert [s.kind for s in operator.asked].count("power-on") == wording()["attempts"]
+    assert any("not verified, the index reads" in n for n in r.notes), r.notes
+    assert json.loads(unit.rig("state"))["inputs"]["1"] == "FF"      # the hands came off
