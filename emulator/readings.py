@@ -48,6 +48,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "eeprom-write-while-moving": (("5.code.busy-eeprom",),
                                   "EW, EFW and EUW are accepted while the axes move (the "
                                   "manuals forbid only D, K, R, M, N and W while running)"),
+    "packet-closed-only-by-end": (("7.packet.breakers",),
+                                  "an open packet is closed only by *E: H, @, > and J "
+                                  "inside it are members (failing it with 4, unanswered); "
+                                  "a second *S still restarts it"),
 }.items()}
 
 

@@ -364,7 +364,9 @@ class Guard:
             self.packet_open = False
             if outcome is not Outcome.UNCLEAR:
                 self.packet = []
-        elif name in _PACKET_BREAKERS:
+        elif name in _PACKET_BREAKERS and r is not None:
+            # unanswered, it may have been taken as a member: that a breaker closes the
+            # packet is our reading [D], and only *E is sure to (spec 7)
             self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return

@@ -216,7 +216,7 @@ class Unit:
                 self._answer(raw, ErrorCode.SYNTAX, [], t, remember=known.remembered)
             return
         command = self.tables[address].get(name or "")
-        if ses.packet is not None and (command is None or command.packet not in (DISCARD, CLOSE)):
+        if ses.packet is not None and not self._leaves_packet(command, name):
             ses.packet.append(member(self.device, name if command else None, params))
             return
         if command is None:
@@ -227,6 +227,15 @@ class Unit:
         if command.packet == DISCARD:
             ses.packet = None
         self._run(raw, command, name, params, t)
+
+    def _leaves_packet(self, command: Command | None, name: str | None) -> bool:
+        """Whether a frame inside an open packet is run rather than taken as a member:
+        `*E`, and the breakers H, @, >, J (the reading packet-closed-only-by-end makes
+        them members; a second *S still restarts the packet)."""
+        if command is None or command.packet not in (DISCARD, CLOSE):
+            return False
+        return command.packet == CLOSE or name == "*S" \
+            or not self.readings.active("packet-closed-only-by-end")
 
     def _run(self, raw: bytes, command: Command, name: str | None, params: str,
              t: int) -> None:

@@ -29,6 +29,9 @@ POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
     # a long vector still running a second later
     "eeprom-write-while-moving": ([b"!0L100000,0,0\r", b"!0EW10,AB\r", b"!0ER10\r"],
                                   b"0\r7\r0,FF\r", b"0\r0\r0,AB\r"),
+    # H is a member (unanswered, failing the packet with 4), so *E1 finds one member
+    "packet-closed-only-by-end": ([b"!0*S\r", b"!0H\r", b"!0*E1\r"],
+                                  b"8\rC,0\r", b"4,1\r"),
 }
 
 
