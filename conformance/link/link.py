@@ -96,6 +96,10 @@ class Link:
             self._record(UNIT, data)
             self._after_answer(data, "during a wait")
         self._last = (_UNASKED, b"", b"")
+        # raw frames not read for an answer: booked as unanswered now, not only when a
+        # later frame goes out on this link (there may be none: a `*S` that ends an
+        # example must still leave the guard knowing that a packet may be open)
+        self._book_unbooked(None)
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool) -> bytes:

@@ -12,6 +12,9 @@ import sys
 import pytest
 
 from conformance.catalogue import select
+from conformance.diff.engine import Budget, Pair, search
+from conformance.diff.grammar import Options
+from conformance.diff.sides import Side
 from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
@@ -50,3 +53,20 @@ def test_a_reading_runs_the_whole_catalogue_through_a_session(reading):
     assert None not in named
     assert MACHINERY[reading] & named, named
     assert named <= set(READINGS[reading].rules), named
+
+
+@pytest.mark.parametrize("reading", sorted(MACHINERY))
+def test_diff_runs_its_budget_through_a_session_taking_a_reading(reading):
+    target = cosim_target("GVE84-100", [reading])
+    pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                target.profile)
+    try:
+        budget = Budget(examples=300)
+        found = search(pair, Options(destructive=True, rig=True), budget)
+        assert budget.used == 300
+    finally:
+        pair.target.session.finish()
+        pair.target.target.close()
+    graded = [(f.disagreement.rule, f.disagreement.verdict) for f in found]
+    assert graded and all(verdict in (NON_STRICT, INFO) and rule in READINGS[reading].rules
+                          for rule, verdict in graded), graded
