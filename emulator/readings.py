@@ -52,6 +52,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                   "an open packet is closed only by *E: H, @, > and J "
                                   "inside it are members (failing it with 4, unanswered); "
                                   "a second *S still restarts it"),
+    "packet-committed-on-arrival": (("7.packet.all-or-nothing",),
+                                    "each valid packet member takes effect as it arrives "
+                                    "(B sets B, C is queued); *E still answers code,k, "
+                                    "and a failed packet keeps what arrived before *E"),
 }.items()}
 
 

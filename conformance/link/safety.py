@@ -311,6 +311,10 @@ class Guard:
         steps = command.fields(self.envelope.axes)
         if command.name == "*E" or (command.name == "C" and self.packet_open):
             members = list(self.packet) + ([steps] if command.name == "C" else [])
+            if command.name == "*E" and outcome is Outcome.REFUSED:
+                # all-or-nothing is our reading [D]: a unit may have committed the
+                # members as they arrived, so a refused *E leaves them maybe committed
+                outcome = Outcome.UNCLEAR
             return lambda e: _commit(e, members, outcome)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from emulator.mutants import Mutant
 from emulator.protocol.checksum import checksum
-from emulator.protocol.cmd_session import member
+from emulator.protocol.cmd_session import commit_on_arrival, member
 from emulator.protocol.device import MS, Device
 from emulator.protocol.framer import Frame, Framer
 from emulator.protocol.params import CommandError
@@ -217,7 +217,10 @@ class Unit:
             return
         command = self.tables[address].get(name or "")
         if ses.packet is not None and not self._leaves_packet(command, name):
-            ses.packet.append(member(self.device, name if command else None, params))
+            m = member(self.device, name if command else None, params)
+            if self.readings.active("packet-committed-on-arrival"):
+                m = commit_on_arrival(self.device, m, t)
+            ses.packet.append(m)
             return
         if command is None:
             lacking = self.readings.active("missing-letter-range") and _LACKING.match(name or "")
