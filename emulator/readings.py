@@ -56,6 +56,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                     "each valid packet member takes effect as it arrives "
                                     "(B sets B, C is queued); *E still answers code,k, "
                                     "and a failed packet keeps what arrived before *E"),
+    "longer-frames": (("3.frame.max-length", "3.frame.bounded-buffer"),
+                      "frames up to 255 bytes (a byte-wide length counter) are taken whole "
+                      "and run as any other; only longer ones answer 4"),
 }.items()}
 
 

@@ -34,7 +34,7 @@ from emulator.protocol.tables import (
 )
 from emulator.readings import Readings
 from gve_fixtures.profile import Profile, load_profile
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import MAX_FRAME, ErrorCode
 
 _HEX = frozenset(b"0123456789ABCDEFabcdef")
 _LONG_DECIMAL = re.compile(r"[0-9]{13}")
@@ -43,6 +43,8 @@ _PLUS = re.compile(r"(^|,)\+(?=[0-9])")
 _LOWER_HEX = re.compile(r"[a-f]")
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 _LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
+#: the reading longer-frames: the longest frame a unit with a byte-wide length counter holds
+LONG_FRAME = 255
 
 
 def _discard(data: bytes, t: int) -> None:
@@ -68,7 +70,8 @@ class Unit:
             self.tables[profile.spindle.address] = spindle_table(profile)
         self.addresses = frozenset(self.tables)
         wd = profile.watchdog_ms if watchdog_ms is None else watchdog_ms
-        self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS)
+        self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS,
+                             LONG_FRAME if self.readings.active("longer-frames") else MAX_FRAME)
         self.emit: Callable[[bytes, int], None] = _discard
         self.now = origin
         self._pending: list[tuple[bytes, Deferred, bool]] = []   # (frame, answer, remembered)
@@ -283,7 +286,7 @@ class Unit:
         last, answer = history
         silent, self.emit = self.emit, _discard
         try:
-            self._frame(Frame(last, len(last), 0, b""), self.now)
+            self._frame(Frame(last, len(last), 0, b"", self.framer.limit), self.now)
         finally:
             self.emit = silent
         self.session.history = (last, answer)

@@ -35,6 +35,9 @@ POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
     # *E2 for one member fails the packet, but its C ran as it arrived
     "packet-committed-on-arrival": ([b"!0*S\r", b"!0C10,0,0\r", b"!0*E2\r", b"!0PF\r"],
                                     b"2,1\r0,0,0,0\r", b"2,1\r0,10,0,0\r"),
+    # a 106-byte frame is run (V with leading zeros); one of 5003 is still too long
+    "longer-frames": ([b"!0V" + b"0" * 100 + b"1000\r", b"!0V" + b"1" * 5000 + b"\r"],
+                      b"4\r4\r", b"0\r4\r"),
 }
 
 
