@@ -59,6 +59,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "longer-frames": (("3.frame.max-length", "3.frame.bounded-buffer"),
                       "frames up to 255 bytes (a byte-wide length counter) are taken whole "
                       "and run as any other; only longer ones answer 4"),
+    "edge-triggered-inputs": (("10.3.inputs.level-triggered",),
+                              "an enabled input interrupts when it becomes active, not "
+                              "while it stays so: G, D, K, R or SW that clear the cause "
+                              "or INTA with the input still active are not undone"),
 }.items()}
 
 

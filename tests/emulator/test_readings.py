@@ -15,8 +15,9 @@ from gve_fixtures.rules import load_rules
 
 EMULATOR = Path(__file__).resolve().parents[1].parent / "emulator"
 
-#: reading -> (frames, the clean emulator's answers, the reading's)
-POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
+#: reading -> (frames, or (port, level) the rig sets; the clean emulator's answers, the
+#: reading's)
+POINTS: dict[str, tuple[list[bytes | tuple[int, int]], bytes, bytes]] = {
     "plus-sign": ([b"!0V+100\r"], b"4\r", b"0\r"),
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
@@ -38,17 +39,24 @@ POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
     # a 106-byte frame is run (V with leading zeros); one of 5003 is still too long
     "longer-frames": ([b"!0V" + b"0" * 100 + b"1000\r", b"!0V" + b"1" * 5000 + b"\r"],
                       b"4\r4\r", b"0\r4\r"),
+    # INTR0 enabled, grounded (active at 0): D clears INTA, which the input still held
+    # sets again at once (8) unless only its edge interrupts (0)
+    "edge-triggered-inputs": ([b"!0SW0,01\r", (1, 0xFE), b"!0D\r", b"!0SR4\r"],
+                              b"0\r8\r8,01\r", b"0\r0\r0,00\r"),
 }
 
 
-def answers(readings: tuple[str, ...], frames: list[bytes]) -> bytes:
+def answers(readings: tuple[str, ...], frames: list[bytes | tuple[int, int]]) -> bytes:
     """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart."""
     unit = Unit("GVE84-100", readings=readings)
     out: list[bytes] = []
     unit.emit = lambda data, t: out.append(data)
     t = 10**9
     for frame in frames:
-        unit.receive(frame, t, 1000)
+        if isinstance(frame, tuple):
+            unit.set_input(*frame, t)
+        else:
+            unit.receive(frame, t, 1000)
         t += 10**9
         unit.advance(t)
     return b"".join(out)
