@@ -63,6 +63,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                               "an enabled input interrupts when it becomes active, not "
                               "while it stays so: G, D, K, R or SW that clear the cause "
                               "or INTA with the input still active are not undone"),
+    "slow-watchdog": (("3.frame.watchdog-time",),
+                      "the watchdog drops an unfinished frame after 1 s without a byte, "
+                      "not 100 ms"),
 }.items()}
 
 

@@ -43,6 +43,8 @@ _PLUS = re.compile(r"(^|,)\+(?=[0-9])")
 _LOWER_HEX = re.compile(r"[a-f]")
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 _LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
+#: the reading slow-watchdog: a second, the time a reader may take for "in time"
+SLOW_WATCHDOG_MS = 1000
 #: the reading longer-frames: the longest frame a unit with a byte-wide length counter holds
 LONG_FRAME = 255
 
@@ -70,6 +72,8 @@ class Unit:
             self.tables[profile.spindle.address] = spindle_table(profile)
         self.addresses = frozenset(self.tables)
         wd = profile.watchdog_ms if watchdog_ms is None else watchdog_ms
+        if watchdog_ms is None and self.readings.active("slow-watchdog"):
+            wd = SLOW_WATCHDOG_MS
         self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS,
                              LONG_FRAME if self.readings.active("longer-frames") else MAX_FRAME)
         self.emit: Callable[[bytes, int], None] = _discard

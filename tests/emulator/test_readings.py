@@ -15,9 +15,10 @@ from gve_fixtures.rules import load_rules
 
 EMULATOR = Path(__file__).resolve().parents[1].parent / "emulator"
 
-#: reading -> (frames, or (port, level) the rig sets; the clean emulator's answers, the
-#: reading's)
-POINTS: dict[str, tuple[list[bytes | tuple[int, int]], bytes, bytes]] = {
+#: reading -> (frames, (port, level) the rig sets, or the seconds until the next one when
+#: not a second; the clean emulator's answers, the reading's)
+Step = bytes | tuple[int, int] | float
+POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "plus-sign": ([b"!0V+100\r"], b"4\r", b"0\r"),
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
@@ -43,21 +44,27 @@ POINTS: dict[str, tuple[list[bytes | tuple[int, int]], bytes, bytes]] = {
     # sets again at once (8) unless only its edge interrupts (0)
     "edge-triggered-inputs": ([b"!0SW0,01\r", (1, 0xFE), b"!0D\r", b"!0SR4\r"],
                               b"0\r8\r8,01\r", b"0\r0\r0,00\r"),
+    # half a second without a byte inside a frame: dropped (2), or the frame runs whole
+    "slow-watchdog": ([b"!0V10", 0.5, b"00\r"], b"2\r", b"0\r"),
 }
 
 
-def answers(readings: tuple[str, ...], frames: list[bytes | tuple[int, int]]) -> bytes:
-    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart."""
+def answers(readings: tuple[str, ...], frames: list[Step]) -> bytes:
+    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart unless
+    a number says otherwise."""
     unit = Unit("GVE84-100", readings=readings)
     out: list[bytes] = []
     unit.emit = lambda data, t: out.append(data)
     t = 10**9
-    for frame in frames:
+    for i, frame in enumerate(frames):
+        if isinstance(frame, float):
+            continue
         if isinstance(frame, tuple):
             unit.set_input(*frame, t)
         else:
             unit.receive(frame, t, 1000)
-        t += 10**9
+        after = frames[i + 1] if i + 1 < len(frames) else None
+        t += int(after * 10**9) if isinstance(after, float) else 10**9
         unit.advance(t)
     return b"".join(out)
 

@@ -24,6 +24,7 @@ from gve_fixtures.profile import load_profile
 #: reading -> the rules its differences must name (at least one of them shows)
 MACHINERY = {
     "packet-closed-only-by-end": {"7.packet.breakers"},
+    "slow-watchdog": {"3.frame.watchdog-time"},
 }
 
 
