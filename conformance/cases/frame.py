@@ -107,7 +107,6 @@ WATCHDOG_CEILING_S = 5.0
       rule="A frame left unfinished longer than the watchdog time is dropped and answered 2",
       timing=True)
 def watchdog(ctx: CaseContext) -> None:
-    link = ctx.link
     before = index(ctx)
     r, rest = _stalled(ctx, 0.5)
     if r is None or r.code != 2:
