@@ -66,6 +66,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "slow-watchdog": (("3.frame.watchdog-time",),
                       "the watchdog drops an unfinished frame after 1 s without a byte, "
                       "not 100 ms"),
+    "index-remembered": (("8.repeat.remembered",),
+                         "@ is remembered for > like any received command: > after @ "
+                         "answers !0@ and the index it gave (the manual's > repeats the "
+                         "last received command and its answer)"),
 }.items()}
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -251,6 +252,8 @@ class Unit:
              t: int) -> None:
         act = self.mutant.active
         reads = self.readings.active
+        if name == "@" and reads("index-remembered"):
+            command = replace(command, remembered=True)
         try:
             if reads("plus-sign"):
                 params = _PLUS.sub(r"\1", params)

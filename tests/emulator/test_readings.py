@@ -46,6 +46,9 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
                               b"0\r8\r8,01\r", b"0\r0\r0,00\r"),
     # half a second without a byte inside a frame: dropped (2), or the frame runs whole
     "slow-watchdog": ([b"!0V10", 0.5, b"00\r"], b"2\r", b"0\r"),
+    "index-remembered": ([b"!0?\r", b"!0@\r", b"!0>\r"],
+                         b"0,IP84 v3 27.1.2010\r0,1\r!0?\r0,IP84 v3 27.1.2010\r",
+                         b"0,IP84 v3 27.1.2010\r0,1\r!0@\r0,1\r"),
 }
 
 
