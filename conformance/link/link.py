@@ -303,11 +303,14 @@ class Link:
                                    f"{readable(data)} late")
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
-             every: float = 0.05) -> Response | None:
-        """Send ``body`` until ``until(response)`` holds; the last response, or None."""
+             every: float = 0.05, *, send: Callable[[str], Response | None] | None = None
+             ) -> Response | None:
+        """Send ``body`` until ``until(response)`` holds; the last response, or None.
+        ``send``: what sends each frame (a caller that books them), else :meth:`send`."""
+        send = self.send if send is None else send
         deadline = self.now + max_seconds * SECOND
         while True:
-            r = self.send(body)
+            r = send(body)
             if r is not None and until(r):
                 return r
             if self.now > deadline:

@@ -7,6 +7,7 @@ import itertools
 import pytest
 
 from conformance.cli.diff import DEFAULT_EXAMPLES
+from conformance.diff import engine
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options, probes
 from conformance.diff.gvt import steps_of, transcript
@@ -128,3 +129,19 @@ def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
     again = hunt("queue-one-short", 600, probes=False)[1]
     assert [str(s) for s in again.steps] == [str(s) for s in first.steps]
     assert again.frames == first.frames
+
+
+def test_without_hypothesis_internals_the_search_runs_as_it_is(monkeypatch):
+    """Where Hypothesis's internals moved, its pool of constants is left alone and the
+    search still runs; where they are, the pool is empty only while it runs."""
+    providers = engine._providers
+    pool = providers._get_local_constants
+    with engine._seed_alone():
+        assert providers._get_local_constants is not pool
+        assert not list(providers._get_local_constants())
+    assert providers._get_local_constants is pool
+    monkeypatch.setattr(engine, "_providers", None)
+    with engine._seed_alone():
+        assert providers._get_local_constants is pool
+    p = pair("go-without-inta")
+    assert search(p, EVERYTHING, Budget(examples=40), stop_after=1, with_probes=False)
