@@ -104,3 +104,14 @@ def test_each_machine_keeps_its_own_examples(tmp_path):
         run_machine(context(), type("OtherChecked", (UnbookedChecked,), {}))
         assert one > 0 and entries() > one
     assert Factory(ChecksumMachine, context()).__name__ == "ChecksumMachine"
+
+
+@pytest.mark.parametrize("machine", [KeepMachine, RecoveryMachine])
+def test_the_machines_that_check_positions_book_the_index_too(machine):
+    """Their every frame goes through `send`: with the index invariant added they keep
+    it, faults and detours and all."""
+    checked = type(f"Checked{machine.__name__}", (machine,),
+                   {"index_is_the_models": index_invariant()})
+    ctx = context()
+    run_machine(ctx, checked)
+    assert not failed(ctx) and any(c.ok for c in ctx.checks)
