@@ -30,8 +30,8 @@ _READINGS = ("P", "PF", ">")
 
 
 class Timing:
-    """Exact timing, both sides in virtual time: each step starts at the same instant on both, and a
-    run repeats exactly (a disagreement seen once is seen every time)."""
+    """Exact timing, both sides in virtual time: each step starts at the same instant
+    on both, and a run repeats exactly (a disagreement seen once is seen every time)."""
 
     exact = True
     repeatable = True
