@@ -26,6 +26,7 @@ from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.labels import command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
+from conformance.link.line_band import EXACT, LineBand, line_band
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
@@ -101,6 +102,7 @@ class Pair:
         self._ceiling = _Ceiling(profile)
         self._idle_since: int | None = 0
         self._latency_ns = self._slack_ns = self._cut_ns = 0   # real time: see _retimed
+        self._trips: list[int] = []          # real time: the target's round trips (ns)
         self._lost = False
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         #: real time: disagreements seen once that their sequence did not show again
@@ -119,6 +121,7 @@ class Pair:
         self.reference.open()
         self._idle_since = 0
         self._latency_ns = self._slack_ns = self._cut_ns = 0
+        self._trips = []
         self._lost = False
         if self.target.real:
             self._prelude()
@@ -273,11 +276,19 @@ class Pair:
             if command in ("P", "PF", ">"):
                 moving = self._moving_near(rec) if command != ">" else True
         late = self._cut_ns + (self._slack_ns if moving else 0)
-        judge = replace(self.judge, rate=self._ceiling.rate * self._factor, slack_ns=late)
+        judge = replace(self.judge, rate=self._ceiling.rate * self._factor, slack_ns=late,
+                        line=self._line())
         kind = difference(command, rec.target, rec.reference, judge, moving=moving)
         if kind is None:
             rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)
         return kind
+
+    def _line(self) -> LineBand:
+        """Real time: the target's line band, from the round trip its session measured and
+        those of the example so far (zero when both sides are exact)."""
+        if self.exact:
+            return EXACT
+        return line_band(self.target.link.round_trip, [t / 1e6 for t in self._trips])
 
     def _retimed(self, command: str, rec: Record | None) -> None:
         """Real time: the reference acts on a frame when the target's exchange began, the
@@ -291,6 +302,7 @@ class Pair:
         if rec is not None and command not in _DEFERRED and rec.target.answer:
             self._latency_ns = max(self._latency_ns,
                                    rec.target.received_at - rec.target.sent_at)
+            self._trips.append(rec.target.received_at - rec.target.sent_at)
         if command in ("D", "K") and self._cut_ns:
             self._lost = True
         if command in _RETIMING and self._idle_since is None:
