@@ -12,9 +12,11 @@ frame. The band is that uncertainty on either side of the instant the host sees:
     jitter           = max − min round trip
     band             = one-way latency + jitter + one byte's time
 
-A case may add the round trips it saw itself (the line under load in the middle of a run
-is not the line at its start): they widen min and max. In virtual time the line is exact
-and the band is zero (:data:`EXACT`), never printed.
+The median (the line's typical latency) is the session's. The jitter is that of the
+round trips the case saw itself when it saw two or more (the line under load in the
+middle of a run is not the line at its start, and one slow `?` among the session's five
+must not blunt every case of the run), else the session's. In virtual time the line is
+exact and the band is zero (:data:`EXACT`), never printed.
 """
 
 from __future__ import annotations
@@ -59,10 +61,12 @@ EXACT = LineBand()
 def line_band(line: Mapping[str, float] | None, observed_ms: Iterable[float] = ()) -> LineBand:
     """The band of a line measured as ``line`` (``SessionReport.line``: ``min_ms``,
     ``median_ms``, ``max_ms``, ``byte_ms``, ``bytes_ms``; any of them may be missing),
-    widened by the round trips ``observed_ms`` a case saw itself (ms)."""
+    its jitter from the round trips ``observed_ms`` a case saw itself (ms) when there are
+    two or more."""
     line = line or {}
     seen = sorted(observed_ms)
-    trips = [v for v in (line.get("min_ms"), line.get("max_ms")) if v is not None] + seen
+    trips = seen if len(seen) >= 2 else \
+        [v for v in (line.get("min_ms"), line.get("max_ms")) if v is not None] + seen
     if not trips:
         return EXACT
     median = line.get("median_ms", seen[len(seen) // 2] if seen else trips[0])

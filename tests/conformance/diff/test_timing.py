@@ -58,7 +58,9 @@ def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
     assert t.line().seconds == 4.5e-3                # 1 one way + 3 jitter + 0.5 a byte
     t.retimed("V", Exchange(b"V", b"0\r", 0, 6 * MS, None))
     t.retimed("H", Exchange(b"H", b"8\r", 0, 300 * MS, None))
-    assert abs(t.line().seconds - 6.5e-3) < 1e-12     # jitter 6 - 1
+    assert abs(t.line().seconds - 6.5e-3) < 1e-12     # jitter 6 - 1 (the session's min)
+    t.retimed("V", Exchange(b"V", b"0\r", 0, 5 * MS, None))
+    assert abs(t.line().seconds - 2.5e-3) < 1e-12     # two of its own: jitter 6 - 5
     t.begin()
     assert t.line().seconds == 4.5e-3
     target.close_example()

@@ -16,10 +16,14 @@ def test_one_way_latency_plus_jitter_plus_a_byte() -> None:
     assert str(line_band(LINE)) == "±4.5 ms line"
 
 
-def test_round_trips_a_case_saw_widen_the_jitter() -> None:
-    # min 0.5, max 6: jitter 5.5 ms; the median stays the session's
+def test_the_jitter_is_the_case_s_own_when_it_saw_two_round_trips_or_more() -> None:
+    # 0.5..6: jitter 5.5 ms; the median stays the session's
     assert line_band(LINE, [0.5, 6.0]).seconds == pytest.approx(7.0e-3)
+    # 2.0..2.5: a quiet line during the case, whatever the session's slowest `?` was
+    assert line_band(LINE, [2.0, 2.5]).seconds == pytest.approx(2.0e-3)
+    # one round trip alone: the session's 1..4, widened by it
     assert line_band(LINE, [2.0]).seconds == pytest.approx(4.5e-3)
+    assert line_band(LINE, [9.0]).seconds == pytest.approx(9.5e-3)
 
 
 def test_bytes_that_take_no_time_leave_no_negative_latency() -> None:
