@@ -27,11 +27,12 @@ from conformance.diff.labels import command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
-#: frames that close an open packet (spec 7)
-_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
+_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: a vector that moves nothing (and so waits no dwell)
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
@@ -342,14 +343,15 @@ class Pair:
 
 
 #: frames that change the course of a motion: a difference after them is theirs
-_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+_COURSE_CHANGERS = classes(course=True)
 #: what changes a running motion's course at the instant the unit acts on it (an input
 #: set by the rig too): in real time that instant is known only within a latency
-_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+_RETIMING = classes(retimes=True) | {"input"}
 #: of those, what stops a motion short of its vectors' ends
-_STOPPING = ("H", "SW6", "input")
-#: frames answered when their action ends, not at once
-_DEFERRED = ("H", "W", "J")
+_STOPPING = classes(stops=True) | {"input"}
+#: frames whose answer does not come at once: answered when the motion has stopped, or
+#: followed by a restart (their answer's time is no measure of the line's latency)
+_DEFERRED = classes(deferred=True) | classes(restart=True)
 
 
 class _Dwell:

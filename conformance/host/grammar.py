@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from functools import cache
 
 from conformance.protocol.catalogue import Command, Field, classes, commands
+from conformance.protocol.parse import parse
 from conformance.protocol.wire import byte_sum
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import MAX_FRAME
@@ -51,7 +52,8 @@ class ParsedFrame:
     raw: bytes
     address: int | None = None
     body: str = ""                  # without the checksum
-    command: str | None = None      # a name of the command table
+    command: str | None = None      # the command's wire name, as the frame is classed
+    key: str = ""                   # the frame's class (`SW6` for a write of ST6)
     params: list[str] = field(default_factory=list)
     checksum: str | None = None
     problems: list[Problem] = field(default_factory=list)
@@ -86,7 +88,7 @@ def command_of(raw: bytes, units: dict[int, Profile]) -> str | None:
     digit = raw[1:2]
     if not (digit.isdigit() and int(digit) <= 7 and int(digit) in units):
         return None
-    return _longest_prefix(raw[2:5].decode("latin-1"), command_table())
+    return parse(raw[2:].decode("latin-1")).name
 
 
 class LineGrammar:
@@ -140,16 +142,19 @@ def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFram
 
 def _command(f: ParsedFrame, profile: Profile) -> None:
     table = command_table()
-    name = _longest_prefix(f.body, table)
-    upper = _longest_prefix(f.body.upper(), table)
+    name = parse(f.body, strict=True).name
+    classed = parse(f.body)
+    upper = classed.name
     lower = name is None and upper is not None
+    # the frame is classed as every reader of the suite classes it (lower case too), and
+    # judged as spec 3 writes it
+    f.command, f.key = upper, classed.key
     f.check(not lower, "3.frame.upper-case",
             lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
     if not f.check(name is not None or lower, "1.profile.command-set",
                    lambda: f"`{f.body[:3]}…` is no command of spec 10") or name is None:
         return
     command = table[name]
-    f.command = name
     spindle = profile.spindle is not None and f.address == profile.spindle.address
     allowed = profile.spindle.commands if spindle else profile.commands
     family_lacks = name in classes(checksums=True) and profile.family == "GVE54"
@@ -159,13 +164,6 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
                    lambda: f"`{name}`: the {where} has no such command"):
         return
     _params(f, command, f.body[len(name):], profile, spindle)
-
-
-def _longest_prefix(body: str, table: dict[str, Command]) -> str | None:
-    for n in (3, 2, 1):
-        if body[:n] in table:
-            return body[:n]
-    return None
 
 
 def _params(f: ParsedFrame, command: Command, text: str, profile: Profile,

@@ -60,6 +60,9 @@ class Command:
     retimes: bool = False
     stops: bool = False
     asks: bool = False
+    reaction: bool = False
+    position: bool = False
+    optional: bool = False
     examples: tuple[str, ...] = field(default=(), compare=False)
 
     @property

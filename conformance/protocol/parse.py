@@ -15,11 +15,14 @@ A frame whose command is ``SW`` and whose first field reads 6 writes ST6 and is 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from conformance.protocol.catalogue import ST6_WRITE, catalogue, names_longest_first
 
 _ST6 = 6
+_DEC = re.compile(r"-?[0-9]+")
+_HEX = re.compile(r"[0-9A-Fa-f]+")
 
 
 @dataclass(frozen=True)
@@ -86,6 +89,8 @@ def split_fields(name: str, params: str) -> tuple[str, ...]:
 def read_int(text: str, *, strict: bool = False, base: int = 10) -> int | None:
     """A field's integer; lenient: spaces and a leading `+` as a unit that does not
     conform might take them. None: not an integer."""
+    if strict and not (_HEX if base == 16 else _DEC).fullmatch(text):
+        return None
     if not strict:
         text = text.strip().lstrip("+")
     try:
