@@ -258,7 +258,7 @@ def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
 
 def _resends(ex: Exchange, nxt: Exchange) -> bool:
     if ex.parsed.command == "*E":
-        return nxt.parsed.command in ("*S", "*E")
+        return nxt.parsed.command in classes(packet="opens") | classes(packet="closes")
     return nxt.frame.raw == ex.frame.raw
 
 

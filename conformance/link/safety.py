@@ -62,6 +62,7 @@ DESTRUCTIVE = classes(destructive=True)
 LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
 _PACKET_BREAKERS = classes(packet="breaker")
+_PACKET_MEMBERS = classes(packet="member")
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
 
@@ -265,7 +266,7 @@ class Guard:
             return
         command = Command.parse(body)
         outcome = outcome_of(response)
-        if command.name in ("C", "B") and self.packet_open:
+        if command.name in _PACKET_MEMBERS and self.packet_open:
             steps = command.fields(self.envelope.axes)
             if command.name == "C":
                 self.packet.append(steps)
@@ -364,7 +365,7 @@ class Guard:
             st6 = r.values[0] if r.values else ""
             if re.fullmatch(r"[0-9A-F]{2}", st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
                 self.envelope.ended()
-        elif name in ("P", "PF"):
+        elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
                 self.envelope.observe({i: int(r.values[i]) for i in range(axes)})
