@@ -52,8 +52,8 @@ class ParsedFrame:
     raw: bytes
     address: int | None = None
     body: str = ""                  # without the checksum
-    command: str | None = None      # the command's wire name, as the frame is classed
-    key: str = ""                   # the frame's class (`SW6` for a write of ST6)
+    command: str | None = None      # the command's wire name, read strictly (spec 3)
+    key: str = ""                   # the frame's class, read leniently (`SW6`: writes ST6)
     params: list[str] = field(default_factory=list)
     checksum: str | None = None
     problems: list[Problem] = field(default_factory=list)
@@ -88,7 +88,7 @@ def command_of(raw: bytes, units: dict[int, Profile]) -> str | None:
     digit = raw[1:2]
     if not (digit.isdigit() and int(digit) <= 7 and int(digit) in units):
         return None
-    return parse(raw[2:].decode("latin-1")).name
+    return parse(raw[2:].decode("latin-1"), strict=True).name
 
 
 class LineGrammar:
@@ -146,15 +146,16 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
     classed = parse(f.body)
     upper = classed.name
     lower = name is None and upper is not None
-    # the frame is classed as every reader of the suite classes it (lower case too), and
-    # judged as spec 3 writes it
-    f.command, f.key = upper, classed.key
+    # the frame's class is every reader's (lower case too); what the unit does with it
+    # (``command``) is read as spec 3 writes it, as the conforming units behind the relay read it
+    f.key = classed.key
     f.check(not lower, "3.frame.upper-case",
             lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
     if not f.check(name is not None or lower, "1.profile.command-set",
                    lambda: f"`{f.body[:3]}…` is no command of spec 10") or name is None:
         return
     command = table[name]
+    f.command = name
     spindle = profile.spindle is not None and f.address == profile.spindle.address
     allowed = profile.spindle.commands if spindle else profile.commands
     family_lacks = name in classes(checksums=True) and profile.family == "GVE54"
