@@ -178,7 +178,7 @@ class Link:
             if piece:
                 self._write(piece)
         if frames:
-            self._last = (_UNASKED, frames[-1].raw, b"")
+            self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
