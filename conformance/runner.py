@@ -1,5 +1,5 @@
-"""Running cases against targets and collecting graded results (issue 4 items 1, 7;
-issue 8: one session per target per run, Ctrl-C, a target that stops answering)."""
+"""Running cases against targets and collecting graded results: one
+session per target per run, Ctrl-C, a target that stops answering."""
 
 from __future__ import annotations
 

@@ -69,7 +69,7 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
                         "beyond ±8388607", "10"),
     "position-ignores-microstep": ("10.7", "GVE54 positions are reported in commanded steps",
                                    "10.7"),
-    # the eleven interaction errors of the emulator issue
+    # the eleven interaction errors: what one command leaves behind for the next
     "inputs-forgotten-after-delete": (
         "10.3, 10.4, 10.5", "D, K and R clear the cause bits and INTA although an enabled "
         "input is still active (the level is not looked at again)", "10.3"),

@@ -1,5 +1,5 @@
 """Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
-case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
+case ``11.golden.<name>``. The player is the suite's own."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """The faults a real line and unit bring, injected by the relay at one point of the host's
-job (issue 11 item 3). Each fault acts through the same few hooks of the relay:
+job. Each fault acts through the same few hooks of the relay:
 
 - ``hold(partial)``: keep the bytes of the frame in progress back from the unit for now;
 - ``frame(ex)``: what the unit gets for a frame that was held whole (None: nothing);

@@ -1,4 +1,4 @@
-"""The relay: the suite plays the unit to a host program (issue 11 item 1).
+"""The relay: the suite plays the unit to a host program.
 
 The host's bytes come in on a port (pty, TCP, serial device), are timed as they arrive and
 passed on at once to emulated units; the units' answers go back to the host. The units'

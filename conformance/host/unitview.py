@@ -19,7 +19,7 @@ from gve_fixtures.profile import Profile
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
 MODAL = ("V", "A", "B", "$", "T", "VK", "VN", "VL", "XM")
-#: settings a fault scenario may target ("a setting", issue 11 item 3)
+#: settings a fault scenario may target (what "a setting" means to the fault scenarios)
 SETTINGS = (*MODAL, "SW", "O", "M")
 #: commands that change the motion or the counters: kept in the executed sequence
 MARKERS = ("D", "N", "NX", "NY", "NZ", "NA", "K", "R", "W", "H", "M", "XA", "XU", "XD", "J")

@@ -1,4 +1,4 @@
-"""The run-wide guard on a real unit (issue 8): every frame is judged here before it is
+"""The run-wide guard on a real unit: every frame is judged here before it is
 sent and booked here after its answer, whoever sends it (a case, a machine, a golden
 replay's raw bytes, the diff runner, the session itself).
 

@@ -1,5 +1,5 @@
 """`python -m emulator` refuses what it cannot serve with one line on stderr and exit
-status 2, before it serves anything, never with a traceback (issue 8 item 9)."""
+status 2, before it serves anything, never with a traceback."""
 
 from __future__ import annotations
 
