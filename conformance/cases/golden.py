@@ -34,10 +34,16 @@ def play(ctx: CaseContext, t: Transcript, rule: str | None = None) -> None:
         if rec.direction == HOST:
             link.send_raw(rec.data)
         elif rec.direction in (UNIT, UNIT_MATCH):
-            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False)
+            lenient = not setup and tag in ("D", "D-info")
+            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False,
+                                   settle=not lenient)
             got = r.raw if r else b""
             ok = (got == rec.data if rec.direction == UNIT
                   else bool(rec.pattern().fullmatch(got)))
+            if not ok and lenient and r is not None:
+                # a unit reading this [D] point otherwise may answer with more lines:
+                # they are this record's, not a second answer or the next one's
+                got += link.rest_of_answer()
             if setup:
                 ctx.require(ok, f"setup answered {got!r} at {what}")
             else:

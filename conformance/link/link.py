@@ -111,6 +111,10 @@ class Link:
             self._record(UNIT, data)
             self._after_answer(data, "during a wait")
         self._last = (_UNASKED, b"", b"")
+        # raw frames not read for an answer: booked as unanswered now, not only when a
+        # later frame goes out on this link (there may be none: a `*S` that ends an
+        # example must still leave the guard knowing that a packet may be open)
+        self._book_unbooked(None)
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool) -> bytes:
@@ -234,7 +238,10 @@ class Link:
             self.checksums = False
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
-                      summed: bool | None = None) -> Response | None:
+                      summed: bool | None = None, settle: bool = True) -> Response | None:
+        """The next answer (``lines`` lines); in real time bytes right behind it are
+        taken as a second answer unless ``settle`` is false (the caller may take them as
+        :meth:`rest_of_answer`)."""
         timeout = MARGIN if timeout is None else timeout
         raw = bytearray()
         self.port.timeout = timeout
@@ -254,7 +261,7 @@ class Link:
         # a frame an injected fault dropped cannot be answered late
         self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
                       self._last[1], data)
-        if not self.virtual and data and self.port.in_waiting:
+        if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
         self._book_unbooked(real)
         r = real
@@ -269,6 +276,22 @@ class Link:
         if not self._dropped:
             self.guard.answered(real)
         return r
+
+    def rest_of_answer(self, seconds: float = MARGIN) -> bytes:
+        """The lines that follow an answer at once, taken as part of it (not as a
+        second answer): a unit reading a [D] point otherwise may answer a frame with
+        more lines than expected (`>` after `@`, if `@` is remembered)."""
+        raw = bytearray()
+        self.port.timeout = seconds
+        while True:
+            chunk = self.port.read_until(CR)
+            raw += chunk
+            if not chunk.endswith(CR):
+                break
+            self.port.timeout = self.byte_seconds(64)
+        if raw:
+            self._record(UNIT, bytes(raw), "the rest of the answer")
+        return bytes(raw)
 
     def settle(self, *, final: bool = False) -> bytes:
         """Take what arrived although nothing was asked, before the next frame (or, with

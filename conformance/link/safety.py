@@ -325,6 +325,10 @@ class Guard:
         steps = command.fields(self.envelope.axes)
         if command.name == "*E" or (command.name == "C" and self.packet_open):
             members = list(self.packet) + ([steps] if command.name == "C" else [])
+            if command.name == "*E" and outcome is Outcome.REFUSED:
+                # all-or-nothing is our reading [D]: a unit may have committed the
+                # members as they arrived, so a refused *E leaves them maybe committed
+                outcome = Outcome.UNCLEAR
             return lambda e: _commit(e, members, outcome)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
@@ -378,7 +382,9 @@ class Guard:
             self.packet_open = False
             if outcome is not Outcome.UNCLEAR:
                 self.packet = []
-        elif name in _PACKET_BREAKERS:
+        elif name in _PACKET_BREAKERS and r is not None:
+            # unanswered, it may have been taken as a member: that a breaker closes the
+            # packet is our reading [D], and only *E is sure to (spec 7)
             self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
