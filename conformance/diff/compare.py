@@ -20,7 +20,8 @@ import math
 from dataclasses import dataclass
 
 from conformance.diff.sides import Exchange
-from conformance.motion.tolerance import PLACEMENT_STEPS, SECOND, Window, reading_band
+from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+from gve_fixtures.protocol import SECOND
 
 POSITION_COMMANDS = ("P", "PF")
 

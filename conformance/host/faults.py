@@ -18,7 +18,7 @@ from typing import Protocol
 
 from conformance.host.grammar import byte_sum
 from conformance.host.recording import Exchange, show
-from gve_fixtures.protocol import INTA_BIT, ErrorCode
+from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode
 
 #: how late a late answer is: longer than a host's least patience (checks.PATIENCE)
 LATE_S = 0.4
@@ -28,7 +28,6 @@ NOISE = b"\x00\xff"
 #: how long the queue pretends to be full, and an input stays active
 QUEUE_FULL_S = 0.3
 INTERRUPT_S = 0.3
-SECOND = 1_000_000_000
 
 
 class Context(Protocol):

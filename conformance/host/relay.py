@@ -37,9 +37,9 @@ from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
 from conformance.link.virtual import line_of
+from gve_fixtures.protocol import SECOND
 
 MS = 1_000_000
-SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
 #: most answers are this short or shorter (`0,5C`, `0,-1000,2000,50,xx`)

@@ -34,10 +34,9 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next

@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
-from conformance.motion.arith import SECOND
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
@@ -30,6 +29,7 @@ from conformance.motion.tolerance import (
     processing_window,
     tolerance,
 )
+from gve_fixtures.protocol import SECOND
 
 #: dense model points per trace
 TRACE_POINTS = 60

@@ -33,7 +33,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-SECOND = 1_000_000_000
+from gve_fixtures.protocol import SECOND
+
 #: bits per byte on an 8N1 line (spec 2): start, 8 data, stop
 BITS_PER_BYTE = 10
 #: steps a real target may differ by from the model at a known instant (step placement)
