@@ -178,7 +178,7 @@ def _without_rig(case: Case, console: Console | None) -> str | None:
         return f"needs a test rig: no hand can do it: {cannot}"
     if console is None or not console.interactive:
         return ("needs a test rig (the emulator's, or an exec: simulator's control channel) "
-                "or a technician's hands: run on a terminal with --operator")
+                "or a technician's hands: run gve-conformance on a terminal with --operator")
     return None
 
 

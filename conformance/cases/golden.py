@@ -97,6 +97,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
     address = int(t.meta.get("address", profile.address))
     guard = Guard(profile, address, max_travel=2**62, allow_destructive=True)
     framer, summed, pending, need = HostFramer(), False, [], 0.0
+    queued = 0           # vectors the exchange has queued (D empties the queue)
     for rec in t.records:
         if rec.direction == HOST:
             pending += framer.frames(rec.data)
@@ -106,9 +107,9 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
             if rec.action[0] == "poll":      # until its answer
                 batches = [(f, unescape(rec.action[3])) for f in frames]
             else:    # until the queue is full, then 1 (more if vectors end meanwhile)
-                sent = int(rec.action[1])
-                batches = ([(f, b"0\r") for f in frames] * min(sent, profile.buffer)
-                           + [(f, b"1\r") for f in frames] * (sent > profile.buffer))
+                sent, room = int(rec.action[1]), max(0, profile.buffer - queued)
+                batches = ([(f, b"0\r") for f in frames] * min(sent, room)
+                           + [(f, b"1\r") for f in frames] * (sent > room))
         elif rec.direction in (UNIT, UNIT_MATCH):
             # the answer is the last frame's; those before it got none (*S, members)
             answer = rec.data if rec.direction == UNIT else None
@@ -122,6 +123,10 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
             body = f.bodies(summed)[0]
             r = None if answer is None else parse_response(answer, summed=summed)
             guard.accepted(body, r, f.address)
+            if body[:1] in ("L", "C") and answer == b"0\r":
+                queued += 1
+            elif body == "D":
+                queued = 0
             if body in ("%+", "%-") and r is not None and r.code == 0:
                 summed = body == "%+"
     return None if math.isinf(need) else math.ceil(need)

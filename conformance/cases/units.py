@@ -17,6 +17,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from conformance.protocol.catalogue import classes
 
 # command -> (a valid frame on an idle unit after reset, a regex of its answer, the rule
 # of spec 10 it checks)
@@ -43,8 +44,7 @@ FORMATS = {
     "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 # commands of spec 10 a profile may lack (the refusal is 3)
-OPTIONAL = ["VL", "VK", "VN", "XM", "NX", "NY", "NZ", "NA", "W", "EFR", "EFW", "EUR", "EUW",
-            "M", "Y", "I0", "I2", "%", "*S", "*E"]
+OPTIONAL = classes(optional=True)
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 LACKING_LETTER = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100",
@@ -74,7 +74,7 @@ def formats(ctx: CaseContext) -> None:
       tag="M", source="spec 1, 5: code 3",
       rule="A command the profile lacks answers 3")
 def absent(ctx: CaseContext) -> None:
-    lacking = [c for c in OPTIONAL if c not in ctx.profile.commands]
+    lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
         ctx.expect(True, "the profile has every optional command")
     for name in lacking:

@@ -3,8 +3,8 @@ and judges the host's traffic on the wire, under the faults a real line and unit
 
     ports/      where the host meets the relay (pty, TCP, serial device)
     units.py    the emulated units behind the relay (gve://, its rig and its clock)
-    framer.py   the host's byte stream cut into frames, every byte timed
-    grammar.py  one frame judged against spec 3 and 10 (commands.toml: the parameters)
+    grammar.py  one frame judged against spec 3 and 10 (the command catalogue's parameters;
+                the host's bytes are framed by conformance/protocol/framer.py)
     relay.py    host <-> units, answers paired with frames, faults applied: only what
                 the line needs while it runs
     ledger.py   the frames read and the units' views booked in the relay's order, when

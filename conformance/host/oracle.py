@@ -29,13 +29,14 @@ from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.unitview import VECTORS, Step, UnitView
+from conformance.protocol.catalogue import classes
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
 from gve_fixtures.rules import load_rules
 
 NS = 1e9
 #: commands by which a host shows it noticed an interrupt (spec 10.4, 10.5)
-REACTIONS = ("G", "D", "K", "R", "H")
+REACTIONS = classes(reaction=True)
 
 
 @dataclass

@@ -30,13 +30,14 @@ from dataclasses import dataclass
 import serial
 
 from conformance.host.faults import Fault
-from conformance.host.framer import HostFrame, HostFramer
 from conformance.host.grammar import command_of
 from conformance.host.ledger import Ledger
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
 from conformance.link.virtual import line_of
+from conformance.protocol.catalogue import classes
+from conformance.protocol.framer import HostFrame, HostFramer
 from gve_fixtures.protocol import SECOND
 
 MS = 1_000_000
@@ -49,7 +50,7 @@ IDLE_S = 0.02
 #: how far the line's clock may lag the wall clock before the relay brings it up
 LAG = MS // 2
 #: commands that answer when the motion has stopped (spec 2)
-DEFERRED = ("H", "W")
+DEFERRED = classes(deferred=True)
 
 
 @dataclass

@@ -63,6 +63,9 @@ class Link:
         self.guard = guard
         self.rig = rig
         self.checksums = False
+        #: real time: the line's round trip as the session measured it at its start
+        #: (``SessionReport.line``; empty when it was not), for the timing bands
+        self.round_trip: dict[str, float] = {}
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[str] = []
@@ -174,7 +177,7 @@ class Link:
             if piece:
                 self._write(piece)
         if frames:
-            self._last = (_UNASKED, frames[-1].raw, b"")
+            self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
-from conformance.link.framing import HostFramer, Response
+from conformance.link.framing import HostFramer, Response, frame
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
@@ -224,6 +224,7 @@ class RealSession(Session):
         link = super()._new_link(address)
         if before is not None:                      # the same unit: its mode too
             link.checksums = before.checksums
+        link.round_trip = self.report.line
         return link
 
     def open_link(self, address: int | None = None) -> Link:
@@ -575,14 +576,17 @@ ROUND_TRIPS = 5
 
 
 def _round_trip(link: Link) -> dict[str, float]:
-    """The round trip of a harmless `?` in ms (min, median, max) and one byte's time at
-    the link's baud rate: what the line adds to every exchange."""
-    trips = sorted((r.received_at - r.sent_at) / 1e6 for r in
-                   (link.send("?") for _ in range(ROUND_TRIPS)) if r is not None)
+    """The round trip of a harmless `?` in ms (min, median, max), one byte's time at the
+    link's baud rate and the time of one exchange's bytes (frame and answer): what the
+    line adds to every exchange (conformance/link/line_band.py)."""
+    answers = [r for r in (link.send("?") for _ in range(ROUND_TRIPS)) if r is not None]
+    trips = sorted((r.received_at - r.sent_at) / 1e6 for r in answers)
     if not trips:
         return {}
+    sent = len(frame("?", link.address, link.checksums))
     return {"min_ms": trips[0], "median_ms": trips[len(trips) // 2], "max_ms": trips[-1],
-            "byte_ms": link.byte_seconds(1) * 1e3}
+            "byte_ms": link.byte_seconds(1) * 1e3,
+            "bytes_ms": link.byte_seconds(sent + len(answers[0].raw)) * 1e3}
 
 
 def _hex_ok(r: Response | None) -> bool:

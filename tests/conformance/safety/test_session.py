@@ -194,3 +194,12 @@ def test_the_line_round_trip_is_measured_at_the_start():
     assert line["byte_ms"] == pytest.approx(10 / 115200 * 1e3)
     # a `?` frame (4 bytes) and its answer take at least their bytes' time
     assert 4 * line["byte_ms"] < line["min_ms"] <= line["median_ms"] <= line["max_ms"]
+    # the `?` exchange's bytes: `!0?\r` and `0,IP84 v3 27.1.2010\r`
+    assert line["bytes_ms"] == pytest.approx((4 + 20) * line["byte_ms"])
+
+
+def test_every_link_of_a_real_session_carries_the_measured_line():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    link = unit.open_link()
+    assert link.round_trip == unit.session.report.line and link.round_trip["max_ms"] > 0
+    unit.session.finish()
