@@ -18,10 +18,7 @@ from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
 from conformance.operator import Console
 from conformance.targets import Session, SessionError, Target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
-
-#: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
-ALWAYS = "always"
+from conformance.verdict import ALWAYS, COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
 
 @dataclass

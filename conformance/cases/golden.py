@@ -12,10 +12,10 @@ from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
-TAGS = {"M", "M-ex", "D", "D-info"}
 
 
 def _tag(kind: str | None, default: str) -> str:
