@@ -1,5 +1,5 @@
-"""The host role (issue 11): the suite plays GVE units to a host program and judges the
-host's traffic on the wire, under the faults a real line and unit bring.
+"""The host role (spec 2, 3, 6, 7, 8, 10.1): the suite plays GVE units to a host program
+and judges the host's traffic on the wire, under the faults a real line and unit bring.
 
     ports/      where the host meets the relay (pty, TCP, serial device)
     units.py    the emulated units behind the relay (gve://, its rig and its clock)

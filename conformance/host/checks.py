@@ -1,4 +1,4 @@
-"""The host rules, judged on the wire after each run (issue 11 item 2): one function per
+"""The host rules, judged on the wire after each run: one function per
 kind of evidence, each naming the rules of fixtures/rules.toml it judges.
 
 :data:`WIRE_CHECKS` maps every rule a host can fail here to the check that judges it

@@ -1,4 +1,4 @@
-"""The relay: the suite plays the unit to a host program (issue 11 item 1).
+"""The relay: the suite plays the unit to a host program.
 
 The host's bytes come in on a port (pty, TCP, serial device), are timed as they arrive and
 passed on at once to emulated units; the units' answers go back to the host. The units'
@@ -38,9 +38,9 @@ from conformance.host.unitview import UnitView
 from conformance.link.virtual import line_of
 from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFrame, HostFramer
+from gve_fixtures.protocol import SECOND
 
 MS = 1_000_000
-SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
 #: most answers are this short or shorter (`0,5C`, `0,-1000,2000,50,xx`)

@@ -10,7 +10,7 @@ goes out and booked with its answer afterwards: frames built by :meth:`Link.send
 bytes of :meth:`Link.send_raw` (golden replays, noise) and frames changed by an injected
 fault alike.
 
-Answers belong to their frame (issue 8 item 5): bytes that arrive before a frame is
+Answers belong to their frame: bytes that arrive before a frame is
 sent are logged as unsolicited and never read as its answer; after a frame timed out
 the link waits for a quiet line before the next one (real time), so a late answer is
 not taken for a later frame's; bytes after a complete answer are recorded in
@@ -34,10 +34,9 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next

@@ -1,4 +1,4 @@
-"""The run-wide guard on a real unit (issue 8): every frame is judged here before it is
+"""The run-wide guard on a real unit: every frame is judged here before it is
 sent and booked here after its answer, whoever sends it (a case, a machine, a golden
 replay's raw bytes, the diff runner, the session itself).
 
@@ -33,6 +33,7 @@ from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
 from conformance.protocol.catalogue import classes, eeprom_width
 from conformance.protocol.parse import parse
+from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
@@ -383,7 +384,7 @@ class Guard:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
             st6 = r.values[0] if r.values else ""
-            if re.fullmatch(r"[0-9A-F]{2}", st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
+            if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
                 self.envelope.ended()
         elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)

@@ -17,6 +17,8 @@ import re
 from dataclasses import dataclass, field
 from itertools import pairwise
 
+from conformance.protocol.wire import is_hex_byte
+
 CR, LF, BANG = 0x0D, 0x0A, 0x21
 _SPECIAL = re.compile(rb"[!\r]")
 #: an unterminated frame is kept up to this many bytes (the rest is only counted)
@@ -56,7 +58,7 @@ class HostFrame:
         """The frame's possible bodies: without the checksum when ``summed``, as it is
         when not, and both when the checksum mode is not known."""
         head, comma, tail = self.text.rpartition(",")
-        stripped = head if comma and re.fullmatch(r"[0-9A-Fa-f]{2}", tail) else None
+        stripped = head if comma and is_hex_byte(tail, either_case=True) else None
         if summed is True:
             return [stripped if stripped is not None else self.text]
         if summed is False or stripped is None:

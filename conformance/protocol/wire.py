@@ -21,8 +21,15 @@ from gve_fixtures.transcript import escape
 CR = b"\r"
 BANG = b"!"
 
-_HEX_BYTE = re.compile(r"[0-9A-F]{2}")
+#: a byte as the unit writes it: two upper-case hex digits (spec 4, 6)
+HEX_BYTE = "[0-9A-F]{2}"
+_HEX_BYTE = re.compile(HEX_BYTE)
 _DECIMAL = re.compile(r"-?\d+")
+
+
+def is_hex_byte(text: str, either_case: bool = False) -> bool:
+    """Whether ``text`` is two hex digits (upper case, or of ``either_case``)."""
+    return _HEX_BYTE.fullmatch(text.upper() if either_case else text) is not None
 
 
 def readable(data: bytes) -> str:
@@ -101,7 +108,7 @@ class Response:
     def hex(self, index: int = 0) -> int:
         """Value ``index`` as two upper-case hex digits (status words, ports, EEPROM bytes)."""
         text = self.values[index]
-        if not _HEX_BYTE.fullmatch(text):
+        if not is_hex_byte(text):
             raise self._fail(f"has {text!r} where two hex digits belong")
         return int(text, 16)
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.protocol.framer import HostFramer
-from conformance.protocol.wire import UnitDataError, parse_response
+from conformance.protocol.wire import UnitDataError, is_hex_byte, parse_response
 from gve_fixtures.protocol import ErrorCode, St6
 
 
@@ -22,6 +22,13 @@ def test_a_response_names_its_code_and_reads_st6():
 def test_a_field_that_is_not_two_hex_digits_is_the_units_fault():
     with pytest.raises(UnitDataError):
         parse_response(b"0,C\r", summed=False).st6()
+
+
+def test_a_hex_byte_is_two_digits_upper_case_unless_either_case_is_allowed():
+    assert is_hex_byte("00") and is_hex_byte("C0") and is_hex_byte("FF")
+    assert not any(is_hex_byte(t) for t in ("c0", "C", "C00", "G0", "", " C", "-1"))
+    assert is_hex_byte("c0", either_case=True) and is_hex_byte("aF", either_case=True)
+    assert not is_hex_byte("g0", either_case=True)
 
 
 def test_frames_as_the_link_reads_them():
