@@ -71,30 +71,32 @@ def mixed(case: Case) -> bool:
     return len({GRADES[known[r].tag] for r in case.rules}) > 1
 
 
-def case(id: str, *, rule: str | None = None, tag: str | None = None, source: str | None = None,
+def case(id: str, *, rules: tuple[str, ...], tag: str | None = None,
          requires: tuple[str, ...] = (), absent: tuple[str, ...] = (),
          applies: Callable[[Profile], bool] | None = None, rig: bool = False,
-         destructive: bool = False, timing: bool = False, rules: tuple[str, ...] = (),
-         hands: bool = False):
-    """Register a case (see docs/suite.md). ``rule``, ``tag`` and ``source`` default to
-    those of the first rule the case names, so that a case quotes its requirement from
-    fixtures/rules.toml rather than writing it again."""
+         destructive: bool = False, timing: bool = False, hands: bool = False):
+    """Register a case (see docs/suite.md). Its requirement is that of the rules it names
+    in fixtures/rules.toml, never written again: the first rule's text and tag, and the
+    sources of all of them. ``tag`` only picks another grade among the rules' (a case
+    that fails as [M] on a [D] first rule); what a case does beyond its rules is its
+    function's docstring."""
     known = load_rules()
+    if not rules:
+        raise ValueError(f"{id}: name its rules (see fixtures/rules.toml)")
     unknown = [r for r in rules if r not in known]
     if unknown:
         raise ValueError(f"{id}: unknown rule(s) {unknown} (see fixtures/rules.toml)")
-    if (rule is None or tag is None or source is None) and not rules:
-        raise ValueError(f"{id}: name its rules, or give rule, tag and source")
-    first = known[rules[0]] if rules else None
-    rule = first.text if rule is None else rule
+    first = known[rules[0]]
     if tag is not None and tag not in TAGS:
         raise ValueError(f"{id}: tag must be one of {', '.join(TAGS)}")
+    if tag == first.tag:
+        raise ValueError(f"{id}: tag {tag} restates its first rule's; leave it out")
     graded = {GRADES[known[r].tag] for r in rules}
-    if tag is not None and rules and GRADES[tag] not in graded:
+    if tag is not None and GRADES[tag] not in graded:
         raise ValueError(f"{id}: declared tag {tag} contradicts its rules, tagged "
                          f"{', '.join(sorted({known[r].tag for r in rules}))}")
-    tag = first.tag if tag is None else tag
-    source = first.source if source is None else source
+    rule, tag = first.text, first.tag if tag is None else tag
+    source = "; ".join(dict.fromkeys(known[r].source for r in rules))
 
     def register(func: Callable[[CaseContext], None]) -> Callable[[CaseContext], None]:
         old = REGISTRY.get(id)

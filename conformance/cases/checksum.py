@@ -9,18 +9,18 @@ from conformance.link.framing import byte_sum
 
 @case("6.checksum.mode-on-off",
       rules=("6.checksum.mode-answers",),
-      tag="M-ex", source="M84 12.3.2; M114 13.3.2 (G1)",
-      requires=("%",), rule="!0%+ answers 0,5C (already summed); !0%-,CF answers 0")
+      requires=("%",))
 def on_off(ctx: CaseContext) -> None:
+    """!0%+ answers 0,5C (already summed); !0%-,CF answers 0."""
     answers(ctx, ctx.link.send("%+", checksum=False), "0,5C", "%+ → 0,5C")
     answers(ctx, ctx.link.send("%-", checksum=True), "0", "%-,CF → 0 without a checksum")
 
 
 @case("6.checksum.command-summed",
       rules=("6.checksum.sum",),
-      tag="M-ex", source="M84 12.3.2 (G2)", requires=("%",),
-      rule="The checksum sums every byte from '!' through the comma: !0A100, → 4F")
+      tag="M-ex", requires=("%",))
 def command_summed(ctx: CaseContext) -> None:
+    """The checksum sums every byte from '!' through the comma: !0A100, → 4F."""
     setup(ctx, "%+", checksum=False)
     ctx.expect(byte_sum(b"!0A100,") == 0x4F, "the suite's own sum of the example")
     answers(ctx, ctx.link.send("A100", checksum="4F"), "0,5C", "!0A100,4F is accepted")
@@ -28,9 +28,9 @@ def command_summed(ctx: CaseContext) -> None:
 
 @case("6.checksum.bad-sum-rejected",
       rules=("6.checksum.bad-refused", "4.response.failed-not-executed"),
-      tag="D", source="spec 6 [D]; M84 12.3.2",
-      requires=("%",), rule="In checksum mode a wrong checksum is not executed and answers 4")
+      requires=("%",))
 def bad_sum(ctx: CaseContext) -> None:
+    """In checksum mode a wrong checksum is not executed and answers 4."""
     setup(ctx, "%+", checksum=False)
     r = ctx.link.send("SW0,0F", checksum="00")
     code(ctx, r, 4, "a wrong checksum → 4", rule="6.checksum.bad-refused")
@@ -43,27 +43,27 @@ def bad_sum(ctx: CaseContext) -> None:
 
 @case("6.checksum.missing-sum-rejected",
       rules=("6.checksum.bad-refused",),
-      tag="D", source="spec 6 [D]", requires=("%",),
-      rule="In checksum mode a frame without a checksum answers 4")
+      requires=("%",))
 def missing(ctx: CaseContext) -> None:
+    """In checksum mode a frame without a checksum answers 4."""
     setup(ctx, "%+", checksum=False)
     code(ctx, ctx.link.send("A100", checksum=False), 4, "no checksum → 4")
 
 
 @case("6.checksum.lower-case-accepted",
       rules=("3.frame.checksum-case",),
-      tag="D", source="spec 3 [D]", requires=("%",),
-      rule="Checksum hex digits are accepted in either case")
+      requires=("%",))
 def lower(ctx: CaseContext) -> None:
+    """Checksum hex digits are accepted in either case."""
     setup(ctx, "%+", checksum=False)
     answers(ctx, ctx.link.send("A100", checksum="4f"), "0,5C", "!0A100,4f is accepted")
 
 
 @case("6.checksum.responses-summed",
       rules=("6.checksum.response-sum",),
-      tag="M", source="M84 12.3.2", requires=("%",),
-      rule="Responses are summed the same way from their first byte, in upper-case hex")
+      tag="M", requires=("%",))
 def responses(ctx: CaseContext) -> None:
+    """Responses are summed the same way from their first byte, in upper-case hex."""
     setup(ctx, "%+", checksum=False)
     for body in ("SR2", "PF", "?", "@"):
         r = ctx.link.send(body)
@@ -73,7 +73,7 @@ def responses(ctx: CaseContext) -> None:
 
 @case("6.checksum.absent-on-gve54",
       rules=("1.profile.gve54-no-checksums", "1.profile.command-set"),
-      tag="M", source="spec 1; M54", absent=("%",),
-      rule="A unit without checksums answers % with 3")
+      absent=("%",))
 def absent(ctx: CaseContext) -> None:
+    """A unit without checksums answers % with 3."""
     code(ctx, ctx.link.send("%+"), 3, "%+ → 3")

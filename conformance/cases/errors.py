@@ -8,16 +8,16 @@ from conformance.cases._kit import answers, code, fill_queue, halted_with_queue,
 
 @case("5.errors.ok",
       rules=("5.code.ok", "10.cmd.vector", "3.params.commas"),
-      tag="M-ex", source="M84 12.6 (G4a)", rule="An accepted command answers 0")
+      tag="M-ex")
 def ok(ctx: CaseContext) -> None:
+    """An accepted command answers 0."""
     answers(ctx, ctx.link.send("L" + vector(ctx, 100)), "0", "L100,0,0 on an idle unit")
 
 
 @case("5.errors.queue-full",
-      rules=("5.code.queue-full", "1.profile.buffer", "10.1.queue.cont-buffer"),
-      tag="M", source="M84 12.5.2, 12.6 code 1",
-      rule="C with no room in the CONT buffer answers 1; the buffer holds the profile's size")
+      rules=("5.code.queue-full", "1.profile.buffer", "10.1.queue.cont-buffer"))
 def queue_full(ctx: CaseContext) -> None:
+    """C with no room in the CONT buffer answers 1; the buffer holds the profile's size."""
     n = ctx.profile.buffer
     if fill_queue(ctx):
         code(ctx, ctx.link.send("C" + vector(ctx, 1)), 1, f"vector {n + 1} answers 1")
@@ -25,38 +25,34 @@ def queue_full(ctx: CaseContext) -> None:
 
 
 @case("5.errors.unknown",
-      rules=("5.code.unknown",),
-      tag="M", source="M84 12.6 code 3",
-      rule="An unknown command answers 3")
+      rules=("5.code.unknown",))
 def unknown(ctx: CaseContext) -> None:
+    """An unknown command answers 3."""
     for body in ("Z", "E", "XQ"):
         code(ctx, ctx.link.send(body), 3, f"{body} → 3")
 
 
 @case("5.errors.out-of-range",
-      rules=("5.code.range", "10.cmd.status-words", "10.cmd.modal", "10.cmd.accel-range"),
-      tag="M-ex", source="M84 12.6 (G4e)",
-      rule="A parameter out of range answers 5 (!0SW8,F1 → 5)")
+      rules=("5.code.range", "10.cmd.status-words", "10.cmd.modal", "10.cmd.accel-range"))
 def out_of_range(ctx: CaseContext) -> None:
     # A0: the accelerations' range is our reading [D]; the others the manual's
+    """A parameter out of range answers 5 (!0SW8,F1 → 5)"""
     for body, rule in (("SW8,F1", "5.code.range"), ("T25", "10.cmd.modal"),
                        ("A0", "10.cmd.accel-range"), ("SR7", "10.cmd.status-words")):
         code(ctx, ctx.link.send(body), 5, f"{body} → 5", rule=rule)
 
 
 @case("5.errors.go-without-inta",
-      rules=("5.code.nothing-to-go", "10.4.go.without-inta"),
-      tag="M", source="M84 12.6 code 6",
-      rule="G while INTA = 0 answers 6 and does nothing")
+      rules=("5.code.nothing-to-go", "10.4.go.without-inta"))
 def go_idle(ctx: CaseContext) -> None:
+    """G while INTA = 0 answers 6 and does nothing."""
     code(ctx, ctx.link.send("G"), 6, "G on an idle unit → 6")
 
 
 @case("5.errors.busy",
-      rules=("5.code.busy-moving", "5.code.busy-run", "5.moving.definition"),
-      tag="M", source="M84 12.5.6, 12.5.8: 'nelze použít za chodu'",
-      rule="D, K, R, N while a vector runs answer 7")
+      rules=("5.code.busy-moving", "5.code.busy-run", "5.moving.definition"))
 def busy(ctx: CaseContext) -> None:
+    """D, K, R, N while a vector runs answer 7."""
     setup(ctx, "V1000")
     setup(ctx, "C" + vector(ctx, 1500))      # 1.5 s at V1000: moving for every probe
     ctx.link.wait(0.3)
@@ -67,20 +63,18 @@ def busy(ctx: CaseContext) -> None:
 
 
 @case("5.errors.n-while-run",
-      rules=("5.code.busy-run", "5.moving.after-halt"),
-      tag="M", source="M84 12.5.6: 'pri RUN=1'",
-      rule="N is refused (7) while interrupted vectors still hold RUN = 1")
+      rules=("5.code.busy-run", "5.moving.after-halt"))
 def n_run(ctx: CaseContext) -> None:
+    """N is refused (7) while interrupted vectors still hold RUN = 1."""
     halted_with_queue(ctx)
     code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True,
          rule="5.code.busy-run")
 
 
 @case("5.errors.refused-not-executed",
-      rules=("4.response.failed-not-executed", "10.1.queue.line-alone"),
-      tag="M", source="spec 4; M84 12.6",
-      rule="A command answered with an error is not executed")
+      rules=("4.response.failed-not-executed", "10.1.queue.line-alone"))
 def refused_not_executed(ctx: CaseContext) -> None:
+    """A command answered with an error is not executed."""
     ctx.link.send("V1000,5")
     ctx.link.send("SW0,1FF")
     r = ctx.link.send("SR0")

@@ -10,10 +10,9 @@ from conformance.motion.tolerance import byte_ns
 
 
 @case("2.link.other-address-ignored",
-      rules=("2.link.addressed-only", "3.frame.other-address-whole", "8.index.uncounted"),
-      tag="M", source="M114 1, 9.5; spec 2-3",
-      rule="Only the addressed unit answers; a frame for another address is ignored whole")
+      rules=("2.link.addressed-only", "3.frame.other-address-whole", "8.index.uncounted"))
 def other_address(ctx: CaseContext) -> None:
+    """Only the addressed unit answers; a frame for another address is ignored whole."""
     link = ctx.link
     other = (link.address + 1) % 8
     if other == 7:
@@ -28,19 +27,16 @@ def other_address(ctx: CaseContext) -> None:
 
 
 @case("3.frame.noise-before-bang",
-      rules=("3.frame.noise-ignored",),
-      tag="D", source="spec 3 [D]",
-      rule="Bytes before '!' are ignored")
+      rules=("3.frame.noise-ignored",))
 def noise(ctx: CaseContext) -> None:
     ctx.link.send_raw(b"\x00xyz 12\n")
     answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "a frame after noise")
 
 
 @case("3.frame.bang-restarts",
-      rules=("3.frame.bang-restarts", "2.link.simplex"),
-      tag="D", source="spec 3 [D]",
-      rule="A '!' inside an unfinished frame starts a new frame; the old one gets no answer")
+      rules=("3.frame.bang-restarts", "2.link.simplex"))
 def restart(ctx: CaseContext) -> None:
+    """A '!' inside an unfinished frame starts a new frame; the old one gets no answer."""
     before = index(ctx)
     ctx.link.send_raw(b"!%dV12" % ctx.link.address)
     index_moved(ctx, before, 0, "only the complete frame is answered; the dropped one not counted",
@@ -51,9 +47,7 @@ def restart(ctx: CaseContext) -> None:
 
 
 @case("3.frame.lf-after-cr",
-      rules=("3.frame.lf-ignored", "2.link.simplex"),
-      tag="D", source="spec 3 [D]",
-      rule="A LF after CR is ignored")
+      rules=("3.frame.lf-ignored", "2.link.simplex"))
 def lf(ctx: CaseContext) -> None:
     before = index(ctx)
     ctx.link.send_raw(b"!%dV1000\r\n" % ctx.link.address)
@@ -63,10 +57,9 @@ def lf(ctx: CaseContext) -> None:
 
 
 @case("3.frame.lower-case-unknown",
-      rules=("3.frame.upper-case", "5.code.unknown"),
-      tag="D", source="spec 3 [D]",
-      rule="Command letters are upper case: a lower-case command is unknown (3)")
+      rules=("3.frame.upper-case", "5.code.unknown"))
 def lower(ctx: CaseContext) -> None:
+    """Command letters are upper case: a lower-case command is unknown (3)"""
     code(ctx, ctx.link.send("v1000"), 3, "v1000 is an unknown command",
          rule="3.frame.upper-case")
     r = ctx.link.send("?")
@@ -75,12 +68,11 @@ def lower(ctx: CaseContext) -> None:
 
 
 @case("3.frame.syntax-errors",
-      rules=("3.params.decimal", "5.code.syntax"),
-      tag="D", source="spec 3 [D]; M84 12.6 code 4",
-      rule="A '+', a space, an empty field or a non-digit in a number is a syntax error (4)")
+      rules=("3.params.decimal", "5.code.syntax"))
 def syntax(ctx: CaseContext) -> None:
     # a wrong count or a letter in a number is the manual's; a sign, a space, an empty
     # field our reading [D]
+    """A '+', a space, an empty field or a non-digit in a number is a syntax error (4)"""
     for body, rule in (("V+100", "3.params.decimal"), ("V 100", "3.params.decimal"),
                        ("V", "5.code.syntax"), ("V1x", "5.code.syntax"),
                        ("T5,5", "5.code.syntax"), ("L1,,2", "3.params.decimal")):
@@ -88,10 +80,9 @@ def syntax(ctx: CaseContext) -> None:
 
 
 @case("3.frame.too-long",
-      rules=("3.frame.max-length",),
-      tag="D", source="spec 3 [D]",
-      rule="A frame longer than 96 bytes is a syntax error (4) once its CR arrives")
+      rules=("3.frame.max-length",))
 def too_long(ctx: CaseContext) -> None:
+    """A frame longer than 96 bytes is a syntax error (4) once its CR arrives."""
     code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), 4, "a 106-byte frame → 4")
 
 
@@ -103,10 +94,9 @@ WATCHDOG_CEILING_S = 5.0
 @case("3.frame.watchdog",
       rules=("3.frame.watchdog", "5.code.watchdog", "8.index.uncounted",
              "3.frame.watchdog-time"),
-      tag="M", source="M84 12.6 code 2; spec 3 [timing D]",
-      rule="A frame left unfinished longer than the watchdog time is dropped and answered 2",
       timing=True)
 def watchdog(ctx: CaseContext) -> None:
+    """A frame left unfinished longer than the watchdog time is dropped and answered 2."""
     before = index(ctx)
     r, rest = _stalled(ctx, 0.5)
     if r is None or r.code != 2:
@@ -131,19 +121,18 @@ def _stalled(ctx: CaseContext, seconds: float) -> tuple[Response | None, bytes]:
 
 @case("3.frame.lone-bang-silent",
       rules=("3.frame.watchdog-lone-bang",),
-      tag="D", source="spec 3 [D]",
-      rule="If only '!' arrived before the watchdog time, nothing is answered", timing=True)
+      timing=True)
 def lone_bang(ctx: CaseContext) -> None:
+    """If only '!' arrived before the watchdog time, nothing is answered."""
     ctx.link.send_raw(b"!")
     got = ctx.link.wait(0.5)
     ctx.expect(got == b"", "no answer to a lone '!'", observed=got, expected=b"")
 
 
 @case("4.response.inta-bit",
-      rules=("4.response.inta-bit",),
-      tag="M", source="M84 12.6",
-      rule="While ST6.INTA = 1 every response carries bit 3 (8..F)")
+      rules=("4.response.inta-bit",))
 def inta_bit(ctx: CaseContext) -> None:
+    """While ST6.INTA = 1 every response carries bit 3 (8..F)"""
     from conformance.cases._kit import halted_with_queue
     halted_with_queue(ctx)
     for body, value in (("V1000", 0), ("T99", 5), ("Z", 3), ("SR6", 0), ("PF", 0)):
@@ -153,19 +142,18 @@ def inta_bit(ctx: CaseContext) -> None:
 
 @case("4.response.hex-values",
       rules=("4.response.value-format", "3.params.hex-digits"),
-      tag="M", source="M-ex 12.6; M84 12.5.11",
-      rule="Status words and ports are two upper-case hex digits")
+      tag="M")
 def hex_values(ctx: CaseContext) -> None:
+    """Status words and ports are two upper-case hex digits."""
     ctx.link.send("SW2,ab")
     answers(ctx, ctx.link.send("SR2"), "0,AB", "SR2 in upper case after SW2,ab",
             rule="3.params.hex-digits")
 
 
 @case("4.response.refused-has-no-values",
-      rules=("4.response.failed-no-values",),
-      tag="D", source="spec 4 [D]",
-      rule="A failing command's response carries no values")
+      rules=("4.response.failed-no-values",))
 def refused(ctx: CaseContext) -> None:
+    """A failing command's response carries no values."""
     for body in ("SR9", "ERXY", "PF1"):
         r = ctx.link.send(body)
         ctx.expect(r is not None and r.code and not r.values, f"{body} → code only",

@@ -13,6 +13,7 @@ from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import TAGS
+from gve_fixtures.rules import load_rules
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
@@ -137,18 +138,19 @@ def _register(path: Path) -> None:
     families = t.meta.get("profiles", "").split()
     needs_rig = any(r.direction == ACTION and r.action[0] in RIG_ACTIONS for r in t.records)
     address = int(t.meta.get("address", "-1"))
-    tag = _tag(t.tag.kind if t.tag else None, "M-ex")
     # the golden exchange's own rule (spec "11 G4" -> 11.golden.g4), then those its
     # records check (header "rules:")
     golden = re.search(r"\b11 G(\d+)", t.meta.get("spec", ""))
     rule = f"11.golden.g{golden.group(1)}" if golden else None
     rules = tuple(r for r in (rule, *t.meta.get("rules", "").split()) if r)
+    # the exchange's tag where it is not its first rule's (its requirement is the rules')
+    tag = _tag(t.tag.kind if t.tag else None, "M-ex")
+    own = None if rules and tag == load_rules()[rules[0]].tag else tag
 
     def applies(profile) -> bool:
         return not families or profile.family in families or profile.name in families
 
-    @case(f"11.golden.{path.stem}", rule=t.meta.get("title", path.stem),
-          tag=tag, source=t.meta.get("source", ""), rules=rules,
+    @case(f"11.golden.{path.stem}", tag=own, rules=rules,
           applies=applies, rig=needs_rig, destructive=bool(t.meta.get("destructive")))
     def replay(ctx: CaseContext) -> None:
         if address >= 0 and address != ctx.link.address:

@@ -14,14 +14,11 @@ from conformance.cases._kit import (
 )
 from conformance.link.framing import byte_sum
 
-SRC = "M84 12.5.12; spec 8 [D what counts]"
-
 
 @case("8.index.counts-every-frame",
-      rules=("8.index.counts",),
-      tag="M", source=SRC,
-      rule="Every complete frame advances the index by one, refused ones too")
+      rules=("8.index.counts",))
 def counts(ctx: CaseContext) -> None:
+    """Every complete frame advances the index by one, refused ones too."""
     link = ctx.link
     before = index(ctx)
     link.send("V1000")
@@ -41,9 +38,9 @@ def queries(ctx: CaseContext) -> None:
 
 
 @case("8.index.modulo-256",
-      rules=("8.index.counts",),
-      tag="M", source=SRC, rule="The index counts modulo 256")
+      rules=("8.index.counts",))
 def modulo(ctx: CaseContext) -> None:
+    """The index counts modulo 256."""
     before = index(ctx)
     for _ in range(258):
         ctx.link.send("F")
@@ -51,10 +48,9 @@ def modulo(ctx: CaseContext) -> None:
 
 
 @case("8.repeat.last-frame-and-answer",
-      rules=("8.repeat.answer", "8.repeat.remembered"),
-      tag="D", source=SRC,
-      rule="> answers the last frame as received, then the response it got")
+      rules=("8.repeat.answer", "8.repeat.remembered"))
 def repeat(ctx: CaseContext) -> None:
+    """> answers the last frame as received, then the response it got."""
     link = ctx.link
     link.send("T99")
     r = link.send(">", lines=2)
@@ -63,10 +59,9 @@ def repeat(ctx: CaseContext) -> None:
 
 
 @case("8.repeat.no-history",
-      rules=("8.repeat.answer",),
-      tag="D", source=SRC,
-      rule="With no history since reset, > answers a single line 0")
+      rules=("8.repeat.answer",))
 def no_history(ctx: CaseContext) -> None:
+    """With no history since reset, > answers a single line 0."""
     fresh_reset(ctx)
     answers(ctx, ctx.link.send(">"), "0", "> right after reset")
 
@@ -89,10 +84,9 @@ def not_again(ctx: CaseContext) -> None:
 
 
 @case("8.recovery.lost-response",
-      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"),
-      tag="M", source="M84 12.5.12: recovery with @ and >",
-      rule="A lost response is recovered with @ and > without executing the vector twice")
+      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"))
 def lost_response(ctx: CaseContext) -> None:
+    """A lost response is recovered with @ and > without executing the vector twice."""
     link = ctx.link
     before = index(ctx)
     link.inject("unit", "drop")

@@ -14,14 +14,11 @@ from conformance.cases._kit import (
     vector,
 )
 
-SRC = "M84 12.5.8; M114 13.6.9; M54"
-
 
 @case("10.5.keep.saves-st6",
-      rules=("10.5.keep.saves", "10.5.restore.exact", "4.response.inta-after-command"),
-      tag="M", source=SRC,
-      rule="K saves the queue and ST4..ST6 and clears them; R brings them back")
+      rules=("10.5.keep.saves", "10.5.restore.exact", "4.response.inta-after-command"))
 def saves(ctx: CaseContext) -> None:
+    """K saves the queue and ST4..ST6 and clears them; R brings them back."""
     halted_with_queue(ctx)
     r = ctx.link.send("K")
     code(ctx, r, 0, "K is accepted", rule="10.5.keep.saves")
@@ -38,10 +35,9 @@ def saves(ctx: CaseContext) -> None:
 
 
 @case("10.5.keep.partial-vector",
-      rules=("10.5.keep.saves", "10.5.restore.exact"),
-      tag="M", source=SRC,
-      rule="K keeps the rest of the interrupted vector: after R and G no step is lost")
+      rules=("10.5.keep.saves", "10.5.restore.exact"))
 def partial(ctx: CaseContext) -> None:
+    """K keeps the rest of the interrupted vector: after R and G no step is lost."""
     halted_with_queue(ctx)
     setup(ctx, "K")
     setup(ctx, "L" + vector(ctx, 0, 0, -100))
@@ -57,10 +53,9 @@ def partial(ctx: CaseContext) -> None:
 
 @case("10.5.keep.single-l",
       rules=("10.5.keep.c-refused", "10.5.keep.single-l"),
-      tag="D", source="M84 12.5.8 [M]; C → 4 [D]",
-      applies=lambda p: p.keep == "single-L",
-      rule="After K the GVE84/GVE114 queue takes only L (a C answers 4)")
+      applies=lambda p: p.keep == "single-L")
 def single_l(ctx: CaseContext) -> None:
+    """After K the GVE84/GVE114 queue takes only L (a C answers 4)"""
     halted_with_queue(ctx)
     setup(ctx, "K")
     code(ctx, ctx.link.send("C" + vector(ctx, 10)), 4, "C after K → 4",
@@ -70,10 +65,9 @@ def single_l(ctx: CaseContext) -> None:
 
 
 @case("10.5.keep.refused-while-moving",
-      rules=("5.code.busy-moving", "10.5.keep.saves"),
-      tag="M", source=SRC,
-      rule="K and R are not possible while moving (7)")
+      rules=("5.code.busy-moving", "10.5.keep.saves"))
 def moving(ctx: CaseContext) -> None:
+    """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
     code(ctx, ctx.link.send("K"), 7, "K while moving")
@@ -82,20 +76,18 @@ def moving(ctx: CaseContext) -> None:
 
 
 @case("10.5.restore.empty",
-      rules=("10.5.restore.pops",),
-      tag="D", source="spec 10.5 [D]",
-      rule="R with nothing saved restores an empty save and answers 0")
+      rules=("10.5.restore.pops",))
 def restore_empty(ctx: CaseContext) -> None:
+    """R with nothing saved restores an empty save and answers 0."""
     fresh_reset(ctx)
     answers(ctx, ctx.link.send("R"), "0", "R at reset")
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved")
 
 
 @case("10.5.keep.one-level",
-      rules=("10.5.keep.one-level", "10.5.keep.one-level-info"),
-      tag="M", source="M54 [M]; M84 12.5.8, M114 13.6.9 [INFO]",
-      rule="The save has one level: a second K without R overwrites it")
+      rules=("10.5.keep.one-level", "10.5.keep.one-level-info"))
 def one_level(ctx: CaseContext) -> None:
+    """The save has one level: a second K without R overwrites it."""
     halted_with_queue(ctx)
     setup(ctx, "K")      # saves the halted queue, INTA = 1
     setup(ctx, "K")      # saves the now empty queue over it

@@ -16,10 +16,9 @@ from conformance.cases._kit import (
 
 
 @case("10.1.line.refused-while-busy",
-      rules=("10.1.queue.line-alone", "5.code.queue-full"),
-      tag="M", source="M84 12.5.2",
-      rule="L is accepted only when nothing is queued or running; otherwise 1")
+      rules=("10.1.queue.line-alone", "5.code.queue-full"))
 def l_busy(ctx: CaseContext) -> None:
+    """L is accepted only when nothing is queued or running; otherwise 1."""
     setup(ctx, "C" + vector(ctx, 500))
     code(ctx, ctx.link.send("L" + vector(ctx, 10)), 1, "L while a C runs → 1")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
@@ -28,10 +27,9 @@ def l_busy(ctx: CaseContext) -> None:
 
 
 @case("10.1.line.wait-idiom",
-      rules=("10.1.queue.wait-idiom",),
-      tag="M", source="M84 12.5.2",
-      rule="L0,0,0 answers 1 until everything before it has finished, then 0")
+      rules=("10.1.queue.wait-idiom",))
 def idiom(ctx: CaseContext) -> None:
+    """L0,0,0 answers 1 until everything before it has finished, then 0."""
     setup(ctx, "L" + vector(ctx, 300))
     code(ctx, ctx.link.send("L" + vector(ctx, 0)), 1, "L0,0,0 while moving → 1")
     r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
@@ -41,10 +39,9 @@ def idiom(ctx: CaseContext) -> None:
 
 
 @case("10.1.queue.executing-counts",
-      rules=("10.1.queue.cont-buffer", "10.cmd.flags", "1.profile.buffer"),
-      tag="M", source="M84 12.5.2: '1 je vykonáván'",
-      rule="The CONT buffer's size includes the executing vector; F shows bit 5 when full")
+      rules=("10.1.queue.cont-buffer", "10.cmd.flags", "1.profile.buffer"))
 def queue_full_flag(ctx: CaseContext) -> None:
+    """The CONT buffer's size includes the executing vector; F shows bit 5 when full."""
     if fill_queue(ctx):
         r = ctx.link.send("F")
         ctx.expect(r is not None and r.values[:1] == ["F0"], "F = INTA + RUN + INTCOM + full",
@@ -53,10 +50,9 @@ def queue_full_flag(ctx: CaseContext) -> None:
 
 
 @case("10.2.motion.targets-reached",
-      rules=("10.1.queue.relative", "10.2.motion.step-placement"),
-      tag="M", source="M84 12.5.2: vectors are relative",
-      rule="Vectors are relative to the previous end point and end exactly on target")
+      rules=("10.1.queue.relative", "10.2.motion.step-placement"))
 def targets(ctx: CaseContext) -> None:
+    """Vectors are relative to the previous end point and end exactly on target."""
     setup(ctx, "V5000")
     moves = [(100, -37, 5), (-250, 40, 0), (3, 3, -3)]
     for m in moves:
@@ -69,10 +65,9 @@ def targets(ctx: CaseContext) -> None:
 
 
 @case("10.4.halt.answers-when-stopped",
-      rules=("10.4.halt.ramp", "10.cmd.halt-answer", "10.3.st6.inta-run", "10.3.st6.bits"),
-      tag="M", source="M84 12.5.8",
-      rule="H brakes on the ramp and answers (8) only once the motion has stopped")
+      rules=("10.4.halt.ramp", "10.cmd.halt-answer", "10.3.st6.inta-run", "10.3.st6.bits"))
 def halt(ctx: CaseContext) -> None:
+    """H brakes on the ramp and answers (8) only once the motion has stopped."""
     halted_with_queue(ctx)
     first = position(ctx)
     ctx.link.wait(0.5)
@@ -84,10 +79,9 @@ def halt(ctx: CaseContext) -> None:
 
 
 @case("10.4.go.resumes-exactly",
-      rules=("10.4.go.resume",),
-      tag="M", source="M84 12.5.8",
-      rule="G resumes the interrupted vector from the exact step: no step lost or gained")
+      rules=("10.4.go.resume",))
 def go(ctx: CaseContext) -> None:
+    """G resumes the interrupted vector from the exact step: no step lost or gained."""
     halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
@@ -96,10 +90,9 @@ def go(ctx: CaseContext) -> None:
 
 
 @case("10.4.delete.clears",
-      rules=("10.4.delete",),
-      tag="M", source="M84 12.5.8",
-      rule="D empties the queue and clears ST4..ST6; the position is unchanged")
+      rules=("10.4.delete",))
 def delete(ctx: CaseContext) -> None:
+    """D empties the queue and clears ST4..ST6; the position is unchanged."""
     halted_with_queue(ctx)
     here = position(ctx)
     answers(ctx, ctx.link.send("D"), "0", "D after H")
@@ -110,10 +103,9 @@ def delete(ctx: CaseContext) -> None:
 
 
 @case("10.4.delete.refused-while-moving",
-      rules=("10.4.delete", "5.code.busy-moving"),
-      tag="M", source="M84 12.5.8",
-      rule="D while moving answers 7")
+      rules=("10.4.delete", "5.code.busy-moving"))
 def delete_moving(ctx: CaseContext) -> None:
+    """D while moving answers 7."""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
     code(ctx, ctx.link.send("D"), 7, "D while moving → 7")
@@ -122,9 +114,9 @@ def delete_moving(ctx: CaseContext) -> None:
 
 @case("10.commands.zero-axis",
       rules=("10.cmd.set-axis", "10.cmd.zero"),
-      tag="M-ex", source="M84 12.5.6", requires=("NX",),
-      rule="!0NX100 sets the X counter; !0N zeroes every axis")
+      requires=("NX",))
 def set_axis(ctx: CaseContext) -> None:
+    """!0NX100 sets the X counter; !0N zeroes every axis."""
     answers(ctx, ctx.link.send("NX100"), "0", "NX100")
     ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx))
     answers(ctx, ctx.link.send("N"), "0", "N")

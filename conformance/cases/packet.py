@@ -15,8 +15,6 @@ from conformance.cases._kit import (
 )
 from conformance.link.framing import byte_sum
 
-RULE = "spec 7 [D]; M84 12.3.3"
-
 
 def _packet(ctx: CaseContext, members: list[str], count: int):
     link = ctx.link
@@ -28,9 +26,9 @@ def _packet(ctx: CaseContext, members: list[str], count: int):
 
 @case("7.packet.commits-all",
       rules=("7.packet.exchange", "7.packet.members", "7.packet.all-or-nothing"),
-      tag="M", source="M84 12.3.3", requires=("*S",),
-      rule="*E<n> commits every member in order and answers code,k")
+      tag="M", requires=("*S",))
 def commits(ctx: CaseContext) -> None:
+    """*E<n> commits every member in order and answers code,k."""
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
     answers(ctx, r, "0,3", "a good packet → 0,3", rule="7.packet.exchange")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
@@ -40,9 +38,9 @@ def commits(ctx: CaseContext) -> None:
 
 @case("7.packet.count-mismatch",
       rules=("7.packet.codes", "7.packet.all-or-nothing", "5.code.watchdog"),
-      tag="D", source=RULE, requires=("*S",),
-      rule="k ≠ n: nothing is committed and *E answers 2,k")
+      requires=("*S",))
 def count(ctx: CaseContext) -> None:
+    """k ≠ n: nothing is committed and *E answers 2,k."""
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
     answers(ctx, r, "2,2", "2 members, *E3 → 2,2", rule="5.code.watchdog")
     ctx.link.wait(1.0)
@@ -52,9 +50,9 @@ def count(ctx: CaseContext) -> None:
 
 @case("7.packet.invalid-member",
       rules=("7.packet.other-member", "7.packet.codes", "7.packet.all-or-nothing"),
-      tag="D", source=RULE, requires=("*S",),
-      rule="A member other than C or B fails the packet with 4; nothing is committed")
+      requires=("*S",))
 def invalid(ctx: CaseContext) -> None:
+    """A member other than C or B fails the packet with 4; nothing is committed."""
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
     answers(ctx, r, "4,3", "V inside a packet → 4,3")
     ctx.link.wait(1.0)
@@ -64,18 +62,18 @@ def invalid(ctx: CaseContext) -> None:
 
 @case("7.packet.out-of-range-member",
       rules=("7.packet.codes",),
-      tag="D", source=RULE, requires=("*S",),
-      rule="A member out of range fails the packet with its code (5)")
+      requires=("*S",))
 def out_of_range(ctx: CaseContext) -> None:
+    """A member out of range fails the packet with its code (5)"""
     r = _packet(ctx, ["B1", "C" + vector(ctx, 10)], 2)
     answers(ctx, r, "5,2", "B1 (below range) → 5,2")
 
 
 @case("7.packet.no-room",
       rules=("7.packet.codes", "5.code.queue-full", "7.packet.all-or-nothing"),
-      tag="D", source=RULE, requires=("*S",),
-      rule="A packet that does not fit the queue answers 1 and commits nothing")
+      requires=("*S",))
 def no_room(ctx: CaseContext) -> None:
+    """A packet that does not fit the queue answers 1 and commits nothing."""
     if not fill_queue(ctx, ctx.profile.buffer - 1, rule="5.code.queue-full"):
         return
     r = _packet(ctx, ["C" + vector(ctx, 1), "C" + vector(ctx, -1)], 2)
@@ -90,17 +88,17 @@ def no_room(ctx: CaseContext) -> None:
 
 @case("7.packet.end-without-start",
       rules=("7.packet.breakers",),
-      tag="D", source=RULE, requires=("*S",),
-      rule="*E with no open packet answers 4,0")
+      requires=("*S",))
 def end_alone(ctx: CaseContext) -> None:
+    """*E with no open packet answers 4,0."""
     answers(ctx, ctx.link.send("*E1"), "4,0", "*E1 alone → 4,0")
 
 
 @case("7.packet.halt-inside",
       rules=("7.packet.breakers", "8.index.counts"),
-      tag="D", source=RULE, requires=("*S",),
-      rule="H, @, > inside an open packet are answered at once and discard the packet")
+      requires=("*S",))
 def breakers(ctx: CaseContext) -> None:
+    """H, @, > inside an open packet are answered at once and discard the packet."""
     link = ctx.link
     before = index(ctx)
     link.send("*S", answer=False)
@@ -120,9 +118,9 @@ def breakers(ctx: CaseContext) -> None:
 
 @case("7.packet.with-checksums",
       rules=("7.packet.checksums",),
-      tag="M-ex", source="M84 12.3.3 (G3)", requires=("*S",),
-      rule="Packets work in checksum mode, each member with its own checksum")
+      requires=("*S",))
 def summed(ctx: CaseContext) -> None:
+    """Packets work in checksum mode, each member with its own checksum."""
     setup(ctx, "%+", checksum=False)
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 2)
     ctx.expect(r is not None and r.code == 0 and r.values == ["2"] and r.checksum_ok,

@@ -7,10 +7,9 @@ from conformance.cases._kit import answers, code, position, setup, show, vector
 
 
 @case("10.3.status.all-bits-stored",
-      rules=("10.3.status.all-bits", "10.cmd.status-words"),
-      tag="D", source="spec 10.3 [D]; M84 12.5.8 SW1,3F",
-      rule="Every status word stores all 8 bits as written")
+      rules=("10.3.status.all-bits", "10.cmd.status-words"))
 def all_bits(ctx: CaseContext) -> None:
+    """Every status word stores all 8 bits as written."""
     for n, value in ((2, "2B"), (3, "FF"), (5, "80"), (1, "3F"), (0, "A2")):
         r = ctx.link.send(f"SW{n},{value}")     # may interrupt: only the code matters here
         ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {show(r)}")
@@ -20,10 +19,9 @@ def all_bits(ctx: CaseContext) -> None:
 
 
 @case("10.3.status.run-bit",
-      rules=("10.3.st6.bits", "10.3.st6.inta-run"),
-      tag="M", source="M84 12.5.11",
-      rule="ST6 bit 6 (RUN) is set while a vector is processed and clear when idle")
+      rules=("10.3.st6.bits", "10.3.st6.inta-run"))
 def run_bit(ctx: CaseContext) -> None:
+    """ST6 bit 6 (RUN) is set while a vector is processed and clear when idle."""
     setup(ctx, "L" + vector(ctx, 500))
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
@@ -33,19 +31,18 @@ def run_bit(ctx: CaseContext) -> None:
 
 
 @case("10.3.status.inputs-read-ff",
-      rules=("10.3.inputs.idle-level", "10.cmd.inputs"),
-      tag="D", source="spec 10.3 [D]",
-      rule="Input ports read FF with nothing connected")
+      rules=("10.3.inputs.idle-level", "10.cmd.inputs"))
 def inputs(ctx: CaseContext) -> None:
+    """Input ports read FF with nothing connected."""
     answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected",
             rule="10.3.inputs.idle-level")
 
 
 @case("10.3.interrupt.stops-motion",
       rules=("10.3.inputs.interrupt", "10.3.status.meaning"),
-      tag="M", source="M84 12.5.11", rig=True,
-      rule="An enabled active input stops the motion, sets its cause bit and INTA")
+      tag="M", rig=True)
 def interrupt(ctx: CaseContext) -> None:
+    """An enabled active input stops the motion, sets its cause bit and INTA."""
     link = ctx.link
     setup(ctx, "SW0,01")
     setup(ctx, "C" + vector(ctx, 3000))
@@ -63,9 +60,9 @@ def interrupt(ctx: CaseContext) -> None:
 
 @case("10.3.interrupt.polarity",
       rules=("10.3.inputs.polarity", "4.response.inta-level"),
-      tag="M", source="M84 12.5.11", hands=True,
-      rule="An input is active when its level equals its polarity bit")
+      hands=True)
 def polarity(ctx: CaseContext) -> None:
+    """An input is active when its level equals its polarity bit."""
     link = ctx.link
     ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
     setup(ctx, "SW0,01")                 # IN0 enabled; unconnected (1) is inactive at 0
@@ -81,9 +78,8 @@ def polarity(ctx: CaseContext) -> None:
 
 
 @case("10.3.flags.f-command",
-      rules=("10.cmd.flags", "3.params.none-expected"),
-      tag="M", source="M84 12.5.11",
-      rule="F answers ST6 with bit 5 = queue full")
+      rules=("10.cmd.flags", "3.params.none-expected"))
 def f_idle(ctx: CaseContext) -> None:
+    """F answers ST6 with bit 5 = queue full."""
     answers(ctx, ctx.link.send("F"), "0,00", "F when idle", rule="10.cmd.flags")
     code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", rule="3.params.none-expected")

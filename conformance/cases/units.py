@@ -57,10 +57,10 @@ REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100
                   "*E": "*E1"}
 
 
-@case("10.commands.formats", tag="M", source="M84 12.5; M114 13.6; M54; spec 10",
-      rules=("4.response.grammar", *sorted({rule for _, _, rule in FORMATS.values()})),
-      rule="Every command of the profile answers in the format of spec 10")
+@case("10.commands.formats",
+      rules=("4.response.grammar", *sorted({rule for _, _, rule in FORMATS.values()})))
 def formats(ctx: CaseContext) -> None:
+    """Every command of the profile answers in the format of spec 10."""
     for name, (body, pattern, rule) in FORMATS.items():
         if name not in ctx.profile.commands:
             continue
@@ -73,10 +73,9 @@ def formats(ctx: CaseContext) -> None:
 
 
 @case("10.commands.absent-refused",
-      rules=("1.profile.command-set", "5.code.unknown"),
-      tag="M", source="spec 1, 5: code 3",
-      rule="A command the profile lacks answers 3")
+      rules=("1.profile.command-set", "5.code.unknown"))
 def absent(ctx: CaseContext) -> None:
+    """A command the profile lacks answers 3."""
     lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
         ctx.expect(True, "the profile has every optional command")
@@ -90,19 +89,17 @@ def absent(ctx: CaseContext) -> None:
 
 
 @case("1.profile.version",
-      rules=("1.profile.version", "2.link.serial-8n1", "3.frame.grammar"),
-      tag="D", source="spec 1 [D]",
-      rule="? answers 0,<the profile's firmware string>")
+      rules=("1.profile.version", "2.link.serial-8n1", "3.frame.grammar"))
 def version(ctx: CaseContext) -> None:
+    """? answers 0,<the profile's firmware string>."""
     answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string",
             rule="1.profile.version")
 
 
 @case("9.reset.state",
-      rules=("9.reset.state", "8.index.counts"),
-      tag="M", source="M84 12.4; M114 13.5; M54",
-      rule="After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off")
+      rules=("9.reset.state", "8.index.counts"))
 def reset_state(ctx: CaseContext) -> None:
+    """After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off."""
     fresh_reset(ctx)
     before = index(ctx)
     for n in range(7):
@@ -114,9 +111,10 @@ def reset_state(ctx: CaseContext) -> None:
 
 @case("9.reset.after-j",
       rules=("10.cmd.restart", "9.reset.state", "8.index.answer", "2.link.ready-after-restart"),
-      tag="D", source="M84 12.4; spec 9, 10 J [D]", destructive=True,
-      rule="J answers a plain 0 and restores the reset state after about 2 s", timing=True)
+      destructive=True,
+      timing=True)
 def after_j(ctx: CaseContext) -> None:
+    """J answers a plain 0 and restores the reset state after about 2 s."""
     link = ctx.link
     setup(ctx, "SW2,2B")
     setup(ctx, "L" + vector(ctx, 16))
@@ -130,9 +128,9 @@ def after_j(ctx: CaseContext) -> None:
 
 @case("10.6.eeprom.round-trip",
       rules=("10.cmd.eeprom-bytes",),
-      tag="M", source="M84 11; M114 11-12", destructive=True,
-      rule="EW writes a byte that ER reads back (kept, then restored by the suite)")
+      tag="M", destructive=True)
 def eeprom(ctx: CaseContext) -> None:
+    """EW writes a byte that ER reads back (kept, then restored by the suite)"""
     link = ctx.link
     r = link.send("ER40")
     ctx.require(r is not None and r.code == 0, "ER40 answered")
@@ -144,9 +142,10 @@ def eeprom(ctx: CaseContext) -> None:
 
 @case("10.6.eeprom.words",
       rules=("10.cmd.eeprom-words", "3.params.word-values-decimal"),
-      tag="D", source="spec 10 EFR/EUR [D]", destructive=True,
-      requires=("EFW", "EUW"), rule="EFW/EFR store float32 and EUW/EUR uint32 little-endian")
+      destructive=True,
+      requires=("EFW", "EUW"))
 def words(ctx: CaseContext) -> None:
+    """EFW/EFR store float32 and EUW/EUR uint32 little-endian."""
     link = ctx.link
     answers(ctx, link.send("EFW30,0.25"), "0", "EFW30,0.25")
     answers(ctx, link.send("EFR30"), "0,0.25", "EFR30 → 0.25")
@@ -158,9 +157,9 @@ def words(ctx: CaseContext) -> None:
 
 @case("10.7.microstep.positions-in-sixteenths",
       rules=("10.2.motion.gve54-units", "10.7.motor.modes"),
-      tag="M-ex", source="M54 (G5)",
-      requires=("M",), rule="GVE54 positions are in 1/16 steps: M4, L100,100,100 → 400")
+      requires=("M",))
 def microstep(ctx: CaseContext) -> None:
+    """GVE54 positions are in 1/16 steps: M4, L100,100,100 → 400."""
     link = ctx.link
     setup(ctx, "M4")
     setup(ctx, "L100,100,100")
@@ -171,10 +170,10 @@ def microstep(ctx: CaseContext) -> None:
 
 @case("12.spindle.address-7",
       rules=("12.spindle.speed", "12.spindle.commands"),
-      tag="M-ex", source="M114 13.7 (G8)", rig=True,
-      applies=lambda p: p.spindle is not None,
-      rule="!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate")
+      tag="M-ex", rig=True,
+      applies=lambda p: p.spindle is not None)
 def spindle(ctx: CaseContext) -> None:
+    """!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate."""
     link = ctx.link
     speed = "12.spindle.speed"
     answers(ctx, link.send("V300", address=7), "0", "!7V300", rule=speed)

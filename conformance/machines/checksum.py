@@ -55,8 +55,8 @@ class ChecksumMachine(UnitMachine):
 @case("6.machine.checksum-framing",
       rules=("6.checksum.bad-refused", "6.checksum.mode-commands", "6.checksum.response-sum",
              "8.index.uncounted", "8.index.counts", "6.checksum.sum"),
-      tag="M", source="M84 12.3.2; spec 6, 8 [D]",
-      requires=("%",),
-      rule="Checksum mode on/off with good, bad, missing and lower-case sums keeps its rules")
+      tag="M",
+      requires=("%",))
 def checksum_machine(ctx: CaseContext) -> None:
+    """Checksum mode on/off with good, bad, missing and lower-case sums keeps its rules."""
     run_machine(ctx, ChecksumMachine)

@@ -93,8 +93,7 @@ class ErrorMachine(UnitMachine):
              "5.code.syntax", "5.code.range", "4.response.inta-bit",
              "4.response.inta-after-command", "5.code.ok", "3.params.decimal",
              "10.cmd.accel-range", "10.1.queue.wait-idiom", "10.1.queue.cont-buffer",
-             "10.cmd.status-words"),
-      tag="M", source="M84 12.6; spec 4, 5",
-      rule="Each error code arises exactly in its states, with the INTA bit of ST6")
+             "10.cmd.status-words"))
 def error_machine(ctx: CaseContext) -> None:
+    """Each error code arises exactly in its states, with the INTA bit of ST6."""
     run_machine(ctx, ErrorMachine)

@@ -67,8 +67,8 @@ class RecoveryMachine(UnitMachine):
 
 
 @case("8.machine.recovery",
-      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"),
-      tag="M", source="M84 12.5.12: recovery with @ and >",
-      rule="Lost commands and lost/corrupted responses are recovered with @ and > exactly once")
+      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"))
 def recovery_machine(ctx: CaseContext) -> None:
+    """Lost commands and lost/corrupted responses are recovered with @ and > exactly
+    once."""
     run_machine(ctx, RecoveryMachine)

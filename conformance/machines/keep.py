@@ -97,8 +97,7 @@ class KeepMachine(UnitMachine):
 
 @case("10.5.machine.keep-restore",
       rules=("10.5.keep.saves", "10.5.restore.exact", "10.4.go.resume", "10.5.keep.single-l"),
-      tag="M", source="M84 12.5.8; M114 13.6.9",
-      applies=lambda p: p.keep == "single-L" or p.keep == "full",
-      rule="KEEP/RESTORE around detours with HALT, GO and XA loses and gains no step")
+      applies=lambda p: p.keep == "single-L" or p.keep == "full")
 def keep_machine(ctx: CaseContext) -> None:
+    """KEEP/RESTORE around detours with HALT, GO and XA loses and gains no step."""
     run_machine(ctx, KeepMachine)

@@ -80,7 +80,7 @@ class PacketMachine(UnitMachine):
 @case("7.machine.packets",
       rules=("7.packet.all-or-nothing", "7.packet.codes", "7.packet.exchange",
              "7.packet.checksums", "7.packet.breakers"),
-      tag="D", source="M84 12.3.3; spec 7 [D]", requires=("*S",),
-      rule="Packets commit all or nothing, answer code,k, with and without checksums")
+      requires=("*S",))
 def packet_machine(ctx: CaseContext) -> None:
+    """Packets commit all or nothing, answer code,k, with and without checksums."""
     run_machine(ctx, PacketMachine)

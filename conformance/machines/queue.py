@@ -95,8 +95,7 @@ class QueueMachine(UnitMachine):
       rules=("10.1.queue.cont-buffer", "10.1.queue.wait-idiom", "10.cmd.flags",
              "10.cmd.status-words", "10.cmd.eeprom-bytes", "10.1.queue.wait-for-go",
              "4.response.inta-bit", "5.code.ok"),
-      tag="M", source="M84 12.5.2, 12.5.11, 11",
-      destructive=True,
-      rule="The queue's room, L0,0,0, F, status words and EEPROM bytes keep their rules")
+      destructive=True)
 def queue_machine(ctx: CaseContext) -> None:
+    """The queue's room, L0,0,0, F, status words and EEPROM bytes keep their rules."""
     run_machine(ctx, QueueMachine)

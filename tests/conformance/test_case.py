@@ -58,7 +58,7 @@ def test_a_check_naming_a_rule_its_case_does_not_list_is_a_defect(target):
     assert r.verdict == ERROR
 
 
-def test_a_case_quotes_its_first_rule_when_it_gives_no_text():
+def test_a_case_quotes_its_first_rule():
     try:
         case("99.toy.quoted", rules=("5.code.range",))(lambda ctx: None)
         c = REGISTRY["99.toy.quoted"]
@@ -67,9 +67,37 @@ def test_a_case_quotes_its_first_rule_when_it_gives_no_text():
         with pytest.raises(ValueError, match="unknown rule"):
             case("99.toy.unknown", rules=("5.code.nope",))(lambda ctx: None)
         with pytest.raises(ValueError, match="name its rules"):
-            case("99.toy.bare", rule="r")(lambda ctx: None)
+            case("99.toy.bare", rules=())(lambda ctx: None)
     finally:
         REGISTRY.pop("99.toy.quoted", None)
+
+
+def test_a_case_cites_the_sources_of_all_its_rules_once_each():
+    try:
+        case("99.toy.cited", rules=("5.code.range", "10.cmd.status-words", "5.code.unknown"))(
+            lambda ctx: None)
+        assert REGISTRY["99.toy.cited"].source == "M84 12.6; M84 12.5.11"
+    finally:
+        REGISTRY.pop("99.toy.cited", None)
+
+
+def test_a_case_cannot_write_its_requirement_again():
+    with pytest.raises(TypeError):
+        case("99.toy.restated", rules=("5.code.range",), rule="out of range")(lambda ctx: None)
+    with pytest.raises(TypeError):
+        case("99.toy.restated", rules=("5.code.range",), source="M84 12.6")(lambda ctx: None)
+    with pytest.raises(ValueError, match="restates its first rule"):
+        case("99.toy.restated", rules=("5.code.range",), tag="M-ex")(lambda ctx: None)
+    assert "99.toy.restated" not in REGISTRY
+
+
+def test_a_case_may_grade_by_another_of_its_rules_tags():
+    try:
+        case("99.toy.regraded", rules=("8.index.queries-uncounted", "8.index.counts"),
+             tag="M")(lambda ctx: None)
+        assert REGISTRY["99.toy.regraded"].tag == "M"
+    finally:
+        REGISTRY.pop("99.toy.regraded", None)
 
 
 def test_every_case_of_the_catalogue_names_known_rules():

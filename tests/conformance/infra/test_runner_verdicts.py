@@ -101,8 +101,8 @@ def test_destructive_cases_wait_for_permission_on_real_units():
 def test_one_id_for_two_different_cases_is_refused():
     from conformance.case import REGISTRY, case
     try:
-        case("99.toy.twice", rule="r", tag="M", source="test")(_fails)
+        case("99.toy.twice", rules=("5.code.ok",))(_fails)
         with pytest.raises(ValueError, match="registered twice"):
-            case("99.toy.twice", rule="r", tag="M", source="test")(_status_word)
+            case("99.toy.twice", rules=("5.code.ok",))(_status_word)
     finally:
         REGISTRY.pop("99.toy.twice", None)
