@@ -63,7 +63,6 @@ def lower(ctx: CaseContext) -> None:
       rules=("6.checksum.response-sum",),
       tag="M", requires=("%",))
 def responses(ctx: CaseContext) -> None:
-    """Responses are summed the same way from their first byte, in upper-case hex."""
     setup(ctx, "%+", checksum=False)
     for body in ("SR2", "PF", "?", "@"):
         r = ctx.link.send(body)

@@ -36,7 +36,6 @@ def unknown(ctx: CaseContext) -> None:
       rules=("5.code.range", "10.cmd.status-words", "10.cmd.modal", "10.cmd.accel-range"))
 def out_of_range(ctx: CaseContext) -> None:
     # A0: the accelerations' range is our reading [D]; the others the manual's
-    """A parameter out of range answers 5 (!0SW8,F1 → 5)"""
     for body, rule in (("SW8,F1", "5.code.range"), ("T25", "10.cmd.modal"),
                        ("A0", "10.cmd.accel-range"), ("SR7", "10.cmd.status-words")):
         code(ctx, ctx.link.send(body), 5, f"{body} → 5", rule=rule)

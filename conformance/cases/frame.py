@@ -36,7 +36,6 @@ def noise(ctx: CaseContext) -> None:
 @case("3.frame.bang-restarts",
       rules=("3.frame.bang-restarts", "2.link.simplex"))
 def restart(ctx: CaseContext) -> None:
-    """A '!' inside an unfinished frame starts a new frame; the old one gets no answer."""
     before = index(ctx)
     ctx.link.send_raw(b"!%dV12" % ctx.link.address)
     index_moved(ctx, before, 0, "only the complete frame is answered; the dropped one not counted",
@@ -82,7 +81,6 @@ def syntax(ctx: CaseContext) -> None:
 @case("3.frame.too-long",
       rules=("3.frame.max-length",))
 def too_long(ctx: CaseContext) -> None:
-    """A frame longer than 96 bytes is a syntax error (4) once its CR arrives."""
     code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), 4, "a 106-byte frame → 4")
 
 

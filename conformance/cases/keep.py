@@ -87,7 +87,6 @@ def restore_empty(ctx: CaseContext) -> None:
 @case("10.5.keep.one-level",
       rules=("10.5.keep.one-level", "10.5.keep.one-level-info"))
 def one_level(ctx: CaseContext) -> None:
-    """The save has one level: a second K without R overwrites it."""
     halted_with_queue(ctx)
     setup(ctx, "K")      # saves the halted queue, INTA = 1
     setup(ctx, "K")      # saves the now empty queue over it

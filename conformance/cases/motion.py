@@ -29,7 +29,6 @@ def l_busy(ctx: CaseContext) -> None:
 @case("10.1.line.wait-idiom",
       rules=("10.1.queue.wait-idiom",))
 def idiom(ctx: CaseContext) -> None:
-    """L0,0,0 answers 1 until everything before it has finished, then 0."""
     setup(ctx, "L" + vector(ctx, 300))
     code(ctx, ctx.link.send("L" + vector(ctx, 0)), 1, "L0,0,0 while moving → 1")
     r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
@@ -52,7 +51,6 @@ def queue_full_flag(ctx: CaseContext) -> None:
 @case("10.2.motion.targets-reached",
       rules=("10.1.queue.relative", "10.2.motion.step-placement"))
 def targets(ctx: CaseContext) -> None:
-    """Vectors are relative to the previous end point and end exactly on target."""
     setup(ctx, "V5000")
     moves = [(100, -37, 5), (-250, 40, 0), (3, 3, -3)]
     for m in moves:
@@ -92,7 +90,6 @@ def go(ctx: CaseContext) -> None:
 @case("10.4.delete.clears",
       rules=("10.4.delete",))
 def delete(ctx: CaseContext) -> None:
-    """D empties the queue and clears ST4..ST6; the position is unchanged."""
     halted_with_queue(ctx)
     here = position(ctx)
     answers(ctx, ctx.link.send("D"), "0", "D after H")

@@ -80,6 +80,5 @@ def polarity(ctx: CaseContext) -> None:
 @case("10.3.flags.f-command",
       rules=("10.cmd.flags", "3.params.none-expected"))
 def f_idle(ctx: CaseContext) -> None:
-    """F answers ST6 with bit 5 = queue full."""
     answers(ctx, ctx.link.send("F"), "0,00", "F when idle", rule="10.cmd.flags")
     code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", rule="3.params.none-expected")
