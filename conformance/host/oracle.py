@@ -28,7 +28,7 @@ from conformance.host.faults import Fault
 from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
-from conformance.host.unitview import VECTORS, Step, UnitView
+from conformance.host.unitview import VECTORS, Executed, UnitView
 from conformance.protocol.catalogue import classes
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
@@ -66,11 +66,11 @@ class Outcome:
     output: str = ""
 
 
-def executed(views: list[UnitView]) -> dict[int, list[Step]]:
+def executed(views: list[UnitView]) -> dict[int, list[Executed]]:
     return {v.address: list(v.executed) for v in views}
 
 
-def difference(expected: list[Step], got: list[Step]) -> str | None:
+def difference(expected: list[Executed], got: list[Executed]) -> str | None:
     """None when the two runs executed the same; else the first difference, in words."""
     matcher = difflib.SequenceMatcher(a=expected, b=got, autojunk=False)
     for op, i1, _, j1, _ in matcher.get_opcodes():
@@ -91,7 +91,7 @@ def difference(expected: list[Step], got: list[Step]) -> str | None:
     return None
 
 
-def _short(step: Step) -> str:
+def _short(step: Executed) -> str:
     return f"`{step.kind}{','.join(map(str, step.values))}`"
 
 
@@ -133,7 +133,7 @@ def wire_checks(g: Grader, j: Judgement) -> None:
     g.notes += j.notes
 
 
-def travel(steps: list[Step], axes: int) -> tuple[int, ...]:
+def travel(steps: list[Executed], axes: int) -> tuple[int, ...]:
     """The full steps each axis travelled in the executed vectors ``steps`` (the sum of
     their lengths, whatever the direction)."""
     out = [0] * axes
@@ -200,7 +200,7 @@ def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None,
                 "its job", f"gave up: {_ending(out)}")
 
 
-def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Step]]) -> None:
+def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Executed]]) -> None:
     """How the host took the restart (INFO): the motion before it, and none after it,
     as the unit's position was lost (spec 9: the counters start at 0)."""
     for address, expected in baseline.executed.items():

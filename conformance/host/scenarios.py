@@ -25,7 +25,7 @@ from conformance.host.faults import (
 )
 from conformance.host.probe import Final
 from conformance.host.recording import Exchange
-from conformance.host.unitview import SETTINGS, VECTORS, Step
+from conformance.host.unitview import SETTINGS, VECTORS, Executed
 
 
 @dataclass
@@ -33,7 +33,7 @@ class Baseline:
     """What the clean run showed: the motion executed per unit, where it ended, the
     exchanges (the points faults aim at) and the interrupt input the host enabled."""
 
-    executed: dict[int, list[Step]]
+    executed: dict[int, list[Executed]]
     final: dict[int, Final]
     exchanges: list[Exchange]
     seconds: float
