@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from conformance.link.faults import Fault
+from conformance.link.faults import FrameFault
 from conformance.link.framing import (
     CR,
     HostFrame,
@@ -69,7 +69,7 @@ class Link:
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[str] = []
-        self._faults: list[Fault] = []
+        self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
         self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
@@ -142,9 +142,9 @@ class Link:
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
         """Plan a fault for the next frame ("host") or response ("unit")."""
-        self._faults.append(Fault(direction, kind, params))
+        self._faults.append(FrameFault(direction, kind, params))
 
-    def _fault(self, direction: str) -> Fault | None:
+    def _fault(self, direction: str) -> FrameFault | None:
         for i, f in enumerate(self._faults):
             if f.direction == direction:
                 return self._faults.pop(i)
