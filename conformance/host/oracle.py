@@ -53,7 +53,7 @@ class HostResult(CaseResult):
 
 
 @dataclass
-class Outcome:
+class HostRun:
     """What one run of the host under one fault left behind."""
 
     recording: Recording
@@ -144,7 +144,7 @@ def travel(steps: list[Executed], axes: int) -> tuple[int, ...]:
     return tuple(out)
 
 
-def driven_checks(g: Grader, out: Outcome, expect: dict[int, tuple[int, ...]] | None
+def driven_checks(g: Grader, out: HostRun, expect: dict[int, tuple[int, ...]] | None
                   ) -> None:
     """The clean run shows a host that drives its units: it sends frames, and the units
     execute the motion its job claims (``expect``: the travel per axis per address)."""
@@ -163,7 +163,7 @@ def driven_checks(g: Grader, out: Outcome, expect: dict[int, tuple[int, ...]] | 
                 f"it travelled {shown or 'nothing'} full steps", "always")
 
 
-def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None,
+def motion_checks(g: Grader, out: HostRun, baseline: Baseline | None,
                   expect: dict[int, tuple[int, ...]] | None = None) -> None:
     sc = g.scenario
     finished = out.ended in ("exited", "operator") and out.exit_code == 0
@@ -215,7 +215,7 @@ def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Executed]]
                 "restart, the first " + _short(after[0]) if after else "none")
 
 
-def _position(baseline: Baseline, out: Outcome, address: int) -> str | None:
+def _position(baseline: Baseline, out: HostRun, address: int) -> str | None:
     want, got = baseline.final.get(address), out.finals.get(address)
     if want is None or got is None or want.position == got.position:
         return (None if got is None or not got.stalled else
@@ -223,7 +223,7 @@ def _position(baseline: Baseline, out: Outcome, address: int) -> str | None:
     return f"the motion ended at {got.position}, the clean run's at {want.position}"
 
 
-def _ending(out: Outcome) -> str:
+def _ending(out: HostRun) -> str:
     if out.ended == "silent":
         return f"silent for too long, not exited after {out.seconds:.1f} s"
     if out.ended == "limit":
@@ -268,7 +268,7 @@ def _register() -> None:
 _register()
 
 
-def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:
+def result(g: Grader, out: HostRun, profile: str, target: str) -> HostResult:
     rec = out.recording
     sc = g.scenario
     if sc.name != "clean" and not out.fault.injected:
