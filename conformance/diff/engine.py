@@ -22,7 +22,7 @@ from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.labels import command_of, label, verdict_of
-from conformance.diff.sides import Exchange, Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
@@ -46,8 +46,8 @@ class Record:
     """One step as it went: the step, the frame's bytes and both sides' exchanges."""
 
     step: Step
-    target: Exchange | None = None
-    reference: Exchange | None = None
+    target: RoundTrip | None = None
+    reference: RoundTrip | None = None
     repeat: int = 0                      # FILL: frames of it before this one
     place: int = 0                       # the step's place in its sequence
     #: answers whose bytes differ but were judged alike: why (the timing band, the index
@@ -60,8 +60,8 @@ class Disagreement:
     index: int                           # the record it happened on
     command: str
     kind: str
-    target: Exchange
-    reference: Exchange
+    target: RoundTrip
+    reference: RoundTrip
     context: frozenset[str]
     earlier: frozenset[str]
     rule: str | None = None
@@ -246,7 +246,7 @@ class Pair:
         except TargetNotResponding as err:
             if self.target.real:       # a fresh unit's silence ends only its example
                 raise
-            rec.target = Exchange(data, b"", 0, 0, None, step.lines)
+            rec.target = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
         self.timing.sent(rec.target.sent_at)
@@ -255,7 +255,7 @@ class Pair:
                                                     answer=step.answer, stall=step.stall,
                                                     body=step.body)
         except TargetNotResponding as err:
-            rec.reference = Exchange(data, b"", 0, 0, None, step.lines)
+            rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = out.ended or str(err)
         if out.ended and not rec.target.answer and not rec.reference.answer:
             return None
@@ -288,7 +288,7 @@ class Pair:
         return {k for k, on in flags.items() if on}
 
 
-def _code(exchange: Exchange) -> int | None:
+def _code(exchange: RoundTrip) -> int | None:
     return None if exchange.code is None else exchange.code & 7
 
 

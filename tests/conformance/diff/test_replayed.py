@@ -6,15 +6,15 @@ from __future__ import annotations
 
 from conformance.diff.engine import Disagreement, Outcome, Record
 from conformance.diff.replayed import frame_lines, header, verdict
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import FRAME, INPUT, Step
 from conformance.link.framing import parse_response
 
 P = Step(FRAME, "P")
 
 
-def _exchange(answer: bytes) -> Exchange:
-    return Exchange(b"!0P\r", answer, 0, 1000, parse_response(answer, summed=False))
+def _exchange(answer: bytes) -> RoundTrip:
+    return RoundTrip(b"!0P\r", answer, 0, 1000, parse_response(answer, summed=False))
 
 
 def _record(target: bytes, reference: bytes, alike: str = "", place: int = 0) -> Record:
