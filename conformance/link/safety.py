@@ -21,10 +21,9 @@ Public interface (docs/suite.md, "The session and its guard")::
 
 from __future__ import annotations
 
-import contextlib
 import math
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
@@ -66,6 +65,23 @@ _PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
+
+
+class _Depth:
+    """How many blocks of one kind are open (they nest): ``with depth:`` opens one; the
+    depth is true while any is open."""
+
+    def __init__(self) -> None:
+        self.open = 0
+
+    def __bool__(self) -> bool:
+        return self.open > 0
+
+    def __enter__(self) -> None:
+        self.open += 1
+
+    def __exit__(self, *exc: object) -> None:
+        self.open -= 1
 
 
 @dataclass(frozen=True)
@@ -132,43 +148,28 @@ class Guard:
         self.silences = 0
         self.garbage = ""                         # the last bytes that were not an answer
         self.dead = False
-        self._own = 0                             # inside the session's own frames
-        self._emergency = 0
-        self._hands_on = 0                        # a technician's hand step is open
+        self._own = _Depth()                      # inside the session's own frames
+        self._emergency = _Depth()
+        self._hands_on = _Depth()                 # a technician's hand step is open
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
         return max_travel * self.scale
 
     # -- who is sending ----------------------------------------------------------------------
-    @contextlib.contextmanager
-    def own_frames(self) -> Iterator[None]:
+    def own_frames(self) -> _Depth:
         """The session's own frames (known state, snapshot, restorations): after Ctrl-C
         these still go out, except motion."""
-        self._own += 1
-        try:
-            yield
-        finally:
-            self._own -= 1
+        return self._own
 
-    @contextlib.contextmanager
-    def emergency(self) -> Iterator[None]:
+    def emergency(self) -> _Depth:
         """`H` and `D` after Ctrl-C: the frames that go out before anything else."""
-        self._emergency += 1
-        try:
-            yield
-        finally:
-            self._emergency -= 1
+        return self._emergency
 
-    @contextlib.contextmanager
-    def hands_on(self) -> Iterator[None]:
+    def hands_on(self) -> _Depth:
         """A technician's hand step is open (a prompt waits for them): no motion until it
         is answered, whoever sends."""
-        self._hands_on += 1
-        try:
-            yield
-        finally:
-            self._hands_on -= 1
+        return self._hands_on
 
     # -- before a frame ----------------------------------------------------------------------
     def check_idle(self) -> None:
