@@ -65,6 +65,13 @@ def total(vectors) -> tuple[int, ...]:
     return tuple(sum(v.steps[i] for v in vectors) for i in range(AXES))
 
 
+def ends_at_the_sum(m, vectors) -> None:
+    """Run the rest out: the unit stands where all of ``vectors`` add up, no step lost or
+    taken twice."""
+    run_out(m)
+    assert m.position(m.now) == total(vectors)
+
+
 # -- the arithmetic ---------------------------------------------------------------------
 
 @given(st.integers(0, 10**6), st.integers(0, 10**8), st.integers(0, 2**35))
@@ -201,8 +208,7 @@ def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
     still = m.position(rest)
     assert m.position(rest + SECOND) == still, "a halted unit does not move"
     m.resume(rest + SECOND)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
@@ -220,8 +226,7 @@ def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
     m.restore(saved, m.now)
     m.set_velocity(data.draw(st.integers(10, MAX_RATE)), m.now)
     m.resume(m.now)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
@@ -240,8 +245,7 @@ def test_overrides_change_speed_not_targets(core, vectors, data):
             m.scale_velocity(15, 16, t, accel=True)
         else:
             m.set_multiplier(data.draw(st.integers(1, 1000)), t)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 def test_multiplier_doubles_the_speed(core):
