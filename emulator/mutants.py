@@ -104,6 +104,8 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "accel-ignored": ("10.2", "A has no effect on the motion: the reset A is used", "10.2"),
     "dwell-ignored": ("10.2", "no T dwell before a vector that starts from rest", "10.2"),
     "junction-stops": ("10.2", "B ignored: every C brakes to rest at its end", "10.2"),
+    "junction-brake-ignored": ("10.2", "B caps no junction: a C runs into the next C at the "
+                               "highest rate the next allows", "10.2"),
     "short-vector-ignored": ("10.2", "the $ rule does not cap short vectors to B", "10.2"),
     "halt-without-ramp": ("10.4", "H stops dead instead of braking on the ramp", "10.4"),
     "go-at-speed": ("10.4", "G resumes at the cruise rate instead of from rest", "10.4"),
@@ -117,6 +119,7 @@ CORE_DEVIATIONS: dict[str, Deviation] = {
     "dwell-between-continuous": Deviation.CONTINUOUS_DWELL,
     "halt-short-of-target": Deviation.HALT_SHORT,
     "junction-stops": Deviation.JUNCTION_STOPS,
+    "junction-brake-ignored": Deviation.JUNCTION_UNBRAKED,
     "halt-without-ramp": Deviation.HALT_DEAD,
     "go-at-speed": Deviation.GO_AT_SPEED,
 }

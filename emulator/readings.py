@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from emulator.motion.interface import Deviation
+
 
 class ReadingSpec(NamedTuple):
     rules: tuple[str, ...]   # the rules of fixtures/rules.toml whose silence it reads
@@ -48,7 +50,15 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "eeprom-write-while-moving": (("5.code.busy-eeprom",),
                                   "EW, EFW and EUW are accepted while the axes move (the "
                                   "manuals forbid only D, K, R, M, N and W while running)"),
+    "next-vectors-B": (("10.2.motion.junction-own-b",),
+                       "a junction of two C is passed at the B the next C captured, not the "
+                       "one of the C that ends there"),
 }.items()}
+
+#: readings whose behaviour lives in the stepper core
+CORE_READINGS: dict[str, Deviation] = {
+    "next-vectors-B": Deviation.NEXT_BRAKE,
+}
 
 
 class UnknownReading(ValueError):
@@ -82,6 +92,14 @@ class Readings:
         if name not in READINGS:
             raise UnknownReading(f"the emulator asks for an unknown reading {name!r}")
         return name in self.names
+
+    @property
+    def deviations(self) -> Deviation:
+        """The stepper core's deviations these readings take."""
+        flags = Deviation.NONE
+        for name in self.names:
+            flags |= CORE_READINGS.get(name, Deviation.NONE)
+        return flags
 
 
 NONE = Readings()

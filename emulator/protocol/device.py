@@ -38,7 +38,7 @@ class Device:
         self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
-                             deviations=mutant.deviations)
+                             deviations=mutant.deviations | readings.deviations)
         self.motion.advance(origin)
         self.inputs = dict(UNCONNECTED)
         self.switches: dict[str, int | None] = {}

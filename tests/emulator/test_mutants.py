@@ -68,6 +68,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "accel-ignored": ("m06-acceleration", "GVE84-100"),
     "dwell-ignored": ("m07-dwell", "GVE84-100"),
     "junction-stops": ("m08-junction", "GVE84-100"),
+    "junction-brake-ignored": ("m12-junction-brake", "GVE114-500"),
     "short-vector-ignored": ("m09-short-vector", "GVE84-100"),
     "halt-without-ramp": ("m10-halt-ramp", "GVE84-100"),
     "go-at-speed": ("m10-halt-ramp", "GVE114-500"),

@@ -1,0 +1,46 @@
+"""The cases of the areas the catalogue used to sample (which B governs a junction,
+settings that share nothing, each micro-step mode) catch the mutant made for each on
+every profile the case applies to, through the check of the rule it breaks, PASS the
+clean emulator there, and grade the reading of a silence NON-STRICT, never FAIL."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.runner import run_case
+from conformance.targets import parse_target
+from conformance.verdict import FAIL, NON_STRICT, PASS
+
+#: mutant -> (the case made to catch it, the rule of its failing check, the profiles)
+CATCHES = {
+    "junction-brake-ignored": ("10.2.measured.junction-brake-sides", "10.2.motion.junction",
+                               ("GVE84-100", "GVE114-500", "GVE54")),
+}
+
+#: reading -> (the case that measures its point, the rule it reads, the profiles)
+READ = {
+    "next-vectors-B": ("10.2.measured.junction-brake-sides", "10.2.motion.junction-own-b",
+                       ("GVE84-100", "GVE54")),
+}
+
+
+@pytest.mark.parametrize(("mutant", "profile"),
+                         [(m, p) for m, (_, _, ps) in CATCHES.items() for p in ps])
+def test_the_case_catches_its_mutant(mutant: str, profile: str) -> None:
+    case_id, rule, _ = CATCHES[mutant]
+    (c,) = select([case_id])
+    broken = run_case(c, parse_target(f"emu:{profile}", mutant=mutant), "mutation")
+    assert broken.verdict == FAIL
+    assert {k["rule"] for k in broken.checks if not k["ok"]} == {rule}
+    assert run_case(c, parse_target(f"emu:{profile}"), "mutation").verdict == PASS
+
+
+@pytest.mark.parametrize(("reading", "profile"),
+                         [(r, p) for r, (_, _, ps) in READ.items() for p in ps])
+def test_the_reading_grades_non_strict(reading: str, profile: str) -> None:
+    case_id, rule, _ = READ[reading]
+    (c,) = select([case_id])
+    read = run_case(c, parse_target(f"emu:{profile}?reading={reading}"), "mutation")
+    assert read.verdict == NON_STRICT
+    assert {k["rule"] for k in read.checks if not k["ok"]} == {rule}
