@@ -104,6 +104,12 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "accel-ignored": ("10.2", "A has no effect on the motion: the reset A is used", "10.2"),
     "dwell-ignored": ("10.2", "no T dwell before a vector that starts from rest", "10.2"),
     "junction-stops": ("10.2", "B ignored: every C brakes to rest at its end", "10.2"),
+    # settings that share nothing
+    "spindle-sets-feed-rate": ("12, 10", "the GVE114's !7V n also sets the feed rate V of "
+                               "address 0", "12"),
+    "axis-limit-x-for-all": ("10", "VL caps every axis at its X value", "10"),
+    "override-rewrites-velocity": ("10", "XM n also sets the modal V to V·n/100: XM100 no "
+                                   "longer returns to the V last set", "10"),
     "junction-brake-ignored": ("10.2", "B caps no junction: a C runs into the next C at the "
                                "highest rate the next allows", "10.2"),
     "short-vector-ignored": ("10.2", "the $ rule does not cap short vectors to B", "10.2"),

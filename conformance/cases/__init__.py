@@ -8,6 +8,7 @@ from conformance.cases import (  # noqa: F401
     families,
     frame,
     golden,
+    independence,
     index,
     interactions,
     keep,

@@ -124,5 +124,7 @@ def cmd_spindle(dev: Device, ses: Session, p: str, t: int) -> Reply:
     assert sp is not None
     value = within(dec(p), sp.range.lo, sp.range.hi)
     dev.state.spindle = value
+    if value and dev.mutant.active("spindle-sets-feed-rate"):
+        dev.state.modal.V = value
     dev.state.outputs = dev.state.outputs & 0xFE if value else dev.state.outputs | 0x01
     return []

@@ -151,6 +151,9 @@ class Device:
     def override(self, percent: int, t: int) -> None:
         """XM: an override of every vector, held and later ones (spec 10 XM)."""
         self.state.xm = percent
+        if self.mutant.active("override-rewrites-velocity"):
+            r, modal = self.profile.ranges["V"], self.state.modal
+            modal.V = max(r.lo, min(r.hi, modal.V * percent // 100))
         if not self.mutant.active("override-late"):
             self.motion.set_multiplier(percent, t)
 

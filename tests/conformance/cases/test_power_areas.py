@@ -16,6 +16,12 @@ from conformance.verdict import FAIL, NON_STRICT, PASS
 CATCHES = {
     "junction-brake-ignored": ("10.2.measured.junction-brake-sides", "10.2.motion.junction",
                                ("GVE84-100", "GVE114-500", "GVE54")),
+    "spindle-sets-feed-rate": ("12.spindle.measured.feed-unchanged",
+                               "12.spindle.feed-independent", ("GVE114-500",)),
+    "axis-limit-x-for-all": ("10.cmd.measured.axis-limits-own-axis",
+                             "10.cmd.axis-limits-own-axis", ("GVE84-100", "GVE114-500")),
+    "override-rewrites-velocity": ("10.cmd.measured.override-leaves-v",
+                                   "10.cmd.override-leaves-v", ("GVE84-100", "GVE114-500")),
 }
 
 #: reading -> (the case that measures its point, the rule it reads, the profiles)
@@ -44,3 +50,11 @@ def test_the_reading_grades_non_strict(reading: str, profile: str) -> None:
     read = run_case(c, parse_target(f"emu:{profile}?reading={reading}"), "mutation")
     assert read.verdict == NON_STRICT
     assert {k["rule"] for k in read.checks if not k["ok"]} == {rule}
+
+
+def test_the_spindle_case_reads_the_spindle_after_each_feed_rate() -> None:
+    (c,) = select(["12.spindle.unchanged-by-feed"])
+    r = run_case(c, parse_target("emu:GVE114-500"), "ci")
+    assert r.verdict == PASS
+    assert [k["what"] for k in r.checks if "still at 300" in k["what"]] == [
+        f"the spindle still at 300 after !0V{v}" for v in (40, 2000, 1000)]
