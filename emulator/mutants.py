@@ -115,6 +115,8 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "short-vector-ignored": ("10.2", "the $ rule does not cap short vectors to B", "10.2"),
     "halt-without-ramp": ("10.4", "H stops dead instead of braking on the ramp", "10.4"),
     "go-at-speed": ("10.4", "G resumes at the cruise rate instead of from rest", "10.4"),
+    "microstep-modes-swapped": ("10.7", "GVE54: M2 and M8 are swapped (M2 moves 2 sixteenths "
+                                "a step, M8 moves 8)", "10.7"),
     "microstep-rates-unscaled": ("10.7", "GVE54: V and B are not scaled by the micro-step "
                                  "factor", "10.7"),
 }.items()}

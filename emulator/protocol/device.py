@@ -63,7 +63,12 @@ class Device:
     def factor(self) -> int:
         """Counter units per commanded step (GVE54 micro-stepping, spec 10.7)."""
         ms = self.profile.microstep
-        return ms.factors[self.state.microstep] if ms is not None else 1
+        if ms is None:
+            return 1
+        mode = self.state.microstep
+        if self.mutant.active("microstep-modes-swapped"):
+            mode = {"2": "8", "8": "2"}.get(mode, mode)
+        return ms.factors[mode]
 
     def mpg_active(self) -> bool:
         """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""

@@ -76,6 +76,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "halt-without-ramp": ("m10-halt-ramp", "GVE84-100"),
     "go-at-speed": ("m10-halt-ramp", "GVE114-500"),
     "microstep-rates-unscaled": ("m11-microstep-rates", "GVE54"),
+    "microstep-modes-swapped": ("m16-each-microstep-mode", "GVE54"),
 }
 
 
