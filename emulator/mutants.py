@@ -107,7 +107,7 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     # settings that share nothing
     "spindle-sets-feed-rate": ("12, 10", "the GVE114's !7V n also sets the feed rate V of "
                                "address 0", "12"),
-    "axis-limit-x-for-all": ("10", "VL caps every axis at its X value", "10"),
+    "axis-limit-x-for-all": ("10, 10.2", "VL caps every axis at its X value", "10.2"),
     "override-rewrites-velocity": ("10", "XM n also sets the modal V to V·n/100: XM100 no "
                                    "longer returns to the V last set", "10"),
     "junction-brake-ignored": ("10.2", "B caps no junction: a C runs into the next C at the "

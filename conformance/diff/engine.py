@@ -178,7 +178,10 @@ class Pair:
             if out.ended:
                 return self._end(out)
             if command:
-                earlier.add(command)
+                # the spindle's V is not the feed rate's: a read after it names the spindle
+                spindle = self.profile.spindle
+                to_spindle = spindle is not None and step.address == spindle.address
+                earlier.add("spindle" if to_spindle else command)
             if command == "*S" and step.address is None:
                 context_packet = True
             elif command in _PACKET_BREAKERS:
