@@ -183,7 +183,7 @@ class Grammar:
             elif f.startswith("wait "):
                 continue
             elif (command_of(_PREFIX.sub("", f)) not in allowed
-                  or f.startswith("spindle:") and self.profile.spindle is None):
+                  or (f.startswith("spindle:") and self.profile.spindle is None)):
                 return False
         return True
 
