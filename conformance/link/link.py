@@ -46,6 +46,9 @@ QUIET = 2.5
 #: real time: at the end of a case, how long to listen for bytes still on their way
 END_QUIET = 0.05
 
+#: answers summed after the command whatever the mode before (spec 6, 10 J)
+_MODE_AFTER = {"%+": True, "%-": False, "J": False}
+
 # what the last frame left on the line
 _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
 
@@ -83,6 +86,18 @@ class Link:
 
     def byte_seconds(self, n: int) -> float:
         return n * 10 / self.baud
+
+    def answer_timeout(self, body: str, size: int) -> float:
+        """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
+        the frame's and an answer's bytes, a margin, and what the command itself takes
+        when it answers at its end."""
+        slow = self.guard.answer_seconds(body) or 0.0
+        return MARGIN + self.byte_seconds(size + 64) + slow
+
+    def summed_after(self, body: str) -> bool:
+        """Whether the answer to ``body`` carries a checksum: iff the mode is on after
+        the command (spec 6, 10 J)."""
+        return _MODE_AFTER.get(body, self.checksums)
 
     def wait(self, seconds: float) -> bytes:
         """Let ``seconds`` pass; returns whatever arrived meanwhile."""
@@ -190,12 +205,9 @@ class Link:
             self._book(sent, None)
             return None
         if timeout is None:
-            slow = self.guard.answer_seconds(body)
-            timeout = MARGIN + self.byte_seconds(len(data) + 64) + (slow or 0.0)
-        # the answer is summed iff the mode is on after the command (spec 6, 10 J)
-        after = {"%+": True, "%-": False, "J": False}.get(body, self.checksums)
+            timeout = self.answer_timeout(body, len(data))
         self._unbooked = sent
-        r = self.read_response(timeout, lines, summed=after)
+        r = self.read_response(timeout, lines, summed=self.summed_after(body))
         if r is not None:
             r.sent_at = sent_at
         return r
@@ -291,11 +303,14 @@ class Link:
                                    f"{readable(data)} late")
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
-             every: float = 0.05) -> Response | None:
-        """Send ``body`` until ``until(response)`` holds; the last response, or None."""
+             every: float = 0.05, *, send: Callable[[str], Response | None] | None = None
+             ) -> Response | None:
+        """Send ``body`` until ``until(response)`` holds; the last response, or None.
+        ``send``: what sends each frame (a caller that books them), else :meth:`send`."""
+        send = self.send if send is None else send
         deadline = self.now + max_seconds * SECOND
         while True:
-            r = self.send(body)
+            r = send(body)
             if r is not None and until(r):
                 return r
             if self.now > deadline:
