@@ -43,6 +43,8 @@ MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
     "go-without-inta": ("5, 10.4", "G with INTA = 0 answers 0 instead of 6", "10.4"),
     "line-while-busy": ("10.1", "L is accepted while vectors are queued or running", "10.1"),
     "queue-one-short": ("10.1", "the CONT buffer refuses one vector before it is full", "10.1"),
+    "refused-status-write-stored": ("4, 5, 10.3", "SW n,x with x beyond FF answers 5 but "
+                                    "stores the low byte of x", "4"),
     "refused-vector-queued": ("10.1", "a C answered 1 (no room) still enters the queue",
                               "10.1"),
     "packet-partial-commit": ("7", "a failing packet still commits its valid members", "7"),

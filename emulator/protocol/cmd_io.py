@@ -108,6 +108,8 @@ def cmd_status_read(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_status_write(dev: Device, ses: Session, p: str, t: int) -> Reply:
     a, x = fields(p, (2,))
     n, value = dec(a), hexa(x)
+    if value > 0xFF and 0 <= n <= 5 and dev.mutant.active("refused-status-write-stored"):
+        dev.write_status(n, value & 0xFF, t)
     dev.write_status(within(n, 0, 6), within(value, 0, 0xFF), t)
     return []
 

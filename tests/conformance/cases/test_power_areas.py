@@ -1,7 +1,8 @@
 """The cases of the areas the catalogue used to sample (which B governs a junction,
-settings that share nothing, each micro-step mode) catch the mutant made for each on
-every profile the case applies to, through the check of the rule it breaks, PASS the
-clean emulator there, and grade the reading of a silence NON-STRICT, never FAIL."""
+settings that share nothing, each micro-step mode, what a refusal leaves read back)
+catch the mutant made for each on every profile the case applies to, through the check
+of the rule it breaks, PASS the clean emulator there, and grade the reading of a silence
+NON-STRICT, never FAIL."""
 
 from __future__ import annotations
 
@@ -23,6 +24,8 @@ CATCHES = {
     "override-rewrites-velocity": ("10.cmd.measured.override-leaves-v",
                                    "10.cmd.override-leaves-v", ("GVE84-100", "GVE114-500")),
     "microstep-modes-swapped": ("10.7.microstep.each-mode", "10.7.motor.modes", ("GVE54",)),
+    "refused-status-write-stored": ("4.machine.refusals-read-back",
+                                    "4.response.failed-not-executed", ("GVE84-100",)),
 }
 
 #: reading -> (the case that measures its point, the rule it reads, the profiles)
