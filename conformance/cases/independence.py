@@ -5,7 +5,7 @@ one set, the motion (or the spindle) measured shows the other as it was."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers
+from conformance.cases._kit import answers, show
 from conformance.motion.probe import Probe
 
 #: per-axis limits, each its own: a limit taken from another axis changes every move
@@ -46,14 +46,18 @@ def override_leaves_v(ctx: CaseContext) -> None:
       applies=lambda p: p.spindle is not None,
       rules=("12.spindle.feed-independent", "12.spindle.speed"))
 def feed_unchanged(ctx: CaseContext) -> None:
-    link = ctx.link
     probe = Probe(ctx, "the feed rate V1500 after !7V900", "12.spindle.feed-independent")
     probe.send("V1500")
-    answers(ctx, link.send("V900", address=7), "0", "!7V900", rule="12.spindle.speed")
+    spindle(ctx, 900)
     probe.run(["A10000", "L600,0,0", [600, 0, 0], "L-600,0,0", [0, 0, 0]])
-    answers(ctx, link.send("V0", address=7), "0", "!7V0 switches the spindle off",
-            rule="12.spindle.speed")
+    spindle(ctx, 0)
     probe.judge()
+
+
+def spindle(ctx: CaseContext, value: int) -> None:
+    """Setup: the spindle at ``value`` (its answer is judged by 12.spindle.address-7)."""
+    r = ctx.link.send(f"V{value}", address=7)
+    ctx.require(r is not None and r.code == 0, f"!7V{value} answered {show(r)}")
 
 
 @case("12.spindle.unchanged-by-feed", rig=True, applies=lambda p: p.spindle is not None,

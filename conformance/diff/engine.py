@@ -266,7 +266,8 @@ class Pair:
 
     def _difference(self, command: str, rec: Record) -> str | None:
         moving, late = self.timing.allowance(command, rec.target, rec.reference)
-        judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late)
+        judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late,
+                        line=self.timing.line())
         kind = difference(command, rec.target, rec.reference, judge, moving=moving)
         if kind is None:
             rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)

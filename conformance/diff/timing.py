@@ -5,12 +5,15 @@ their comparison allows for where they cannot be: chosen once per pair.
 same instant on both, and nothing is allowed for (an answer's bytes and its timing must
 be the same). :class:`RealTime` (a target in real time) lets the reference follow the
 target's clock, and widens the positions' band by what the target's latency leaves
-uncertain.
+uncertain and by the line's band (conformance/link/line_band.py: the round trip the
+target's session measured and the example's own).
 """
 
 from __future__ import annotations
 
 from conformance.diff.sides import Exchange, Side
+from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
 #: real time: how long the reference must have been at rest, besides the target's
@@ -20,13 +23,14 @@ SETTLE_NS = 50_000_000
 
 #: what changes a running motion's course at the instant the unit acts on it (an input
 #: set by the rig too): in real time that instant is known only within a latency
-_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+_RETIMING = classes(retimes=True) | {"input"}
 #: of those, what stops a motion short of its vectors' ends
-_STOPPING = ("H", "SW6", "input")
-#: frames answered when their action ends, not at once
-_DEFERRED = ("H", "W", "J")
+_STOPPING = classes(stops=True) | {"input"}
+#: frames whose answer does not come at once: answered when the motion has stopped, or
+#: followed by a restart (their answer's time is no measure of the line's latency)
+_DEFERRED = classes(deferred=True) | classes(restart=True)
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
-_READINGS = ("P", "PF", ">")
+_READINGS = classes(position=True) | {">"}
 
 
 class Timing:
@@ -67,6 +71,11 @@ class Timing:
         reference on what changed the motion's course)."""
         return False, 0
 
+    def line(self) -> LineBand:
+        """How far either side of its exchange the target may have acted on a frame or
+        read its counters: nothing in virtual time."""
+        return EXACT
+
     def _follow(self, instant: int) -> None:
         """The reference waits until ``instant`` on the target's clock (if it is behind)."""
         self.reference.wait(max(0, instant - self.reference.now) / 1e9)
@@ -92,6 +101,7 @@ class RealTime(Timing):
         #: when the reference was first seen at rest (None: moving)
         self.idle_since: int | None = 0
         self.latency_ns = self.slack_ns = self.cut_ns = 0
+        self.trips: list[int] = []       # the target's round trips, answered at once (ns)
         self.lost = False
 
     def align(self) -> None:
@@ -110,6 +120,7 @@ class RealTime(Timing):
     def retimed(self, command: str, target: Exchange | None) -> None:
         if target is not None and command not in _DEFERRED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
+            self.trips.append(target.received_at - target.sent_at)
         if command in ("D", "K") and self.cut_ns:
             self.lost = True
         if command in _RETIMING and self.idle_since is None:
@@ -123,6 +134,9 @@ class RealTime(Timing):
         moving = command in _READINGS and (command == ">"
                                            or self._moving_near(target, reference))
         return moving, self.cut_ns + (self.slack_ns if moving else 0)
+
+    def line(self) -> LineBand:
+        return line_band(self.target.link.round_trip, [t / 1e6 for t in self.trips])
 
     def _watch_reference(self) -> None:
         """Note when the reference was first seen at rest (after each step; a late note

@@ -44,3 +44,23 @@ def test_in_real_time_a_course_change_while_moving_widens_later_readings():
     assert not t.lost and sent("D", 1) == (3, 4, 2) and t.lost
     t.begin()                                        # a new example forgets it all
     assert (t.latency_ns, t.slack_ns, t.cut_ns, t.lost, t.idle_since) == (0, 0, 0, False, 0)
+
+
+def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
+    """Exact in virtual time; in real time from the round trip the target's session
+    measured, its min and max widened by the example's immediate answers (not an H's)."""
+    target, reference = sides()
+    assert Timing(target, reference).line().exact
+    t = RealTime(target, reference)
+    target.open()
+    target.link.round_trip = {"min_ms": 1.0, "median_ms": 3.0, "max_ms": 4.0,
+                              "byte_ms": 0.5, "bytes_ms": 1.0}
+    assert t.line().seconds == 4.5e-3                # 1 one way + 3 jitter + 0.5 a byte
+    t.retimed("V", Exchange(b"V", b"0\r", 0, 6 * MS, None))
+    t.retimed("H", Exchange(b"H", b"8\r", 0, 300 * MS, None))
+    assert abs(t.line().seconds - 6.5e-3) < 1e-12     # jitter 6 - 1 (the session's min)
+    t.retimed("V", Exchange(b"V", b"0\r", 0, 5 * MS, None))
+    assert abs(t.line().seconds - 2.5e-3) < 1e-12     # two of its own: jitter 6 - 5
+    t.begin()
+    assert t.line().seconds == 4.5e-3
+    target.close_example()
