@@ -16,6 +16,7 @@ from conformance.cases import (  # noqa: F401
     motion,
     packet,
     params,
+    ports,
     reference,
     refusals,
     status,

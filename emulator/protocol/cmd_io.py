@@ -93,7 +93,10 @@ def cmd_output(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 def read_input(port: int) -> Handler:
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
-        return ["%02X" % dev.inputs[port]]
+        value = dev.inputs[port]
+        if dev.mutant.active("input-bits-swapped"):
+            value = value & 0xF9 | (value & 2) << 1 | (value & 4) >> 1
+        return ["%02X" % value]
     handler.__name__ = f"cmd_input_{port}"
     return handler
 

@@ -26,7 +26,15 @@ CATCHES = {
     "microstep-modes-swapped": ("10.7.microstep.each-mode", "10.7.motor.modes", ("GVE54",)),
     "refused-status-write-stored": ("4.machine.refusals-read-back",
                                     "4.response.failed-not-executed", ("GVE84-100",)),
+    "input-bits-swapped": ("10.cmd.ports.bit-by-bit", "10.cmd.port-bits",
+                           ("GVE84-100", "GVE114-500", "GVE54")),
 }
+
+#: further cases made for a mutant: (case, mutant, the rule of its failing check, profile)
+ALSO = (
+    ("10.3.status.register-ends", "refused-status-write-stored", "10.cmd.status-words",
+     "GVE54"),
+)
 
 #: reading -> (the case that measures its point, the rule it reads, the profiles)
 READ = {
@@ -72,3 +80,13 @@ def test_the_mode_case_moves_in_every_mode_of_the_profile() -> None:
     ends = [k["what"] for k in r.checks if k["rule"] == "10.7.motor.modes"]
     for mode, sixteenths in (("2", 8), ("4", 4), ("8", 2), ("F", 1)):
         assert f"M{mode}: L60,-30,15 ends {sixteenths} sixteenths a step on" in ends
+
+
+@pytest.mark.parametrize(("case_id", "mutant", "rule", "profile"), ALSO)
+def test_a_further_case_catches_the_mutant(case_id: str, mutant: str, rule: str,
+                                           profile: str) -> None:
+    (c,) = select([case_id])
+    broken = run_case(c, parse_target(f"emu:{profile}", mutant=mutant), "mutation")
+    assert broken.verdict == FAIL
+    assert rule in {k["rule"] for k in broken.checks if not k["ok"]}
+    assert run_case(c, parse_target(f"emu:{profile}"), "mutation").verdict == PASS
