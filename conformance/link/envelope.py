@@ -265,11 +265,12 @@ class Envelope:
                 continue
             read = point(value) + self.offset[axis]
             met = self.start[axis].meet(read)
-            if met is None and self.set_counters:
-                # a counter set since the last read at rest reads what no frame explains:
-                # taken for a counter that does not hold the value set (a narrow one
-                # wraps), not for axes moved millions of steps; the frames' bookkeeping
-                # stays and the counter is anchored to it again
+            if met is None and self.set_counters and self.outside([read]) is not None:
+                # a counter set since the last read at rest reads the axis beyond the
+                # envelope the guard never let it leave: taken for a counter that does
+                # not hold the value set (a narrow one wraps), not for axes moved
+                # millions of steps; the frames' bookkeeping stays and the counter is
+                # anchored to it again
                 self.offset[axis] = self.start[axis] - point(value)
                 self.unheld.append(axis)
                 continue
