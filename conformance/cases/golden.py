@@ -1,5 +1,5 @@
 """Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
-case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
+case ``11.golden.<name>``. The player is the suite's own."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
-TAGS = {"M", "M-ex", "D", "D-info"}
 
 
 def _tag(kind: str | None, default: str) -> str:
@@ -34,10 +34,16 @@ def play(ctx: CaseContext, t: Transcript, rule: str | None = None) -> None:
         if rec.direction == HOST:
             link.send_raw(rec.data)
         elif rec.direction in (UNIT, UNIT_MATCH):
-            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False)
+            lenient = not setup and tag in ("D", "D-info")
+            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False,
+                                   settle=not lenient)
             got = r.raw if r else b""
             ok = (got == rec.data if rec.direction == UNIT
                   else bool(rec.pattern().fullmatch(got)))
+            if not ok and lenient and r is not None:
+                # a unit reading this [D] point otherwise may answer with more lines:
+                # they are this record's, not a second answer or the next one's
+                got += link.rest_of_answer()
             if setup:
                 ctx.require(ok, f"setup answered {got!r} at {what}")
             else:

@@ -54,7 +54,7 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     "10.2.measured.short-vector": (
         ("10.2.motion.short-vector", "10.cmd.modal"), (), (),
         ["A10000", "$1000", "B300", "V2000", "L150,0,0", 0.5]),
-    # a zero-length C between two C: the next starts from rest, after T (10.2; issue 9 #3)
+    # a zero-length C between two C: the next starts from rest, after T (10.2)
     "10.2.measured.zero-length-c": (
         ("10.2.motion.zero-length",), (), (), ["C0,-92,0", "C0,0,0", "C0,46,0", 0.3]),
     # the rate never exceeds the variant's maximum (10.2)

@@ -17,7 +17,11 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from conformance.protocol.catalogue import classes
+from conformance.protocol.wire import HEX_BYTE
 
+#: an answer of one byte: `0,` and two hex digits
+HEX_ANSWER = rf"0,{HEX_BYTE}"
 # command -> (a valid frame on an idle unit after reset, a regex of its answer, the rule
 # of spec 10 it checks)
 FORMATS = {
@@ -32,19 +36,18 @@ FORMATS = {
     "PF": ("PF", r"0(,-?\d+){3}", "10.cmd.positions"), "N": ("N", "0", "10.cmd.zero"),
     "NX": ("NX0", "0", "10.cmd.set-axis"), "NY": ("NY0", "0", "10.cmd.set-axis"),
     "NZ": ("NZ0", "0", "10.cmd.set-axis"), "NA": ("NA0", "0", "10.cmd.set-axis"),
-    "ER": ("ER05", r"0,[0-9A-F]{2}", "10.cmd.eeprom-bytes"),
+    "ER": ("ER05", HEX_ANSWER, "10.cmd.eeprom-bytes"),
     "EFR": ("EFR30", r"0,\S+", "10.cmd.eeprom-words"),
     "EUR": ("EUR4C", r"0,\d+", "10.cmd.eeprom-words"), "O0": ("O0,FF", "0", "10.cmd.output"),
-    "I0": ("I0", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "I1": ("I1", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "I2": ("I2", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "SR": ("SR0", r"0,[0-9A-F]{2}", "10.cmd.status-words"),
-    "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", r"0,[0-9A-F]{2}", "10.cmd.flags"),
+    "I0": ("I0", HEX_ANSWER, "10.cmd.inputs"),
+    "I1": ("I1", HEX_ANSWER, "10.cmd.inputs"),
+    "I2": ("I2", HEX_ANSWER, "10.cmd.inputs"),
+    "SR": ("SR0", HEX_ANSWER, "10.cmd.status-words"),
+    "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", HEX_ANSWER, "10.cmd.flags"),
     "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 # commands of spec 10 a profile may lack (the refusal is 3)
-OPTIONAL = ["VL", "VK", "VN", "XM", "NX", "NY", "NZ", "NA", "W", "EFR", "EFW", "EUR", "EUW",
-            "M", "Y", "I0", "I2", "%", "*S", "*E"]
+OPTIONAL = classes(optional=True)
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 LACKING_LETTER = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100",
@@ -74,7 +77,7 @@ def formats(ctx: CaseContext) -> None:
       tag="M", source="spec 1, 5: code 3",
       rule="A command the profile lacks answers 3")
 def absent(ctx: CaseContext) -> None:
-    lacking = [c for c in OPTIONAL if c not in ctx.profile.commands]
+    lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
         ctx.expect(True, "the profile has every optional command")
     for name in lacking:

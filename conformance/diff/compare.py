@@ -24,9 +24,11 @@ from dataclasses import dataclass
 
 from conformance.diff.sides import Exchange
 from conformance.link.line_band import EXACT, LineBand
-from conformance.motion.tolerance import PLACEMENT_STEPS, SECOND, Window, reading_band
+from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+from conformance.protocol.catalogue import classes
+from gve_fixtures.protocol import SECOND
 
-POSITION_COMMANDS = ("P", "PF")
+POSITION_COMMANDS = classes(position=True)
 
 
 @dataclass(frozen=True)

@@ -10,14 +10,15 @@ import re
 
 from conformance.diff.sides import Exchange
 from conformance.diff.steps import Step
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 
-#: frames that close an open packet (spec 7)
-_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
+_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 #: a vector that moves nothing (and so waits no dwell)
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
-_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+_COURSE_CHANGERS = classes(course=True)
 
 
 class Course:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from conformance.diff.sides import Exchange, Side
 from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
 #: real time: how long the reference must have been at rest, besides the target's
@@ -22,13 +23,14 @@ SETTLE_NS = 50_000_000
 
 #: what changes a running motion's course at the instant the unit acts on it (an input
 #: set by the rig too): in real time that instant is known only within a latency
-_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+_RETIMING = classes(retimes=True) | {"input"}
 #: of those, what stops a motion short of its vectors' ends
-_STOPPING = ("H", "SW6", "input")
-#: frames answered when their action ends, not at once
-_DEFERRED = ("H", "W", "J")
+_STOPPING = classes(stops=True) | {"input"}
+#: frames whose answer does not come at once: answered when the motion has stopped, or
+#: followed by a restart (their answer's time is no measure of the line's latency)
+_DEFERRED = classes(deferred=True) | classes(restart=True)
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
-_READINGS = ("P", "PF", ">")
+_READINGS = classes(position=True) | {">"}
 
 
 class Timing:

@@ -1,4 +1,4 @@
-"""The motion envelope of a run (issue 8 item 1): where each axis may physically be, in
+"""The motion envelope of a run: where each axis may physically be, in
 counter units from where the run began, kept from the frames the unit accepted.
 
 Pure bookkeeping, no I/O. Every axis is a :class:`Span` (an interval: a position known

@@ -10,7 +10,7 @@ goes out and booked with its answer afterwards: frames built by :meth:`Link.send
 bytes of :meth:`Link.send_raw` (golden replays, noise) and frames changed by an injected
 fault alike.
 
-Answers belong to their frame (issue 8 item 5): bytes that arrive before a frame is
+Answers belong to their frame: bytes that arrive before a frame is
 sent are logged as unsolicited and never read as its answer; after a frame timed out
 the link waits for a quiet line before the next one (real time), so a late answer is
 not taken for a later frame's; bytes after a complete answer are recorded in
@@ -34,10 +34,9 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next
@@ -114,6 +113,10 @@ class Link:
             self._record(UNIT, data)
             self._after_answer(data, "during a wait")
         self._last = (_UNASKED, b"", b"")
+        # raw frames not read for an answer: booked as unanswered now, not only when a
+        # later frame goes out on this link (there may be none: a `*S` that ends an
+        # example must still leave the guard knowing that a packet may be open)
+        self._book_unbooked(None)
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool) -> bytes:
@@ -174,7 +177,7 @@ class Link:
             if piece:
                 self._write(piece)
         if frames:
-            self._last = (_UNASKED, frames[-1].raw, b"")
+            self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -237,7 +240,10 @@ class Link:
             self.checksums = False
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
-                      summed: bool | None = None) -> Response | None:
+                      summed: bool | None = None, settle: bool = True) -> Response | None:
+        """The next answer (``lines`` lines); in real time bytes right behind it are
+        taken as a second answer unless ``settle`` is false (the caller may take them as
+        :meth:`rest_of_answer`)."""
         timeout = MARGIN if timeout is None else timeout
         raw = bytearray()
         self.port.timeout = timeout
@@ -257,7 +263,7 @@ class Link:
         # a frame an injected fault dropped cannot be answered late
         self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
                       self._last[1], data)
-        if not self.virtual and data and self.port.in_waiting:
+        if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
         self._book_unbooked(real)
         r = real
@@ -272,6 +278,22 @@ class Link:
         if not self._dropped:
             self.guard.answered(real)
         return r
+
+    def rest_of_answer(self, seconds: float = MARGIN) -> bytes:
+        """The lines that follow an answer at once, taken as part of it (not as a
+        second answer): a unit reading a [D] point otherwise may answer a frame with
+        more lines than expected (`>` after `@`, if `@` is remembered)."""
+        raw = bytearray()
+        self.port.timeout = seconds
+        while True:
+            chunk = self.port.read_until(CR)
+            raw += chunk
+            if not chunk.endswith(CR):
+                break
+            self.port.timeout = self.byte_seconds(64)
+        if raw:
+            self._record(UNIT, bytes(raw), "the rest of the answer")
+        return bytes(raw)
 
     def settle(self, *, final: bool = False) -> bytes:
         """Take what arrived although nothing was asked, before the next frame (or, with

@@ -21,7 +21,6 @@ from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
 from conformance.link.line_band import EXACT, LineBand, line_band
-from conformance.motion.arith import SECOND
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
@@ -33,6 +32,7 @@ from conformance.motion.tolerance import (
     tolerance,
     widened,
 )
+from gve_fixtures.protocol import SECOND
 
 #: dense model points per trace
 TRACE_POINTS = 60

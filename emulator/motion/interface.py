@@ -16,9 +16,6 @@ from dataclasses import dataclass
 from enum import IntFlag
 from typing import Protocol, runtime_checkable
 
-#: One second in clock units.
-SECOND = 1_000_000_000
-
 
 @dataclass(frozen=True)
 class Vector:

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from emulator.motion.interface import EMPTY_SAVE, SECOND, KeepSave
+from emulator.motion.interface import EMPTY_SAVE, KeepSave
 from emulator.protocol.device import Device
 from emulator.protocol.params import CommandError, dec, fields, within
 from emulator.protocol.reply import Deferred, Reply
 from emulator.protocol.session import Session
 from emulator.protocol.state import INTA, INTCOM, Saved
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import SECOND, ErrorCode
 
 Handler = Callable[[Device, Session, str, int], Reply]
 

@@ -1,4 +1,4 @@
-"""The C core and the Python twin are bit-identical (issue 3): the same random sequences of
+"""The C core and the Python twin are bit-identical: the same random sequences of
 pushes, waits, halts, resumes, overrides, KEEP/RESTORE, DELETE and N give the same
 positions, flags, queue lengths, events, drain instants and pulse trains."""
 

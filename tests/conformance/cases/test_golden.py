@@ -35,3 +35,15 @@ def test_an_exchange_no_envelope_lets_through_says_so():
     (c,) = select(["11.golden.g3-packet"])
     stopped = run_case(c, used_unit("GVE114-500", max_travel=100_000))
     assert stopped.verdict == COULD_NOT_TEST and "the emulator only" in stopped.notes[0]
+
+
+def test_a_d_record_takes_the_extra_lines_of_a_unit_reading_it_otherwise():
+    # a unit that remembers @ answers > after @ with two lines where g7 expects one (a
+    # [D] record): the second line is that record's, not a second answer nor SR0's
+    from conformance.targets import parse_target
+    from conformance.verdict import NON_STRICT
+    (c,) = select(["11.golden.g7-reset-state"])
+    r = run_case(c, parse_target("emu:GVE84-100?reading=index-remembered"))
+    assert r.verdict == NON_STRICT, r.notes
+    (failed,) = [ch for ch in r.checks if not ch["ok"]]
+    assert failed["observed"] == "!0@\\r0,0\\r" and failed["tag"] == "D"

@@ -1,4 +1,4 @@
-"""Ctrl-C for real (issue 8 item 4): `gve-conformance` runs against the emulator on a pty
+"""Ctrl-C for real: `gve-conformance` runs against the emulator on a pty
 behind a proxy, which delivers SIGINT to it while a chosen frame is in flight. The next
 frames on the line are H, then D; no motion follows; the EEPROM image (random bytes) and
 the status words are as found; the reports are written and show the interrupted case."""
