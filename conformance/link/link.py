@@ -99,8 +99,8 @@ class Link:
     def line_seconds(self) -> float:
         """Real time: twice the slowest round trip the session measured (a USB adapter
         holds an answer's bytes up to its latency timer, and may hold its last piece
-        that long again); nothing when the line was not measured."""
-        return 2 * self.round_trip.get("max_ms", 0.0) / 1e3
+        that long again); nothing in virtual time or when the line was not measured."""
+        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
