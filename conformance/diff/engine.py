@@ -173,7 +173,10 @@ class Pair:
         if out.ended:
             return True
         if command:
-            earlier.add(command)
+            # the spindle's V is not the feed rate's: a read after it names the spindle
+            spindle = self.profile.spindle
+            to_spindle = spindle is not None and step.address == spindle.address
+            earlier.add("spindle" if to_spindle else command)
         self.course.stepped(command, step)
         return False
 
