@@ -91,10 +91,16 @@ class Link:
 
     def answer_timeout(self, body: str, size: int) -> float:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
-        the frame's and an answer's bytes, a margin, and what the command itself takes
-        when it answers at its end."""
+        the frame's and an answer's bytes, a margin, what the command itself takes when it
+        answers at its end, and what the line adds (:meth:`line_seconds`)."""
         slow = self.guard.answer_seconds(body) or 0.0
-        return MARGIN + self.byte_seconds(size + 64) + slow
+        return MARGIN + self.byte_seconds(size + 64) + slow + self.line_seconds()
+
+    def line_seconds(self) -> float:
+        """Real time: twice the slowest round trip the session measured (a USB adapter
+        holds an answer's bytes up to its latency timer, and may hold its last piece
+        that long again); nothing in virtual time or when the line was not measured."""
+        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
@@ -252,7 +258,7 @@ class Link:
             raw += chunk
             if not chunk.endswith(CR):
                 break
-            self.port.timeout = MARGIN
+            self.port.timeout = MARGIN + self.line_seconds()
         data = bytes(raw)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None
