@@ -48,6 +48,7 @@ CORE_DEVIATIONS: dict[str, Deviation] = {
     "dwell-between-continuous": Deviation.CONTINUOUS_DWELL,
     "halt-short-of-target": Deviation.HALT_SHORT,
     "junction-stops": Deviation.JUNCTION_STOPS,
+    "junction-brake-ignored": Deviation.JUNCTION_UNBRAKED,
     "halt-without-ramp": Deviation.HALT_DEAD,
     "go-at-speed": Deviation.GO_AT_SPEED,
 }

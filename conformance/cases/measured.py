@@ -131,3 +131,26 @@ def reset_motion(ctx: CaseContext) -> None:
     Probe(ctx, "reset VN, XM, VL, T", "9.reset.decided").script(
         ["L300,-400,0", [300, -400, 0], "L10,0,0", 0.03])
     Probe(ctx, "reset B", "9.reset.brake").script(["C-300,400,0", "C-200,0,0", 0.7])
+
+
+#: a junction with B differing on both sides, each way round: (B before, B after)
+JUNCTION_SIDES = ((300, 1500), (1500, 300))
+
+
+@case("10.2.measured.junction-brake-sides", timing=True,
+      rules=("10.2.motion.junction", "10.2.motion.junction-own-b"))
+def junction_sides(ctx: CaseContext) -> None:
+    """Which B governs a junction when the two C captured different ones: the ending C's
+    (10.2.motion.junction-own-b [D]). Readings that fit a junction at the next C's B are
+    that other reading (NON-STRICT); readings that fit neither break B itself [M]."""
+    for before, after in JUNCTION_SIDES:
+        name = f"B{before} before the junction, B{after} after"
+        probe = Probe(ctx, name, "10.2.motion.junction")
+        probe.run(["A5", "V2000", f"B{before}", "C700,0,0", f"B{after}", "C700,0,0", 1.2,
+                   [1400, 0, 0]])
+        probe.next_brake = True
+        other = probe.fits()
+        probe.next_brake = False
+        if other and not probe.fits():
+            probe.rule = "10.2.motion.junction-own-b"
+        probe.judge()

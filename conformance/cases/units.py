@@ -17,6 +17,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from conformance.motion.probe import Probe
 from conformance.protocol.catalogue import classes
 from conformance.protocol.wire import HEX_BYTE
 
@@ -184,3 +185,42 @@ def spindle(ctx: CaseContext) -> None:
     ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
     code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors",
          rule="12.spindle.commands")
+
+
+#: the move each micro-step mode makes (commanded steps): a factor of another mode ends
+#: elsewhere on every axis
+MODE_MOVE = (60, -30, 15)
+
+
+def _rest(ctx: CaseContext) -> None:
+    r = ctx.link.poll("L0,0,0", lambda r: r.code != 1, 30)
+    ctx.require(r is not None and r.code == 0, "the move did not end within 30 s")
+
+
+@case("10.7.microstep.each-mode", requires=("M",), timing=True,
+      rules=("10.7.motor.modes", "10.7.motor.rates-scaled", "10.2.motion.gve54-units"))
+def each_mode(ctx: CaseContext) -> None:
+    """Every micro-step mode with the same move: where it ends (exact, in sixteenths) and
+    how it gets there (measured, the rates scaled by the mode's factor)."""
+    ms = ctx.profile.microstep
+    start = position(ctx)
+    ctx.require(start is not None, "PF did not answer with positions")
+    for mode, factor in ms.factors.items():
+        setup(ctx, f"M{mode}")
+        setup(ctx, "L" + vector(ctx, *MODE_MOVE))
+        _rest(ctx)
+        want = [s + factor * d for s, d in zip(start, MODE_MOVE, strict=True)]
+        ctx.expect(position(ctx) == want, f"M{mode}: L{vector(ctx, *MODE_MOVE)} ends "
+                   f"{factor} sixteenths a step on", observed=position(ctx), expected=want,
+                   rule="10.7.motor.modes")
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+    setup(ctx, f"M{ms.reset_mode}")
+    for mode in ms.factors:
+        Probe(ctx, f"the move in M{mode}", "10.7.motor.rates-scaled").script(
+            [f"M{mode}", "A2", "V400", "L" + vector(ctx, *MODE_MOVE), 0.5])
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+        setup(ctx, f"M{ms.reset_mode}")
+    ctx.expect(position(ctx) == start, "the axes are back where the case found them",
+               observed=position(ctx), expected=start, rule="10.7.motor.modes")

@@ -33,6 +33,7 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
+    add_loudness,
     exit_status,
     positive,
     run_id,
@@ -121,11 +122,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    loud = ap.add_mutually_exclusive_group()
-    loud.add_argument("-q", "--quiet", action="store_true",
-                      help="print only the last line (the verdict)")
-    loud.add_argument("-v", "--verbose", action="store_true",
-                      help="print a line for every case, on a terminal too")
+    add_loudness(ap, "print a line for every case, on a terminal too")
     ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
                     default="auto", help="colour the verdicts: auto (a terminal without "
                     "NO_COLOR set), always or never (default auto)")

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import re
 
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
@@ -49,7 +49,7 @@ class Course:
         self.in_packet = False
 
     # -- what it was given -----------------------------------------------------------------
-    def took(self, command: str, body: str, reference: Exchange, *, first: bool = True
+    def took(self, command: str, body: str, reference: RoundTrip, *, first: bool = True
              ) -> None:
         """The reference answered ``body``; ``first``: not a later frame of a fill (whose
         vectors join the first: no dwell)."""
@@ -67,7 +67,7 @@ class Course:
         elif command in _PACKET_BREAKERS:
             self.in_packet = False
 
-    def _dwell(self, command: str, body: str, reference: Exchange) -> None:
+    def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
         if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:

@@ -27,6 +27,7 @@ _SENT = {
     "bad": lambda profile: {"checksum": "bad"},
     "stalled": lambda profile: {"stall": (2, (profile.watchdog_ms + 50) / 1000)},
     "other": lambda profile: {"address": (profile.address + 1) % 8, "answer": False},
+    "spindle": lambda profile: {"address": profile.spindle.address},
 }
 _PREFIX = re.compile(r"^(%s):" % "|".join(_SENT))
 
@@ -222,7 +223,10 @@ class Grammar:
             elif f.startswith("fill "):
                 if command_of(f.split()[2]) not in allowed:
                     return False
-            elif not f.startswith("wait ") and command_of(_PREFIX.sub("", f)) not in allowed:
+            elif f.startswith("wait "):
+                continue
+            elif (command_of(_PREFIX.sub("", f)) not in allowed
+                  or (f.startswith("spindle:") and self.profile.spindle is None)):
                 return False
         return True
 
@@ -355,7 +359,8 @@ class Grammar:
         """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`,
         `fill N BODY`, `bad:BODY` (a wrong checksum in checksum mode), `stalled:BODY` (a
         pause longer than the watchdog after its second byte), `other:BODY` (to another
-        address), else a frame; `J` is followed by its restart's wait."""
+        address), `spindle:BODY` (to the GVE114's spindle address), else a frame; `J` is
+        followed by its restart's wait."""
         out = []
         for f in lines:
             word, _, rest = f.partition(" ")

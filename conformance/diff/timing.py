@@ -11,7 +11,7 @@ target's session measured and the example's own).
 
 from __future__ import annotations
 
-from conformance.diff.sides import Exchange, Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.link.line_band import EXACT, LineBand, line_band
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
@@ -60,11 +60,11 @@ class Timing:
         """The target waited a while: the reference waits as long."""
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: Exchange | None) -> None:
+    def retimed(self, command: str, target: RoundTrip | None) -> None:
         """A frame went to both sides, ``target`` its exchange with the target (None: a
         rig input)."""
 
-    def allowance(self, command: str, target: Exchange, reference: Exchange
+    def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
         """For the answers to ``command``: (whether the reading may have been taken while
         the axes moved, how much later in ns the target may have acted than the
@@ -117,7 +117,7 @@ class RealTime(Timing):
         self._watch_reference()
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: Exchange | None) -> None:
+    def retimed(self, command: str, target: RoundTrip | None) -> None:
         if target is not None and command not in _DEFERRED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
             self.trips.append(target.received_at - target.sent_at)
@@ -128,7 +128,7 @@ class RealTime(Timing):
             if command in _STOPPING:
                 self.cut_ns += self.latency_ns
 
-    def allowance(self, command: str, target: Exchange, reference: Exchange
+    def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
         self._watch_reference()
         moving = command in _READINGS and (command == ">"
@@ -154,7 +154,7 @@ class RealTime(Timing):
             if not self.lost:
                 self.cut_ns = 0
 
-    def _moving_near(self, target: Exchange, reference: Exchange) -> bool:
+    def _moving_near(self, target: RoundTrip, reference: RoundTrip) -> bool:
         """Whether the reading may have been taken while the axes moved on either side:
         the reference had not been at rest for as long as the target's window is wide
         (the target may have processed the frame that much later or earlier)."""

@@ -16,7 +16,7 @@ from functools import cache
 
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from conformance.protocol.parse import parse
-from conformance.protocol.wire import byte_sum
+from conformance.protocol.wire import HEX_BYTE, byte_sum
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import MAX_FRAME
 from gve_fixtures.rules import load_rules
@@ -24,7 +24,7 @@ from gve_fixtures.rules import load_rules
 _DEC = re.compile(r"-?[0-9]+\Z")
 _HEX = re.compile(r"[0-9A-Fa-f]+\Z")
 _FLOAT = re.compile(r"-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?\Z")
-_SUM = re.compile(rb",([0-9A-Fa-f]{2})\Z")
+_SUM = re.compile(rb",(%b)\Z" % HEX_BYTE.encode(), re.IGNORECASE)
 _PRINTABLE = re.compile(rb"[\x20-\x7e]*")
 #: what a host might put between parameters instead of a comma (spec 3 [M] "commas")
 _SEPARATORS = re.compile(r"[ ;:\t]")

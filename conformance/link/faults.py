@@ -17,7 +17,7 @@ Pieces = list[tuple[bytes, float]]
 
 
 @dataclass
-class Fault:
+class FrameFault:
     direction: str
     kind: str
     params: dict = field(default_factory=dict)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from conformance.link.faults import Fault
+from conformance.link.faults import FrameFault
 from conformance.link.framing import (
     CR,
     HostFrame,
@@ -69,7 +69,7 @@ class Link:
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[str] = []
-        self._faults: list[Fault] = []
+        self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
         self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
@@ -91,10 +91,16 @@ class Link:
 
     def answer_timeout(self, body: str, size: int) -> float:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
-        the frame's and an answer's bytes, a margin, and what the command itself takes
-        when it answers at its end."""
+        the frame's and an answer's bytes, a margin, what the command itself takes when it
+        answers at its end, and what the line adds (:meth:`line_seconds`)."""
         slow = self.guard.answer_seconds(body) or 0.0
-        return MARGIN + self.byte_seconds(size + 64) + slow
+        return MARGIN + self.byte_seconds(size + 64) + slow + self.line_seconds()
+
+    def line_seconds(self) -> float:
+        """Real time: twice the slowest round trip the session measured (a USB adapter
+        holds an answer's bytes up to its latency timer, and may hold its last piece
+        that long again); nothing in virtual time or when the line was not measured."""
+        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
@@ -142,9 +148,9 @@ class Link:
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
         """Plan a fault for the next frame ("host") or response ("unit")."""
-        self._faults.append(Fault(direction, kind, params))
+        self._faults.append(FrameFault(direction, kind, params))
 
-    def _fault(self, direction: str) -> Fault | None:
+    def _fault(self, direction: str) -> FrameFault | None:
         for i, f in enumerate(self._faults):
             if f.direction == direction:
                 return self._faults.pop(i)
@@ -252,7 +258,7 @@ class Link:
             raw += chunk
             if not chunk.endswith(CR):
                 break
-            self.port.timeout = MARGIN
+            self.port.timeout = MARGIN + self.line_seconds()
         data = bytes(raw)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None

@@ -75,6 +75,8 @@ def cmd_axis_limits(dev: Device, ses: Session, p: str, t: int) -> Reply:
     values = [dec(x) for x in fields(p, (3, 4) if axes == 4 else (axes,))]
     r = dev.profile.ranges["VL"]
     limits = [min(within(v, r.lo, r.hi), dev.profile.max_rate) for v in values]
+    if dev.mutant.active("axis-limit-x-for-all"):
+        limits = limits[:1] * len(limits)
     dev.state.modal.VL[: len(limits)] = limits
     return []
 

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from conformance.diff.grammar import load_grammar
 from conformance.diff.labels import command_of
 from conformance.host.grammar import parse_frame
-from conformance.link.safety import Command
+from conformance.link.safety import Body
 from conformance.protocol.catalogue import catalogue, commands
 from conformance.protocol.framer import HostFramer
 from gve_fixtures.profile import load_profile
@@ -27,7 +27,7 @@ def classes(body: str) -> tuple[str, ...]:
     """The class each reader gives the body: the guard's, diff's, the host role's on
     each profile ("" for none)."""
     raw = b"!0" + body.encode("latin-1")
-    return (Command.parse(body).name, command_of(body),
+    return (Body.parse(body).name, command_of(body),
             *(parse_frame(raw, units, checksums=False).key for units in UNITS))
 
 
