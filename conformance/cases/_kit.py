@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from conformance.case import CaseContext
+from conformance.case import CaseContext, case
 from conformance.link.framing import Response
+from conformance.motion.probe import Probe
 
 
 def show(r: Response | None) -> str:
@@ -138,3 +139,32 @@ def step_factor(ctx: CaseContext) -> int:
     reset's: GVE54 MF, one sixteenth; 1 where there is no micro-stepping)."""
     m = ctx.profile.microstep
     return 1 if m is None else m.factors[m.reset_mode]
+
+
+def fill_scenario(step, ctx: CaseContext):
+    """The scenario's placeholders: ``{max}`` the variant's maximum rate, ``{max10}`` a
+    tenth of it, ``{xm}`` an override doubling V where the profile has XM."""
+    if not isinstance(step, str):
+        return step
+    rate = ctx.profile.max_rate
+    return step.format(max=rate, max10=rate // 10, xm="XM200" * ("XM" in ctx.profile.commands))
+
+
+def measured_case(id: str, rules: tuple[str, ...], requires: tuple[str, ...],
+                  families: tuple[str, ...], scenario: list) -> None:
+    """Register the case ``id`` of the motion measured. Each case runs a short scenario,
+    reads ``PF`` at known instants and judges every reading against the suite's own model of
+    spec 10.2 (conformance/motion), with the tolerance printed in each check: zero on the
+    embedded emulator's virtual clock (and not printed); on serial and TCP targets the window
+    in which the unit processed each frame, widened by the line's band (from the round trip
+    measured at the session's start and the scenario's own, conformance/link/line_band.py),
+    and one step: a position read at rest after an override, a HALT or a micro-step change is
+    judged with what the event's instant so widened can change (``±1.8 ms line, ±7 steps``).
+
+    A scenario is a list: a frame to send, seconds to sample ``PF`` for (every 50 ms, or a
+    pair: seconds and how often), or a position (in commanded steps) to poll ``PF`` until."""
+    @case(id, rules=rules, requires=requires, timing=True,
+          applies=(lambda p: p.family in families) if families else None)
+    def measured(ctx: CaseContext) -> None:
+        steps = (fill_scenario(s, ctx) for s in scenario)
+        Probe(ctx, id, rules[0]).script([s for s in steps if s])

@@ -1,17 +1,12 @@
-"""Section 8: index @ and repeat >."""
+"""Spec section 8, Index `@` and repeat `>`: the cases that check it.
+
+`@` counts the frames a unit received, `>` repeats the last one and its answer: the host's
+way to recover a lost answer."""
 
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import (
-    answers,
-    fresh_reset,
-    index,
-    index_moved,
-    position,
-    setup,
-    vector,
-)
+from conformance.cases._kit import answers, fresh_reset, index, index_moved, position, setup, vector
 from conformance.link.framing import byte_sum
 
 
@@ -27,6 +22,16 @@ def counts(ctx: CaseContext) -> None:
     index_moved(ctx, before, 3, "three frames, two refused, counted")
 
 
+@case("8.index.modulo-256",
+      rules=("8.index.counts",))
+def modulo(ctx: CaseContext) -> None:
+    """The index counts modulo 256."""
+    before = index(ctx)
+    for _ in range(258):
+        ctx.link.send("F")
+    index_moved(ctx, before, 258, "258 frames later the index moved by 2 (mod 256)")
+
+
 @case("8.index.queries-not-counted", rules=("8.index.queries-uncounted",))
 def queries(ctx: CaseContext) -> None:
     link = ctx.link
@@ -37,14 +42,24 @@ def queries(ctx: CaseContext) -> None:
     index_moved(ctx, before, 1, "only V1000 counted", queries=True)
 
 
-@case("8.index.modulo-256",
-      rules=("8.index.counts",))
-def modulo(ctx: CaseContext) -> None:
-    """The index counts modulo 256."""
+@case("8.recovery.lost-response",
+      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"))
+def lost_response(ctx: CaseContext) -> None:
+    """A lost response is recovered with @ and > without executing the vector twice."""
+    link = ctx.link
     before = index(ctx)
-    for _ in range(258):
-        ctx.link.send("F")
-    index_moved(ctx, before, 258, "258 frames later the index moved by 2 (mod 256)")
+    link.inject("unit", "drop")
+    lost = link.send("L" + vector(ctx, 9))
+    ctx.require(lost is None, "the injected loss did not happen")
+    index_moved(ctx, before, 1, "the index shows the command arrived", rule="8.index.counts")
+    r = link.send(">", lines=2)
+    # > showing the @ just sent: that @ is never remembered is our reading [D]
+    shows_index = r is not None and r.lines[:1] == [f"!{link.address}@".encode()]
+    answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer",
+            rule="8.repeat.remembered" if shows_index else "8.repeat.answer")
+    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
+               expected=[9, 0, 0], tag="always")
 
 
 @case("8.repeat.last-frame-and-answer",
@@ -81,26 +96,6 @@ def not_again(ctx: CaseContext) -> None:
     here = position(ctx)
     want = [start[0] + 7, start[1], start[2]]
     ctx.expect(here == want, "the vector ran once", observed=here, expected=want, tag="always")
-
-
-@case("8.recovery.lost-response",
-      rules=("8.index.counts", "8.repeat.answer", "8.repeat.remembered"))
-def lost_response(ctx: CaseContext) -> None:
-    """A lost response is recovered with @ and > without executing the vector twice."""
-    link = ctx.link
-    before = index(ctx)
-    link.inject("unit", "drop")
-    lost = link.send("L" + vector(ctx, 9))
-    ctx.require(lost is None, "the injected loss did not happen")
-    index_moved(ctx, before, 1, "the index shows the command arrived", rule="8.index.counts")
-    r = link.send(">", lines=2)
-    # > showing the @ just sent: that @ is never remembered is our reading [D]
-    shows_index = r is not None and r.lines[:1] == [f"!{link.address}@".encode()]
-    answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer",
-            rule="8.repeat.remembered" if shows_index else "8.repeat.answer")
-    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
-    ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
-               expected=[9, 0, 0], tag="always")
 
 
 @case("8.repeat.queries-forgotten", requires=("%",), rules=("8.repeat.remembered",))

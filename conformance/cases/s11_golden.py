@@ -1,5 +1,7 @@
-"""Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
-case ``11.golden.<name>``. The player is the suite's own."""
+"""Spec section 11, Golden exchanges from the documents: the cases that check it.
+
+Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a case
+``11.golden.<name>``. The player is the suite's own."""
 
 from __future__ import annotations
 
@@ -133,7 +135,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
     return None if math.isinf(need) else math.ceil(need)
 
 
-def _register(path: Path) -> None:
+def measured_case(path: Path) -> None:
     t = load(path)
     families = t.meta.get("profiles", "").split()
     needs_rig = any(r.direction == ACTION and r.action[0] in RIG_ACTIONS for r in t.records)
@@ -167,4 +169,4 @@ def _register(path: Path) -> None:
 
 
 for _path in golden_transcripts():
-    _register(_path)
+    measured_case(_path)

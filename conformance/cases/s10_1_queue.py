@@ -1,17 +1,71 @@
-"""Sections 4, 7, 10.1: what a refused frame leaves behind. A vector refused with 1 leaves
-the queue exactly as it was (the vectors that run after it and where they end show it),
-and a packet that fails leaves no effect of any member: no vector queued, no `B` set (a
-junction at the reset `B`, measured)."""
+"""Spec section 10.1, Queue, L and C: the cases that check it.
+
+The CONT buffer, stand-alone and continuous vectors."""
 
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, fill_queue, position, show, step_factor, vector
-from conformance.motion.probe import Probe
+from conformance.cases._kit import (
+    answers,
+    code,
+    fill_queue,
+    measured_case,
+    position,
+    setup,
+    show,
+    step_factor,
+    vector,
+)
 
 #: the vectors refused for want of room, then sent again until accepted: along Y and Z,
 #: where the queue's back-and-forth vectors along X never go
 REFUSED_C, REFUSED_L = (0, 3, 0), (0, 0, 5)
+
+
+# id -> (rules (the first judges the readings), commands it requires, families, scenario)
+SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], list]] = {
+    # modal parameters are captured with each vector when it is accepted (10.1)
+    "10.1.measured.captured": (
+        ("10.1.queue.captured",), (), (),
+        ["A10000", "V1000", "C400,0,0", "V3000", "A1", "C400,0,0", 0.9]),
+}
+
+
+for _id, (_rules, _requires, _families, _scenario) in SCENARIOS.items():
+    measured_case(_id, _rules, _requires, _families, _scenario)
+
+
+@case("10.1.line.refused-while-busy",
+      rules=("10.1.queue.line-alone", "5.code.queue-full"))
+def l_busy(ctx: CaseContext) -> None:
+    """L is accepted only when nothing is queued or running; otherwise 1."""
+    setup(ctx, "C" + vector(ctx, 500))
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 1, "L while a C runs → 1")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.expect(position(ctx) == [500, 0, 0], "the refused L did not move",
+               observed=position(ctx), expected=[500, 0, 0], tag="always")
+
+
+@case("10.1.line.wait-idiom",
+      rules=("10.1.queue.wait-idiom",))
+def idiom(ctx: CaseContext) -> None:
+    setup(ctx, "L" + vector(ctx, 300))
+    code(ctx, ctx.link.send("L" + vector(ctx, 0)), 1, "L0,0,0 while moving → 1")
+    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
+    code(ctx, r, 0, "L0,0,0 once idle → 0")
+    ctx.expect(position(ctx) == [300, 0, 0], "the first L completed",
+               observed=position(ctx), expected=[300, 0, 0])
+
+
+@case("10.1.queue.executing-counts",
+      rules=("10.1.queue.cont-buffer", "10.cmd.flags", "1.profile.buffer"))
+def queue_full_flag(ctx: CaseContext) -> None:
+    """The CONT buffer's size includes the executing vector; F shows bit 5 when full."""
+    if fill_queue(ctx):
+        r = ctx.link.send("F")
+        ctx.expect(r is not None and r.values[:1] == ["F0"], "F = INTA + RUN + INTCOM + full",
+                   observed=show(r), expected="8,F0")
+    ctx.link.send("D")
 
 
 @case("10.1.queue.refused-leaves-queue",
@@ -47,33 +101,3 @@ def refused_vector(ctx: CaseContext) -> None:
                "every queued vector ran once, and each refused one only once taken",
                observed=position(ctx), expected=expected,
                rule="4.response.failed-not-executed")
-
-
-#: packets that fail, each with a B member that must not be set: (members, *E's n, answer)
-FAILING = (
-    (["B10", "C0,50,0", "C0,50,0"], 4, "2,3"),       # count mismatch
-    (["B20", "C0,50,0", "V100"], 3, "4,3"),          # a member that may not be one
-    (["B30", "B1", "C0,50,0"], 3, "5,3"),            # a member out of range
-)
-
-
-@case("7.packet.failed-leaves-nothing", requires=("*S",), timing=True,
-      rules=("7.packet.all-or-nothing", "7.packet.codes"))
-def failed_packet(ctx: CaseContext) -> None:
-    link = ctx.link
-    start = position(ctx)
-    for members, n, want in FAILING:
-        link.send("*S", answer=False)
-        for m in members:
-            link.send(m, answer=False)
-        answers(ctx, link.send(f"*E{n}"), want, f"{', '.join(members)}, *E{n} → {want}",
-                rule="7.packet.codes")
-    link.wait(0.3)
-    ctx.expect(position(ctx) == start, "no C member moved", observed=position(ctx),
-               expected=start, rule="7.packet.all-or-nothing")
-    code(ctx, link.send("L" + vector(ctx, 0)), 0, "nothing was queued: L0,0,0 → 0 at once",
-         rule="7.packet.all-or-nothing")
-    # B is the junction's rate: at the reset B two C pass their junction at speed, at
-    # B10..B30 they would all but stop there
-    Probe(ctx, "the junction at the reset B after the failed packets",
-          "7.packet.all-or-nothing").script(["A5", "V2000", "C700,0,0", "C700,0,0", 1.0])

@@ -1,0 +1,100 @@
+"""Spec section 1, Units (profiles): the cases that check it.
+
+What distinguishes the GVE54, the GVE84 and the GVE114 and their variants. A profile
+(`fixtures/profiles/*.toml`) is this table as data."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, setup, show
+
+# parameter -> (frame template, the rule its range belongs to on GVE54 / on GVE84, GVE114)
+RANGES = {
+    "V": ("V{}", "1.profile.v-b-range-gve54", "1.profile.v-b-range"),
+    "B": ("B{}", "1.profile.v-b-range-gve54", "1.profile.v-b-range"),
+    "$": ("${}", "1.profile.dollar-range", "1.profile.dollar-range"),
+    "T": ("T{}", "10.cmd.modal", "10.cmd.modal"),
+    "A": ("A{}", "10.cmd.accel-range", "10.cmd.accel-range"),
+    "XM": ("XM{}", None, "10.cmd.override"),
+    "VL": ("VL{},{},{}", None, "10.cmd.axis-limits"),
+}
+
+
+@case("1.profile.axes.count", rules=("1.profile.axes",))
+def axes(ctx: CaseContext) -> None:
+    four = len(ctx.profile.axes) == 4
+    setup(ctx, "H", expect="8")              # vectors wait in the queue while INTA = 1
+    code(ctx, ctx.link.send("C0,0,0,1"), 0 if four else 4,
+         f"a fourth component: {'the A axis' if four else 'no such axis'}", inta=True)
+    code(ctx, ctx.link.send("C1,0"), 4, "two components are too few", inta=True)
+    setup(ctx, "D")
+
+
+@case("1.profile.interrupt-inputs.wired", rig=True,
+      rules=("1.profile.interrupt-inputs", "1.profile.interrupt-inputs-gve114",
+             "10.3.status.meaning"))
+def wired(ctx: CaseContext) -> None:
+    p = ctx.profile
+    rule = "1.profile.interrupt-inputs" + ("-gve114" if p.family == "GVE114" else "")
+    for port, enable, cause, mask in ((1, 0, 4, p.low_mask), (2, 1, 5, p.high_mask)):
+        for bit in range(8):
+            link = ctx.fresh_link()
+            r = link.send("SW%d,%02X" % (enable, 1 << bit))
+            ctx.require(r is not None and r.code == 0, f"SW{enable} answered {show(r)}")
+            # grounded once enabled: an interrupt whether inputs are level- or
+            # edge-triggered (level is our reading [D])
+            link.rig.set_input(port, 0xFF ^ (1 << bit))
+            r = link.send(f"SR{cause}")
+            ctx.require(r is not None and r.code == 0, f"SR{cause} answered {show(r)}")
+            wired = bool(mask >> bit & 1)
+            ctx.expect(r.inta == wired, f"IN{bit} of port I{port} "
+                       f"{'interrupts' if wired else 'has no input behind it'}",
+                       observed=show(r), expected="8,%02X" % (1 << bit) if wired else "0,00",
+                       rule=rule)
+            if wired:
+                answers(ctx, r, "8,%02X" % (1 << bit),
+                        f"ST{cause} names IN{bit} of port I{port}", rule="10.3.status.meaning")
+
+
+@case("1.profile.parameter-ranges",
+      rules=("1.profile.v-b-range", "1.profile.v-b-range-gve54", "1.profile.dollar-range",
+             "10.cmd.modal", "10.cmd.accel-range", "10.cmd.override", "10.cmd.axis-limits",
+             "10.cmd.axis-limits-clamped", "5.code.range"))
+def ranges(ctx: CaseContext) -> None:
+    p = ctx.profile
+    for name, (template, rule54, rule) in RANGES.items():
+        rule = rule54 if p.family == "GVE54" else rule
+        if rule is None or name not in p.ranges:
+            continue
+        lo, hi = p.ranges[name].lo, p.ranges[name].hi
+        for value, want in ((lo - 1, 5), (lo, 0), (hi, 0), (hi + 1, 5)):
+            body = template.format(*[value] * template.count("{}"))
+            code(ctx, ctx.link.send(body), want, f"{body} → {want}", rule=rule)
+    if "VL" in p.commands and p.ranges["VL"].hi > p.max_rate:
+        hi = p.ranges["VL"].hi
+        code(ctx, ctx.link.send(f"VL{hi},{hi},{hi}"), 0,
+             f"VL above the variant's {p.max_rate} is accepted (clamped)",
+             rule="10.cmd.axis-limits-clamped")
+    else:
+        code(ctx, ctx.link.send("VL1000,1000,1000" if "VL" in p.commands else "V1000"), 0,
+             "a rate in pulses/s within the variant's maximum is accepted as it is",
+             rule="10.cmd.axis-limits-clamped" if "VL" in p.commands else "10.cmd.modal")
+
+
+# on a real unit the guard sends no vector beyond --max-travel: COULD-NOT-TEST there
+@case("1.profile.vector-range.limits", rules=("1.profile.vector-range",))
+def vector_range(ctx: CaseContext) -> None:
+    top = ctx.profile.vector_range
+    setup(ctx, "H", expect="8")              # vectors wait in the queue while INTA = 1
+    code(ctx, ctx.link.send(f"C{top},0,0"), 0, f"a component of {top} is in range", inta=True)
+    code(ctx, ctx.link.send(f"C0,{-top},0"), 0, f"and of {-top}", inta=True)
+    code(ctx, ctx.link.send(f"C{top + 1},0,0"), 5, f"{top + 1} is out of range", inta=True)
+    setup(ctx, "D")
+
+
+@case("1.profile.version",
+      rules=("1.profile.version", "2.link.serial-8n1", "3.frame.grammar"))
+def version(ctx: CaseContext) -> None:
+    """? answers 0,<the profile's firmware string>."""
+    answers(ctx, ctx.link.send("?"), "0," + ctx.profile.version, "the firmware string",
+            rule="1.profile.version")

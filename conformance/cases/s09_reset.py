@@ -1,0 +1,96 @@
+"""Spec section 9, Reset state: the cases that check it.
+
+What power-on and `J` leave."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import (
+    answers,
+    code,
+    fresh_reset,
+    index,
+    index_moved,
+    position,
+    setup,
+    show,
+    vector,
+)
+from conformance.motion.probe import Probe
+
+
+@case("9.reset.after-j",
+      rules=("10.cmd.restart", "9.reset.state", "8.index.answer", "2.link.ready-after-restart"),
+      destructive=True,
+      timing=True)
+def after_j(ctx: CaseContext) -> None:
+    """J answers a plain 0 and restores the reset state after about 2 s."""
+    link = ctx.link
+    setup(ctx, "SW2,2B")
+    setup(ctx, "L" + vector(ctx, 16))
+    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
+    link.wait(2.5)
+    answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
+    answers(ctx, link.send("@"), "0,1", "the index restarted at 0", rule="8.index.answer")
+    ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", rule="9.reset.state")
+
+
+@case("9.reset.gve54-sixteenths", requires=("M",), rules=("9.reset.gve54-motor",))
+def gve54_reset(ctx: CaseContext) -> None:
+    fresh_reset(ctx)
+    setup(ctx, "L3,0,0")
+    ctx.link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    ctx.expect(position(ctx) == [3, 0, 0], "after reset a step is a sixteenth (MF)",
+               observed=position(ctx), expected=[3, 0, 0])
+    answers(ctx, ctx.link.send("MD"), "0", "half current (MD) is a mode it takes")
+
+
+@case("9.reset.measured-defaults", rules=("9.reset.state", "9.reset.decided", "9.reset.brake"),
+      timing=True)
+def reset_motion(ctx: CaseContext) -> None:
+    """A20, V1000 (9.reset.state); VN, XM100, VL = max, T = 5 ms (9.reset.decided); B = max:
+    a junction at the full rate (9.reset.brake), each measured from the reset state."""
+    fresh_reset(ctx)
+    Probe(ctx, "reset A and V", "9.reset.state").script(["L500,0,0", 0.7])
+    Probe(ctx, "reset VN, XM, VL, T", "9.reset.decided").script(
+        ["L300,-400,0", [300, -400, 0], "L10,0,0", 0.03])
+    Probe(ctx, "reset B", "9.reset.brake").script(["C-300,400,0", "C-200,0,0", 0.7])
+
+
+@case("9.reset.mpg-enabled", requires=("Y",), destructive=True,
+      rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg"))
+def mpg_moving(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "EW06,01")                    # MPG enabled (spec 9, M114 12.2)
+    answers(ctx, link.send("J"), "0", "J → 0", tag="D")
+    link.wait(2.5)
+    r = link.send("SR6")
+    ctx.expect(r is not None and r.values == ["40"], "after J the MPG holds RUN = 1",
+               observed=show(r), expected="0,40", rule="9.reset.mpg")
+    code(ctx, link.send("L" + vector(ctx, 10)), 7, "vectors are refused: 7", rule="9.reset.mpg")
+    for body in ("D", "K", "R", "EW40,00", "EFW44,1", "EUW48,1"):
+        code(ctx, link.send(body), 7, f"{body} while the MPG holds RUN → 7",
+             rule="5.moving.definition")
+    answers(ctx, link.send("Y-"), "0,Y-", "Y- turns the MPG off", rule="10.cmd.mpg")
+    answers(ctx, link.send("SR6"), "0,00", "and RUN clears", rule="10.cmd.mpg")
+
+
+# a unit whose EEPROM 06 is known to be as shipped (FF): the emulator's
+@case("9.reset.mpg-inert.as-shipped", requires=("Y",), rig=True, rules=("9.reset.mpg-inert",))
+def mpg_inert(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("SR6"), "0,00", "MPG mode after reset, EEPROM 06 = FF: inert")
+    answers(ctx, ctx.link.send("L" + vector(ctx, 10)), "0", "and vectors are accepted")
+
+
+@case("9.reset.state",
+      rules=("9.reset.state", "8.index.counts"))
+def reset_state(ctx: CaseContext) -> None:
+    """After reset: ST0..ST6 = 00, position 0, outputs FF, checksums off."""
+    fresh_reset(ctx)
+    before = index(ctx)
+    for n in range(7):
+        answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00")
+    here = position(ctx)
+    ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0])
+    index_moved(ctx, before, 8, "the index counted the SR and PF frames", rule="8.index.counts")

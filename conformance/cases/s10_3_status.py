@@ -1,0 +1,185 @@
+"""Spec section 10.3, Status words: the cases that check it.
+
+ST0..ST6: interrupt enables, polarities, causes, and the stepper's state."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, halted_line, position, setup, show, vector
+
+IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 10.3)
+
+
+def _interrupted_by_input(ctx: CaseContext) -> None:
+    """Setup: IN0 enabled and active, so the unit is interrupted (INTA, ST4 bit 0)."""
+    r = ctx.link.send("SW0,01")
+    ctx.require(r is not None and r.code == 0 and r.inta, f"SW0,01 answered {show(r)}")
+
+
+def _after_clearing(ctx: CaseContext, body: str) -> None:
+    _interrupted_by_input(ctx)
+    code(ctx, ctx.link.send(body), 0, f"{body} with the input still active → 8", inta=True,
+         rule="4.response.inta-level")
+    for n, value in ((6, "80"), (4, "01")):
+        r = ctx.link.send(f"SR{n}")
+        ctx.expect(r is not None and r.inta and r.values == [value],
+                   f"after {body}: ST{n} set again at once", observed=show(r),
+                   expected=f"8,{value}", rule="10.3.inputs.level-triggered")
+    code(ctx, ctx.link.send("L" + vector(ctx, 300)), 0,
+         f"after {body}: L is accepted and waits", inta=True,
+         rule="10.3.inputs.level-triggered")
+    ctx.link.wait(0.5)
+    here = position(ctx)
+    ctx.expect(here == [0, 0, 0], f"after {body}: nothing moved while the input is active",
+               observed=here, expected=[0, 0, 0], rule="10.3.inputs.level-triggered")
+
+
+#: the status words written at their ends (ST6's bits act: written 00 only, idle)
+WORDS = range(6)
+
+
+def _in0_was_the_cause(ctx: CaseContext, what: str, *, rule: str) -> None:
+    """ST4 names IN0 (bit 0) as the interrupt's cause, and INTA is set (spec 10.3)."""
+    r = ctx.link.send("SR4")
+    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"], what, observed=show(r),
+               expected="8,01", rule=rule)
+
+
+@case("10.3.flags.f-command",
+      rules=("10.cmd.flags", "3.params.none-expected"))
+def f_idle(ctx: CaseContext) -> None:
+    answers(ctx, ctx.link.send("F"), "0,00", "F when idle", rule="10.cmd.flags")
+    code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", rule="3.params.none-expected")
+
+
+@case("10.3.inputs.level-after-clearing", hands=True,
+      rules=("10.3.inputs.level-triggered", "4.response.inta-level"))
+def level_after_clearing(ctx: CaseContext) -> None:
+    for body in ("G", "D", "K", "R"):
+        ctx.fresh_link()
+        with ctx.operator.grounded(1, 0, "the X reference input"):
+            _after_clearing(ctx, body)
+
+
+@case("10.3.inputs.physical-across-restart", rig=True, destructive=True,
+      rules=("10.3.inputs.physical",))
+def physical(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.rig.set_input(1, IN0_ACTIVE)
+    answers(ctx, link.send("J"), "0", "J → 0", tag="D")
+    link.wait(2.5)
+    answers(ctx, link.send("I1"), "0,FE", "after J the grounded input still reads 0")
+    link.rig.power_on()
+    link.wait(2.5)
+    answers(ctx, link.send("I1"), "0,FE", "after power-on the grounded input still reads 0")
+
+
+@case("10.3.interrupt.polarity",
+      rules=("10.3.inputs.polarity", "4.response.inta-level"),
+      hands=True)
+def polarity(ctx: CaseContext) -> None:
+    """An input is active when its level equals its polarity bit."""
+    ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
+    setup(ctx, "SW0,01")                 # IN0 enabled; unconnected (1) is inactive at 0
+    # IN0 active at log. 1: the unconnected input becomes active, an interrupt whether
+    # inputs are level- or edge-triggered (level is our reading [D])
+    r = ctx.link.send("SW2,01")
+    ctx.expect(r is not None and r.code == 0 and r.inta, "making it active interrupts at once",
+               observed=show(r), expected="8", rule="4.response.inta-level")
+    _in0_was_the_cause(ctx, "an unconnected input with polarity 1 interrupts at once",
+                      rule="10.3.inputs.polarity")
+
+
+@case("10.3.interrupt.stops-motion",
+      rules=("10.3.inputs.interrupt", "10.3.status.meaning"),
+      tag="M", rig=True)
+def interrupt(ctx: CaseContext) -> None:
+    """An enabled active input stops the motion, sets its cause bit and INTA."""
+    link = ctx.link
+    setup(ctx, "SW0,01")
+    setup(ctx, "C" + vector(ctx, 3000))
+    link.wait(0.3)
+    link.rig.set_input(1, 0xFE)          # IN0 grounded: active at polarity 0
+    link.wait(1.0)
+    here = position(ctx)
+    link.wait(0.5)
+    ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here,
+               rule="10.3.inputs.interrupt")
+    _in0_was_the_cause(ctx, "ST4 bit 0, INTA", rule="10.3.status.meaning")
+
+
+@case("10.3.status.all-bits-stored",
+      rules=("10.3.status.all-bits", "10.cmd.status-words"))
+def all_bits(ctx: CaseContext) -> None:
+    """Every status word stores all 8 bits as written."""
+    for n, value in ((2, "2B"), (3, "FF"), (5, "80"), (1, "3F"), (0, "A2")):
+        r = ctx.link.send(f"SW{n},{value}")     # may interrupt: only the code matters here
+        ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {show(r)}")
+        r = ctx.link.send(f"SR{n}")
+        ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
+                   observed=show(r), expected=value, rule="10.3.status.all-bits")
+
+
+@case("10.3.status.inputs-read-ff",
+      rules=("10.3.inputs.idle-level", "10.cmd.inputs"))
+def inputs(ctx: CaseContext) -> None:
+    """Input ports read FF with nothing connected."""
+    answers(ctx, ctx.link.send("I1"), "0,FF", "I1 with nothing connected",
+            rule="10.3.inputs.idle-level")
+
+
+@case("10.3.status.register-ends",
+      rules=("10.3.status.all-bits", "10.cmd.status-words", "5.code.range"))
+def register_ends(ctx: CaseContext) -> None:
+    link = ctx.link
+    for n in WORDS:
+        for value in ("FF", "00", "FF"):
+            r = link.send(f"SW{n},{value}")     # may interrupt: only the code matters here
+            ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {r}")
+            r = link.send(f"SR{n}")
+            ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
+                       observed=r.text if r else None, expected=value,
+                       rule="10.3.status.all-bits")
+        code(ctx, link.send(f"SW{n},100"), 5, f"SW{n},100: one beyond FF → 5",
+             inta=None, rule="5.code.range")
+        r = link.send(f"SR{n}")
+        ctx.expect(r is not None and r.values == ["FF"], f"ST{n} still FF after the refusal",
+                   observed=r.text if r else None, expected="FF", rule="10.cmd.status-words")
+        link.send(f"SW{n},00")
+        link.send("D")                          # whatever an interrupt left
+    answers(ctx, link.send("SW6,00"), "0", "SW6,00 when idle", rule="10.cmd.status-words")
+    answers(ctx, link.send("SR6"), "0,00", "SR6: ST6 idle", rule="10.cmd.status-words")
+    code(ctx, link.send("SW6,100"), 5, "SW6,100: one beyond FF → 5", rule="5.code.range")
+
+
+@case("10.3.status.run-bit",
+      rules=("10.3.st6.bits", "10.3.st6.inta-run"))
+def run_bit(ctx: CaseContext) -> None:
+    """ST6 bit 6 (RUN) is set while a vector is processed and clear when idle."""
+    setup(ctx, "L" + vector(ctx, 500))
+    r = ctx.link.send("SR6")
+    ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
+               observed=show(r), expected="0,40")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    answers(ctx, ctx.link.send("SR6"), "0,00", "idle again")
+
+
+@case("10.3.sw6.writing-st6", rules=("10.3.sw6.acts", "10.3.sw6.live-bits"))
+def sw6(ctx: CaseContext) -> None:
+    link = ctx.link
+    code(ctx, link.send("SW6,80"), 0, "SW6,80 sets INTA", inta=True, rule="10.3.sw6.acts")
+    code(ctx, link.send("L" + vector(ctx, 100)), 0, "L is accepted while INTA = 1", inta=True,
+         rule="10.3.sw6.acts")
+    link.wait(0.5)
+    ctx.expect(position(ctx) == [0, 0, 0], "the vector waits for G", observed=position(ctx),
+               expected=[0, 0, 0], rule="10.3.sw6.acts")
+    link = ctx.fresh_link()
+    halted_line(ctx, 300, 0.1)
+    code(ctx, link.send("SW6,00"), 0, "SW6,00 clears INTA", inta=False, rule="10.3.sw6.acts")
+    r = link.poll("SR6", lambda r: r.values == ["00"], 10)
+    ctx.expect(r is not None, "RUN clears when the resumed vector ends", observed=show(r),
+               expected="0,00", rule="10.3.sw6.live-bits")
+    ctx.expect(position(ctx) == [300, 0, 0], "the vector resumed to its target",
+               observed=position(ctx), expected=[300, 0, 0], rule="10.3.sw6.acts")
+    code(ctx, link.send("L" + vector(ctx, 0)), 0, "idle again: L0,0,0 → 0",
+         rule="10.3.sw6.live-bits")

@@ -1,0 +1,110 @@
+"""Spec section 10.4, HALT, GO, DELETE: the cases that check it.
+
+Stopping, resuming and discarding motion."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import (
+    answers,
+    code,
+    halted_with_queue,
+    measured_case,
+    position,
+    setup,
+    show,
+    vector,
+)
+
+# id -> (rules (the first judges the readings), commands it requires, families, scenario)
+SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], list]] = {
+    # H brakes on the ramp and answers at rest; G resumes from rest (10.4)
+    "10.4.measured.halt-ramp": (
+        ("10.4.halt.ramp", "10.4.go.resume"), (), (),
+        ["A3", "V1500", "C1500,0,0", 0.6, "H", 0.05, "G", 0.8]),
+    # the HALT ramp runs on into the following vectors (10.4)
+    "10.4.measured.halt-through-vectors": (
+        ("10.4.halt.through-vectors",), (), (),
+        ["A2", "V2000", "C500,0,0", "C500,0,0", "C500,0,0", 0.55, "H", 0.05, "G", 0.6]),
+    # G resumes from the exact step, accelerating from rest (10.4)
+    "10.4.measured.go-from-rest": (
+        ("10.4.go.resume",), (), (),
+        ["A2", "V1200", "L1400,0,0", 0.5, "H", 0.05, "G", 0.3]),
+}
+
+
+for _id, (_rules, _requires, _families, _scenario) in SCENARIOS.items():
+    measured_case(_id, _rules, _requires, _families, _scenario)
+
+
+@case("10.4.delete.clears",
+      rules=("10.4.delete",))
+def delete(ctx: CaseContext) -> None:
+    halted_with_queue(ctx)
+    here = position(ctx)
+    answers(ctx, ctx.link.send("D"), "0", "D after H")
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared")
+    ctx.link.wait(1.0)
+    ctx.expect(position(ctx) == here, "position unchanged", observed=position(ctx),
+               expected=here)
+
+
+@case("10.4.delete.refused-while-moving",
+      rules=("10.4.delete", "5.code.busy-moving"))
+def delete_moving(ctx: CaseContext) -> None:
+    """D while moving answers 7."""
+    setup(ctx, "C" + vector(ctx, 2000))
+    ctx.link.wait(0.2)
+    code(ctx, ctx.link.send("D"), 7, "D while moving → 7")
+    ctx.link.send("H")
+
+
+@case("10.4.go.empty-queue", rules=("10.4.go.empty",))
+def go_empty(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "H", expect="8")
+    answers(ctx, link.send("G"), "0", "G with an empty queue clears INTA")
+    answers(ctx, link.send("SR6"), "0,00", "INTA and INTCOM cleared")
+    code(ctx, link.send("G"), 6, "and there is nothing more to resume")
+    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", observed=position(ctx),
+               expected=[0, 0, 0])
+
+
+@case("10.4.go.resumes-exactly",
+      rules=("10.4.go.resume",))
+def go(ctx: CaseContext) -> None:
+    """G resumes the interrupted vector from the exact step: no step lost or gained."""
+    halted_with_queue(ctx)
+    answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
+    ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
+               observed=position(ctx), expected=[990, 0, 0])
+
+
+@case("10.4.halt.answers-when-stopped",
+      rules=("10.4.halt.ramp", "10.cmd.halt-answer", "10.3.st6.inta-run", "10.3.st6.bits"))
+def halt(ctx: CaseContext) -> None:
+    """H brakes on the ramp and answers (8) only once the motion has stopped."""
+    halted_with_queue(ctx)
+    first = position(ctx)
+    ctx.link.wait(0.5)
+    ctx.expect(position(ctx) == first, "no motion after H's answer",
+               observed=position(ctx), expected=first)
+    r = ctx.link.send("SR6")
+    ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 = INTA+RUN+INTCOM, STOP clear",
+               observed=show(r), expected="8,D0")
+
+
+@case("10.4.halt.in-final-deceleration", rules=("10.4.halt.ramp", "10.3.st6.inta-run"),
+      timing=True)
+def halt_final(ctx: CaseContext) -> None:
+    link = ctx.link
+    link.wait(0.03)
+    setup(ctx, "V1500")
+    setup(ctx, "L" + vector(ctx, 0, 0, 245))
+    link.wait(0.20)
+    answers(ctx, link.send("H"), "8", "H during the final deceleration", rule="10.4.halt.ramp")
+    answers(ctx, link.send("PF"), "8,0,0,245", "the vector ended on its target",
+            rule="10.4.halt.ramp")
+    answers(ctx, link.send("SR6"), "8,90", "INTA and INTCOM; RUN = 0: nothing is left",
+            rule="10.3.st6.inta-run")

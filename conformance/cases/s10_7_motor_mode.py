@@ -1,0 +1,93 @@
+"""Spec section 10.7, GVE54 motor mode `M`: the cases that check it.
+
+Micro-stepping and current of the GVE54."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, measured_case, position, setup, vector
+from conformance.motion.probe import Probe
+
+#: the move each micro-step mode makes (commanded steps): a factor of another mode ends
+#: elsewhere on every axis
+MODE_MOVE = (60, -30, 15)
+
+
+def _rest(ctx: CaseContext) -> None:
+    r = ctx.link.poll("L0,0,0", lambda r: r.code != 1, 30)
+    ctx.require(r is not None and r.code == 0, "the move did not end within 30 s")
+
+
+# id -> (rules (the first judges the readings), commands it requires, families, scenario)
+SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], list]] = {
+    # GVE54: rates and vectors in commanded steps, positions in sixteenths (10.7)
+    "10.7.measured.microstep-rates": (
+        ("10.7.motor.rates-scaled", "10.2.motion.gve54-units"), ("M",), (),
+        ["M4", "A2", "V500", "L300,-100,0", 0.35, [300, -100, 0], "MF", "L400,0,0", 0.3]),
+}
+
+
+for _id, (_rules, _requires, _families, _scenario) in SCENARIOS.items():
+    measured_case(_id, _rules, _requires, _families, _scenario)
+
+
+@case("10.7.microstep.each-mode", requires=("M",), timing=True,
+      rules=("10.7.motor.modes", "10.7.motor.rates-scaled", "10.2.motion.gve54-units"))
+def each_mode(ctx: CaseContext) -> None:
+    """Every micro-step mode with the same move: where it ends (exact, in sixteenths) and
+    how it gets there (measured, the rates scaled by the mode's factor)."""
+    ms = ctx.profile.microstep
+    start = position(ctx)
+    ctx.require(start is not None, "PF did not answer with positions")
+    for mode, factor in ms.factors.items():
+        setup(ctx, f"M{mode}")
+        setup(ctx, "L" + vector(ctx, *MODE_MOVE))
+        _rest(ctx)
+        want = [s + factor * d for s, d in zip(start, MODE_MOVE, strict=True)]
+        ctx.expect(position(ctx) == want, f"M{mode}: L{vector(ctx, *MODE_MOVE)} ends "
+                   f"{factor} sixteenths a step on", observed=position(ctx), expected=want,
+                   rule="10.7.motor.modes")
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+    setup(ctx, f"M{ms.reset_mode}")
+    for mode in ms.factors:
+        Probe(ctx, f"the move in M{mode}", "10.7.motor.rates-scaled").script(
+            [f"M{mode}", "A2", "V400", "L" + vector(ctx, *MODE_MOVE), 0.5])
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+        setup(ctx, f"M{ms.reset_mode}")
+    ctx.expect(position(ctx) == start, "the axes are back where the case found them",
+               observed=position(ctx), expected=start, rule="10.7.motor.modes")
+
+
+@case("10.7.microstep.positions-in-sixteenths",
+      rules=("10.2.motion.gve54-units", "10.7.motor.modes"),
+      requires=("M",))
+def microstep(ctx: CaseContext) -> None:
+    """GVE54 positions are in 1/16 steps: M4, L100,100,100 → 400."""
+    link = ctx.link
+    setup(ctx, "M4")
+    setup(ctx, "L100,100,100")
+    link.poll("L0,0,0", lambda r: r.code == 0, 60)
+    answers(ctx, link.send("PF"), "0,400,400,400", "PF after M4 and L100,100,100")
+    code(ctx, link.send("MQ"), 4, "an unknown mode → 4", tag="D")
+
+
+@case("10.7.motor.modes-while-moving", requires=("M",),
+      rules=("10.7.motor.busy", "10.7.motor.any-position"))
+def motor_busy(ctx: CaseContext) -> None:
+    link = ctx.link
+    setup(ctx, "V5000")
+    setup(ctx, "L1001,500,399")
+    code(ctx, link.send("M4"), 7, "M while moving → 7", rule="10.7.motor.busy")
+    link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    ctx.expect(position(ctx) == [1001, 500, 399], "in MF the counters count the steps",
+               observed=position(ctx), expected=[1001, 500, 399], rule="10.7.motor.any-position")
+    answers(ctx, link.send("M2"), "0", "a coarser mode at a position not divisible by 8",
+            rule="10.7.motor.any-position")
+    setup(ctx, "MF")
+    setup(ctx, "L-1,0,1")
+    link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    ctx.expect(position(ctx) == [1000, 500, 400], "the manual's example: L-1,0,1",
+               observed=position(ctx), expected=[1000, 500, 400], rule="10.7.motor.any-position")
+    answers(ctx, link.send("M4"), "0", "then M4", rule="10.7.motor.any-position")

@@ -1,0 +1,57 @@
+"""Spec section 12, GVE114 spindle, address 7: the cases that check it.
+
+The spindle speed the GVE114 takes at address 7."""
+
+from __future__ import annotations
+
+from conformance.case import CaseContext, case
+from conformance.cases._kit import answers, code, show
+from conformance.motion.probe import Probe
+
+
+def spindle(ctx: CaseContext, value: int) -> None:
+    """Setup: the spindle at ``value`` (its answer is judged by 12.spindle.address-7)."""
+    r = ctx.link.send(f"V{value}", address=7)
+    ctx.require(r is not None and r.code == 0, f"!7V{value} answered {show(r)}")
+
+
+@case("12.spindle.address-7",
+      rules=("12.spindle.speed", "12.spindle.commands"),
+      tag="M-ex", rig=True,
+      applies=lambda p: p.spindle is not None)
+def address_7(ctx: CaseContext) -> None:
+    """!7V<n> sets the spindle (per mille); V0 switches OUT0 off; !0V is the feed rate."""
+    link = ctx.link
+    speed = "12.spindle.speed"
+    answers(ctx, link.send("V300", address=7), "0", "!7V300", rule=speed)
+    ctx.expect(link.rig.spindle() == 300, "spindle 300", observed=link.rig.spindle(),
+               rule=speed)
+    ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs(), rule=speed)
+    answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)
+    ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
+    code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors",
+         rule="12.spindle.commands")
+
+
+@case("12.spindle.measured.feed-unchanged", timing=True,
+      applies=lambda p: p.spindle is not None,
+      rules=("12.spindle.feed-independent", "12.spindle.speed"))
+def feed_unchanged(ctx: CaseContext) -> None:
+    probe = Probe(ctx, "the feed rate V1500 after !7V900", "12.spindle.feed-independent")
+    probe.send("V1500")
+    spindle(ctx, 900)
+    probe.run(["A10000", "L600,0,0", [600, 0, 0], "L-600,0,0", [0, 0, 0]])
+    spindle(ctx, 0)
+    probe.judge()
+
+
+@case("12.spindle.unchanged-by-feed", rig=True, applies=lambda p: p.spindle is not None,
+      rules=("12.spindle.feed-independent", "12.spindle.speed"))
+def spindle_unchanged(ctx: CaseContext) -> None:
+    link, rule = ctx.link, "12.spindle.feed-independent"
+    answers(ctx, link.send("V300", address=7), "0", "!7V300", rule="12.spindle.speed")
+    for feed in ("V40", "V2000", "V1000"):
+        answers(ctx, link.send(feed), "0", f"!0{feed}", rule=rule)
+        ctx.expect(link.rig.spindle() == 300, f"the spindle still at 300 after !0{feed}",
+                   observed=link.rig.spindle(), expected=300, rule=rule)
+    answers(ctx, link.send("V0", address=7), "0", "!7V0", rule="12.spindle.speed")
