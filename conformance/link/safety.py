@@ -22,6 +22,7 @@ Public interface (docs/suite.md, "The session and its guard")::
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import re
 from collections.abc import Callable, Iterator
@@ -78,6 +79,10 @@ class Command:
 
     @classmethod
     def parse(cls, body: str) -> Command:
+        return _parse(body)
+
+    @classmethod
+    def _read(cls, body: str) -> Command:
         text = body.upper()
         for name in _NAMES:
             if text.startswith(name):
@@ -94,6 +99,13 @@ class Command:
         unbounded)."""
         parts = self.params.split(",") if self.params else []
         return [_number(parts[i]) if i < len(parts) else ZERO for i in range(count)]
+
+
+@functools.lru_cache(maxsize=4096)
+def _parse(body: str) -> Command:
+    """Command.parse, once a body (a frame's reading is asked for before it is sent,
+    after its answer and for its timeout; the known state's bodies recur every case)."""
+    return Command._read(body)
 
 
 def _number(text: str, base: int = 10) -> Span:
