@@ -48,6 +48,28 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "eeprom-write-while-moving": (("5.code.busy-eeprom",),
                                   "EW, EFW and EUW are accepted while the axes move (the "
                                   "manuals forbid only D, K, R, M, N and W while running)"),
+    "packet-closed-only-by-end": (("7.packet.breakers",),
+                                  "an open packet is closed only by *E: H, @, > and J "
+                                  "inside it are members (failing it with 4, unanswered); "
+                                  "a second *S still restarts it"),
+    "packet-committed-on-arrival": (("7.packet.all-or-nothing",),
+                                    "each valid packet member takes effect as it arrives "
+                                    "(B sets B, C is queued); *E still answers code,k, "
+                                    "and a failed packet keeps what arrived before *E"),
+    "longer-frames": (("3.frame.max-length", "3.frame.bounded-buffer"),
+                      "frames up to 255 bytes (a byte-wide length counter) are taken whole "
+                      "and run as any other; only longer ones answer 4"),
+    "edge-triggered-inputs": (("10.3.inputs.level-triggered",),
+                              "an enabled input interrupts when it becomes active, not "
+                              "while it stays so: G, D, K, R or SW that clear the cause "
+                              "or INTA with the input still active are not undone"),
+    "slow-watchdog": (("3.frame.watchdog-time",),
+                      "the watchdog drops an unfinished frame after 1 s without a byte, "
+                      "not 100 ms"),
+    "index-remembered": (("8.repeat.remembered",),
+                         "@ is remembered for > like any received command: > after @ "
+                         "answers !0@ and the index it gave (the manual's > repeats the "
+                         "last received command and its answer)"),
 }.items()}
 
 

@@ -63,13 +63,16 @@ def interrupt(ctx: CaseContext) -> None:
 
 @case("10.3.interrupt.polarity",
       rules=("10.3.inputs.polarity", "4.response.inta-level"),
-      tag="M", source="M84 12.5.11", rig=True,
+      tag="M", source="M84 12.5.11", hands=True,
       rule="An input is active when its level equals its polarity bit")
 def polarity(ctx: CaseContext) -> None:
     link = ctx.link
-    setup(ctx, "SW2,01")                 # IN0 active at log. 1: unconnected = active
-    r = link.send("SW0,01")
-    ctx.expect(r is not None and r.code == 0 and r.inta, "enabling it interrupts at once",
+    ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
+    setup(ctx, "SW0,01")                 # IN0 enabled; unconnected (1) is inactive at 0
+    # IN0 active at log. 1: the unconnected input becomes active, an interrupt whether
+    # inputs are level- or edge-triggered (level is our reading [D])
+    r = link.send("SW2,01")
+    ctx.expect(r is not None and r.code == 0 and r.inta, "making it active interrupts at once",
                observed=show(r), expected="8", rule="4.response.inta-level")
     r = link.send("SR4")
     ctx.expect(r is not None and r.inta and r.values[:1] == ["01"],

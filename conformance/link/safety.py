@@ -152,6 +152,7 @@ class Guard:
         self.dead = False
         self._own = 0                             # inside the session's own frames
         self._emergency = 0
+        self._hands_on = 0                        # a technician's hand step is open
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
@@ -177,6 +178,16 @@ class Guard:
         finally:
             self._emergency -= 1
 
+    @contextlib.contextmanager
+    def hands_on(self) -> Iterator[None]:
+        """A technician's hand step is open (a prompt waits for them): no motion until it
+        is answered, whoever sends."""
+        self._hands_on += 1
+        try:
+            yield
+        finally:
+            self._hands_on -= 1
+
     # -- before a frame ----------------------------------------------------------------------
     def check_idle(self) -> None:
         """Raise if the run must stop here (Ctrl-C; a target that stopped answering):
@@ -200,6 +211,9 @@ class Guard:
                 raise SafetyStop(f"{body} for address {address}: another unit may be on "
                                  "the line there; the suite moves and writes only its own")
             return
+        if command.name in MOTION and self._hands_on:
+            raise SafetyStop(f"{body}: motion refused while a hand step is open (the "
+                             "technician's hands may be on the machine)")
         if command.name in DESTRUCTIVE:
             self._check_destructive(body, command)
         if command.name in MOTION:
@@ -323,6 +337,10 @@ class Guard:
         steps = command.fields(self.envelope.axes)
         if command.name == "*E" or (command.name == "C" and self.packet_open):
             members = list(self.packet) + ([steps] if command.name == "C" else [])
+            if command.name == "*E" and outcome is Outcome.REFUSED:
+                # all-or-nothing is our reading [D]: a unit may have committed the
+                # members as they arrived, so a refused *E leaves them maybe committed
+                outcome = Outcome.UNCLEAR
             return lambda e: _commit(e, members, outcome)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
@@ -376,7 +394,9 @@ class Guard:
             self.packet_open = False
             if outcome is not Outcome.UNCLEAR:
                 self.packet = []
-        elif name in _PACKET_BREAKERS:
+        elif name in _PACKET_BREAKERS and r is not None:
+            # unanswered, it may have been taken as a member: that a breaker closes the
+            # packet is our reading [D], and only *E is sure to (spec 7)
             self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return

@@ -44,6 +44,7 @@ class Device:
         self.switches: dict[str, int | None] = {}
         self.state: DeviceState = reset_state(profile)
         self.deaf_until = origin          # restarting (power-on, J) until then
+        self._was_active = self._active()  # the reading edge-triggered-inputs: last seen
 
     # -- power ------------------------------------------------------------------------
     def reset(self, t: int) -> None:
@@ -57,6 +58,7 @@ class Device:
         self.motion.set_multiplier(self.state.xm, t)
         if self.mutant.active("restart-resets-inputs"):
             self.inputs = dict(UNCONNECTED)
+        self._was_active = self._active()
         self.deaf_until = t + p.restart_ms * MS
 
     # -- derived state ----------------------------------------------------------------
@@ -155,11 +157,20 @@ class Device:
             self.motion.set_multiplier(percent, t)
 
     # -- interrupts (spec 10.3) ---------------------------------------------------------
+    def _active(self) -> tuple[int, int]:
+        """The inputs that are active now (level equals polarity), per word."""
+        s, i = self.state.status, self.inputs
+        return ~(i[1] ^ s[2]) & 0xFF, ~(i[2] ^ s[3]) & 0xFF
+
     def _hits(self) -> tuple[int, int]:
-        """The enabled inputs that are active now (level equals polarity), per word."""
-        s, i, p = self.state.status, self.inputs, self.profile
-        active1 = ~(i[1] ^ s[2]) & 0xFF
-        active2 = ~(i[2] ^ s[3]) & 0xFF
+        """The enabled inputs that are active now, per word; with the reading
+        edge-triggered-inputs only those that became active since last looked at."""
+        s, p = self.state.status, self.profile
+        active1, active2 = self._active()
+        if self.readings.active("edge-triggered-inputs"):
+            was1, was2 = self._was_active
+            self._was_active = (active1, active2)
+            active1, active2 = active1 & ~was1, active2 & ~was2
         return s[0] & active1 & p.low_mask, s[1] & active2 & p.high_mask
 
     def check_inputs(self, t: int) -> None:

@@ -15,8 +15,10 @@ from gve_fixtures.rules import load_rules
 
 EMULATOR = Path(__file__).resolve().parents[1].parent / "emulator"
 
-#: reading -> (frames, the clean emulator's answers, the reading's)
-POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
+#: reading -> (frames, (port, level) the rig sets, or the seconds until the next one when
+#: not a second; the clean emulator's answers, the reading's)
+Step = bytes | tuple[int, int] | float
+POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "plus-sign": ([b"!0V+100\r"], b"4\r", b"0\r"),
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
@@ -29,18 +31,43 @@ POINTS: dict[str, tuple[list[bytes], bytes, bytes]] = {
     # a long vector still running a second later
     "eeprom-write-while-moving": ([b"!0L100000,0,0\r", b"!0EW10,AB\r", b"!0ER10\r"],
                                   b"0\r7\r0,FF\r", b"0\r0\r0,AB\r"),
+    # H is a member (unanswered, failing the packet with 4), so *E1 finds one member
+    "packet-closed-only-by-end": ([b"!0*S\r", b"!0H\r", b"!0*E1\r"],
+                                  b"8\rC,0\r", b"4,1\r"),
+    # *E2 for one member fails the packet, but its C ran as it arrived
+    "packet-committed-on-arrival": ([b"!0*S\r", b"!0C10,0,0\r", b"!0*E2\r", b"!0PF\r"],
+                                    b"2,1\r0,0,0,0\r", b"2,1\r0,10,0,0\r"),
+    # a 106-byte frame is run (V with leading zeros); one of 5003 is still too long
+    "longer-frames": ([b"!0V" + b"0" * 100 + b"1000\r", b"!0V" + b"1" * 5000 + b"\r"],
+                      b"4\r4\r", b"0\r4\r"),
+    # INTR0 enabled, grounded (active at 0): D clears INTA, which the input still held
+    # sets again at once (8) unless only its edge interrupts (0)
+    "edge-triggered-inputs": ([b"!0SW0,01\r", (1, 0xFE), b"!0D\r", b"!0SR4\r"],
+                              b"0\r8\r8,01\r", b"0\r0\r0,00\r"),
+    # half a second without a byte inside a frame: dropped (2), or the frame runs whole
+    "slow-watchdog": ([b"!0V10", 0.5, b"00\r"], b"2\r", b"0\r"),
+    "index-remembered": ([b"!0?\r", b"!0@\r", b"!0>\r"],
+                         b"0,IP84 v3 27.1.2010\r0,1\r!0?\r0,IP84 v3 27.1.2010\r",
+                         b"0,IP84 v3 27.1.2010\r0,1\r!0@\r0,1\r"),
 }
 
 
-def answers(readings: tuple[str, ...], frames: list[bytes]) -> bytes:
-    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart."""
+def answers(readings: tuple[str, ...], frames: list[Step]) -> bytes:
+    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart unless
+    a number says otherwise."""
     unit = Unit("GVE84-100", readings=readings)
     out: list[bytes] = []
     unit.emit = lambda data, t: out.append(data)
     t = 10**9
-    for frame in frames:
-        unit.receive(frame, t, 1000)
-        t += 10**9
+    for i, frame in enumerate(frames):
+        if isinstance(frame, float):
+            continue
+        if isinstance(frame, tuple):
+            unit.set_input(*frame, t)
+        else:
+            unit.receive(frame, t, 1000)
+        after = frames[i + 1] if i + 1 < len(frames) else None
+        t += int(after * 10**9) if isinstance(after, float) else 10**9
         unit.advance(t)
     return b"".join(out)
 

@@ -48,3 +48,11 @@ def test_a_modal_setting_the_sequence_needs_wins_over_the_command_and_packet():
 def test_a_position_after_go_is_the_resume_even_after_restore():
     assert label("PF", "position", set(), {"L", "H", "K", "R", "G"}, 0) == "10.4.go.resume"
     assert label("SR", "data", set(), {"L", "H", "K", "R"}, 0) == "10.5.restore.exact"
+
+
+def test_a_breaker_unanswered_inside_a_packet_is_the_breakers_rule():
+    # a unit that closes a packet only with *E takes H, @, >, J as members
+    for command in ("H", "@", ">", "J"):
+        assert label(command, "silence", {"in-packet"}, {"*S"}, 0) == "7.packet.breakers"
+    assert label("H", "silence", {"bad-checksum", "in-packet"}, {"*S"}, 4) == \
+        "7.packet.bad-checksum-member"
