@@ -413,7 +413,9 @@ class RealSession(Session):
         r = link.send(body)
         if r is None or r.code != 0:
             raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
-        seconds = max(abs(b) for b in back) / speed * 2 + 2 * self.guard.stop_seconds() + 2
+        cruise = max(abs(b) for b in back) / speed        # the least the way back takes
+        seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
+        link.wait(cruise)                                  # asking before it ends is moot
         if link.poll("L0,0,0", lambda r: r.code == 0, seconds) is None:
             raise CouldNotTest("the return to where the run began did not end in time")
         self._position(link)
