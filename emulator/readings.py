@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from emulator.motion.interface import Deviation
+
 
 class ReadingSpec(NamedTuple):
     rules: tuple[str, ...]   # the rules of fixtures/rules.toml whose silence it reads
@@ -70,7 +72,15 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                          "@ is remembered for > like any received command: > after @ "
                          "answers !0@ and the index it gave (the manual's > repeats the "
                          "last received command and its answer)"),
+    "next-vectors-B": (("10.2.motion.junction-own-b",),
+                       "a junction of two C is passed at the B the next C captured, not the "
+                       "one of the C that ends there"),
 }.items()}
+
+#: readings whose behaviour lives in the stepper core
+CORE_READINGS: dict[str, Deviation] = {
+    "next-vectors-B": Deviation.NEXT_BRAKE,
+}
 
 
 class UnknownReading(ValueError):
@@ -104,6 +114,14 @@ class Readings:
         if name not in READINGS:
             raise UnknownReading(f"the emulator asks for an unknown reading {name!r}")
         return name in self.names
+
+    @property
+    def deviations(self) -> Deviation:
+        """The stepper core's deviations these readings take."""
+        flags = Deviation.NONE
+        for name in self.names:
+            flags |= CORE_READINGS.get(name, Deviation.NONE)
+        return flags
 
 
 NONE = Readings()

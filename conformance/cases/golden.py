@@ -1,5 +1,5 @@
 """Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
-case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
+case ``11.golden.<name>``. The player is the suite's own."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
-TAGS = {"M", "M-ex", "D", "D-info"}
 
 
 def _tag(kind: str | None, default: str) -> str:

@@ -54,7 +54,7 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     "10.2.measured.short-vector": (
         ("10.2.motion.short-vector", "10.cmd.modal"), (), (),
         ["A10000", "$1000", "B300", "V2000", "L150,0,0", 0.5]),
-    # a zero-length C between two C: the next starts from rest, after T (10.2; issue 9 #3)
+    # a zero-length C between two C: the next starts from rest, after T (10.2)
     "10.2.measured.zero-length-c": (
         ("10.2.motion.zero-length",), (), (), ["C0,-92,0", "C0,0,0", "C0,46,0", 0.3]),
     # the rate never exceeds the variant's maximum (10.2)
@@ -131,3 +131,28 @@ def reset_motion(ctx: CaseContext) -> None:
     Probe(ctx, "reset VN, XM, VL, T", "9.reset.decided").script(
         ["L300,-400,0", [300, -400, 0], "L10,0,0", 0.03])
     Probe(ctx, "reset B", "9.reset.brake").script(["C-300,400,0", "C-200,0,0", 0.7])
+
+
+#: a junction with B differing on both sides, each way round: (B before, B after)
+JUNCTION_SIDES = ((300, 1500), (1500, 300))
+
+
+@case("10.2.measured.junction-brake-sides", timing=True,
+      rules=("10.2.motion.junction", "10.2.motion.junction-own-b"))
+def junction_sides(ctx: CaseContext) -> None:
+    """Which B governs a junction when the two C captured different ones: the ending C's
+    (10.2.motion.junction-own-b [D]). Readings that fit a junction at the next C's B are
+    that other reading (NON-STRICT); readings that fit neither break B itself [M]."""
+    # the second path runs back, so that the case ends where it began (the envelope)
+    for way, (before, after) in zip((1, -1), JUNCTION_SIDES, strict=True):
+        name = f"B{before} before the junction, B{after} after"
+        probe = Probe(ctx, name, "10.2.motion.junction")
+        leg = f"C{700 * way},0,0"
+        probe.run(["A5", "V2000", f"B{before}", leg, f"B{after}", leg, 1.2,
+                   [1400 * way, 0, 0]])
+        probe.next_brake = True
+        other = probe.fits()
+        probe.next_brake = False
+        if other and not probe.fits():
+            probe.rule = "10.2.motion.junction-own-b"
+        probe.judge()

@@ -6,6 +6,13 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, position, setup, show, vector
 
 
+def _in0_was_the_cause(ctx: CaseContext, what: str, *, rule: str) -> None:
+    """ST4 names IN0 (bit 0) as the interrupt's cause, and INTA is set (spec 10.3)."""
+    r = ctx.link.send("SR4")
+    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"], what, observed=show(r),
+               expected="8,01", rule=rule)
+
+
 @case("10.3.status.all-bits-stored",
       rules=("10.3.status.all-bits", "10.cmd.status-words"),
       tag="D", source="spec 10.3 [D]; M84 12.5.8 SW1,3F",
@@ -56,9 +63,7 @@ def interrupt(ctx: CaseContext) -> None:
     link.wait(0.5)
     ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here,
                rule="10.3.inputs.interrupt")
-    r = link.send("SR4")
-    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"], "ST4 bit 0, INTA",
-               observed=show(r), expected="8,01", rule="10.3.status.meaning")
+    _in0_was_the_cause(ctx, "ST4 bit 0, INTA", rule="10.3.status.meaning")
 
 
 @case("10.3.interrupt.polarity",
@@ -66,18 +71,15 @@ def interrupt(ctx: CaseContext) -> None:
       tag="M", source="M84 12.5.11", hands=True,
       rule="An input is active when its level equals its polarity bit")
 def polarity(ctx: CaseContext) -> None:
-    link = ctx.link
     ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
     setup(ctx, "SW0,01")                 # IN0 enabled; unconnected (1) is inactive at 0
     # IN0 active at log. 1: the unconnected input becomes active, an interrupt whether
     # inputs are level- or edge-triggered (level is our reading [D])
-    r = link.send("SW2,01")
+    r = ctx.link.send("SW2,01")
     ctx.expect(r is not None and r.code == 0 and r.inta, "making it active interrupts at once",
                observed=show(r), expected="8", rule="4.response.inta-level")
-    r = link.send("SR4")
-    ctx.expect(r is not None and r.inta and r.values[:1] == ["01"],
-               "an unconnected input with polarity 1 interrupts at once", observed=show(r),
-               expected="8,01", rule="10.3.inputs.polarity")
+    _in0_was_the_cause(ctx, "an unconnected input with polarity 1 interrupts at once",
+                      rule="10.3.inputs.polarity")
 
 
 @case("10.3.flags.f-command",

@@ -14,6 +14,7 @@ from conformance.cli.unit import ask_before_motion, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    add_loudness,
     one_line,
     positive,
     seconds,
@@ -61,12 +62,8 @@ def common(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--strict", action="store_true",
                     help="grade the target by the project's decisions too: a [D] "
                          "difference FAILs instead of NON-STRICT")
-    loud = ap.add_mutually_exclusive_group()
-    loud.add_argument("-q", "--quiet", action="store_true",
-                      help="print only the last line (the verdict)")
-    loud.add_argument("-v", "--verbose", action="store_true",
-                      help="print every line: for diff each disagreement's transcript too, "
-                           "for replay every frame (its default)")
+    add_loudness(ap, "print every line: for diff each disagreement's transcript too, "
+                 "for replay every frame (its default)")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:

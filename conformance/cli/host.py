@@ -20,6 +20,7 @@ from conformance.cli.ending import counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    add_loudness,
     positive,
     seconds,
     summary,
@@ -78,11 +79,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     ap.add_argument("--report-dir", default="reports")
     ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the scenarios and exit")
-    loud = ap.add_mutually_exclusive_group()
-    loud.add_argument("-q", "--quiet", action="store_true",
-                      help="print only the last line (the verdict)")
-    loud.add_argument("-v", "--verbose", action="store_true",
-                      help="print a line for every scenario (the default)")
+    add_loudness(ap, "print a line for every scenario (the default)")
     args = ap.parse_args(argv)
     args.command = command or None
     return args

@@ -33,6 +33,7 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
+    add_loudness,
     exit_status,
     positive,
     run_id,
@@ -77,8 +78,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--yes", action="store_true",
                     help="real units: move without asking first (unattended benches)")
     ap.add_argument("--operator", action=argparse.BooleanOptionalAction, default=None,
-                    help="real units: ask a technician for hand steps (ground an input...); "
-                         "default: when standard input is a terminal")
+                    help="real units: a technician stands in for the test rig (ground an "
+                         "input, cycle the power, read the outputs; each step read back, "
+                         "s skips it); default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
@@ -120,11 +122,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    loud = ap.add_mutually_exclusive_group()
-    loud.add_argument("-q", "--quiet", action="store_true",
-                      help="print only the last line (the verdict)")
-    loud.add_argument("-v", "--verbose", action="store_true",
-                      help="print a line for every case, on a terminal too")
+    add_loudness(ap, "print a line for every case, on a terminal too")
     ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
                     default="auto", help="colour the verdicts: auto (a terminal without "
                     "NO_COLOR set), always or never (default auto)")

@@ -51,6 +51,15 @@ def summary(doc: str | None) -> str:
     return textwrap.fill(" ".join(first.split()), 88)
 
 
+def add_loudness(ap: argparse.ArgumentParser, verbose: str) -> None:
+    """``-q`` (only the verdict's line) or ``-v`` (``verbose``: what every line is), one
+    or the other, alike on every subcommand."""
+    loud = ap.add_mutually_exclusive_group()
+    loud.add_argument("-q", "--quiet", action="store_true",
+                      help="print only the last line (the verdict)")
+    loud.add_argument("-v", "--verbose", action="store_true", help=verbose)
+
+
 class _Version(argparse.Action):
     """``--version``: the version, the C stepper core's state and the Python, read only
     when asked (the emulator is not imported otherwise)."""

@@ -22,11 +22,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.link.line_band import EXACT, LineBand
-from conformance.motion.tolerance import PLACEMENT_STEPS, SECOND, Window, reading_band
+from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+from conformance.protocol.catalogue import classes
+from gve_fixtures.protocol import SECOND
 
-POSITION_COMMANDS = ("P", "PF")
+POSITION_COMMANDS = classes(position=True)
 
 
 @dataclass(frozen=True)
@@ -44,7 +46,7 @@ class Judge:
     line: LineBand = EXACT
 
 
-def difference(command: str, target: Exchange, reference: Exchange, judge: Judge,
+def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Judge,
                *, moving: bool = False) -> str | None:
     """The kind of difference between the two answers (None: alike)."""
     a, b = target.answer, reference.answer
@@ -75,7 +77,7 @@ def difference(command: str, target: Exchange, reference: Exchange, judge: Judge
     return "data"
 
 
-def alike_because(command: str, target: Exchange, reference: Exchange, judge: Judge,
+def alike_because(command: str, target: RoundTrip, reference: RoundTrip, judge: Judge,
                   *, moving: bool = False) -> str:
     """Why two answers :func:`difference` found alike are alike ("" when their bytes are
     the same): what a replay prints beside two answers that differ in their bytes."""
@@ -108,7 +110,7 @@ def _numbers(values: list[str]) -> list[int] | None:
         return None
 
 
-def band(target: Exchange, reference: Exchange, judge: Judge, moving: bool) -> int:
+def band(target: RoundTrip, reference: RoundTrip, judge: Judge, moving: bool) -> int:
     """Steps two readings may differ by: exact at rest; while moving the rate times how
     far apart the two instants can be, plus placement; and the rate times how late the
     target may have acted on what changed the motion's course."""
@@ -121,7 +123,7 @@ def band(target: Exchange, reference: Exchange, judge: Judge, moving: bool) -> i
     return reading_band(a, b, judge.rate, placement=PLACEMENT_STEPS) + late
 
 
-def _positions_close(target: Exchange, reference: Exchange, judge: Judge,
+def _positions_close(target: RoundTrip, reference: RoundTrip, judge: Judge,
                      moving: bool) -> bool:
     xs, ys = _numbers(target.response.values), _numbers(reference.response.values)
     if xs is None or ys is None or len(xs) != len(ys):

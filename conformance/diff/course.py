@@ -8,16 +8,17 @@ from __future__ import annotations
 import math
 import re
 
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 
-#: frames that close an open packet (spec 7)
-_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
+_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 #: a vector that moves nothing (and so waits no dwell)
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
-_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
+_COURSE_CHANGERS = classes(course=True)
 
 
 class Course:
@@ -48,7 +49,7 @@ class Course:
         self.in_packet = False
 
     # -- what it was given -----------------------------------------------------------------
-    def took(self, command: str, body: str, reference: Exchange, *, first: bool = True
+    def took(self, command: str, body: str, reference: RoundTrip, *, first: bool = True
              ) -> None:
         """The reference answered ``body``; ``first``: not a later frame of a fill (whose
         vectors join the first: no dwell)."""
@@ -66,7 +67,7 @@ class Course:
         elif command in _PACKET_BREAKERS:
             self.in_packet = False
 
-    def _dwell(self, command: str, body: str, reference: Exchange) -> None:
+    def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
         if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:

@@ -22,7 +22,7 @@ from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.labels import command_of, label, verdict_of
-from conformance.diff.sides import Exchange, Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
@@ -42,12 +42,12 @@ AGE_SECONDS = 1.0
 
 
 @dataclass
-class Record:
+class StepRecord:
     """One step as it went: the step, the frame's bytes and both sides' exchanges."""
 
     step: Step
-    target: Exchange | None = None
-    reference: Exchange | None = None
+    target: RoundTrip | None = None
+    reference: RoundTrip | None = None
     repeat: int = 0                      # FILL: frames of it before this one
     place: int = 0                       # the step's place in its sequence
     #: answers whose bytes differ but were judged alike: why (the timing band, the index
@@ -60,8 +60,8 @@ class Disagreement:
     index: int                           # the record it happened on
     command: str
     kind: str
-    target: Exchange
-    reference: Exchange
+    target: RoundTrip
+    reference: RoundTrip
     context: frozenset[str]
     earlier: frozenset[str]
     rule: str | None = None
@@ -76,8 +76,10 @@ class Disagreement:
 
 
 @dataclass
-class Outcome:
-    records: list[Record] = field(default_factory=list)
+class ExampleRun:
+    """One example run on both sides: its steps as they went, and where they disagreed."""
+
+    records: list[StepRecord] = field(default_factory=list)
     disagreement: Disagreement | None = None
     frames: int = 0
     refused: list[str] = field(default_factory=list)     # steps the guard did not send
@@ -107,8 +109,8 @@ class Pair:
         return self.timing.exact
 
     # -- one example ----------------------------------------------------------------------
-    def run(self, steps: list[Step]) -> Outcome:
-        out = Outcome()
+    def run(self, steps: list[Step]) -> ExampleRun:
+        out = ExampleRun()
         if not self._begin(out):
             return out
         earlier: set[str] = set()          # what the sequence did before (labels read it)
@@ -116,14 +118,14 @@ class Pair:
             if step.kind == WAIT:
                 self.target.wait(step.seconds)
                 self.timing.waited()
-                out.records.append(Record(step, place=place))
+                out.records.append(StepRecord(step, place=place))
             elif step.kind == INPUT:
                 self._input(step, place, out, earlier)
             elif self._frames(step, place, out, earlier):
                 break
         return self._end(out)
 
-    def _begin(self, out: Outcome) -> bool:
+    def _begin(self, out: ExampleRun) -> bool:
         """Both sides in the known state; False when the guard refused it."""
         try:
             self.target.open()
@@ -139,17 +141,17 @@ class Pair:
         self.course = Course(self.profile)
         return True
 
-    def _input(self, step: Step, place: int, out: Outcome, earlier: set[str]) -> None:
+    def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
         """A rig input set on both sides (left out where a side has no rig)."""
         if not (self.target.has_rig and self.reference.has_rig):
             return
         self.timing.retimed("input", None)
         if (self.target.set_input(step.port, step.value)
                 and self.reference.set_input(step.port, step.value)):
-            out.records.append(Record(step, place=place))
+            out.records.append(StepRecord(step, place=place))
             earlier.add("input")
 
-    def _frames(self, step: Step, place: int, out: Outcome, earlier: set[str]) -> bool:
+    def _frames(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:
         """A frame (a fill: until the queue is full) to both sides; True when the example
         ends here (a disagreement, a side silent for good)."""
         command = command_of(step.body)
@@ -173,11 +175,14 @@ class Pair:
         if out.ended:
             return True
         if command:
-            earlier.add(command)
+            # the spindle's V is not the feed rate's: a read after it names the spindle
+            spindle = self.profile.spindle
+            to_spindle = spindle is not None and step.address == spindle.address
+            earlier.add("spindle" if to_spindle else command)
         self.course.stepped(command, step)
         return False
 
-    def _disagreement(self, step: Step, command: str, kind: str, out: Outcome,
+    def _disagreement(self, step: Step, command: str, kind: str, out: ExampleRun,
                       earlier: set[str]) -> Disagreement:
         """The last record's difference, in its context, labelled and graded."""
         rec = out.records[-1]
@@ -191,7 +196,7 @@ class Pair:
         d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
         return d
 
-    def _end(self, out: Outcome) -> Outcome:
+    def _end(self, out: ExampleRun) -> ExampleRun:
         for side in (self.target, self.reference):
             with contextlib.suppress(TargetNotResponding):
                 side.close_example()
@@ -230,10 +235,10 @@ class Pair:
                                     if image.defaults.get(a, image.erased) != v}
         self.reference.write_eeprom(self._eeprom_changes)
 
-    def _exchange(self, step: Step, out: Outcome) -> Record | None:
+    def _exchange(self, step: Step, out: ExampleRun) -> StepRecord | None:
         self.timing.align()
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
-        rec = Record(step)
+        rec = StepRecord(step)
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
                                               stall=step.stall, body=step.body)
@@ -244,7 +249,7 @@ class Pair:
         except TargetNotResponding as err:
             if self.target.real:       # a fresh unit's silence ends only its example
                 raise
-            rec.target = Exchange(data, b"", 0, 0, None, step.lines)
+            rec.target = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
         self.timing.sent(rec.target.sent_at)
@@ -253,13 +258,13 @@ class Pair:
                                                     answer=step.answer, stall=step.stall,
                                                     body=step.body)
         except TargetNotResponding as err:
-            rec.reference = Exchange(data, b"", 0, 0, None, step.lines)
+            rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = out.ended or str(err)
         if out.ended and not rec.target.answer and not rec.reference.answer:
             return None
         return rec
 
-    def _difference(self, command: str, rec: Record) -> str | None:
+    def _difference(self, command: str, rec: StepRecord) -> str | None:
         moving, late = self.timing.allowance(command, rec.target, rec.reference)
         judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late,
                         line=self.timing.line())
@@ -286,7 +291,7 @@ class Pair:
         return {k for k, on in flags.items() if on}
 
 
-def _code(exchange: Exchange) -> int | None:
+def _code(exchange: RoundTrip) -> int | None:
     return None if exchange.code is None else exchange.code & 7
 
 
@@ -296,7 +301,7 @@ class Finding:
     """One disagreement, shrunk: its minimal sequence and how it went."""
 
     steps: list[Step]
-    outcome: Outcome
+    outcome: ExampleRun
 
     @property
     def disagreement(self) -> Disagreement:
@@ -377,7 +382,7 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
     return Finding(steps, outcome)
 
 
-def _lesser(steps: list[Step], i: int, outcome: Outcome) -> Iterator[list[Step]]:
+def _lesser(steps: list[Step], i: int, outcome: ExampleRun) -> Iterator[list[Step]]:
     """Sequences with step ``i`` made less, most reduced first."""
     s = steps[i]
     nxt = steps[i + 1] if i + 1 < len(steps) else None

@@ -9,11 +9,18 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from conformance.diff.engine import Finding, Record
+from conformance.diff.engine import Finding, StepRecord
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from conformance.link.framing import HostFramer, readable
-from gve_fixtures.transcript import ACTION, HOST, UNIT, Transcript, TranscriptError, unescape
-from gve_fixtures.transcript import Record as Line
+from gve_fixtures.transcript import (
+    ACTION,
+    HOST,
+    UNIT,
+    Record,
+    Transcript,
+    TranscriptError,
+    unescape,
+)
 
 
 def transcript(finding: Finding, *, profile: str, target: str, reference: str,
@@ -35,13 +42,13 @@ def transcript(finding: Finding, *, profile: str, target: str, reference: str,
         meta["seed"] = str(seed)
     if not d.rule:
         del meta["rules"]
-    lines: list[Line] = []
+    lines: list[Record] = []
     records = finding.outcome.records
     for i, rec in enumerate(records):
         last = i == len(records) - 1
         if rec.step.kind == FILL and not last and _fill_ends(records, i):
             first = records[i - rec.repeat]
-            lines.append(Line(ACTION, f"fill {rec.repeat + 1} {_payload(first)}".encode(),
+            lines.append(Record(ACTION, f"fill {rec.repeat + 1} {_payload(first)}".encode(),
                               first.target.sent_at))
             continue
         if rec.step.kind == FILL and not last:
@@ -50,32 +57,32 @@ def transcript(finding: Finding, *, profile: str, target: str, reference: str,
     return Transcript(meta, lines)
 
 
-def _payload(rec: Record) -> str:
-    return Line(HOST, rec.target.sent).line().split(" ", 1)[1]
+def _payload(rec: StepRecord) -> str:
+    return Record(HOST, rec.target.sent).line().split(" ", 1)[1]
 
 
-def _fill_ends(records: list[Record], i: int) -> bool:
+def _fill_ends(records: list[StepRecord], i: int) -> bool:
     """Whether record ``i`` ends the part of its fill written as one action: the next
     record is another step, or the last one (the disagreement, written as a frame)."""
     nxt = records[i + 1]
     return nxt.step is not records[i].step or nxt.repeat == 0 or i + 2 == len(records)
 
 
-def _lines(rec: Record, disagreeing: bool, rule: str | None, verdict: str) -> list[Line]:
+def _lines(rec: StepRecord, disagreeing: bool, rule: str | None, verdict: str) -> list[Record]:
     step = rec.step
     if step.kind == WAIT:
-        return [Line(ACTION, f"wait {step.seconds:g}".encode())]
+        return [Record(ACTION, f"wait {step.seconds:g}".encode())]
     if step.kind == INPUT:
-        return [Line(ACTION, f"input {step.port} {step.value:02X}".encode())]
-    out: list[Line] = []
+        return [Record(ACTION, f"input {step.port} {step.value:02X}".encode())]
+    out: list[Record] = []
     sent = rec.target.sent
     if step.stall is not None:
         at, seconds = step.stall
-        out += [Line(HOST, sent[:at], rec.target.sent_at),
-                Line(ACTION, f"wait {seconds:g}".encode(), comment="stalled: the watchdog"),
-                Line(HOST, sent[at:])]
+        out += [Record(HOST, sent[:at], rec.target.sent_at),
+                Record(ACTION, f"wait {seconds:g}".encode(), comment="stalled: the watchdog"),
+                Record(HOST, sent[at:])]
     else:
-        out.append(Line(HOST, sent, rec.target.sent_at))
+        out.append(Record(HOST, sent, rec.target.sent_at))
     expected = rec.reference.answer
     differs = rec.target.answer != expected
     note = f"target: {readable(rec.target.answer) or '(none)'}" if differs else ""
@@ -85,10 +92,10 @@ def _lines(rec: Record, disagreeing: bool, rule: str | None, verdict: str) -> li
     if expected and not expected.endswith(b"\r"):
         pieces.append(expected.rsplit(b"\r", 1)[-1])
     for j, piece in enumerate(pieces):
-        out.append(Line(UNIT, piece, rec.reference.received_at if j == 0 else None,
+        out.append(Record(UNIT, piece, rec.reference.received_at if j == 0 else None,
                         note if j == len(pieces) - 1 else ""))
     if not pieces and note:
-        out.append(Line(ACTION, b"silence 0", comment=f"reference: (none); {note}"))
+        out.append(Record(ACTION, b"silence 0", comment=f"reference: (none); {note}"))
     return out
 
 

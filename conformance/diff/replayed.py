@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from conformance.diff.engine import Outcome, Record
+from conformance.diff.engine import ExampleRun, StepRecord
 from conformance.diff.steps import FILL, FRAME, INPUT, Step
 from conformance.link.framing import readable
 from conformance.verdict import COULD_NOT_TEST, PASS
@@ -56,12 +56,12 @@ def _one(data: bytes) -> str:
     return readable(data) or "-"
 
 
-def frame_lines(outcome: Outcome, steps: list[Step], expected: list[bytes]) -> list[str]:
+def frame_lines(outcome: ExampleRun, steps: list[Step], expected: list[bytes]) -> list[str]:
     """Each step of the transcript as it went: a frame with both answers now, the one the
     transcript expects (``expected``, step by step) and how the two were judged —
     ``same``, ``alike`` and why (the timing band), or ``DIFFERENT``; a step not sent and
     why; a fill's first and last frames (those between agreed)."""
-    by_place: dict[int, list[tuple[int, Record]]] = {}
+    by_place: dict[int, list[tuple[int, StepRecord]]] = {}
     for i, rec in enumerate(outcome.records):
         by_place.setdefault(rec.place, []).append((i, rec))
     refused = iter(outcome.refused)
@@ -102,14 +102,14 @@ def frame_lines(outcome: Outcome, steps: list[Step], expected: list[bytes]) -> l
     return out
 
 
-def _not_run(steps: list[Step], outcome: Outcome) -> list[Step]:
+def _not_run(steps: list[Step], outcome: ExampleRun) -> list[Step]:
     """The rig's input steps left out (a side without a rig, or one that stopped
     answering)."""
     done = {rec.place for rec in outcome.records if rec.step.kind == INPUT}
     return [s for i, s in enumerate(steps) if s.kind == INPUT and i not in done]
 
 
-def verdict(outcome: Outcome, steps: list[Step], meta: dict[str, str]) -> Verdict:
+def verdict(outcome: ExampleRun, steps: list[Step], meta: dict[str, str]) -> Verdict:
     """The one verdict the comparison gives: a disagreement (still the recorded one, or
     another); else agreement on every frame, unless something of the transcript was not
     replayed (then it could not be tested)."""

@@ -22,7 +22,7 @@ from conformance.verdict import CouldNotTest
 
 
 @dataclass
-class Exchange:
+class RoundTrip:
     """One frame on one side: what went out, what came back and when (ns since the
     example began, on that side's clock)."""
 
@@ -96,7 +96,7 @@ class Side:
 
     def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
                  stall: tuple[int, float] | None = None, body: str | None = None
-                 ) -> Exchange:
+                 ) -> RoundTrip:
         """Send a frame's bytes (through the guard: SafetyStop when refused) and take
         what comes back: its answer (``answer``), else whatever arrives while the
         answer's bytes would have taken. ``body``: the frame's command, when known (it
@@ -115,7 +115,7 @@ class Side:
         else:
             back = link.wait(link.byte_seconds(len(data) + 64) + 0.005)
             r = parse_response(back, summed=link.checksums) if back else None
-        return Exchange(data, back, sent_at, self.now, r, lines)
+        return RoundTrip(data, back, sent_at, self.now, r, lines)
 
     def wait(self, seconds: float) -> bytes:
         return self.link.wait(seconds)

@@ -11,8 +11,9 @@ target's session measured and the example's own).
 
 from __future__ import annotations
 
-from conformance.diff.sides import Exchange, Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
 #: real time: how long the reference must have been at rest, besides the target's
@@ -22,13 +23,14 @@ SETTLE_NS = 50_000_000
 
 #: what changes a running motion's course at the instant the unit acts on it (an input
 #: set by the rig too): in real time that instant is known only within a latency
-_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
+_RETIMING = classes(retimes=True) | {"input"}
 #: of those, what stops a motion short of its vectors' ends
-_STOPPING = ("H", "SW6", "input")
-#: frames answered when their action ends, not at once
-_DEFERRED = ("H", "W", "J")
+_STOPPING = classes(stops=True) | {"input"}
+#: frames whose answer does not come at once: answered when the motion has stopped, or
+#: followed by a restart (their answer's time is no measure of the line's latency)
+_DEFERRED = classes(deferred=True) | classes(restart=True)
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
-_READINGS = ("P", "PF", ">")
+_READINGS = classes(position=True) | {">"}
 
 
 class Timing:
@@ -58,11 +60,11 @@ class Timing:
         """The target waited a while: the reference waits as long."""
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: Exchange | None) -> None:
+    def retimed(self, command: str, target: RoundTrip | None) -> None:
         """A frame went to both sides, ``target`` its exchange with the target (None: a
         rig input)."""
 
-    def allowance(self, command: str, target: Exchange, reference: Exchange
+    def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
         """For the answers to ``command``: (whether the reading may have been taken while
         the axes moved, how much later in ns the target may have acted than the
@@ -115,7 +117,7 @@ class RealTime(Timing):
         self._watch_reference()
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: Exchange | None) -> None:
+    def retimed(self, command: str, target: RoundTrip | None) -> None:
         if target is not None and command not in _DEFERRED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
             self.trips.append(target.received_at - target.sent_at)
@@ -126,7 +128,7 @@ class RealTime(Timing):
             if command in _STOPPING:
                 self.cut_ns += self.latency_ns
 
-    def allowance(self, command: str, target: Exchange, reference: Exchange
+    def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
         self._watch_reference()
         moving = command in _READINGS and (command == ">"
@@ -152,7 +154,7 @@ class RealTime(Timing):
             if not self.lost:
                 self.cut_ns = 0
 
-    def _moving_near(self, target: Exchange, reference: Exchange) -> bool:
+    def _moving_near(self, target: RoundTrip, reference: RoundTrip) -> bool:
         """Whether the reading may have been taken while the axes moved on either side:
         the reference had not been at rest for as long as the target's window is wide
         (the target may have processed the frame that much later or earlier)."""

@@ -1,5 +1,5 @@
 """A host certification: the clean run first (the baseline), then every fault scenario,
-each a separate run of the host's job against fresh units (issue 11 items 1, 3).
+each a separate run of the host's job against fresh units.
 
 Launched: the host program is started once per scenario with ``{port}`` replaced by the
 port it should open; scenarios after the clean one run side by side where each can have
@@ -26,7 +26,7 @@ from typing import TextIO
 from conformance.host import oracle, probe
 from conformance.host.checks import LineFacts, judge
 from conformance.host.faults import Fault
-from conformance.host.oracle import HostResult, Outcome
+from conformance.host.oracle import HostResult, HostRun
 from conformance.host.ports import HostPort, open_port
 from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
@@ -126,7 +126,7 @@ def _wait_group_gone(pgid: int, deadline: float) -> None:
 
 def run_once(plan: Plan, fault: Fault, port: HostPort, *,
              done: Callable[[], int | None] | None = None,
-             limit: float = CLEAN_LIMIT_S) -> Outcome:
+             limit: float = CLEAN_LIMIT_S) -> HostRun:
     """One run of the host's job under ``fault``: launched (``plan.command``), or until
     ``done()`` returns the exit status the operator reported."""
     line = open_line(plan.units, plan.baud)
@@ -144,7 +144,7 @@ def run_once(plan: Plan, fault: Fault, port: HostPort, *,
         finals = {v.address: probe.final_state(line, v, relay.rec) for v in views}
     finally:
         line.close()
-    return Outcome(relay.rec, views, finals, code, ended, seconds, fault, output)
+    return HostRun(relay.rec, views, finals, code, ended, seconds, fault, output)
 
 
 def _attended_run(relay: Relay, done: Callable[[], int | None]) -> tuple[str, int | None, str]:
@@ -187,7 +187,7 @@ def _launched_run(relay: Relay, plan: Plan, port: HostPort,
     return ended, proc.returncode if ended == "exited" else None, output
 
 
-def baseline_of(out: Outcome) -> Baseline | None:
+def baseline_of(out: HostRun) -> Baseline | None:
     if out.ended not in ("exited", "operator") or out.exit_code != 0:
         return None
     b = Baseline(oracle.executed(out.views), out.finals, out.recording.exchanges,
@@ -200,7 +200,7 @@ def baseline_of(out: Outcome) -> Baseline | None:
     return b
 
 
-def grade(plan: Plan, sc: Scenario, out: Outcome) -> HostResult:
+def grade(plan: Plan, sc: Scenario, out: HostRun) -> HostResult:
     """The scenario's result, against the plan's baseline (the clean run's)."""
     units = profiles_by_address(out.views)
     line = LineFacts(out.views, units, plan.baud, out.recording.origin, out.exit_code)
@@ -222,7 +222,7 @@ def _fault_limit(plan: Plan) -> float:
 def launched(plan: Plan, on_result: Callable[[HostResult], None]) -> None:
     """Every scenario of ``plan`` with its host program started for each: the clean run,
     then the others side by side; ``on_result`` gets them in scenario order."""
-    def run(sc: Scenario, fault: Fault, limit: float) -> Outcome:
+    def run(sc: Scenario, fault: Fault, limit: float) -> HostRun:
         plan.started.add(sc.id)
         port = open_port(plan.port, plan.baud)
         try:

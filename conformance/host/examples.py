@@ -8,11 +8,12 @@ import re
 from dataclasses import dataclass
 from functools import cache
 
+from conformance.protocol.wire import HEX_BYTE
 from gve_fixtures import golden_transcripts
 from gve_fixtures.rules import load_rules
 from gve_fixtures.transcript import HOST, load
 
-_CHECKSUMMED = re.compile(rb"^(!.*),[0-9A-F]{2}\r?$")
+_CHECKSUMMED = re.compile(rb"^(!.*),%b\r?$" % HEX_BYTE.encode())
 _GOLDEN = re.compile(r"\b11 G(\d+)")
 
 

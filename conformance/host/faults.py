@@ -1,5 +1,5 @@
 """The faults a real line and unit bring, injected by the relay at one point of the host's
-job (issue 11 item 3). Each fault acts through the same few hooks of the relay:
+job. Each fault acts through the same few hooks of the relay:
 
 - ``hold(partial)``: keep the bytes of the frame in progress back from the unit for now;
 - ``frame(ex)``: what the unit gets for a frame that was held whole (None: nothing);
@@ -7,7 +7,7 @@ job (issue 11 item 3). Each fault acts through the same few hooks of the relay:
 - ``after(ex)`` / ``tick(now)``: act on the unit through its rig (an input, a power cycle).
 
 The point of the job comes from the clean run: "the middle vector", "the middle `*E`",
-"the middle setting", or "after half of the job's vectors" (:class:`Target`). Only the
+"the middle setting", or "after half of the job's vectors" (:class:`JobPoint`). Only the
 fault's own point is faulted; everything else passes through untouched.
 """
 
@@ -18,7 +18,7 @@ from typing import Protocol
 
 from conformance.host.grammar import byte_sum
 from conformance.host.recording import Exchange, show
-from gve_fixtures.protocol import INTA_BIT, ErrorCode
+from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode
 
 #: how late a late answer is: longer than a host's least patience (checks.PATIENCE)
 LATE_S = 0.4
@@ -28,7 +28,6 @@ NOISE = b"\x00\xff"
 #: how long the queue pretends to be full, and an input stays active
 QUEUE_FULL_S = 0.3
 INTERRUPT_S = 0.3
-SECOND = 1_000_000_000
 
 
 class Context(Protocol):
@@ -44,7 +43,7 @@ class Context(Protocol):
 
 
 @dataclass(frozen=True)
-class Target:
+class JobPoint:
     """A point of the job: the frame (bytes from `!` to before CR) of the clean run and how
     many vectors the unit had accepted before it; ``raw`` empty = any frame after
     ``vectors`` accepted vectors."""
@@ -103,7 +102,7 @@ class AnswerFault(Fault):
     it. Only an answer of `0` is faulted: the host must find out that its command did
     run (spec 8)."""
 
-    def __init__(self, kind: str, target: Target) -> None:
+    def __init__(self, kind: str, target: JobPoint) -> None:
         super().__init__()
         self.kind, self.target = kind, target
 
@@ -152,7 +151,7 @@ class FrameFault(Fault):
     """The target frame never reaches the unit (``lost-frame``), or only its first half
     does and the unit's watchdog ends it (``cut-frame``, spec 3)."""
 
-    def __init__(self, kind: str, target: Target) -> None:
+    def __init__(self, kind: str, target: JobPoint) -> None:
         super().__init__()
         self.kind, self.target = kind, target
 
@@ -186,7 +185,7 @@ class QueueFull(Fault):
 
     kind = "queue-full"
 
-    def __init__(self, target: Target) -> None:
+    def __init__(self, target: JobPoint) -> None:
         super().__init__()
         self.target = target
         self.until: int | None = None
@@ -251,7 +250,7 @@ class Interrupt(Fault):
 
     kind = "interrupt"
 
-    def __init__(self, target: Target, port: int, bit: int, level: int,
+    def __init__(self, target: JobPoint, port: int, bit: int, level: int,
                  address: int) -> None:
         super().__init__()
         self.target, self.port, self.bit, self.level = target, port, bit, level
@@ -288,7 +287,7 @@ class Restart(Fault):
 
     kind = "restart"
 
-    def __init__(self, target: Target, address: int) -> None:
+    def __init__(self, target: JobPoint, address: int) -> None:
         super().__init__()
         self.target, self.address = target, address
 

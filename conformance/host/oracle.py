@@ -1,4 +1,4 @@
-"""Grading one scenario (issue 11 item 3): the host rules found on the wire, and the
+"""Grading one scenario: the host rules found on the wire, and the
 executed motion against the clean run's.
 
 - On the clean line the host must finish its own job (exit 0): a host that cannot is a
@@ -28,14 +28,15 @@ from conformance.host.faults import Fault
 from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
-from conformance.host.unitview import VECTORS, Step, UnitView
+from conformance.host.unitview import VECTORS, Executed, UnitView
+from conformance.protocol.catalogue import classes
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
 from gve_fixtures.rules import load_rules
 
 NS = 1e9
 #: commands by which a host shows it noticed an interrupt (spec 10.4, 10.5)
-REACTIONS = ("G", "D", "K", "R", "H")
+REACTIONS = classes(reaction=True)
 
 
 @dataclass
@@ -52,7 +53,7 @@ class HostResult(CaseResult):
 
 
 @dataclass
-class Outcome:
+class HostRun:
     """What one run of the host under one fault left behind."""
 
     recording: Recording
@@ -65,11 +66,11 @@ class Outcome:
     output: str = ""
 
 
-def executed(views: list[UnitView]) -> dict[int, list[Step]]:
+def executed(views: list[UnitView]) -> dict[int, list[Executed]]:
     return {v.address: list(v.executed) for v in views}
 
 
-def difference(expected: list[Step], got: list[Step]) -> str | None:
+def difference(expected: list[Executed], got: list[Executed]) -> str | None:
     """None when the two runs executed the same; else the first difference, in words."""
     matcher = difflib.SequenceMatcher(a=expected, b=got, autojunk=False)
     for op, i1, _, j1, _ in matcher.get_opcodes():
@@ -90,7 +91,7 @@ def difference(expected: list[Step], got: list[Step]) -> str | None:
     return None
 
 
-def _short(step: Step) -> str:
+def _short(step: Executed) -> str:
     return f"`{step.kind}{','.join(map(str, step.values))}`"
 
 
@@ -132,7 +133,7 @@ def wire_checks(g: Grader, j: Judgement) -> None:
     g.notes += j.notes
 
 
-def travel(steps: list[Step], axes: int) -> tuple[int, ...]:
+def travel(steps: list[Executed], axes: int) -> tuple[int, ...]:
     """The full steps each axis travelled in the executed vectors ``steps`` (the sum of
     their lengths, whatever the direction)."""
     out = [0] * axes
@@ -143,7 +144,7 @@ def travel(steps: list[Step], axes: int) -> tuple[int, ...]:
     return tuple(out)
 
 
-def driven_checks(g: Grader, out: Outcome, expect: dict[int, tuple[int, ...]] | None
+def driven_checks(g: Grader, out: HostRun, expect: dict[int, tuple[int, ...]] | None
                   ) -> None:
     """The clean run shows a host that drives its units: it sends frames, and the units
     execute the motion its job claims (``expect``: the travel per axis per address)."""
@@ -162,7 +163,7 @@ def driven_checks(g: Grader, out: Outcome, expect: dict[int, tuple[int, ...]] | 
                 f"it travelled {shown or 'nothing'} full steps", "always")
 
 
-def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None,
+def motion_checks(g: Grader, out: HostRun, baseline: Baseline | None,
                   expect: dict[int, tuple[int, ...]] | None = None) -> None:
     sc = g.scenario
     finished = out.ended in ("exited", "operator") and out.exit_code == 0
@@ -199,7 +200,7 @@ def motion_checks(g: Grader, out: Outcome, baseline: Baseline | None,
                 "its job", f"gave up: {_ending(out)}")
 
 
-def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Step]]) -> None:
+def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Executed]]) -> None:
     """How the host took the restart (INFO): the motion before it, and none after it,
     as the unit's position was lost (spec 9: the counters start at 0)."""
     for address, expected in baseline.executed.items():
@@ -214,7 +215,7 @@ def restart_checks(g: Grader, baseline: Baseline, got: dict[int, list[Step]]) ->
                 "restart, the first " + _short(after[0]) if after else "none")
 
 
-def _position(baseline: Baseline, out: Outcome, address: int) -> str | None:
+def _position(baseline: Baseline, out: HostRun, address: int) -> str | None:
     want, got = baseline.final.get(address), out.finals.get(address)
     if want is None or got is None or want.position == got.position:
         return (None if got is None or not got.stalled else
@@ -222,7 +223,7 @@ def _position(baseline: Baseline, out: Outcome, address: int) -> str | None:
     return f"the motion ended at {got.position}, the clean run's at {want.position}"
 
 
-def _ending(out: Outcome) -> str:
+def _ending(out: HostRun) -> str:
     if out.ended == "silent":
         return f"silent for too long, not exited after {out.seconds:.1f} s"
     if out.ended == "limit":
@@ -267,7 +268,7 @@ def _register() -> None:
 _register()
 
 
-def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:
+def result(g: Grader, out: HostRun, profile: str, target: str) -> HostResult:
     rec = out.recording
     sc = g.scenario
     if sc.name != "clean" and not out.fault.injected:
@@ -280,7 +281,7 @@ def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:
              *(f"unit {a}: {f.note}" for a, f in out.finals.items() if f.note), *g.notes]
     return HostResult(
         id=sc.id, section=sc.section, rule=sc.title, tag="D-info" if sc.info else "M",
-        source="issue 11; spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
+        source="spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
         verdict=g.verdict(), checks=[asdict(c) for c in g.checks], notes=notes,
         wire_log=rec.wire_log(), artifacts={"host output": out.output} if out.output else {},
         seconds=out.seconds, frames=len(rec.exchanges), scenario=sc.name,
@@ -292,5 +293,5 @@ def skipped(sc: Scenario, verdict: str, why: str, profile: str, target: str) -> 
     """A scenario that did not run: MISSING (the job has no point for it) or
     COULD-NOT-TEST."""
     return HostResult(id=sc.id, section=sc.section, rule=sc.title, tag="M",
-                      source="issue 11", profile=profile, target=target, verdict=verdict,
-                      notes=[why], scenario=sc.name)
+                      source="spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
+                      verdict=verdict, notes=[why], scenario=sc.name)

@@ -1,4 +1,4 @@
-"""The scenarios of a host certification (issue 11 item 3): the clean run, whose executed
+"""The scenarios of a host certification: the clean run, whose executed
 motion is the baseline, and one run per fault, each at its point of the job.
 
 A scenario is filed under the spec section whose rule it exercises most (8: recovery with
@@ -19,13 +19,13 @@ from conformance.host.faults import (
     Fault,
     FrameFault,
     Interrupt,
+    JobPoint,
     QueueFull,
     Restart,
-    Target,
 )
 from conformance.host.probe import Final
 from conformance.host.recording import Exchange
-from conformance.host.unitview import SETTINGS, VECTORS, Step
+from conformance.host.unitview import SETTINGS, VECTORS, Executed
 
 
 @dataclass
@@ -33,7 +33,7 @@ class Baseline:
     """What the clean run showed: the motion executed per unit, where it ended, the
     exchanges (the points faults aim at) and the interrupt input the host enabled."""
 
-    executed: dict[int, list[Step]]
+    executed: dict[int, list[Executed]]
     final: dict[int, Final]
     exchanges: list[Exchange]
     seconds: float
@@ -43,16 +43,16 @@ class Baseline:
     def vectors(self) -> int:
         return sum(1 for steps in self.executed.values() for s in steps if s.kind in VECTORS)
 
-    def middle(self, point: str) -> Target | None:
+    def middle(self, point: str) -> JobPoint | None:
         """The middle exchange of a kind (vector, packet, setting) that the unit took."""
         found = [ex for ex in self.exchanges if point_of(ex) == point]
         if not found:
             return None
         ex = found[len(found) // 2]
-        return Target(ex.frame.raw, ex.vectors_before)
+        return JobPoint(ex.frame.raw, ex.vectors_before)
 
-    def halfway(self) -> Target | None:
-        return Target(b"", max(1, self.vectors // 2)) if self.vectors else None
+    def halfway(self) -> JobPoint | None:
+        return JobPoint(b"", max(1, self.vectors // 2)) if self.vectors else None
 
 
 def point_of(ex: Exchange) -> str | None:

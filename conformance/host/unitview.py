@@ -15,21 +15,22 @@ from dataclasses import dataclass, field
 
 from conformance.host.grammar import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
-MODAL = ("V", "A", "B", "$", "T", "VK", "VN", "VL", "XM")
-#: settings a fault scenario may target ("a setting", issue 11 item 3)
-SETTINGS = (*MODAL, "SW", "O", "M")
+MODAL = classes(modal=True)
+#: settings a fault scenario may target: the modal ones, status words, outputs, motor mode
+SETTINGS = MODAL | classes(setting=True)
 #: commands that change the motion or the counters: kept in the executed sequence
-MARKERS = ("D", "N", "NX", "NY", "NZ", "NA", "K", "R", "W", "H", "M", "XA", "XU", "XD", "J")
+MARKERS = classes(marks=True)
 #: inside an open packet these are executed at once and discard it (spec 7)
-BREAKERS = ("H", "@", ">", "J")
-VECTORS = ("L", "C")
+BREAKERS = classes(packet="breaker")
+VECTORS = classes(vector=True)
 
 
 @dataclass(frozen=True)
-class Step:
+class Executed:
     """One thing the unit executed: a vector with the settings it runs under, or a
     marker (``D``, ``N``, ``power-on``...)."""
 
@@ -56,7 +57,7 @@ class UnitView:
     packet: list[ParsedFrame] | None = None
     modal: dict[str, object] = field(default_factory=dict)
     status: list[int] = field(default_factory=lambda: [0] * 7)
-    executed: list[Step] = field(default_factory=list)
+    executed: list[Executed] = field(default_factory=list)
     deaf_until: int = 0
     vectors: int = 0                    # how many vectors the unit has accepted so far
 
@@ -77,7 +78,7 @@ class UnitView:
     def power_on(self, t: int) -> None:
         """The unit restarted (the rig's power cycle): reset state, deaf for a while."""
         self._reset()
-        self.executed.append(Step("power-on"))
+        self.executed.append(Executed("power-on"))
         self.deaf_until = t + self.profile.restart_ms * 1_000_000
 
     def apply(self, ex: Exchange, units: dict[int, Profile]) -> None:
@@ -122,7 +123,7 @@ class UnitView:
             if name == "%":
                 self.checksums = params[:1] == ["+"]
             elif name == "V":
-                self.executed.append(Step("spindle", (int(params[0]),)))
+                self.executed.append(Executed("spindle", (int(params[0]),)))
             return
         if name == "%":
             self.checksums = params[:1] == ["+"]
@@ -131,7 +132,7 @@ class UnitView:
             values += (0,) * (len(self.profile.axes) - len(values))
             if any(values):
                 modal = tuple((k, self.modal[k]) for k in sorted(self.modal))
-                self.executed.append(Step(name, values, modal))
+                self.executed.append(Executed(name, values, modal))
                 self.vectors += 1
         elif name in ("VK", "VN"):
             self.modal["VK"] = name == "VK"
@@ -143,7 +144,7 @@ class UnitView:
         elif name == "SW":
             self.status[int(params[0])] = int(params[1], 16)
         if name in MARKERS:
-            self.executed.append(Step(name, tuple(params)))
+            self.executed.append(Executed(name, tuple(params)))
 
     def interrupt_input(self) -> tuple[int, int, int] | None:
         """The interrupt input the host enabled, as (port, bit, active level), or None

@@ -25,7 +25,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-SECOND = 1_000_000_000
+from gve_fixtures.protocol import SECOND
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ goes out and booked with its answer afterwards: frames built by :meth:`Link.send
 bytes of :meth:`Link.send_raw` (golden replays, noise) and frames changed by an injected
 fault alike.
 
-Answers belong to their frame (issue 8 item 5): bytes that arrive before a frame is
+Answers belong to their frame: bytes that arrive before a frame is
 sent are logged as unsolicited and never read as its answer; after a frame timed out
 the link waits for a quiet line before the next one (real time), so a late answer is
 not taken for a later frame's; bytes after a complete answer are recorded in
@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 
-from conformance.link.faults import Fault
+from conformance.link.faults import FrameFault
 from conformance.link.framing import (
     CR,
     HostFrame,
@@ -34,10 +34,9 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next
@@ -70,7 +69,7 @@ class Link:
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[str] = []
-        self._faults: list[Fault] = []
+        self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
         self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
@@ -92,10 +91,16 @@ class Link:
 
     def answer_timeout(self, body: str, size: int) -> float:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
-        the frame's and an answer's bytes, a margin, and what the command itself takes
-        when it answers at its end."""
+        the frame's and an answer's bytes, a margin, what the command itself takes when it
+        answers at its end, and what the line adds (:meth:`line_seconds`)."""
         slow = self.guard.answer_seconds(body) or 0.0
-        return MARGIN + self.byte_seconds(size + 64) + slow
+        return MARGIN + self.byte_seconds(size + 64) + slow + self.line_seconds()
+
+    def line_seconds(self) -> float:
+        """Real time: twice the slowest round trip the session measured (a USB adapter
+        holds an answer's bytes up to its latency timer, and may hold its last piece
+        that long again); nothing in virtual time or when the line was not measured."""
+        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
@@ -143,9 +148,9 @@ class Link:
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
         """Plan a fault for the next frame ("host") or response ("unit")."""
-        self._faults.append(Fault(direction, kind, params))
+        self._faults.append(FrameFault(direction, kind, params))
 
-    def _fault(self, direction: str) -> Fault | None:
+    def _fault(self, direction: str) -> FrameFault | None:
         for i, f in enumerate(self._faults):
             if f.direction == direction:
                 return self._faults.pop(i)
@@ -178,7 +183,7 @@ class Link:
             if piece:
                 self._write(piece)
         if frames:
-            self._last = (_UNASKED, frames[-1].raw, b"")
+            self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -264,7 +269,7 @@ class Link:
             raw += chunk
             if not chunk.endswith(CR):
                 break
-            self.port.timeout = MARGIN
+            self.port.timeout = MARGIN + self.line_seconds()
         data = bytes(raw)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None

@@ -1,4 +1,4 @@
-"""The run-wide guard on a real unit (issue 8): every frame is judged here before it is
+"""The run-wide guard on a real unit: every frame is judged here before it is
 sent and booked here after its answer, whoever sends it (a case, a machine, a golden
 replay's raw bytes, the diff runner, the session itself).
 
@@ -21,17 +21,18 @@ Public interface (docs/suite.md, "The session and its guard")::
 
 from __future__ import annotations
 
-import contextlib
-import functools
 import math
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
+from conformance.protocol.catalogue import classes, eeprom_width
+from conformance.protocol.parse import parse
+from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
@@ -52,25 +53,39 @@ class TargetNotResponding(BaseException):
     """Several frames in a row got no answer: the run stops for this target."""
 
 
-#: commands of spec 10 whose names are longer than one letter, longest first
-_NAMES = ("EFW", "EUW", "EFR", "EUR", "EW", "ER", "*S", "*E", "VL", "VK", "VN", "XA", "XU",
-          "XD", "XM", "PF", "SR", "SW", "NX", "NY", "NZ", "NA", "I0", "I1", "I2")
 #: frames that can start an axis moving (and so ask the operator first)
-MOTION = frozenset({"L", "C", "*E", "G", "R", "W", "SW6"})
+MOTION = classes(motion=True)
 #: frames that change what outlives the run: restart, reference run, EEPROM
-DESTRUCTIVE = frozenset({"J", "W", "EW", "EFW", "EUW"})
-_EEPROM_WIDTH = {"EW": 1, "EFW": 4, "EUW": 4}
+DESTRUCTIVE = classes(destructive=True)
 #: the longest an answer is waited for (a `W` whose run would take longer: the unit
 #: refuses such a travel or rate, or the run is not one a test should wait out)
 LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
-_PACKET_BREAKERS = frozenset({"H", "@", ">", "J"})
+_PACKET_BREAKERS = classes(packet="breaker")
+_PACKET_MEMBERS = classes(packet="member")
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
 
 
+class _Depth:
+    """How many blocks of one kind are open (they nest): ``with depth:`` opens one; the
+    depth is true while any is open."""
+
+    def __init__(self) -> None:
+        self.open = 0
+
+    def __bool__(self) -> bool:
+        return self.open > 0
+
+    def __enter__(self) -> None:
+        self.open += 1
+
+    def __exit__(self, *exc: object) -> None:
+        self.open -= 1
+
+
 @dataclass(frozen=True)
-class Command:
+class Body:
     """A frame's body as the guard reads it: leniently (a unit that is not conforming
     may take `l` for `L` or `+5` for 5), so that no reading of it goes unjudged."""
 
@@ -78,34 +93,17 @@ class Command:
     params: str
 
     @classmethod
-    def parse(cls, body: str) -> Command:
-        return _parse(body)
-
-    @classmethod
-    def _read(cls, body: str) -> Command:
-        text = body.upper()
-        for name in _NAMES:
-            if text.startswith(name):
-                params = text[len(name):]
-                if name == "SW" and _number(params.split(",")[0]) == point(6):
-                    name = "SW6"             # writing ST6 may resume motion (spec 10.3)
-                return cls(name, params)
-        if text.startswith("N"):
-            return cls("N", text[1:])        # N followed by junk: N with a bad parameter
-        return cls(text[:1], text[1:])
+    def parse(cls, body: str) -> Body:
+        """The frame's class (``SW6`` for a write of ST6, "" for no command of spec 10)
+        and its parameters, read leniently."""
+        parsed = parse(body)
+        return cls(parsed.key, parsed.params)
 
     def fields(self, count: int) -> list[Span]:
         """The first ``count`` comma-separated integers (missing ones 0, unreadable ones
         unbounded)."""
         parts = self.params.split(",") if self.params else []
         return [_number(parts[i]) if i < len(parts) else ZERO for i in range(count)]
-
-
-@functools.lru_cache(maxsize=4096)
-def _parse(body: str) -> Command:
-    """Command.parse, once a body (a frame's reading is asked for before it is sent,
-    after its answer and for its timeout; the known state's bodies recur every case)."""
-    return Command._read(body)
 
 
 def _number(text: str, base: int = 10) -> Span:
@@ -150,43 +148,28 @@ class Guard:
         self.silences = 0
         self.garbage = ""                         # the last bytes that were not an answer
         self.dead = False
-        self._own = 0                             # inside the session's own frames
-        self._emergency = 0
-        self._hands_on = 0                        # a technician's hand step is open
+        self._own = _Depth()                      # inside the session's own frames
+        self._emergency = _Depth()
+        self._hands_on = _Depth()                 # a technician's hand step is open
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
         return max_travel * self.scale
 
     # -- who is sending ----------------------------------------------------------------------
-    @contextlib.contextmanager
-    def own_frames(self) -> Iterator[None]:
+    def own_frames(self) -> _Depth:
         """The session's own frames (known state, snapshot, restorations): after Ctrl-C
         these still go out, except motion."""
-        self._own += 1
-        try:
-            yield
-        finally:
-            self._own -= 1
+        return self._own
 
-    @contextlib.contextmanager
-    def emergency(self) -> Iterator[None]:
+    def emergency(self) -> _Depth:
         """`H` and `D` after Ctrl-C: the frames that go out before anything else."""
-        self._emergency += 1
-        try:
-            yield
-        finally:
-            self._emergency -= 1
+        return self._emergency
 
-    @contextlib.contextmanager
-    def hands_on(self) -> Iterator[None]:
+    def hands_on(self) -> _Depth:
         """A technician's hand step is open (a prompt waits for them): no motion until it
         is answered, whoever sends."""
-        self._hands_on += 1
-        try:
-            yield
-        finally:
-            self._hands_on -= 1
+        return self._hands_on
 
     # -- before a frame ----------------------------------------------------------------------
     def check_idle(self) -> None:
@@ -204,7 +187,7 @@ class Guard:
         self.check_idle()
         if self._emergency:
             return
-        command = Command.parse(body)
+        command = Body.parse(body)
         address = self.address if address is None else address
         if address not in self.addresses:
             if command.name in MOTION | DESTRUCTIVE:
@@ -235,11 +218,11 @@ class Guard:
             for body in f.bodies(summed):
                 self.check(body, f.address if f.address is not None else self.address)
 
-    def _check_destructive(self, body: str, command: Command) -> None:
+    def _check_destructive(self, body: str, command: Body) -> None:
         if not self.allow_destructive:
             raise SafetyStop(f"{body} restarts the unit, runs to a switch or writes EEPROM: "
                              "needs --allow-destructive")
-        width = _EEPROM_WIDTH.get(command.name)
+        width = eeprom_width(command.name)
         if width:
             touched = self._eeprom_bytes(command, width)
             lost = [a for a in touched if not self.eeprom.backed_up(a)] if touched else [-1]
@@ -248,7 +231,7 @@ class Guard:
                 raise SafetyStop(f"{body}: EEPROM {shown} not backed up, so not written")
             self.eeprom.write(touched)
 
-    def _eeprom_bytes(self, command: Command, width: int) -> list[int]:
+    def _eeprom_bytes(self, command: Body, width: int) -> list[int]:
         start = _number(command.params.split(",")[0], 16)
         if not start.exact:
             return []
@@ -258,15 +241,15 @@ class Guard:
     def farthest(self, body: str) -> float:
         """How far (full steps) from where the run began an axis could be once the frame
         ``body`` went out: the envelope it needs now (inf: it cannot be bounded)."""
-        command = Command.parse(body)
+        command = Body.parse(body)
         reach = self._reach(command) if command.name in MOTION else self.envelope.reach()
         return max(max(-_steps(s.lo, self.scale), _steps(s.hi, self.scale)) for s in reach)
 
-    def _reach(self, command: Command) -> list[Span]:
+    def _reach(self, command: Body) -> list[Span]:
         event = self._event(command, Outcome.UNCLEAR, None)
         return self.envelope.would_reach(event) if event else self.envelope.reach()
 
-    def _check_motion(self, body: str, command: Command) -> None:
+    def _check_motion(self, body: str, command: Body) -> None:
         e = self.envelope
         reach = self._reach(command)
         axis = e.outside(reach)
@@ -297,9 +280,9 @@ class Guard:
         address = self.address if address is None else address
         if address not in self.addresses:
             return
-        command = Command.parse(body)
+        command = Body.parse(body)
         outcome = outcome_of(response)
-        if command.name in ("C", "B") and self.packet_open:
+        if command.name in _PACKET_MEMBERS and self.packet_open:
             steps = command.fields(self.envelope.axes)
             if command.name == "C":
                 self.packet.append(steps)
@@ -317,7 +300,7 @@ class Guard:
         self.envelope.discard(Outcome.ACCEPTED, restart=True)
         self.packet_open = False
 
-    def _event(self, command: Command, outcome: Outcome,
+    def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
         """What ``command`` does to the envelope with ``outcome`` (None: nothing);
         ``code`` is the answer's code when there was one."""
@@ -330,7 +313,7 @@ class Guard:
                  "M": self._mode}.get(command.name)
         return None if build is None else build(command, outcome, code)
 
-    def _vector(self, command: Command, outcome: Outcome,
+    def _vector(self, command: Body, outcome: Outcome,
                 code: int | None) -> Callable[[Envelope], None]:
         """`L`, `C`, and `*E` committing the packet's `C` members (a member sent while
         the packet is open is judged with the members before it)."""
@@ -344,14 +327,14 @@ class Guard:
             return lambda e: _commit(e, members, outcome)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
-    def _mode(self, command: Command, outcome: Outcome,
+    def _mode(self, command: Body, outcome: Outcome,
               code: int | None) -> Callable[[Envelope], None] | None:
         """GVE54 `M`: the micro-step mode of later vectors (currents change nothing)."""
         micro = self.profile.microstep
         factor = micro.factors.get(command.params.strip()) if micro else None
         return None if factor is None else (lambda e: e.mode(factor, outcome))
 
-    def _counters(self, command: Command, outcome: Outcome,
+    def _counters(self, command: Body, outcome: Outcome,
                   code: int | None) -> Callable[[Envelope], None]:
         """`N` zeroes every counter, `N<axis> n` sets one; a value the guard cannot read
         leaves that counter unknown."""
@@ -366,13 +349,13 @@ class Guard:
             values = {}
         return lambda e: e.counters(values, outcome)
 
-    def _reference(self, command: Command, outcome: Outcome,
+    def _reference(self, command: Body, outcome: Outcome,
                    code: int | None) -> Callable[[Envelope], None]:
         """`W<axis>,n2,n3,n4,n5`: to the switch within n2, back within n4 (spec 10 W).
         Answered 5 (no switch, or still active) the axis has moved all the same."""
         names = self.profile.axes
         axis = command.params[:1]
-        n2, _, n4, _ = Command("W", command.params[1:].lstrip(",")).fields(4)
+        n2, _, n4, _ = Body("W", command.params[1:].lstrip(",")).fields(4)
         if code == 5:
             outcome = Outcome.ACCEPTED
         zeroed = code == 0
@@ -384,7 +367,7 @@ class Guard:
         i = names.index(axis)
         return lambda e: e.reference(i, travel, outcome, zeroed=zeroed)
 
-    def _learn(self, command: Command, r: Response | None, outcome: Outcome) -> None:
+    def _learn(self, command: Body, r: Response | None, outcome: Outcome) -> None:
         """What an answer tells beyond the command itself: packets open and close, the
         unit shows it rests, a position is read."""
         name = command.name
@@ -402,9 +385,9 @@ class Guard:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
             st6 = r.values[0] if r.values else ""
-            if re.fullmatch(r"[0-9A-F]{2}", st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
+            if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
                 self.envelope.ended()
-        elif name in ("P", "PF"):
+        elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
                 self.envelope.observe({i: int(r.values[i]) for i in range(axes)})
@@ -444,11 +427,11 @@ class Guard:
 
     def answer_seconds(self, body: str) -> float | None:
         """How long `H` and `W` may take before they answer (None: at once)."""
-        command = Command.parse(body)
+        command = Body.parse(body)
         if command.name == "H":
             return 2 * self.stop_seconds()
         if command.name == "W":
-            n2, n3, n4, n5 = Command("W", command.params[1:].lstrip(",")).fields(4)
+            n2, n3, n4, n5 = Body("W", command.params[1:].lstrip(",")).fields(4)
             if all(x.exact for x in (n2, n3, n4, n5)) and n3.lo > 0 and n5.lo > 0:
                 run = abs(n2.lo) / n3.lo + abs(n4.lo) / n5.lo + 4 * self.stop_seconds()
                 return min(run, LONGEST_ANSWER_S)

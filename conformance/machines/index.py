@@ -45,7 +45,9 @@ class RecoveryMachine(UnitMachine):
     def recover(self, body: str, move: list[int], before: int) -> None:
         """The host's recovery rule of spec 8: ask @; if the command arrived, > shows
         its answer; resend only if it did not arrive or was refused."""
-        arrived = self.index() == (before + 1) % 256
+        # the @ that reads the index counts itself on a unit whose @ counts (measured) [D]
+        counted = "@" not in self.model.uncounted
+        arrived = self.index() == (before + 1 + counted) % 256
         if arrived:
             r = self.send(">", lines=2)
             self.repeated = True

@@ -21,7 +21,6 @@ from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
 from conformance.link.line_band import EXACT, LineBand, line_band
-from conformance.motion.arith import SECOND
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
@@ -33,6 +32,7 @@ from conformance.motion.tolerance import (
     tolerance,
     widened,
 )
+from gve_fixtures.protocol import SECOND
 
 #: dense model points per trace
 TRACE_POINTS = 60
@@ -74,6 +74,7 @@ class Probe:
         self.readings: list[Reading] = []
         self.params: dict = {}
         self.round_trip = 0
+        self.next_brake = False    # model the junctions at the next C's B (a [D] reading)
         self.trips: list[int] = []          # ns: the round trips of frames answered at once
         self.link.wait(SETTLE)
         start = self.read("start")
@@ -136,6 +137,11 @@ class Probe:
         """Run a scenario and judge it: a string is a frame to send, a number the seconds
         to sample PF for (every ``every`` s; a pair: seconds and how often), a list the
         position (in commanded steps) to poll PF until (every 2 ms)."""
+        self.run(steps, every)
+        return self.judge()
+
+    def run(self, steps: list, every: float = 0.05) -> None:
+        """Run a scenario (as :meth:`script`) without judging it yet."""
         for step in steps:
             if isinstance(step, str):
                 self.send(step)
@@ -146,7 +152,6 @@ class Probe:
                            UNTIL_SECONDS, 0.002)
             else:
                 self.sample(step, every)
-        return self.judge()
 
     # -- the frames' meaning (spec 10) --------------------------------------------------
     def _book(self, body: str, w: Window, answered: Window) -> None:
@@ -194,7 +199,7 @@ class Probe:
         """The model fed with every event at its instant: the middle of its window, or
         for the events in ``shift`` (index -> instant) that instant; and the instant it
         comes to rest after each H."""
-        model = MotionModel(self.origin)
+        model = MotionModel(self.origin, next_brake=self.next_brake)
         rests = []
         for i, e in enumerate(self.events):
             t = (shift or {}).get(i, (e.window.lo + e.window.hi) // 2)
@@ -219,6 +224,31 @@ class Probe:
             if e.window.lo != e.window.hi:
                 out += [self.model({i: e.window.lo}), self.model({i: e.window.hi})]
         return out
+
+    def fits(self) -> bool:
+        """Whether every reading after the first event lies within the model's band, the
+        line's band included (as :meth:`judge` would find), recording nothing."""
+        line = self.line()
+        events, readings = self.events, self.readings
+        self._widen(line)
+        try:
+            (model, _), variants = self.model(), self._variants()
+            virtual = self.link.virtual
+            t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
+                  ) + line.ns
+            spread = sum(e.window.hi - e.window.lo for e in self.events)
+            for reading in self.readings:
+                w = reading.window
+                if w.hi - line.ns < t0:
+                    continue
+                tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
+                band = _band(model, variants, w, tol.steps)
+                got = reading.positions[:len(band)]
+                if not all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True)):
+                    return False
+            return True
+        finally:
+            self.events, self.readings = events, readings
 
     def line(self) -> LineBand:
         """The line's band: zero in virtual time; in real time from the round trip the

@@ -41,8 +41,8 @@ import math
 from dataclasses import dataclass
 
 from conformance.link.line_band import EXACT, LineBand
+from gve_fixtures.protocol import SECOND
 
-SECOND = 1_000_000_000
 #: bits per byte on an 8N1 line (spec 2): start, 8 data, stop
 BITS_PER_BYTE = 10
 #: steps a real target may differ by from the model at a known instant (step placement)

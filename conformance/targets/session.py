@@ -396,7 +396,16 @@ class RealSession(Session):
         counters read first unless ``read`` is False: just read)."""
         if read:
             self._position(link)
-        here = self.guard.envelope.position()
+        envelope = self.guard.envelope
+        if envelope.unheld:
+            axes = ", ".join(sorted({self.profile.axes[i] for i in envelope.unheld}))
+            why = (f"position counters ({axes}) set with N<axis> read back other values at "
+                   "rest: taken for counters that do not hold them, the axes where the "
+                   "frames put them")
+            if why not in self.report.problems:
+                self.report.problems.append(why)
+            envelope.unheld.clear()
+        here = envelope.position()
         back = [0 if h is None else -int(h) for h in here]
         if not any(back):
             return

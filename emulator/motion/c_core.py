@@ -16,6 +16,7 @@ pushes one by one (a vector that does not pack is refused by its own push).
 from __future__ import annotations
 
 import struct
+from typing import Any
 
 from emulator.motion.build_stepper import AXES
 from emulator.motion.rebuild import ensure_fresh
@@ -144,36 +145,29 @@ class CMotion:
         return self._out[0] if found else None
 
     # -- queries ----------------------------------------------------------------------
-    def position(self, t: int) -> tuple[int, ...]:
+    def _core(self) -> Any:
+        """The core with every held push sent: what a query must see."""
         if self._held:
             self._send()
-        out = self._out
-        _st_position(self._m, t, out)
-        return tuple(_unpack(out, self.axes))
+        return self._m
+
+    def position(self, t: int) -> tuple[int, ...]:
+        _st_position(self._core(), t, self._out)
+        return tuple(_unpack(self._out, self.axes))
 
     def physical(self, t: int) -> tuple[int, ...]:
-        if self._held:
-            self._send()
-        out = self._out
-        _st_physical(self._m, t, out)
-        return tuple(_unpack(out, self.axes))
+        _st_physical(self._core(), t, self._out)
+        return tuple(_unpack(self._out, self.axes))
 
     def excursion(self, t: int) -> tuple[tuple[int, int], ...]:
-        if self._held:
-            self._send()
-        out = self._out
-        _st_excursion(self._m, t, out)
-        return self._pairs(_unpack(out, 2 * AXES))
+        _st_excursion(self._core(), t, self._out)
+        return self._pairs(_unpack(self._out, 2 * AXES))
 
     def flags(self, t: int) -> MotionFlags:
-        if self._held:
-            self._send()
-        return _FLAGS[_st_flags(self._m, t)]
+        return _FLAGS[_st_flags(self._core(), t)]
 
     def queued(self, t: int) -> int:
-        if self._held:
-            self._send()
-        return _st_queued(self._m, t)
+        return _st_queued(self._core(), t)
 
     def instant_of_position(self, axis: int, value: int) -> int | None:
         if self._held:

@@ -38,7 +38,7 @@ class Device:
         self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
-                             deviations=mutant.deviations)
+                             deviations=mutant.deviations | readings.deviations)
         self.motion.advance(origin)
         self.inputs = dict(UNCONNECTED)
         self.switches: dict[str, int | None] = {}
@@ -65,7 +65,12 @@ class Device:
     def factor(self) -> int:
         """Counter units per commanded step (GVE54 micro-stepping, spec 10.7)."""
         ms = self.profile.microstep
-        return ms.factors[self.state.microstep] if ms is not None else 1
+        if ms is None:
+            return 1
+        mode = self.state.microstep
+        if self.mutant.active("microstep-modes-swapped"):
+            mode = {"2": "8", "8": "2"}.get(mode, mode)
+        return ms.factors[mode]
 
     def mpg_active(self) -> bool:
         """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""
@@ -153,6 +158,9 @@ class Device:
     def override(self, percent: int, t: int) -> None:
         """XM: an override of every vector, held and later ones (spec 10 XM)."""
         self.state.xm = percent
+        if self.mutant.active("override-rewrites-velocity"):
+            r, modal = self.profile.ranges["V"], self.state.modal
+            modal.V = max(r.lo, min(r.hi, modal.V * percent // 100))
         if not self.mutant.active("override-late"):
             self.motion.set_multiplier(percent, t)
 

@@ -171,10 +171,18 @@ def test_keep_takes_only_l_on_gve84_and_gve114(profile):
     assert ask(port, "C10,0,0") == expected
 
 
-def test_restore_without_keep_is_an_empty_save(profile):
+#: short dialogues with a fresh unit: each frame and its answer, in order
+DIALOGUES = {
+    "restore without keep is an empty save": [("R", b"0\r"), ("SR6", b"0,00\r")],
+    "status words store all bits": [("SW1,3F", b"0\r"), ("SR1", b"0,3F\r")],
+}
+
+
+@pytest.mark.parametrize("dialogue", sorted(DIALOGUES))
+def test_short_dialogues(profile, dialogue):
     port = open_line(profile.name)
-    assert ask(port, "R") == b"0\r"
-    assert ask(port, "SR6") == b"0,00\r"
+    frames = DIALOGUES[dialogue]
+    assert [ask(port, body) for body, _ in frames] == [answer for _, answer in frames]
 
 
 def test_interrupt_input_stops_motion_and_sets_the_cause(profile):
@@ -191,12 +199,6 @@ def test_interrupt_input_stops_motion_and_sets_the_cause(profile):
     assert ask(port, "P") == here                   # stopped
     assert ask(port, "G") == b"8\r"                 # still active: stops again [D]
     assert ask(port, "SR4") == b"8,01\r"
-
-
-def test_status_words_store_all_bits(profile):
-    port = open_line(profile.name)
-    assert ask(port, "SW1,3F") == b"0\r"
-    assert ask(port, "SR1") == b"0,3F\r"
 
 
 def test_checksum_mode(profile):

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from emulator.motion.arith import acc_count, acc_time
 from emulator.motion.factory import c_available, create
-from emulator.motion.interface import SECOND, Vector
+from emulator.motion.interface import Vector
+from gve_fixtures.protocol import SECOND
 
 MAX_RATE = 100_000
 AXES = 3
@@ -64,6 +65,21 @@ def total(vectors) -> tuple[int, ...]:
     return tuple(sum(v.steps[i] for v in vectors) for i in range(AXES))
 
 
+def loaded_until(core, vectors, data) -> tuple:
+    """A core loaded with ``vectors``, the instant its run ends, and an instant drawn
+    from 0 to that end."""
+    m = loaded(core, vectors)
+    end = m.drain_instant() or m.now
+    return m, end, data.draw(st.integers(0, end))
+
+
+def ends_at_the_sum(m, vectors) -> None:
+    """Run the rest out: the unit stands where all of ``vectors`` add up, no step lost or
+    taken twice."""
+    run_out(m)
+    assert m.position(m.now) == total(vectors)
+
+
 # -- the arithmetic ---------------------------------------------------------------------
 
 @given(st.integers(0, 10**6), st.integers(0, 10**8), st.integers(0, 2**35))
@@ -99,10 +115,8 @@ def test_vectors_end_on_their_targets_and_pulses_add_up(core, vectors):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_position_equals_the_pulses_before_it(core, vectors, data):
-    m = loaded(core, vectors)
-    end = m.drain_instant() or m.now
+    m, end, instant = loaded_until(core, vectors, data)
     times, masks = m.pulses(0, end + 1)
-    instant = data.draw(st.integers(0, end))
     before = times <= instant
     expect = []
     for i in range(AXES):
@@ -115,9 +129,7 @@ def test_position_equals_the_pulses_before_it(core, vectors, data):
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_pulse_windows_slice_exactly(core, vectors, data):
-    m = loaded(core, vectors)
-    end = m.drain_instant() or m.now
-    cut = data.draw(st.integers(0, end))
+    m, end, cut = loaded_until(core, vectors, data)
     whole = m.pulses(0, end + 1)
     first, second = m.pulses(0, cut), m.pulses(cut, end + 1)
     assert np.array_equal(whole[0], np.concatenate([first[0], second[0]]))
@@ -190,9 +202,7 @@ def test_junction_is_faster_than_stopping(core):
 @given(st.lists(vector_st, min_size=1, max_size=5), st.data())
 @SETTINGS
 def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
-    m = loaded(core, vectors)
-    end = m.drain_instant() or m.now
-    at = data.draw(st.integers(0, end))
+    m, _, at = loaded_until(core, vectors, data)
     rest = m.halt(at)
     assert rest >= at
     flags = m.flags(rest)
@@ -200,16 +210,14 @@ def test_halt_and_resume_end_where_not_halting_ends(core, vectors, data):
     still = m.position(rest)
     assert m.position(rest + SECOND) == still, "a halted unit does not move"
     m.resume(rest + SECOND)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
 @SETTINGS
 def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
-    m = loaded(core, vectors)
-    end = m.drain_instant() or m.now
-    rest = m.halt(data.draw(st.integers(0, end)))
+    m, _, at = loaded_until(core, vectors, data)
+    rest = m.halt(at)
     saved = m.keep(rest)
     assert m.queued(rest) == 0
     m.push(vector((0, 0, -500), continuous=False), rest)
@@ -219,8 +227,7 @@ def test_keep_restore_around_a_detour_loses_no_step(core, vectors, data):
     m.restore(saved, m.now)
     m.set_velocity(data.draw(st.integers(10, MAX_RATE)), m.now)
     m.resume(m.now)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 @given(st.lists(vector_st, min_size=1, max_size=4), st.data())
@@ -239,8 +246,7 @@ def test_overrides_change_speed_not_targets(core, vectors, data):
             m.scale_velocity(15, 16, t, accel=True)
         else:
             m.set_multiplier(data.draw(st.integers(1, 1000)), t)
-    run_out(m)
-    assert m.position(m.now) == total(vectors)
+    ends_at_the_sum(m, vectors)
 
 
 def test_multiplier_doubles_the_speed(core):

@@ -2,16 +2,16 @@
 while the axes may move, exact at rest; the index from where each side began."""
 
 from conformance.diff.compare import Judge, alike_because, difference
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.link.framing import parse_response
 from conformance.link.line_band import LineBand
 
 MS = 1_000_000
 
 
-def ex(answer: bytes, sent_at: int = 0, received_at: int = MS) -> Exchange:
+def ex(answer: bytes, sent_at: int = 0, received_at: int = MS) -> RoundTrip:
     r = parse_response(answer, summed=False) if answer else None
-    return Exchange(b"!0PF\r", answer, sent_at, received_at, r)
+    return RoundTrip(b"!0PF\r", answer, sent_at, received_at, r)
 
 
 def test_alike_answers_at_the_same_instant_agree():
@@ -78,8 +78,8 @@ def test_real_time_index_compared_from_where_each_side_began():
     assert difference("@", ex(b"0,46\r"), ex(b"0,5\r"), judge) == "data"
 
 
-def repeat(answer: bytes, received_at: int = 2 * MS) -> Exchange:
-    return Exchange(b"!0>\r", answer, 0, received_at, parse_response(answer, summed=False,
+def repeat(answer: bytes, received_at: int = 2 * MS) -> RoundTrip:
+    return RoundTrip(b"!0>\r", answer, 0, received_at, parse_response(answer, summed=False,
                                                                       lines=2), 2)
 
 

@@ -2,7 +2,7 @@
 rate its axes can have stepped at, the junction of two C and the open packet."""
 
 from conformance.diff.course import Course
-from conformance.diff.sides import Exchange
+from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import FRAME, Step
 from conformance.link.framing import parse_response
 from conformance.targets import parse_target
@@ -14,10 +14,10 @@ def course() -> Course:
     return Course(parse_target("emu:GVE84-100").profile)     # T5, V1000, XM100
 
 
-def ok(at_ms: int = 0, code: int = 0) -> Exchange:
+def ok(at_ms: int = 0, code: int = 0) -> RoundTrip:
     """The reference's answer ``code``, the frame sent ``at_ms`` into the example."""
     answer = f"{code}\r".encode()
-    return Exchange(b"", answer, at_ms * MS, at_ms * MS, parse_response(answer, summed=False))
+    return RoundTrip(b"", answer, at_ms * MS, at_ms * MS, parse_response(answer, summed=False))
 
 
 def test_a_frame_within_t_of_a_vector_may_meet_its_dwell():

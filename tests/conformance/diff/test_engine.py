@@ -31,7 +31,8 @@ QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-c
 FRAMES = {"dwell-between-continuous": 12}
 #: where a mutant shows only on one family
 PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
-           "mpg-not-moving": "GVE114-500"}
+           "mpg-not-moving": "GVE114-500", "microstep-modes-swapped": "GVE54",
+           "spindle-sets-feed-rate": "GVE114-500"}
 EVERYTHING = Options(destructive=True, rig=True)
 
 

@@ -56,3 +56,8 @@ def test_a_breaker_unanswered_inside_a_packet_is_the_breakers_rule():
         assert label(command, "silence", {"in-packet"}, {"*S"}, 0) == "7.packet.breakers"
     assert label("H", "silence", {"bad-checksum", "in-packet"}, {"*S"}, 4) == \
         "7.packet.bad-checksum-member"
+
+
+def test_a_repeat_after_an_index_is_whether_the_index_is_remembered():
+    assert label(">", "data", set(), {"V", "@"}, 0, 0) == "8.repeat.remembered"
+    assert label(">", "data", set(), {"V"}, 0, 0) == "8.repeat.answer"

@@ -2,7 +2,7 @@
 allowance (latency, slack, cut) as soon as one side is not."""
 
 from conformance.diff.engine import Pair
-from conformance.diff.sides import Exchange, Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.timing import RealTime, Timing
 from conformance.targets import parse_target
 
@@ -17,7 +17,7 @@ def test_two_virtual_sides_are_compared_exactly():
     target, reference = sides()
     p = Pair(target, reference, target.target.profile)
     assert type(p.timing) is Timing and p.exact and p.timing.repeatable
-    reply = Exchange(b"H", b"0\r", 0, 200 * MS, None)
+    reply = RoundTrip(b"H", b"0\r", 0, 200 * MS, None)
     p.timing.retimed("H", reply)
     assert p.timing.allowance("P", reply, reply) == (False, 0)
 
@@ -31,7 +31,7 @@ def test_in_real_time_a_course_change_while_moving_widens_later_readings():
     assert not t.exact and not t.repeatable
 
     def sent(command: str, took_ms: int) -> tuple[int, int, int]:
-        reply = Exchange(command.encode(), b"0\r", 0, took_ms * MS, None)
+        reply = RoundTrip(command.encode(), b"0\r", 0, took_ms * MS, None)
         t.retimed(command, reply)
         return t.latency_ns // MS, t.slack_ns // MS, t.cut_ns // MS
 
@@ -56,10 +56,10 @@ def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
     target.link.round_trip = {"min_ms": 1.0, "median_ms": 3.0, "max_ms": 4.0,
                               "byte_ms": 0.5, "bytes_ms": 1.0}
     assert t.line().seconds == 4.5e-3                # 1 one way + 3 jitter + 0.5 a byte
-    t.retimed("V", Exchange(b"V", b"0\r", 0, 6 * MS, None))
-    t.retimed("H", Exchange(b"H", b"8\r", 0, 300 * MS, None))
+    t.retimed("V", RoundTrip(b"V", b"0\r", 0, 6 * MS, None))
+    t.retimed("H", RoundTrip(b"H", b"8\r", 0, 300 * MS, None))
     assert abs(t.line().seconds - 6.5e-3) < 1e-12     # jitter 6 - 1 (the session's min)
-    t.retimed("V", Exchange(b"V", b"0\r", 0, 5 * MS, None))
+    t.retimed("V", RoundTrip(b"V", b"0\r", 0, 5 * MS, None))
     assert abs(t.line().seconds - 2.5e-3) < 1e-12     # two of its own: jitter 6 - 5
     t.begin()
     assert t.line().seconds == 4.5e-3

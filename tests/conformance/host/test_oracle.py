@@ -4,10 +4,10 @@ the vector, and whether it ran twice, never ran, or ran under another setting.""
 from __future__ import annotations
 
 from conformance.host.oracle import difference
-from conformance.host.unitview import Step
+from conformance.host.unitview import Executed
 
 MODAL = (("V", 1000),)
-A, B, C = (Step("C", (v, 0, 0), MODAL) for v in (1, 2, 3))
+A, B, C = (Executed("C", (v, 0, 0), MODAL) for v in (1, 2, 3))
 
 
 def test_the_same_motion():
@@ -25,6 +25,6 @@ def test_a_vector_lost():
 
 
 def test_a_vector_under_another_setting():
-    slow = Step("C", (2, 0, 0), (("V", 500),))
+    slow = Executed("C", (2, 0, 0), (("V", 500),))
     said = difference([A, B, C], [A, slow, C])
     assert said is not None and "C2,0,0" in said and "V500" in said and "V1000" in said

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.link.faults import Fault
+from conformance.link.faults import FrameFault
 from conformance.verdict import FAIL, INFO, NON_STRICT, PASS, grade, worst
 
 FRAME = b"!0V1000\r"
@@ -19,14 +19,14 @@ FRAME = b"!0V1000\r"
     ("split", {"size": 4, "seconds": 0.01}, [(b"!0V1", 0.0), (b"000\r", 0.01)]),
 ])
 def test_injectors(kind, params, expected):
-    assert Fault("host", kind, params).apply(FRAME) == expected
+    assert FrameFault("host", kind, params).apply(FRAME) == expected
 
 
 def test_unknown_faults_are_refused():
     with pytest.raises(ValueError):
-        Fault("host", "melt")
+        FrameFault("host", "melt")
     with pytest.raises(ValueError):
-        Fault("sideways", "drop")
+        FrameFault("sideways", "drop")
 
 
 def test_grading_follows_the_spec_table():

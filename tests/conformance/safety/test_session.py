@@ -203,3 +203,13 @@ def test_every_link_of_a_real_session_carries_the_measured_line():
     link = unit.open_link()
     assert link.round_trip == unit.session.report.line and link.round_trip["max_ms"] > 0
     unit.session.finish()
+
+
+def test_a_measured_line_lengthens_the_answer_timeout_by_twice_its_slowest_round_trip():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    link = unit.open_link()
+    measured = link.answer_timeout("V1000", 8)
+    link.round_trip = {}
+    assert measured - link.answer_timeout("V1000", 8) == \
+        pytest.approx(2 * unit.session.report.line["max_ms"] / 1e3)
+    unit.session.finish()
