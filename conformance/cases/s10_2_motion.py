@@ -70,11 +70,13 @@ def junction_sides(ctx: CaseContext) -> None:
     """Which B governs a junction when the two C captured different ones: the ending C's
     (10.2.motion.junction-own-b [D]). Readings that fit a junction at the next C's B are
     that other reading (NON-STRICT); readings that fit neither break B itself [M]."""
-    for before, after in JUNCTION_SIDES:
+    # the second path runs back, so that the case ends where it began (the envelope)
+    for way, (before, after) in zip((1, -1), JUNCTION_SIDES, strict=True):
         name = f"B{before} before the junction, B{after} after"
         probe = Probe(ctx, name, "10.2.motion.junction")
-        probe.run(["A5", "V2000", f"B{before}", "C700,0,0", f"B{after}", "C700,0,0", 1.2,
-                   [1400, 0, 0]])
+        leg = f"C{700 * way},0,0"
+        probe.run(["A5", "V2000", f"B{before}", leg, f"B{after}", leg, 1.2,
+                   [1400 * way, 0, 0]])
         probe.next_brake = True
         other = probe.fits()
         probe.next_brake = False
