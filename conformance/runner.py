@@ -10,11 +10,13 @@ from dataclasses import asdict, dataclass, field
 
 from conformance import settings as settings_profiles
 from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetyStop
+from conformance.hands import HandRig, Hands, cannot_by_hand
 from conformance.link.framing import UnitDataError
 from conformance.link.interrupts import Interrupts
+from conformance.link.link import Link
 from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
-from conformance.operator import Console, Hands
+from conformance.operator import Console
 from conformance.targets import Session, SessionError, Target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
@@ -92,18 +94,20 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
     if why:
         result.verdict, result.notes = MISSING, [why]
         return result
-    if case.rig and not target.info.has_rig:
-        result.verdict = COULD_NOT_TEST
-        result.notes = ["needs a test rig (the emulator's, or an exec: simulator's control "
-                        "channel)"]
-        return result
+    by_hand = case.rig and not target.info.has_rig
+    if by_hand:
+        why = _without_rig(case, console)
+        if why:
+            result.verdict, result.notes = COULD_NOT_TEST, [why]
+            return result
     if case.destructive and not target.info.allow_destructive:
         result.verdict, result.notes = COULD_NOT_TEST, ["destructive: needs --allow-destructive"]
         return result
     session = target.session
+    hand_rig = HandRig(lambda: ctx.link, console) if by_hand else None
     ctx = CaseContext(case, profile, target.info,
                       settings_profiles.get(settings_for(target, settings_name)),
-                      session.open_link, seed=seed)
+                      _with_hands(session.open_link, hand_rig), seed=seed)
     ctx.operator = Hands(lambda: ctx.link, console)
     start = time.perf_counter()
     verdicts: list[str] = []
@@ -147,6 +151,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                 link.settle(final=True)
             for violation in link.violations:
                 ctx.expect(False, violation, tag=ALWAYS)
+        if ended and hand_rig is not None and ctx.links:
+            _hands_off(hand_rig, ctx)
         if ended:
             _after_case(session, ctx)
     result.seconds = time.perf_counter() - start
@@ -162,6 +168,39 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                        ["# link", *link.transcript_lines()]]
     result.frames = sum(link.frames for link in ctx.links)
     return result
+
+
+def _without_rig(case: Case, console: Console | None) -> str | None:
+    """Why the rig case cannot run on a target without a rig (None: the technician's
+    hands stand in for it)."""
+    cannot = cannot_by_hand(case.id)
+    if cannot:
+        return f"needs a test rig: no hand can do it: {cannot}"
+    if console is None or not console.interactive:
+        return ("needs a test rig (the emulator's, or an exec: simulator's control channel) "
+                "or a technician's hands: run on a terminal with --operator")
+    return None
+
+
+def _with_hands(open_link: Callable[..., Link], hands: HandRig | None) -> Callable[..., Link]:
+    """``open_link``, its links' rig the technician's hands when ``hands`` is given."""
+    if hands is None:
+        return open_link
+
+    def opened(*args: object, **kwargs: object) -> Link:
+        link = open_link(*args, **kwargs)
+        link.rig = hands
+        return link
+    return opened
+
+
+def _hands_off(hands: HandRig, ctx: CaseContext) -> None:
+    """The inputs the technician changed, put back as found (a step skipped here is
+    noted: the next cases find the input as it was left)."""
+    try:
+        hands.hands_off()
+    except (CouldNotTest, SafetyStop, TargetNotResponding, KeyboardInterrupt) as err:
+        ctx.note(f"after the case, the hands stayed on: {err}")
 
 
 def _after_case(session: Session, ctx: CaseContext) -> None:

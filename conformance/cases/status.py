@@ -63,10 +63,11 @@ def interrupt(ctx: CaseContext) -> None:
 
 @case("10.3.interrupt.polarity",
       rules=("10.3.inputs.polarity", "4.response.inta-level"),
-      tag="M", source="M84 12.5.11", rig=True,
+      tag="M", source="M84 12.5.11", hands=True,
       rule="An input is active when its level equals its polarity bit")
 def polarity(ctx: CaseContext) -> None:
     link = ctx.link
+    ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
     setup(ctx, "SW2,01")                 # IN0 active at log. 1: unconnected = active
     r = link.send("SW0,01")
     ctx.expect(r is not None and r.code == 0 and r.inta, "enabling it interrupts at once",

@@ -61,6 +61,12 @@ def common(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--strict", action="store_true",
                     help="grade the target by the project's decisions too: a [D] "
                          "difference FAILs instead of NON-STRICT")
+    loud = ap.add_mutually_exclusive_group()
+    loud.add_argument("-q", "--quiet", action="store_true",
+                      help="print only the last line (the verdict)")
+    loud.add_argument("-v", "--verbose", action="store_true",
+                      help="print every line: for diff each disagreement's transcript too, "
+                           "for replay every frame (its default)")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -127,9 +133,10 @@ def main(argv: list[str] | None = None) -> int:
     examples = args.examples if args.examples is not None or args.seconds else DEFAULT_EXAMPLES
     budget = Budget(examples=examples, seconds=args.seconds)
     run = RunResult(run_id, targets=[target.info.spec], settings="diff")
-    print(f"diff: {target.info.spec} against {reference.info.spec} "
-          f"({target.profile.name}), seed {args.seed}, "
-          + (f"{examples} sequences" if examples else f"{args.seconds:g} s"), flush=True)
+    say = _nothing if args.quiet else _say                 # -q: the last line only
+    say(f"diff: {target.info.spec} against {reference.info.spec} "
+        f"({target.profile.name}), seed {args.seed}, "
+        + (f"{examples} sequences" if examples else f"{args.seconds:g} s"))
 
     def found(f: Finding) -> None:
         n = len(run.results) + 1
@@ -143,12 +150,12 @@ def main(argv: list[str] | None = None) -> int:
                            transcript=list(t.lines()), path=path)
         run.results.append(r)
         d = f.disagreement
-        print(f"{d.verdict:11} {d.rule or '(no known rule)'}: {readable(d.target.sent)} "
-              f"target {readable(d.target.answer) or '(none)'} / reference "
-              f"{readable(d.reference.answer) or '(none)'} ({d.kind}; {f.frames} frame(s))"
-              + (f"  -> {path}" if path else ""), flush=True)
-        if folder is None:
-            print("\n".join("    " + line for line in t.lines()), flush=True)
+        say(f"{d.verdict:11} {d.rule or '(no known rule)'}: {readable(d.target.sent)} "
+            f"target {readable(d.target.answer) or '(none)'} / reference "
+            f"{readable(d.reference.answer) or '(none)'} ({d.kind}; {f.frames} frame(s))"
+            + (f"  -> {path}" if path else ""))
+        if folder is None or args.verbose:
+            say("\n".join("    " + line for line in t.lines()))
 
     try:
         with interrupts.catching():
@@ -174,15 +181,14 @@ def main(argv: list[str] | None = None) -> int:
         run.problems += report.problems
     for f in pair.unconfirmed:
         d = f.disagreement
-        print(f"not confirmed (seen once, not when replayed): {readable(d.target.sent)} "
-              f"target {readable(d.target.answer) or '(none)'} / reference "
-              f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted",
-              flush=True)
+        say(f"not confirmed (seen once, not when replayed): {readable(d.target.sent)} "
+            f"target {readable(d.target.answer) or '(none)'} / reference "
+            f"{readable(d.reference.answer) or '(none)'} ({d.kind}): not counted")
     agreed = not run.results
     if pair.target.rig_lost:
         run.results.append(rig_lost_result(profile=target.profile.name,
                                            target=target.info.spec, why=pair.target.rig_lost))
-        print(f"{COULD_NOT_TEST}: input steps: {pair.target.rig_lost}", flush=True)
+        say(f"{COULD_NOT_TEST}: input steps: {pair.target.rig_lost}")
     if agreed:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames,
@@ -194,7 +200,15 @@ def main(argv: list[str] | None = None) -> int:
                        "sent, the search not finished"]
         run.results.append(r)
     run.frames, run.seconds = budget.frames, budget.elapsed
-    print(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
-          f"{counted(run)}"
-          + (" (interrupted by a signal: H and D sent)" if run.interrupted else ""), flush=True)
-    return end(run, None if args.no_reports else args.report_dir)
+    say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
+        f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
+                             else ""))
+    return end(run, None if args.no_reports else args.report_dir, quiet=args.quiet)
+
+
+def _say(text: str) -> None:
+    print(text, flush=True)
+
+
+def _nothing(text: str) -> None:
+    """-q: only the last line is printed."""

@@ -88,9 +88,11 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
                             run_id=m.label), "argv": argv}
         (folder / f"{m.label}.job.json").write_text(json.dumps(job), encoding="utf-8")
     jobs = min(args.jobs, len(members))
-    print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
+    quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's last line only
+    if not quiet:
+        print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
-    interrupted = _run_members(members, folder, jobs, start)
+    interrupted = _run_members(members, folder, jobs, start, quiet)
     seconds = time.perf_counter() - start
     for m in members:
         (folder / f"{m.label}.job.json").unlink(missing_ok=True)
@@ -98,21 +100,26 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         if path.is_file():
             m.result = json.loads(path.read_text(encoding="utf-8"))
     summary = _summary(members, run_id, seconds, interrupted)
-    _print_summary(summary)
+    if not quiet:
+        _print_summary(summary)
     if args.junitxml:
-        print(f"JUnit XML: {merge_junit(folder, members, args.junitxml, seconds)}")
+        written = merge_junit(folder, members, args.junitxml, seconds)
+        if not quiet:
+            print(f"JUnit XML: {written}")
     if args.no_reports:
         shutil.rmtree(folder, ignore_errors=True)
     else:
         (folder / SUMMARY_JSON).write_text(json.dumps(summary, indent=1), encoding="utf-8")
         (folder / INDEX_HTML).write_text(_index_html(summary), encoding="utf-8")
-        print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
+        if not quiet:
+            print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
     print(f"{summary['verdict']}: {summary['reason']}")
     return exit_status(summary["verdict"] == PASSED, interrupted or any(
         row["interrupted"] for row in summary["targets"]))
 
 
-def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -> bool:
+def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
+                 quiet: bool = False) -> bool:
     """Run the members' processes, at most ``jobs`` at once; True when interrupted."""
     pending, running = deque(members), []
     wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
@@ -129,7 +136,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -
                 while pending and len(running) < jobs and not interrupted:
                     m = pending.popleft()
                     running.append(m)
-                    _start(m, folder, start, wake, out_lock)
+                    _start(m, folder, start, wake, out_lock, quiet)
                 with contextlib.suppress(queue.Empty):
                     wake.get(timeout=0.5)
                 running = [m for m in running if m.status is None]
@@ -148,7 +155,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float) -
 
 
 def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
-           out_lock: threading.Lock) -> None:
+           out_lock: threading.Lock, quiet: bool = False) -> None:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     m.started = time.perf_counter() - start
     m.process = subprocess.Popen(
@@ -160,6 +167,8 @@ def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
     def relay() -> None:
         assert m.process is not None and m.process.stdout is not None
         for line in m.process.stdout:
+            if quiet:
+                continue                # read all the same, so that the member never blocks
             with out_lock:
                 print(f"[{m.label}] {line}".rstrip(), flush=True)
         status = m.process.wait()

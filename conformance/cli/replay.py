@@ -52,8 +52,8 @@ def main(argv: list[str] | None = None) -> int:
     interrupts = Interrupts()
     session = target.begin(interrupts)
     ask_first(args, target)
-    for line in header(args.file, target.info.spec, reference.info.spec, target.profile.name,
-                       t.meta):
+    for line in [] if args.quiet else header(args.file, target.info.spec, reference.info.spec,
+                                             target.profile.name, t.meta):
         print(line, flush=True)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     outcome = None
@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
         if session.real:
             session.finish()
         target.close()
-    if outcome is not None:
+    if outcome is not None and not args.quiet:
         for line in frame_lines(outcome, steps, expected):
             print(line)
     print(result.line, flush=True)

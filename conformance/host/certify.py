@@ -20,6 +20,7 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TextIO
 
 from conformance.host import oracle, probe
@@ -95,6 +96,32 @@ def _stop(proc: subprocess.Popen) -> None:
                 continue
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)     # what the host left in its group
+        _wait_group_gone(proc.pid, time.monotonic() + TERM_GRACE_S)
+
+
+def _alive_in_group(pgid: int) -> list[int]:
+    """The processes of group ``pgid`` still running (zombies waiting to be reaped are not);
+    empty where ``/proc`` cannot tell."""
+    alive = []
+    with contextlib.suppress(OSError):
+        for entry in os.scandir("/proc"):
+            if not entry.name.isdigit():
+                continue
+            try:
+                stat = Path(f"/proc/{entry.name}/stat").read_text()
+            except OSError:
+                continue
+            fields = stat.rsplit(")", 1)[1].split()
+            if fields[0] != "Z" and int(fields[2]) == pgid:
+                alive.append(int(entry.name))
+    return alive
+
+
+def _wait_group_gone(pgid: int, deadline: float) -> None:
+    """SIGKILL is delivered asynchronously: on a loaded machine a killed child can still be
+    running when killpg returns, so poll until the group is gone (or the deadline)."""
+    while _alive_in_group(pgid) and time.monotonic() < deadline:
+        time.sleep(0.01)
 
 
 def run_once(plan: Plan, fault: Fault, port: HostPort, *,

@@ -64,11 +64,22 @@ class Interrupts:
         if threading.current_thread() is not threading.main_thread():
             yield
             return
+        # The mask holds the signal only where this thread would take it; in a process
+        # with other threads one of them takes it and Python runs the handler here anyway,
+        # so the handlers are swapped for a recorder too, and what it recorded is handed
+        # to the real handlers when the block ends.
+        caught: list[int] = []
+        handlers = {sig: signal.signal(sig, lambda sig, _: caught.append(sig))
+                    for sig in STOPPING}
         previous = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
         try:
             yield
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+            for sig, handler in handlers.items():
+                signal.signal(sig, handler)
+            for sig in caught:
+                _deliver(sig, handlers[sig])
 
     @contextlib.contextmanager
     def catching(self) -> Iterator[Interrupts]:
@@ -83,3 +94,11 @@ class Interrupts:
         finally:
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+
+def _deliver(sig: int, handler: object) -> None:
+    """Hand a signal held back by :meth:`Interrupts.held` to the handler it was meant for."""
+    if callable(handler):
+        handler(sig, None)
+    elif handler == signal.SIG_DFL:
+        signal.raise_signal(sig)

@@ -140,6 +140,7 @@ class Guard:
         self.dead = False
         self._own = 0                             # inside the session's own frames
         self._emergency = 0
+        self._hands_on = 0                        # a technician's hand step is open
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
@@ -165,6 +166,16 @@ class Guard:
         finally:
             self._emergency -= 1
 
+    @contextlib.contextmanager
+    def hands_on(self) -> Iterator[None]:
+        """A technician's hand step is open (a prompt waits for them): no motion until it
+        is answered, whoever sends."""
+        self._hands_on += 1
+        try:
+            yield
+        finally:
+            self._hands_on -= 1
+
     # -- before a frame ----------------------------------------------------------------------
     def check_idle(self) -> None:
         """Raise if the run must stop here (Ctrl-C; a target that stopped answering):
@@ -188,6 +199,9 @@ class Guard:
                 raise SafetyStop(f"{body} for address {address}: another unit may be on "
                                  "the line there; the suite moves and writes only its own")
             return
+        if command.name in MOTION and self._hands_on:
+            raise SafetyStop(f"{body}: motion refused while a hand step is open (the "
+                             "technician's hands may be on the machine)")
         if command.name in DESTRUCTIVE:
             self._check_destructive(body, command)
         if command.name in MOTION:

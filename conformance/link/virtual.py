@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Protocol, runtime_checkable
 
 
+@runtime_checkable
 class Rig(Protocol):
     """A test rig's hands: the unit's inputs, its home switches, its power, and what
     the unit drives (outputs, the spindle)."""

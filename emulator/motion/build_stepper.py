@@ -26,6 +26,9 @@ MODULE = "emulator.motion._stepper_c"
 HEADERS = ("_stepper.h", "_reference.h")
 #: the C files compiled into the module (the core, the benchmark's reference loop)
 C_FILES = ("_stepper.c", "_reference.c")
+#: the most axes the core drives: ``ST_AXES`` of the header, the one place it is written
+AXES = int(re.search(r"^#define ST_AXES (\d+)$", (HERE / "_stepper.h").read_text(),
+                     re.MULTILINE)[1])
 #: every file the module is built from: a change to any of them makes a build stale
 SOURCES = (*HEADERS, "_stepper_math.h", *C_FILES, "build_stepper.py")
 #: precedes the sources' digest in the compiled module
@@ -46,7 +49,7 @@ def _cdef(directory: Path) -> str:
     text = "\n".join(line for name in HEADERS
                      for line in (directory / name).read_text().splitlines()
                      if not line.startswith("#"))
-    return re.sub(r"\bST_AXES\b", "4", text) + "\nconst char *st_sources(void);\n"
+    return re.sub(r"\bST_AXES\b", str(AXES), text) + "\nconst char *st_sources(void);\n"
 
 
 def ffibuilder(directory: Path | None = None) -> FFI:

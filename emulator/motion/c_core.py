@@ -19,6 +19,7 @@ import struct
 
 import numpy as np
 
+from emulator.motion.build_stepper import AXES
 from emulator.motion.rebuild import ensure_fresh
 
 ensure_fresh()   # ImportError for a stale build that cannot be rebuilt
@@ -31,12 +32,11 @@ from emulator.motion.interface import (  # noqa: E402
     Vector,
 )
 
-AXES = 4
-#: st_vector as the C compiler lays it out (native alignment): steps[4], continuous,
-#: velocity, accel, brake, short_, dwell, path_speed, axis_limits[4]
-VECTOR = struct.Struct("@4qi5qi4q")
+#: st_vector as the C compiler lays it out (native alignment): steps[AXES], continuous,
+#: velocity, accel, brake, short_, dwell, path_speed, axis_limits[AXES]
+VECTOR = struct.Struct(f"@{AXES}qi5qi{AXES}q")
 #: st_timed_vector: the instant of a push, then its st_vector
-TIMED = struct.Struct("@q4qi5qi4q")
+TIMED = struct.Struct(f"@q{AXES}qi5qi{AXES}q")
 #: pushes held before they go into C together (any other call sends them at once)
 BATCH = 256
 _pack, _pack_timed = VECTOR.pack_into, TIMED.pack_into
@@ -87,7 +87,7 @@ class CMotion:
         if self._m == ffi.NULL:
             raise MemoryError("st_new")
         lib.st_set_deviations(self._m, int(self.deviations))
-        self._out = ffi.new("int64_t[8]")
+        self._out = ffi.new(f"int64_t[{2 * AXES}]")
         self._buf = bytearray(VECTOR.size)
         self._vec = ffi.from_buffer("st_vector *", self._buf)
         self._pad = (0,) * (AXES - axes)
@@ -247,7 +247,7 @@ class CMotion:
     def restore(self, saved: KeepSave, t: int) -> None:
         if self._held:
             self._send()
-        here = ffi.new("int64_t[4]")
+        here = ffi.new(f"int64_t[{AXES}]")
         lib.st_restore_begin(self._m, t, here)
         for vector, done in saved.entries:
             if lib.st_restore_add(self._m, self._c_vector(vector), done):

@@ -89,6 +89,9 @@ def test_a_wrong_action_is_caught_by_the_read_back(unit):
     _step(term, GROUND)
     unit.rig("in 1 FD")                              # IN1 grounded instead of IN0
     term.answer("")
+    term.expect("not verified: I1 reads FD (IN0 should read 0); try again")
+    term.expect(GROUND)                              # asked once more, then given up
+    term.answer("")
     term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
                 "IN0 (the X reference input): not verified, I1 reads FD (IN0 should read 0)")
     assert term.finish() == 0
@@ -110,3 +113,34 @@ def test_ctrl_c_at_the_question_stops_the_run_and_moves_nothing(unit):
     term.finish()
     assert "interrupted by Ctrl-C" in term.seen and "FAILED" in term.seen
     assert json.loads(unit.rig("state"))["excursion"] == [[0, 0], [0, 0], [0, 0]]
+
+
+def test_the_rig_steps_by_hand_on_a_terminal(unit):
+    """A real unit without a rig: the technician grounds an input, cycles the power and
+    reads the outputs, each step read back; a case no hand can do says why."""
+    term = Terminal(suite("--target", f"serial:{unit.path}", "--profile", "GVE84-100",
+                          "--yes", "--allow-destructive", "--no-reports",
+                          "--cases", "10.3.inputs.physical-across-restart",
+                          "--cases", "10.cmd.output.port",
+                          "--cases", "10.cmd.reference.to-switch"))
+    term.expect("Ground input IN0 of port I1 now, then press Enter; s to skip:")
+    unit.rig("in 1 FE")
+    term.answer("")
+    term.expect("verified: I1 = FE")
+    term.expect("Cycle the unit's power")
+    unit.rig("power-on")                             # the technician's power switch
+    term.answer("")
+    term.expect("verified: the index reads 0")
+    term.expect("Release input IN0 of port I1 now")  # the hands off after the case
+    unit.rig("in 1 FF")
+    term.answer("")
+    term.expect("PASS            10.3.inputs.physical-across-restart [GVE84-100]")
+    for _ in range(2):                               # O0,FB: OUT2 lit, read twice
+        term.expect("Which outputs are on now (lit)?")
+        term.answer("2")
+    term.expect("PASS            10.cmd.output.port [GVE84-100]")
+    term.expect("COULD-NOT-TEST  10.cmd.reference.to-switch [GVE84-100]  -- needs a test "
+                "rig: no hand can do it: a reference switch at an exact position")
+    assert term.finish() == 0
+    assert term.seen.rstrip().splitlines()[-1] == (
+        "PASSED — 2 PASS; not tested: 1 of 3 (1 need a rig no hand stands in for)")

@@ -56,5 +56,6 @@ def test_the_last_line_names_what_was_not_tested(proxy):
                 "--cases", "10.6.eeprom.as-shipped")
     last = done.stdout.rstrip().splitlines()[-1]
     assert done.returncode == 0, done.stdout + done.stderr
-    assert last == ("PASSED — 1 PASS; not tested: 4 of 5 (3 need a rig, "
-                    "1 destructive, need --allow-destructive)"), last
+    assert last == ("PASSED — 1 PASS; not tested: 4 of 5 (2 need a rig or a hand "
+                    "(--operator), 1 destructive, need --allow-destructive, 1 need a rig no "
+                    "hand stands in for)"), last
