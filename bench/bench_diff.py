@@ -1,6 +1,6 @@
 """The differential fuzzer in process: the emulator against a mutant of itself (and
 against itself), frames per second with the search's own overhead (drawing, shrinking),
-and the time 10,000 frames take as a ratio of the issue's 10 s budget (below 1: met);
+and the time 10,000 frames take as a ratio of a 10 s budget (below 1: met);
 then the same search through a co-simulator (`exec:` of `python -m emulator --cosim`,
 docs/cosim.md: virtual time over the text protocol, the unit's known state before each
 sequence), its sequences per second and their ratio to the in-process figure.

@@ -1,4 +1,4 @@
-"""Host role benchmark (issue 11 item 5): figures as ratios measured in one run.
+"""Host role benchmark: figures as ratios measured in one run.
 
 1. The relay and an emulated GVE114-500 at 921 600 baud, fed a host's traffic as fast as
    it comes: the time the line itself needs for those bytes over the time the relay took

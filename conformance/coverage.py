@@ -1,5 +1,5 @@
 """Which rules of the spec (fixtures/rules.toml) the suite can fail, per profile and
-section (issue 10 item 1).
+section.
 
 A unit-role rule is *covered* on a profile when a case of the catalogue names it in its
 ``rules`` and applies to that profile (it is not MISSING there). Such a case FAILs a

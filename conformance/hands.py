@@ -26,6 +26,7 @@ from typing import Any
 
 from conformance.link.framing import Response, UnitDataError
 from conformance.link.link import Link
+from conformance.link.safety import SILENCE_LIMIT
 from conformance.operator import Console, HandStep
 from conformance.verdict import CouldNotTest
 from gve_fixtures.protocol import St6
@@ -178,7 +179,7 @@ class HandRig:
 
         def verify() -> str | None:
             after = None
-            for _ in range(words["asks"]):
+            for _ in range(min(words["asks"], SILENCE_LIMIT - 1)):
                 link.wait(words["ready_seconds"])
                 after = self._index()
                 if after is not None:

@@ -1,4 +1,4 @@
-"""What a run report says about the run itself (issue 12 item 5): when and where it ran,
+"""What a run report says about the run itself: when and where it ran,
 who ran it, which suite, every flag that shaped it, and per target the unit's identity,
 the profile it was judged as and the motion envelope.
 

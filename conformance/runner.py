@@ -1,5 +1,5 @@
-"""Running cases against targets and collecting graded results (issue 4 items 1, 7;
-issue 8: one session per target per run, Ctrl-C, a target that stops answering)."""
+"""Running cases against targets and collecting graded results: one
+session per target per run, Ctrl-C, a target that stops answering."""
 
 from __future__ import annotations
 
@@ -18,10 +18,7 @@ from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
 from conformance.operator import Console
 from conformance.targets import Session, SessionError, Target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
-
-#: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
-ALWAYS = "always"
+from conformance.verdict import ALWAYS, COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
 
 
 @dataclass
@@ -178,7 +175,7 @@ def _without_rig(case: Case, console: Console | None) -> str | None:
         return f"needs a test rig: no hand can do it: {cannot}"
     if console is None or not console.interactive:
         return ("needs a test rig (the emulator's, or an exec: simulator's control channel) "
-                "or a technician's hands: run on a terminal with --operator")
+                "or a technician's hands: run gve-conformance on a terminal with --operator")
     return None
 
 

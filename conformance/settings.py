@@ -1,5 +1,5 @@
-"""Hypothesis settings profiles for the machines (issue 4 item 5), the run's seed and
-example database (issue 12 item 7, issue 13 item 2): the database keeps failing examples
+"""Hypothesis settings profiles for the machines, the run's seed and
+example database: the database keeps failing examples
 so that the next run, or another bench, tries them first."""
 
 from __future__ import annotations

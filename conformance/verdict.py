@@ -6,6 +6,7 @@ from collections.abc import Sequence
 from typing import Protocol
 
 from conformance.untested import grouped
+from gve_fixtures import protocol
 
 PASS = "PASS"
 NON_STRICT = "NON-STRICT"
@@ -25,13 +26,16 @@ class CouldNotTest(Exception):
 
 #: worst first: the verdict of a case is the worst of its checks
 ORDER = (ERROR, FAIL, NON_STRICT, INFO, COULD_NOT_TEST, MISSING, PASS)
-TAGS = ("M", "M-ex", "D", "D-info", "always")
+#: the tag of a check no spec tag softens: a crash, a hang, two answers (spec preamble)
+ALWAYS = "always"
+#: the tags a check may carry: the spec's, and ALWAYS
+CHECK_TAGS = (*protocol.TAGS, ALWAYS)
 
 
 def grade(tag: str, strict: bool) -> str:
     """The verdict of one failed check carrying ``tag`` on a target graded ``strict``ly
     (the reference emulator, or a target run with --strict) or by the tags alone."""
-    if tag in ("M", "M-ex", "always"):
+    if tag in ("M", "M-ex", ALWAYS):
         return FAIL
     if tag == "D":
         return FAIL if strict else NON_STRICT

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import NoReturn
 
 from emulator.link.clock import RealClock
@@ -146,32 +148,31 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     if host is None:
-        return _cosim(line)
+        with _ending_quietly(line):
+            serve_cosim(line)
+        return 0
     try:
         say(host.name)
     except StdoutGone:
         host.close()
         silence_stdout()
         return 0
-    try:
+    with _ending_quietly(line):
         serve(line, host, control_fd())
-    except StdoutGone:
-        silence_stdout()                  # the reader went away: end quietly
-    finally:
-        if line.log is not None:
-            line.log.close()
     return 0
 
 
-def _cosim(line: Line) -> int:
+@contextmanager
+def _ending_quietly(line: Line) -> Iterator[None]:
+    """Serve until done, or end quietly when the reader of stdout (the user, or the
+    co-simulation's driver) went away; the line's transcript is closed either way."""
     try:
-        serve_cosim(line)
+        yield
     except StdoutGone:
-        silence_stdout()                  # the driver went away: end quietly
+        silence_stdout()
     finally:
         if line.log is not None:
             line.log.close()
-    return 0
 
 
 if __name__ == "__main__":

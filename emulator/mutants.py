@@ -7,16 +7,18 @@ conformance suite FAILs every mutant, naming the case that caught it, and PASSes
 clean emulator on every profile; the emulator's own tests show each mutant answering a
 transcript of its rule differently from the clean emulator.
 
-Each entry names the spec sections it touches, what it gets wrong, and the rule area it
-breaks (the spec section whose rules a case must check to catch it). Most mutants are
-planted in the unit (`device.mutant.active(NAME)` where the behaviour lives); those whose
-behaviour lives in the motion model are deviations of the stepper core
-(:data:`CORE_DEVIATIONS`), planted alike in both cores.
+Each entry of mutants.toml names the spec sections it touches, what it gets wrong, and
+the rule area it breaks (the spec section whose rules a case must check to catch it).
+Most mutants are planted in the unit (`device.mutant.active(NAME)` where the behaviour
+lives); those whose behaviour lives in the motion model are deviations of the stepper
+core (:data:`CORE_DEVIATIONS`), planted alike in both cores.
 """
 
 from __future__ import annotations
 
+import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 from typing import NamedTuple
 
 from emulator.motion.interface import Deviation
@@ -28,88 +30,17 @@ class MutantSpec(NamedTuple):
     area: str             # the rule area (spec section) a case must check to catch it
 
 
+#: the registry's data, one table per mutant in the order listed
+REGISTRY = Path(__file__).with_name("mutants.toml")
+
+
+def _load(path: Path = REGISTRY) -> dict[str, MutantSpec]:
+    with path.open("rb") as f:
+        return {name: MutantSpec(**entry) for name, entry in tomllib.load(f).items()}
+
+
 #: name -> (spec sections, what the mutant gets wrong, rule area)
-MUTANTS: dict[str, MutantSpec] = {name: MutantSpec(*spec) for name, spec in {
-    # framing, checksums, index, packets
-    "checksum-no-comma": ("6", "the checksum is summed without the comma that precedes it", "6"),
-    "checksum-unchecked": ("6", "in checksum mode a frame with a wrong checksum is executed",
-                           "6"),
-    "checksum-lower-case": ("4, 6", "response checksums are written in lower-case hex", "6"),
-    "wrong-address-answers": ("2, 3", "frames for another address are answered too", "3"),
-    "lower-case-command": ("3", "lower-case command letters are accepted as upper case", "3"),
-    "watchdog-never": ("3", "an unfinished frame is never dropped: no error 2", "3"),
-    "inta-bit-missing": ("4", "responses lack bit 3 while INTA = 1", "4"),
-    "range-error-code": ("5", "a parameter out of range is answered 4 instead of 5", "5"),
-    "go-without-inta": ("5, 10.4", "G with INTA = 0 answers 0 instead of 6", "10.4"),
-    "line-while-busy": ("10.1", "L is accepted while vectors are queued or running", "10.1"),
-    "queue-one-short": ("10.1", "the CONT buffer refuses one vector before it is full", "10.1"),
-    "refused-vector-queued": ("10.1", "a C answered 1 (no room) still enters the queue",
-                              "10.1"),
-    "packet-partial-commit": ("7", "a failing packet still commits its valid members", "7"),
-    "packet-count-ignored": ("7", "*E commits although the member count differs", "7"),
-    "failed-packet-keeps-b": ("7", "a packet that fails still sets the B of its B members",
-                              "7"),
-    "index-skips-refused": ("8", "frames answered with an error do not advance the index",
-                            "8"),
-    "index-counts-queries": ("8", "@ and > advance the index", "8"),
-    "repeat-reexecutes": ("8", "> executes the last command again", "8"),
-    "halt-answers-early": ("10.4", "H answers at once instead of when the motion has stopped",
-                           "10.4"),
-    "go-loses-step": ("10.4", "G resumes one step past where the vector stopped", "10.4"),
-    "delete-while-moving": ("5, 10.4", "D is accepted while the motion is running", "10.4"),
-    "keep-forgets-st6": ("10.5", "K does not save ST6, so R does not bring INTA back", "10.5"),
-    "restore-drops-partial": ("10.5", "R loses the remainder of the interrupted vector",
-                              "10.5"),
-    "status-word-masked": ("10.3", "SW stores only the bits with an input behind them", "10.3"),
-    "interrupt-ignored": ("10.3", "an enabled active input does not stop the motion", "10.3"),
-    "eeprom-write-lost": ("10.6", "EW answers 0 but does not change the byte", "10.6"),
-    "eeprom-7-bit-address": ("10.6", "ER and EW decode 7 address bits: 80..FF are 00..7F "
-                             "again", "10.6"),
-    "narrow-counters": ("10", "the position counters are 24 bits wide: P and PF wrap "
-                        "beyond ±8388607", "10"),
-    "position-ignores-microstep": ("10.7", "GVE54 positions are reported in commanded steps",
-                                   "10.7"),
-    # the eleven interaction errors of the emulator issue
-    "inputs-forgotten-after-delete": (
-        "10.3, 10.4, 10.5", "D, K and R clear the cause bits and INTA although an enabled "
-        "input is still active (the level is not looked at again)", "10.3"),
-    "restore-keeps-save": ("10.5", "R does not empty the save: a second R restores it again",
-                           "10.5"),
-    "zero-c-keeps-junction": ("10.2", "a zero-length C between two C passes the junction rate "
-                              "on: the next C starts at speed instead of from rest", "10.2"),
-    "sw6-inert": ("10.3", "writing ST6 stores the bits but acts on nothing: setting INTA does "
-                  "not stop, clearing it does not resume", "10.3"),
-    "mpg-not-moving": ("5, 9", "the GVE114's MPG holding RUN = 1 does not count as moving "
-                       "(D, K, R, EW, EFW, EUW are accepted)", "5"),
-    "dwell-between-continuous": ("10.2", "a C whose braking takes less than a step cannot be "
-                                 "joined once planned: it stops at the junction, and the next "
-                                 "C waits out T", "10.2"),
-    "restart-resets-inputs": ("10.3", "J and power-on set the input ports back to FF", "10.3"),
-    "flags-ignore-keep-capacity": ("10, 10.5", "F's queue-full bit counts the whole CONT "
-                                   "buffer after K instead of the one vector", "10"),
-    "halt-short-of-target": ("10.4", "H during the final deceleration lays a ramp of its own "
-                             "and stops a step short, RUN staying 1", "10.4"),
-    "params-ignored-on-bare-commands": ("3", "a command that takes no parameters ignores "
-                                        "given ones (@1 answers the index)", "3"),
-    "long-decimal-syntax-error": ("3", "a field of more than 12 digits is a syntax error (4) "
-                                  "instead of being range-checked", "3"),
-    # the motion, parameter by parameter
-    "velocity-ignored": ("10.2", "V has no effect on the motion: the reset V is used", "10.2"),
-    "path-speed-ignored": ("10.2", "VK behaves as VN", "10.2"),
-    "axis-limit-ignored": ("10.2", "VL caps no axis", "10.2"),
-    "override-late": ("10", "XM reaches only vectors accepted after it, not the running and "
-                      "queued ones", "10"),
-    "xa-ignored": ("10", "XA changes nothing", "10"),
-    "xu-xd-swapped": ("10", "XU slows by 15/16 and XD speeds up by 17/16", "10"),
-    "accel-ignored": ("10.2", "A has no effect on the motion: the reset A is used", "10.2"),
-    "dwell-ignored": ("10.2", "no T dwell before a vector that starts from rest", "10.2"),
-    "junction-stops": ("10.2", "B ignored: every C brakes to rest at its end", "10.2"),
-    "short-vector-ignored": ("10.2", "the $ rule does not cap short vectors to B", "10.2"),
-    "halt-without-ramp": ("10.4", "H stops dead instead of braking on the ramp", "10.4"),
-    "go-at-speed": ("10.4", "G resumes at the cruise rate instead of from rest", "10.4"),
-    "microstep-rates-unscaled": ("10.7", "GVE54: V and B are not scaled by the micro-step "
-                                 "factor", "10.7"),
-}.items()}
+MUTANTS: dict[str, MutantSpec] = _load()
 
 #: mutants whose behaviour lives in the stepper core
 CORE_DEVIATIONS: dict[str, Deviation] = {
@@ -117,6 +48,7 @@ CORE_DEVIATIONS: dict[str, Deviation] = {
     "dwell-between-continuous": Deviation.CONTINUOUS_DWELL,
     "halt-short-of-target": Deviation.HALT_SHORT,
     "junction-stops": Deviation.JUNCTION_STOPS,
+    "junction-brake-ignored": Deviation.JUNCTION_UNBRAKED,
     "halt-without-ramp": Deviation.HALT_DEAD,
     "go-at-speed": Deviation.GO_AT_SPEED,
 }

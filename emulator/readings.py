@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from emulator.motion.interface import Deviation
+
 
 class ReadingSpec(NamedTuple):
     rules: tuple[str, ...]   # the rules of fixtures/rules.toml whose silence it reads
@@ -48,7 +50,37 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "eeprom-write-while-moving": (("5.code.busy-eeprom",),
                                   "EW, EFW and EUW are accepted while the axes move (the "
                                   "manuals forbid only D, K, R, M, N and W while running)"),
+    "packet-closed-only-by-end": (("7.packet.breakers",),
+                                  "an open packet is closed only by *E: H, @, > and J "
+                                  "inside it are members (failing it with 4, unanswered); "
+                                  "a second *S still restarts it"),
+    "packet-committed-on-arrival": (("7.packet.all-or-nothing",),
+                                    "each valid packet member takes effect as it arrives "
+                                    "(B sets B, C is queued); *E still answers code,k, "
+                                    "and a failed packet keeps what arrived before *E"),
+    "longer-frames": (("3.frame.max-length", "3.frame.bounded-buffer"),
+                      "frames up to 255 bytes (a byte-wide length counter) are taken whole "
+                      "and run as any other; only longer ones answer 4"),
+    "edge-triggered-inputs": (("10.3.inputs.level-triggered",),
+                              "an enabled input interrupts when it becomes active, not "
+                              "while it stays so: G, D, K, R or SW that clear the cause "
+                              "or INTA with the input still active are not undone"),
+    "slow-watchdog": (("3.frame.watchdog-time",),
+                      "the watchdog drops an unfinished frame after 1 s without a byte, "
+                      "not 100 ms"),
+    "index-remembered": (("8.repeat.remembered",),
+                         "@ is remembered for > like any received command: > after @ "
+                         "answers !0@ and the index it gave (the manual's > repeats the "
+                         "last received command and its answer)"),
+    "next-vectors-B": (("10.2.motion.junction-own-b",),
+                       "a junction of two C is passed at the B the next C captured, not the "
+                       "one of the C that ends there"),
 }.items()}
+
+#: readings whose behaviour lives in the stepper core
+CORE_READINGS: dict[str, Deviation] = {
+    "next-vectors-B": Deviation.NEXT_BRAKE,
+}
 
 
 class UnknownReading(ValueError):
@@ -82,6 +114,14 @@ class Readings:
         if name not in READINGS:
             raise UnknownReading(f"the emulator asks for an unknown reading {name!r}")
         return name in self.names
+
+    @property
+    def deviations(self) -> Deviation:
+        """The stepper core's deviations these readings take."""
+        flags = Deviation.NONE
+        for name in self.names:
+            flags |= CORE_READINGS.get(name, Deviation.NONE)
+        return flags
 
 
 NONE = Readings()

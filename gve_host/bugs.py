@@ -1,7 +1,7 @@
 """Deliberate host bugs, one switch each (`python -m gve_host ... --bug NAME`): realistic
 mistakes of host programs, planted where the correct behaviour is written
 (``if self.bugs.on("blind-resend")``), so that the certification can show it fails each
-of them with a named rule or scenario (issue 11 item 4)."""
+of them with a named rule or scenario."""
 
 from __future__ import annotations
 

@@ -80,15 +80,20 @@ def wired(ctx: CaseContext) -> None:
     for port, enable, cause, mask in ((1, 0, 4, p.low_mask), (2, 1, 5, p.high_mask)):
         for bit in range(8):
             link = ctx.fresh_link()
-            link.rig.set_input(port, 0xFF ^ (1 << bit))
             r = link.send("SW%d,%02X" % (enable, 1 << bit))
             ctx.require(r is not None and r.code == 0, f"SW{enable} answered {show(r)}")
+            # grounded once enabled: an interrupt whether inputs are level- or
+            # edge-triggered (level is our reading [D])
+            link.rig.set_input(port, 0xFF ^ (1 << bit))
+            r = link.send(f"SR{cause}")
+            ctx.require(r is not None and r.code == 0, f"SR{cause} answered {show(r)}")
             wired = bool(mask >> bit & 1)
             ctx.expect(r.inta == wired, f"IN{bit} of port I{port} "
                        f"{'interrupts' if wired else 'has no input behind it'}",
-                       observed=show(r), expected="8" if wired else "0", rule=rule)
+                       observed=show(r), expected="8,%02X" % (1 << bit) if wired else "0,00",
+                       rule=rule)
             if wired:
-                answers(ctx, link.send(f"SR{cause}"), "8,%02X" % (1 << bit),
+                answers(ctx, r, "8,%02X" % (1 << bit),
                         f"ST{cause} names IN{bit} of port I{port}", rule="10.3.status.meaning")
 
 

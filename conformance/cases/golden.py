@@ -1,5 +1,5 @@
 """Every golden exchange of spec 11 (fixtures/transcripts/*.gvt) replayed exactly, as a
-case ``11.golden.<name>`` (issue 4 item 4). The player is the suite's own."""
+case ``11.golden.<name>``. The player is the suite's own."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import TAGS
 from gve_fixtures.transcript import ACTION, HOST, UNIT, UNIT_MATCH, Transcript, load, unescape
 
 RIG_ACTIONS = {"input", "expect", "power-on"}
-TAGS = {"M", "M-ex", "D", "D-info"}
 
 
 def _tag(kind: str | None, default: str) -> str:
@@ -34,10 +34,16 @@ def play(ctx: CaseContext, t: Transcript, rule: str | None = None) -> None:
         if rec.direction == HOST:
             link.send_raw(rec.data)
         elif rec.direction in (UNIT, UNIT_MATCH):
-            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False)
+            lenient = not setup and tag in ("D", "D-info")
+            r = link.read_response(30.0, rec.data.count(b"\r") or 1, summed=False,
+                                   settle=not lenient)
             got = r.raw if r else b""
             ok = (got == rec.data if rec.direction == UNIT
                   else bool(rec.pattern().fullmatch(got)))
+            if not ok and lenient and r is not None:
+                # a unit reading this [D] point otherwise may answer with more lines:
+                # they are this record's, not a second answer or the next one's
+                got += link.rest_of_answer()
             if setup:
                 ctx.require(ok, f"setup answered {got!r} at {what}")
             else:
@@ -91,6 +97,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
     address = int(t.meta.get("address", profile.address))
     guard = Guard(profile, address, max_travel=2**62, allow_destructive=True)
     framer, summed, pending, need = HostFramer(), False, [], 0.0
+    queued = 0           # vectors the exchange has queued (D empties the queue)
     for rec in t.records:
         if rec.direction == HOST:
             pending += framer.frames(rec.data)
@@ -100,9 +107,9 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
             if rec.action[0] == "poll":      # until its answer
                 batches = [(f, unescape(rec.action[3])) for f in frames]
             else:    # until the queue is full, then 1 (more if vectors end meanwhile)
-                sent = int(rec.action[1])
-                batches = ([(f, b"0\r") for f in frames] * min(sent, profile.buffer)
-                           + [(f, b"1\r") for f in frames] * (sent > profile.buffer))
+                sent, room = int(rec.action[1]), max(0, profile.buffer - queued)
+                batches = ([(f, b"0\r") for f in frames] * min(sent, room)
+                           + [(f, b"1\r") for f in frames] * (sent > room))
         elif rec.direction in (UNIT, UNIT_MATCH):
             # the answer is the last frame's; those before it got none (*S, members)
             answer = rec.data if rec.direction == UNIT else None
@@ -116,6 +123,10 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
             body = f.bodies(summed)[0]
             r = None if answer is None else parse_response(answer, summed=summed)
             guard.accepted(body, r, f.address)
+            if body[:1] in ("L", "C") and answer == b"0\r":
+                queued += 1
+            elif body == "D":
+                queued = 0
             if body in ("%+", "%-") and r is not None and r.code == 0:
                 summed = body == "%+"
     return None if math.isinf(need) else math.ceil(need)

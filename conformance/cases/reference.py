@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, position, setup
-from conformance.motion.tolerance import SECOND
+from gve_fixtures.protocol import SECOND
 
 
 @case("10.cmd.reference.to-switch", rig=True, destructive=True, requires=("W",),

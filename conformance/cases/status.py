@@ -68,9 +68,11 @@ def interrupt(ctx: CaseContext) -> None:
 def polarity(ctx: CaseContext) -> None:
     link = ctx.link
     ctx.operator.release(1, 0, "the X reference input")     # unconnected: reads 1
-    setup(ctx, "SW2,01")                 # IN0 active at log. 1: unconnected = active
-    r = link.send("SW0,01")
-    ctx.expect(r is not None and r.code == 0 and r.inta, "enabling it interrupts at once",
+    setup(ctx, "SW0,01")                 # IN0 enabled; unconnected (1) is inactive at 0
+    # IN0 active at log. 1: the unconnected input becomes active, an interrupt whether
+    # inputs are level- or edge-triggered (level is our reading [D])
+    r = link.send("SW2,01")
+    ctx.expect(r is not None and r.code == 0 and r.inta, "making it active interrupts at once",
                observed=show(r), expected="8", rule="4.response.inta-level")
     r = link.send("SR4")
     ctx.expect(r is not None and r.inta and r.values[:1] == ["01"],

@@ -17,7 +17,12 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from conformance.motion.probe import Probe
+from conformance.protocol.catalogue import classes
+from conformance.protocol.wire import HEX_BYTE
 
+#: an answer of one byte: `0,` and two hex digits
+HEX_ANSWER = rf"0,{HEX_BYTE}"
 # command -> (a valid frame on an idle unit after reset, a regex of its answer, the rule
 # of spec 10 it checks)
 FORMATS = {
@@ -32,19 +37,18 @@ FORMATS = {
     "PF": ("PF", r"0(,-?\d+){3}", "10.cmd.positions"), "N": ("N", "0", "10.cmd.zero"),
     "NX": ("NX0", "0", "10.cmd.set-axis"), "NY": ("NY0", "0", "10.cmd.set-axis"),
     "NZ": ("NZ0", "0", "10.cmd.set-axis"), "NA": ("NA0", "0", "10.cmd.set-axis"),
-    "ER": ("ER05", r"0,[0-9A-F]{2}", "10.cmd.eeprom-bytes"),
+    "ER": ("ER05", HEX_ANSWER, "10.cmd.eeprom-bytes"),
     "EFR": ("EFR30", r"0,\S+", "10.cmd.eeprom-words"),
     "EUR": ("EUR4C", r"0,\d+", "10.cmd.eeprom-words"), "O0": ("O0,FF", "0", "10.cmd.output"),
-    "I0": ("I0", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "I1": ("I1", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "I2": ("I2", r"0,[0-9A-F]{2}", "10.cmd.inputs"),
-    "SR": ("SR0", r"0,[0-9A-F]{2}", "10.cmd.status-words"),
-    "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", r"0,[0-9A-F]{2}", "10.cmd.flags"),
+    "I0": ("I0", HEX_ANSWER, "10.cmd.inputs"),
+    "I1": ("I1", HEX_ANSWER, "10.cmd.inputs"),
+    "I2": ("I2", HEX_ANSWER, "10.cmd.inputs"),
+    "SR": ("SR0", HEX_ANSWER, "10.cmd.status-words"),
+    "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", HEX_ANSWER, "10.cmd.flags"),
     "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 # commands of spec 10 a profile may lack (the refusal is 3)
-OPTIONAL = ["VL", "VK", "VN", "XM", "NX", "NY", "NZ", "NA", "W", "EFR", "EFW", "EUR", "EUW",
-            "M", "Y", "I0", "I2", "%", "*S", "*E"]
+OPTIONAL = classes(optional=True)
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 LACKING_LETTER = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 REFUSAL_FRAMES = {"VL": "VL1000,1000,1000", "VK": "VK", "VN": "VN", "XM": "XM100",
@@ -74,7 +78,7 @@ def formats(ctx: CaseContext) -> None:
       tag="M", source="spec 1, 5: code 3",
       rule="A command the profile lacks answers 3")
 def absent(ctx: CaseContext) -> None:
-    lacking = [c for c in OPTIONAL if c not in ctx.profile.commands]
+    lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
         ctx.expect(True, "the profile has every optional command")
     for name in lacking:
@@ -182,3 +186,42 @@ def spindle(ctx: CaseContext) -> None:
     ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
     code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors",
          rule="12.spindle.commands")
+
+
+#: the move each micro-step mode makes (commanded steps): a factor of another mode ends
+#: elsewhere on every axis
+MODE_MOVE = (60, -30, 15)
+
+
+def _rest(ctx: CaseContext) -> None:
+    r = ctx.link.poll("L0,0,0", lambda r: r.code != 1, 30)
+    ctx.require(r is not None and r.code == 0, "the move did not end within 30 s")
+
+
+@case("10.7.microstep.each-mode", requires=("M",), timing=True,
+      rules=("10.7.motor.modes", "10.7.motor.rates-scaled", "10.2.motion.gve54-units"))
+def each_mode(ctx: CaseContext) -> None:
+    """Every micro-step mode with the same move: where it ends (exact, in sixteenths) and
+    how it gets there (measured, the rates scaled by the mode's factor)."""
+    ms = ctx.profile.microstep
+    start = position(ctx)
+    ctx.require(start is not None, "PF did not answer with positions")
+    for mode, factor in ms.factors.items():
+        setup(ctx, f"M{mode}")
+        setup(ctx, "L" + vector(ctx, *MODE_MOVE))
+        _rest(ctx)
+        want = [s + factor * d for s, d in zip(start, MODE_MOVE, strict=True)]
+        ctx.expect(position(ctx) == want, f"M{mode}: L{vector(ctx, *MODE_MOVE)} ends "
+                   f"{factor} sixteenths a step on", observed=position(ctx), expected=want,
+                   rule="10.7.motor.modes")
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+    setup(ctx, f"M{ms.reset_mode}")
+    for mode in ms.factors:
+        Probe(ctx, f"the move in M{mode}", "10.7.motor.rates-scaled").script(
+            [f"M{mode}", "A2", "V400", "L" + vector(ctx, *MODE_MOVE), 0.5])
+        setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+        _rest(ctx)
+        setup(ctx, f"M{ms.reset_mode}")
+    ctx.expect(position(ctx) == start, "the axes are back where the case found them",
+               observed=position(ctx), expected=start, rule="10.7.motor.modes")

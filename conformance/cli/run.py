@@ -77,8 +77,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--yes", action="store_true",
                     help="real units: move without asking first (unattended benches)")
     ap.add_argument("--operator", action=argparse.BooleanOptionalAction, default=None,
-                    help="real units: ask a technician for hand steps (ground an input...); "
-                         "default: when standard input is a terminal")
+                    help="real units: a technician stands in for the test rig (ground an "
+                         "input, cycle the power, read the outputs; each step read back, "
+                         "s skips it); default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")

@@ -1,4 +1,4 @@
-"""Before a run (issue 12 items 1, 2): which profile a unit is judged as (``--profile
+"""Before a run: which profile a unit is judged as (``--profile
 auto`` asks it), what it says it is (for the report), and the question before the first
 move on a real unit."""
 

@@ -9,7 +9,10 @@ instants: virtual time only, where both sides are exact).
 In virtual time on both sides everything is exact. With a target in real time, positions
 read while moving may differ by the band of ``conformance/motion/tolerance.py`` (the
 fastest rate the reference can have stepped at, times the width of the windows in which
-the two frames were processed, plus a step of placement); at rest they must be equal.
+the two frames were processed, the target's widened by the line's band of
+``conformance/link/line_band.py``, plus a step of placement); at rest they must be equal
+unless a frame changed the motion's course, which the target may have acted on up to its
+latency and the line's band later.
 The index (`@`) is compared from where each side's example began (the index of a real
 unit or a co-simulator is not reset by the known state), in virtual time too.
 """
@@ -20,9 +23,12 @@ import math
 from dataclasses import dataclass
 
 from conformance.diff.sides import Exchange
-from conformance.motion.tolerance import PLACEMENT_STEPS, SECOND, Window, reading_band
+from conformance.link.line_band import EXACT, LineBand
+from conformance.motion.tolerance import PLACEMENT_STEPS, Window, reading_band
+from conformance.protocol.catalogue import classes
+from gve_fixtures.protocol import SECOND
 
-POSITION_COMMANDS = ("P", "PF")
+POSITION_COMMANDS = classes(position=True)
 
 
 @dataclass(frozen=True)
@@ -36,6 +42,8 @@ class Judge:
     #: frames that changed a running motion's course (H, G, XM, an input...), summed:
     #: positions even at rest may differ by the rate times this
     slack_ns: int = 0
+    #: real time: the target's line band (its measured round trip and the example's own)
+    line: LineBand = EXACT
 
 
 def difference(command: str, target: Exchange, reference: Exchange, judge: Judge,
@@ -81,7 +89,8 @@ def alike_because(command: str, target: Exchange, reference: Exchange, judge: Ju
     limit = band(target, reference, judge, moving)
     when = "read while the axes may have moved" if moving else \
         "read after a frame that changed the motion's course"
-    return f"within ±{limit} step(s), {when}"
+    line = "" if judge.line.exact else f" ({judge.line})"
+    return f"within ±{limit} step(s){line}, {when}"
 
 
 def _repeats_position(ra, rb) -> bool:
@@ -105,10 +114,11 @@ def band(target: Exchange, reference: Exchange, judge: Judge, moving: bool) -> i
     """Steps two readings may differ by: exact at rest; while moving the rate times how
     far apart the two instants can be, plus placement; and the rate times how late the
     target may have acted on what changed the motion's course."""
-    late = math.ceil(judge.rate * judge.slack_ns / SECOND)
+    slack = judge.slack_ns + judge.line.ns if judge.slack_ns else 0
+    late = math.ceil(judge.rate * slack / SECOND)
     if not moving:
         return late + PLACEMENT_STEPS if late else 0
-    a = Window(target.sent_at, target.received_at)
+    a = Window(*judge.line.widen(target.sent_at, target.received_at))
     b = Window(reference.sent_at, reference.received_at)
     return reading_band(a, b, judge.rate, placement=PLACEMENT_STEPS) + late
 

@@ -9,7 +9,6 @@ states and everything later would differ too.
 from __future__ import annotations
 
 import contextlib
-import math
 import random
 import re
 import time
@@ -18,28 +17,27 @@ from dataclasses import dataclass, field, replace
 
 from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import Flaky, NoSuchExample
-from hypothesis.internal.conjecture import providers
-from hypothesis.internal.constants_ast import Constants
 
 from conformance.diff.compare import Judge, alike_because, difference
+from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.index import QUERIES, IndexBase
 from conformance.diff.labels import allowed, command_of, label, verdict_of
 from conformance.diff.sides import Exchange, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
+from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import St6
 
-#: frames that close an open packet (spec 7)
-_PACKET_BREAKERS = ("*E", "H", "@", ">", "J")
+try:
+    # internals of Hypothesis, used only to empty its pool of constants while a search
+    # runs; where they moved the pool is left as it is (see _seed_alone)
+    from hypothesis.internal.conjecture import providers as _providers
+    from hypothesis.internal.constants_ast import Constants as _Constants
+except ImportError:
+    _providers = _Constants = None
+
 _LONG_DECIMAL = re.compile(r"\d{13,}")
-#: a vector that moves nothing (and so waits no dwell)
-_ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
-#: real time: how long the reference must have been at rest, besides the target's
-#: window, for positions to be compared exactly (a target's motion ends when the unit
-#: says, the reference's when its model does)
-SETTLE_NS = 50_000_000
 #: real time: how long the fresh reference stands before a sequence
 AGE_SECONDS = 1.0
 
@@ -94,108 +92,120 @@ class Pair:
         self.target = target
         self.reference = reference
         self.profile = profile
-        self.exact = target.virtual and reference.virtual
+        self.timing = timing_for(target, reference)
         # the fastest an axis's counter can change: the variant's top rate, in counter
         # units (GVE54: a coarse micro-step mode moves several sixteenths a step)
         self._factor = max(profile.microstep.factors.values()) if profile.microstep else 1
-        self.judge = Judge(exact=self.exact, rate=profile.max_rate * self._factor)
-        self._ceiling = _Ceiling(profile)
-        self._idle_since: int | None = 0
-        self._latency_ns = self._slack_ns = self._cut_ns = 0   # real time: see _retimed
-        self._lost = False
+        self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor)
+        self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
 
+    @property
+    def exact(self) -> bool:
+        """Both sides in virtual time: every difference, timing too, is one."""
+        return self.timing.exact
+
     # -- one example ----------------------------------------------------------------------
     def run(self, steps: list[Step]) -> Outcome:
         out = Outcome()
+        if not self._begin(out):
+            return out
+        earlier: set[str] = set()          # what the sequence did before (labels read it)
+        for place, step in enumerate(steps):
+            if step.kind == WAIT:
+                self.target.wait(step.seconds)
+                self.timing.waited()
+                out.records.append(Record(step, place=place))
+            elif step.kind == INPUT:
+                self._input(step, place, out, earlier)
+            elif self._frames(step, place, out, earlier):
+                break
+        return self._end(out)
+
+    def _begin(self, out: Outcome) -> bool:
+        """Both sides in the known state; False when the guard refused it."""
         try:
             self.target.open()
         except SafetyStop as err:
             # the known state itself was refused (a minimiser's candidate left the unit
             # where the guard cannot bring it back): the candidate shows nothing
             out.refused.append(f"the known state: {err}")
-            return out
+            return False
         self.reference.open()
-        self._idle_since = 0
-        self._latency_ns = self._slack_ns = self._cut_ns = 0
-        self._lost = False
+        self.timing.begin()
         self._index = IndexBase()
         if self.target.real:
             self._prelude()
-        context_packet = False
-        earlier: set[str] = set()
-        dwell = _Dwell(self.profile.reset.T)
-        self._ceiling = _Ceiling(self.profile)
-        queued: str | None = None
-        for place, step in enumerate(steps):
-            if step.kind == WAIT:
-                self.target.wait(step.seconds)
-                if not self.exact:
-                    # looked at before the wait's end too: a motion that ended early in a
-                    # long wait is at rest for a read right after it
-                    self._follow(self.target.now - 2 * SETTLE_NS)
-                    self._watch_reference()
-                self._follow(self.target.now)
-                out.records.append(Record(step, place=place))
-                continue
-            if step.kind == INPUT:
-                if self.target.has_rig and self.reference.has_rig:
-                    self._retimed("input", None)
-                    if (self.target.set_input(step.port, step.value)
-                            and self.reference.set_input(step.port, step.value)):
-                        out.records.append(Record(step, place=place))
-                        earlier.add("input")
-                continue
-            command = command_of(step.body)
-            times = step.times if step.kind == FILL else 1
-            for i in range(times):
-                rec = self._exchange(step, out)
-                if rec is None:
-                    break
-                rec.repeat, rec.place = i, place
-                out.records.append(rec)
-                self._retimed(command, rec)
-                if command in QUERIES:
-                    self._base_index(command, self._context(step, context_packet), rec)
-                kind = self._difference(command, rec)
-                if kind is not None:
-                    context = self._context(step, context_packet)
-                    if command == "@" and self._index.counts_queries(
-                            _values(rec.target), _values(rec.reference)):
-                        context.add("queries-counted")
-                    facts = (command, kind, context, earlier, _code(rec.reference),
-                             _code(rec.target))
-                    if (why := allowed(*facts)) is not None:
-                        out.ended = f"both answers allowed: {why}"
-                        return self._end(out)
-                    if dwell.within(rec.reference.sent_at):
-                        context.add("in-dwell")
-                    d = Disagreement(len(out.records) - 1, command, kind, rec.target,
-                                     rec.reference, frozenset(context), frozenset(earlier))
-                    d.rule = label(*facts)
-                    d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
-                    out.disagreement = d
-                    return self._end(out)
-                if i == 0:             # a fill's later vectors join the first: no dwell
-                    dwell.note(command, step.body, rec.reference)
-                queued = _queued(command, step.body, rec.reference, queued)
-                self._ceiling.note(command, step.body, rec.reference)
-                if queued == "C+C":
-                    earlier.add("junction")
-                if step.kind == FILL and rec.reference.code != 0:
-                    break
-            if out.ended:
-                return self._end(out)
-            if command:
-                earlier.add(command)
-            if command == "*S" and step.address is None:
-                context_packet = True
-            elif command in _PACKET_BREAKERS:
-                context_packet = False
-        return self._end(out)
+        self.course = Course(self.profile)
+        return True
+
+    def _input(self, step: Step, place: int, out: Outcome, earlier: set[str]) -> None:
+        """A rig input set on both sides (left out where a side has no rig)."""
+        if not (self.target.has_rig and self.reference.has_rig):
+            return
+        self.timing.retimed("input", None)
+        if (self.target.set_input(step.port, step.value)
+                and self.reference.set_input(step.port, step.value)):
+            out.records.append(Record(step, place=place))
+            earlier.add("input")
+
+    def _frames(self, step: Step, place: int, out: Outcome, earlier: set[str]) -> bool:
+        """A frame (a fill: until the queue is full) to both sides; True when the example
+        ends here (a disagreement, a side silent for good)."""
+        command = command_of(step.body)
+        times = step.times if step.kind == FILL else 1
+        for i in range(times):
+            rec = self._exchange(step, out)
+            if rec is None:
+                break
+            rec.repeat, rec.place = i, place
+            out.records.append(rec)
+            self.timing.retimed(command, rec.target)
+            if command in QUERIES:
+                self._base_index(command, self._context(step, self.course.in_packet), rec)
+            kind = self._difference(command, rec)
+            if kind is not None:
+                out.disagreement = self._disagreement(step, command, kind, out, earlier)
+                return True
+            self.course.took(command, step.body, rec.reference, first=i == 0)
+            if self.course.junction:
+                earlier.add("junction")
+            if step.kind == FILL and rec.reference.code != 0:
+                break
+        if out.ended:
+            return True
+        if command:
+            # the spindle's V is not the feed rate's: a read after it names the spindle
+            spindle = self.profile.spindle
+            to_spindle = spindle is not None and step.address == spindle.address
+            earlier.add("spindle" if to_spindle else command)
+        self.course.stepped(command, step)
+        return False
+
+    def _disagreement(self, step: Step, command: str, kind: str, out: Outcome,
+                      earlier: set[str]) -> Disagreement | None:
+        """The last record's difference, in its context, labelled and graded (None: the
+        spec allows both answers, and the example ends there)."""
+        rec = out.records[-1]
+        context = self._context(step, self.course.in_packet)
+        if self.course.within_dwell(rec.reference.sent_at):
+            context.add("in-dwell")
+        if command == "@" and self._index.counts_queries(_values(rec.target),
+                                                         _values(rec.reference)):
+            context.add("queries-counted")
+        why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target))
+        if why is not None:
+            out.ended = f"both answers allowed: {why}"
+            return None
+        d = Disagreement(len(out.records) - 1, command, kind, rec.target, rec.reference,
+                         frozenset(context), frozenset(earlier))
+        d.rule = label(command, kind, context, earlier, _code(rec.reference),
+                       _code(rec.target))
+        d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
+        return d
 
     def _end(self, out: Outcome) -> Outcome:
         for side in (self.target, self.reference):
@@ -224,7 +234,7 @@ class Pair:
                 indexes.append(0)
             side.link.send("SR0")
         self._index = IndexBase((indexes[0] - indexes[1]) % 256)
-        self.judge = Judge(self.exact, self.judge.rate, self._index.offset)
+        self.judge = replace(self.judge, index_offset=self._index.offset)
 
     def _base_index(self, command: str, context: set[str], rec: Record) -> None:
         """The index is compared from each side's first reading of it (index.py)."""
@@ -244,18 +254,8 @@ class Pair:
                                     if image.defaults.get(a, image.erased) != v}
         self.reference.write_eeprom(self._eeprom_changes)
 
-    def _follow(self, instant: int) -> None:
-        """The reference waits until ``instant`` on the target's clock (if it is behind)."""
-        self.reference.wait(max(0, instant - self.reference.now) / 1e9)
-
-    def _sync(self) -> None:
-        """Each step starts at the same instant on both sides."""
-        self.reference.catch_up(self.target.now)
-        if self.exact:
-            self.target.catch_up(self.reference.now)
-
     def _exchange(self, step: Step, out: Outcome) -> Record | None:
-        self._sync()
+        self.timing.align()
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
         rec = Record(step)
         try:
@@ -271,8 +271,7 @@ class Pair:
             rec.target = Exchange(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
-        if self.exact:
-            self.reference.catch_up(rec.target.sent_at)
+        self.timing.sent(rec.target.sent_at)
         try:
             rec.reference = self.reference.exchange(data, lines=step.lines,
                                                     answer=step.answer, stall=step.stall,
@@ -285,61 +284,13 @@ class Pair:
         return rec
 
     def _difference(self, command: str, rec: Record) -> str | None:
-        moving = False
-        if not self.exact:
-            self._watch_reference()
-            if command in ("P", "PF", ">"):
-                moving = self._moving_near(rec) if command != ">" else True
-        late = self._cut_ns + (self._slack_ns if moving else 0)
-        judge = replace(self.judge, rate=self._ceiling.rate * self._factor, slack_ns=late)
+        moving, late = self.timing.allowance(command, rec.target, rec.reference)
+        judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late,
+                        line=self.timing.line())
         kind = difference(command, rec.target, rec.reference, judge, moving=moving)
         if kind is None:
             rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)
         return kind
-
-    def _retimed(self, command: str, rec: Record | None) -> None:
-        """Real time: the reference acts on a frame when the target's exchange began, the
-        target somewhere within its latency (the largest an immediate answer took in the
-        sequence so far). A frame (or rig input) that changes a running motion's course
-        makes the readings while it runs uncertain by the rate times that latency; one
-        that stops it short (H, INTA written, an input) the positions at rest too, until
-        the vector it cut has run to its end — for good once D or K threw the rest away."""
-        if self.exact:
-            return
-        if rec is not None and command not in _DEFERRED and rec.target.answer:
-            self._latency_ns = max(self._latency_ns,
-                                   rec.target.received_at - rec.target.sent_at)
-        if command in ("D", "K") and self._cut_ns:
-            self._lost = True
-        if command in _RETIMING and self._idle_since is None:
-            self._slack_ns += self._latency_ns
-            if command in _STOPPING:
-                self._cut_ns += self._latency_ns
-
-    def _watch_reference(self) -> None:
-        """Real time: note when the reference was first seen at rest (after each step;
-        a late note only makes the comparison more lenient); at rest and not interrupted,
-        every vector has reached its end, and when they were acted on no longer shows."""
-        rig = self.reference.link.rig
-        st6 = 0xFF if rig is None else int(rig.state()["status"][6], 16)
-        if st6 & St6.RUN:
-            self._idle_since = None
-            return
-        if self._idle_since is None:
-            self._idle_since = self.reference.now
-        if not st6 & St6.INTA:
-            self._slack_ns = 0
-            if not self._lost:
-                self._cut_ns = 0
-
-    def _moving_near(self, rec: Record) -> bool:
-        """Whether the reading may have been taken while the axes moved on either side:
-        the reference had not been at rest for as long as the target's window is wide
-        (the target may have processed the frame that much later or earlier)."""
-        if self._idle_since is None:
-            return True
-        width = rec.target.received_at - rec.target.sent_at
-        return rec.reference.sent_at - self._idle_since < 2 * width + SETTLE_NS
 
     def _context(self, step: Step, in_packet: bool) -> set[str]:
         g = load_grammar()["command"]
@@ -359,89 +310,6 @@ class Pair:
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
         }
         return {k for k, on in flags.items() if on}
-
-
-#: frames that change the course of a motion: a difference after them is theirs
-_COURSE_CHANGERS = ("H", "G", "K", "R", "D", "SW6", "J", "W")
-#: what changes a running motion's course at the instant the unit acts on it (an input
-#: set by the rig too): in real time that instant is known only within a latency
-_RETIMING = ("H", "G", "K", "R", "SW6", "SW", "XM", "XA", "XU", "XD", "input")
-#: of those, what stops a motion short of its vectors' ends
-_STOPPING = ("H", "SW6", "input")
-#: frames answered when their action ends, not at once
-_DEFERRED = ("H", "W", "J")
-
-
-class _Dwell:
-    """The modal dwell T and when the reference last took a vector: a frame sent less
-    than T after it may have met the vector still in its dwell (spec 10.2), which is what
-    a difference there points at, whatever command showed it."""
-
-    def __init__(self, t_ms: int) -> None:
-        self.t_ns = t_ms * 1_000_000
-        self.vector_at: int | None = None
-
-    def note(self, command: str, body: str, reference: Exchange) -> None:
-        if reference.code != 0:
-            return
-        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
-            self.vector_at = reference.sent_at
-        elif command in _COURSE_CHANGERS:
-            self.vector_at = None          # what follows is the halt's, the resume's...
-        elif command == "T" and body[1:].isdigit():
-            self.t_ns = int(body[1:]) * 1_000_000
-
-    def within(self, t: int) -> bool:
-        return self.vector_at is not None and t - self.vector_at < self.t_ns
-
-
-class _Ceiling:
-    """The fastest the reference's axes can have stepped so far in the example (steps/s):
-    the highest V it took, raised by the highest override (XM) and by 17/16 for each XU; a
-    reference run (W) or the hand wheel (Y) may step at the variant's top rate. A
-    reading taken while moving is uncertain by this rate times its window, not by the
-    top rate (spec 10.2: a vector cruises at V at most, a short one at B if lower, and
-    no ramp or junction exceeds the cruise; B lowers a rate, it never raises one)."""
-
-    def __init__(self, profile: Profile) -> None:
-        self.top = profile.max_rate
-        self.speed = profile.reset.V
-        self.override = max(100, profile.reset.XM) / 100
-        self.up = 1.0
-
-    @property
-    def rate(self) -> int:
-        return min(self.top, math.ceil(self.speed * self.override * self.up))
-
-    def note(self, command: str, body: str, reference: Exchange) -> None:
-        if reference.code != 0:
-            return
-        value = _first_number(body[len(command):])
-        if command == "V" and value is not None:
-            self.speed = max(self.speed, value)
-        elif command == "XM" and value is not None:
-            self.override = max(self.override, value / 100)
-        elif command == "XU":          # each XU scales the held vectors again
-            self.up *= 17 / 16
-        elif command in ("W", "Y"):
-            self.speed = self.top
-
-
-def _first_number(params: str) -> int | None:
-    try:
-        return int(params.split(",")[0])
-    except ValueError:
-        return None
-
-
-def _queued(command: str, body: str, reference: Exchange, last: str | None) -> str | None:
-    """The last vector the reference queued after ``last``: ``C+C`` when a C followed a C
-    (the two meet at a junction, spec 10.2); a D empties the queue."""
-    if command == "D" and reference.code == 0:
-        return None
-    if command not in ("L", "C") or reference.code != 0 or _ZERO_VECTOR.fullmatch(body.upper()):
-        return last
-    return "C+C" if command == "C" and last in ("C", "C+C") else command
 
 
 def _has_lower(text: str) -> bool:
@@ -578,19 +446,106 @@ def _seed_alone() -> Iterator[None]:
     process has imported: which modules those are (a test run's, a CLI's) would decide
     the sequences as much as the seed. The pool is emptied while the search runs (an
     internal of Hypothesis: where it is missing there is nothing to empty)."""
-    pool = getattr(providers, "_get_local_constants", None)
-    cache = getattr(providers, "CONSTANTS_CACHE", None)
-    if pool is None or cache is None:
+    pool = getattr(_providers, "_get_local_constants", None)
+    cache = getattr(_providers, "CONSTANTS_CACHE", None)
+    if pool is None or cache is None or _Constants is None:
         yield
         return
-    empty = Constants()
+    empty = _Constants()
     cache.cache.clear()
-    providers._get_local_constants = lambda: empty
+    _providers._get_local_constants = lambda: empty
     try:
         yield
     finally:
-        providers._get_local_constants = pool
+        _providers._get_local_constants = pool
         cache.cache.clear()
+
+
+def _settings(examples: int) -> settings:
+    """Hypothesis's own defaults, not whatever profile the process loaded (the suite's
+    pytest plugin loads derandomized ones): the seed alone decides the sequences."""
+    return settings(settings.get_profile("default"), derandomize=False,
+                    max_examples=max(1, examples), database=None, deadline=None,
+                    phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
+                    suppress_health_check=list(HealthCheck))
+
+
+class _Search:
+    """One search's findings, the signatures already kept, and its budget."""
+
+    def __init__(self, pair: Pair, budget: Budget, stop_after: int | None,
+                 on_finding: Callable[[Finding], None] | None) -> None:
+        self.pair = pair
+        self.budget = budget
+        self.stop_after = stop_after
+        self.on_finding = on_finding
+        self.findings: list[Finding] = []
+        self.known: set[tuple] = set()
+
+    def more(self) -> bool:
+        return not self.budget.spent() and (self.stop_after is None
+                                            or len(self.findings) < self.stop_after)
+
+    def trial(self, steps: list[Step]) -> Finding | None:
+        """One example run whole; a finding when it shows a disagreement not kept yet."""
+        self.budget.used += 1
+        outcome = self.pair.run(steps)
+        self.budget.frames += outcome.frames
+        d = outcome.disagreement
+        if d is None or d.signature in self.known:
+            return None
+        return Finding(list(steps), outcome)
+
+    def draw(self, strategy, seed: int) -> Finding | None:
+        """One round of Hypothesis: the smallest new disagreement it saw (None: none)."""
+        best: Finding | None = None
+
+        def fails(steps: list[Step]) -> bool:
+            nonlocal best
+            if self.budget.spent():
+                raise _Spent           # also while shrinking: the smallest seen is kept
+            found = self.trial(steps)
+            if found is None:
+                return False
+            if best is None or frames_in(steps) <= frames_in(best.steps):
+                best = found
+            if self.budget.spent():
+                raise _Spent       # shrinking stops here: the smallest seen is kept
+            return True
+
+        b = self.budget
+        left = (b.examples - b.used) if b.examples is not None else 10**6
+        try:
+            with _seed_alone():
+                find(strategy, fails, settings=_settings(left), random=random.Random(seed))
+        except (NoSuchExample, _Spent):
+            pass
+        except Flaky:
+            # real time: a disagreement Hypothesis could not see again (kept only if it
+            # shows once more)
+            pass
+        return best
+
+    def keep(self, found: Finding, *, written: bool = False) -> None:
+        """A disagreement made minimal, confirmed in real time, kept once. A probe
+        (``written``) in real time only loses the frames it does not need (its waits and
+        slow rates are what make it show beyond the timing band), and stays as written
+        unless the lesser one shows again."""
+        pair, repeatable = self.pair, self.pair.timing.repeatable
+        finding = minimise(pair, found, self.budget, frames_only=written and not repeatable)
+        if finding.disagreement.signature in self.known:
+            return
+        self.known.add(finding.disagreement.signature)
+        confirmed = repeatable or _again(pair, finding, self.budget)
+        if not confirmed and written and finding.steps != found.steps:
+            finding = found
+            confirmed = _again(pair, found, self.budget)
+        if not confirmed:
+            pair.unconfirmed.append(finding)
+            return
+        self.findings.append(finding)
+        if self.on_finding is not None:
+            self.on_finding(finding)
 
 
 def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
@@ -600,84 +555,22 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
     and kind), until the budget is spent (or ``stop_after`` findings): first the probes
     (unless ``with_probes`` is false), each run whole, then the sequences Hypothesis
     draws."""
-    findings: list[Finding] = []
-    known: set[tuple] = set()
-
-    def more() -> bool:
-        return not budget.spent() and (stop_after is None or len(findings) < stop_after)
-
-    def keep(found: Finding, *, written: bool = False) -> None:
-        """A disagreement made minimal, confirmed in real time, kept once. A probe
-        (``written``) in real time only loses the frames it does not need (its waits and
-        slow rates are what make it show beyond the timing band), and stays as written
-        unless the lesser one shows again."""
-        finding = minimise(pair, found, budget, frames_only=written and not pair.exact)
-        if finding.disagreement.signature in known:
-            return
-        known.add(finding.disagreement.signature)
-        confirmed = pair.exact or _again(pair, finding, budget)
-        if not confirmed and written and finding.steps != found.steps:
-            finding = found
-            confirmed = _again(pair, found, budget)
-        if not confirmed:
-            pair.unconfirmed.append(finding)
-            return
-        findings.append(finding)
-        if on_finding is not None:
-            on_finding(finding)
-
+    hunt = _Search(pair, budget, stop_after, on_finding)
     grammar = Grammar(pair.profile, options)
     for _, steps in grammar.probes() if with_probes else ():
-        if not more():
-            return findings
-        budget.used += 1
-        outcome = pair.run(steps)
-        budget.frames += outcome.frames
-        d = outcome.disagreement
-        if d is not None and d.signature not in known:
-            keep(Finding(steps, outcome), written=True)
-
+        if not hunt.more():
+            return hunt.findings
+        found = hunt.trial(steps)
+        if found is not None:
+            hunt.keep(found, written=True)
     strategy = grammar.sequences()
     rounds = 0
-    while more():
-        best: dict[str, Finding] = {}
-
-        def fails(steps: list[Step], best: dict[str, Finding] = best) -> bool:
-            if budget.spent():
-                raise _Spent           # also while shrinking: the smallest seen is kept
-            budget.used += 1
-            outcome = pair.run(steps)
-            budget.frames += outcome.frames
-            d = outcome.disagreement
-            if d is None or d.signature in known:
-                return False
-            found = Finding(list(steps), outcome)
-            if "found" not in best or frames_in(steps) <= frames_in(best["found"].steps):
-                best["found"] = found
-            if budget.spent():
-                raise _Spent       # shrinking stops here: the smallest seen is kept
-            return True
-
-        left = (budget.examples - budget.used) if budget.examples is not None else 10**6
-        # Hypothesis's own defaults, not whatever profile the process loaded (the suite's
-        # pytest plugin loads derandomized ones): the seed alone decides the sequences
-        chosen = settings(settings.get_profile("default"), derandomize=False,
-                          max_examples=max(1, left), database=None, deadline=None,
-                          phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
-                          suppress_health_check=list(HealthCheck))
-        try:
-            with _seed_alone():
-                find(strategy, fails, settings=chosen, random=random.Random(seed + rounds))
-        except (NoSuchExample, _Spent):
-            pass
-        except Flaky:
-            # real time: a disagreement Hypothesis could not see again (kept below only
-            # if it shows once more)
-            pass
+    while hunt.more():
+        found = hunt.draw(strategy, seed + rounds)
         rounds += 1
-        if "found" not in best:
+        if found is None:
             if budget.spent() or budget.examples is not None:
                 break                  # (with examples left: Hypothesis found nothing new)
             continue
-        keep(best["found"])
-    return findings
+        hunt.keep(found)
+    return hunt.findings

@@ -14,10 +14,12 @@ from hypothesis import strategies as st
 
 from conformance.diff.labels import command_of
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
+from conformance.protocol.catalogue import Command, Field, commands
 from gve_fixtures.profile import Profile
 
 GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
 PROBES_FILE = Path(__file__).with_name("probes.toml")
+_DEFAULTS = {"weight": 1, "answer": True, "lines": 1, "destructive": False}
 #: an idiom's vector along the first axis only
 _ONE_COMPONENT = re.compile(r"[LC]-?\d+")
 #: how an idiom's frame is sent, written before its body, and what that changes of the step
@@ -25,6 +27,7 @@ _SENT = {
     "bad": lambda profile: {"checksum": "bad"},
     "stalled": lambda profile: {"stall": (2, (profile.watchdog_ms + 50) / 1000)},
     "other": lambda profile: {"address": (profile.address + 1) % 8, "answer": False},
+    "spindle": lambda profile: {"address": profile.spindle.address},
 }
 _PREFIX = re.compile(r"^(%s):" % "|".join(_SENT))
 
@@ -39,7 +42,48 @@ class Options:
 
 @cache
 def load_grammar(path: Path = GRAMMAR_FILE) -> dict:
-    return tomllib.loads(path.read_text(encoding="utf-8"))
+    """grammar.toml, with ``command``: what is drawn of each command of the catalogue, by
+    the name a profile's command set uses (``O0``), in the catalogue's order."""
+    raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    draw = raw.pop("draw", {})
+    unknown = set(draw) - set(commands())
+    if unknown:
+        raise ValueError(f"{path.name}: [draw]: no such command(s) {sorted(unknown)}")
+    raw["command"] = {c.known_as: _drawn(c, draw.get(name, {}))
+                      for name, c in commands().items()}
+    return raw
+
+
+def _drawn(c: Command, draw: dict) -> dict:
+    entry: dict = {}
+    if c.known_as != c.name:
+        entry["text"] = c.name
+    params = draw.get("params", [_kind(f) for f in c.fields])
+    if c.repeat == "axes" and params != ["vector"]:
+        params = params * 3
+    if params:
+        entry["params"] = params
+    for key, value in (("weight", draw.get("weight", 1)), ("answer", c.answer),
+                       ("lines", c.lines), ("destructive", c.destructive)):
+        if value != _DEFAULTS[key]:
+            entry[key] = value
+    if c.restart:
+        entry["then_wait"] = "restart"
+    return entry
+
+
+def _kind(f: Field) -> str:
+    """The field kind (grammar.toml) that draws a parameter of the catalogue."""
+    if f.kind == "word":
+        return "choice:" + "|".join(f.choices)
+    if f.kind == "float":
+        return "float"
+    if f.range == "vector":
+        return "vector"
+    if isinstance(f.range, str):
+        return f"range:{f.range}"
+    assert f.range is not None
+    return f"{f.kind}:{f.range[0]}:{f.range[1]}"
 
 
 @cache
@@ -179,7 +223,10 @@ class Grammar:
             elif f.startswith("fill "):
                 if command_of(f.split()[2]) not in allowed:
                     return False
-            elif not f.startswith("wait ") and command_of(_PREFIX.sub("", f)) not in allowed:
+            elif f.startswith("wait "):
+                continue
+            elif (command_of(_PREFIX.sub("", f)) not in allowed
+                  or (f.startswith("spindle:") and self.profile.spindle is None)):
                 return False
         return True
 
@@ -312,7 +359,8 @@ class Grammar:
         """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`,
         `fill N BODY`, `bad:BODY` (a wrong checksum in checksum mode), `stalled:BODY` (a
         pause longer than the watchdog after its second byte), `other:BODY` (to another
-        address), else a frame; `J` is followed by its restart's wait."""
+        address), `spindle:BODY` (to the GVE114's spindle address), else a frame; `J` is
+        followed by its restart's wait."""
         out = []
         for f in lines:
             word, _, rest = f.partition(" ")

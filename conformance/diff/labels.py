@@ -7,36 +7,24 @@ sequence ends there (the states differ from then on)."""
 
 from __future__ import annotations
 
-import re
 import tomllib
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+from conformance.protocol.parse import parse
 from conformance.verdict import INFO, grade
 from gve_fixtures.rules import load_rules
 
 LABELS_FILE = Path(__file__).with_name("labels.toml")
 _FIELDS = ("command", "kind", "context", "earlier", "reference", "target")
 
-#: spec 10's command names, longest first (so `PF` is not read as `P`)
-NAMES = sorted(["?", "Q", "L", "C", "T", "$", "A", "V", "VL", "B", "VK", "VN", "XA", "XU",
-                "XD", "XM", "P", "PF", "N", "NX", "NY", "NZ", "NA", "W", "K", "R", "H",
-                "D", "G", "ER", "EW", "EFR", "EFW", "EUR", "EUW", "O", "I0", "I1", "I2",
-                "SR", "SW", "F", "M", "Y", "@", ">", "J", "%", "*S", "*E"],
-               key=len, reverse=True)
 
 
 def command_of(body: str) -> str:
-    """The spec 10 name of a frame's command (`SW6` for a write of ST6), read as upper
-    case; "" when none matches."""
-    text = body.upper()
-    for name in NAMES:
-        if text.startswith(name):
-            if name == "SW" and re.match(r"SW0*6(,|$)", text):
-                return "SW6"
-            return name
-    return ""
+    """The class of a frame's command as every reader of the suite reads it (spec 10's
+    name, `SW6` for a write of ST6), "" when none matches."""
+    return parse(body).key
 
 
 @dataclass(frozen=True)

@@ -14,14 +14,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from conformance.link.framing import HostFramer, Response, parse_response
-from conformance.link.link import MARGIN, Link
+from conformance.link.link import Link
 from conformance.link.virtual import line_of
 from conformance.targets import Session, Target
 from conformance.targets.session import EmuSession
 from conformance.verdict import CouldNotTest
-
-#: answers summed after the command whatever the mode before (spec 6, 10 J)
-_MODE_AFTER = {"%+": True, "%-": False, "J": False}
 
 
 @dataclass
@@ -112,9 +109,8 @@ class Side:
         sent_at = self.now
         link.send_raw(data)
         if answer:
-            slow = link.guard.answer_seconds(body) or 0.0
-            timeout = MARGIN + link.byte_seconds(len(data) + 64) + slow
-            r = link.read_response(timeout, lines, summed=_MODE_AFTER.get(body, link.checksums))
+            r = link.read_response(link.answer_timeout(body, len(data)), lines,
+                                   summed=link.summed_after(body))
             back = r.raw if r is not None else b""
         else:
             back = link.wait(link.byte_seconds(len(data) + 64) + 0.005)

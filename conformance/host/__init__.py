@@ -1,10 +1,10 @@
-"""The host role (issue 11): the suite plays GVE units to a host program and judges the
-host's traffic on the wire, under the faults a real line and unit bring.
+"""The host role (spec 2, 3, 6, 7, 8, 10.1): the suite plays GVE units to a host program
+and judges the host's traffic on the wire, under the faults a real line and unit bring.
 
     ports/      where the host meets the relay (pty, TCP, serial device)
     units.py    the emulated units behind the relay (gve://, its rig and its clock)
-    framer.py   the host's byte stream cut into frames, every byte timed
-    grammar.py  one frame judged against spec 3 and 10 (commands.toml: the parameters)
+    grammar.py  one frame judged against spec 3 and 10 (the command catalogue's parameters;
+                the host's bytes are framed by conformance/protocol/framer.py)
     relay.py    host <-> units, answers paired with frames, faults applied: only what
                 the line needs while it runs
     ledger.py   the frames read and the units' views booked in the relay's order, when

@@ -1,5 +1,5 @@
 """A host certification: the clean run first (the baseline), then every fault scenario,
-each a separate run of the host's job against fresh units (issue 11 items 1, 3).
+each a separate run of the host's job against fresh units.
 
 Launched: the host program is started once per scenario with ``{port}`` replaced by the
 port it should open; scenarios after the clean one run side by side where each can have

@@ -1,4 +1,4 @@
-"""The host rules, judged on the wire after each run (issue 11 item 2): one function per
+"""The host rules, judged on the wire after each run: one function per
 kind of evidence, each naming the rules of fixtures/rules.toml it judges.
 
 :data:`WIRE_CHECKS` maps every rule a host can fail here to the check that judges it
@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from conformance.host.examples import worked_frames
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -22,7 +23,7 @@ from gve_fixtures.protocol import ErrorCode
 PATIENCE_MS = 100
 MS = 1_000_000
 #: `@` and `>`: asking, never resending (spec 8)
-ASKING = ("@", ">")
+ASKING = classes(asks=True)
 
 
 @dataclass(frozen=True)
@@ -179,11 +180,11 @@ def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
                         f"{n} member(s) sent since `*S`")
             members[f.address] = None
         elif n is not None:
-            if f.command in ("H", "@", ">", "J"):
+            if f.command in classes(packet="breaker"):
                 members[f.address] = None          # breaks the packet (spec 7)
                 continue
             members[f.address] = n + 1             # a member, failing or not
-            if f.command not in ("C", "B"):
+            if f.command not in classes(packet="member"):
                 out.add("7.packet.members", _at(ex.frame.start, line), ex.text,
                         f"`{f.command}` inside a packet")
             elif f.checksum is None and summed(ex):
@@ -257,7 +258,7 @@ def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
 
 def _resends(ex: Exchange, nxt: Exchange) -> bool:
     if ex.parsed.command == "*E":
-        return nxt.parsed.command in ("*S", "*E")
+        return nxt.parsed.command in classes(packet="opens") | classes(packet="closes")
     return nxt.frame.raw == ex.frame.raw
 
 

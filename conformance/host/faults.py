@@ -1,5 +1,5 @@
 """The faults a real line and unit bring, injected by the relay at one point of the host's
-job (issue 11 item 3). Each fault acts through the same few hooks of the relay:
+job. Each fault acts through the same few hooks of the relay:
 
 - ``hold(partial)``: keep the bytes of the frame in progress back from the unit for now;
 - ``frame(ex)``: what the unit gets for a frame that was held whole (None: nothing);
@@ -18,7 +18,7 @@ from typing import Protocol
 
 from conformance.host.grammar import byte_sum
 from conformance.host.recording import Exchange, show
-from gve_fixtures.protocol import INTA_BIT, ErrorCode
+from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode
 
 #: how late a late answer is: longer than a host's least patience (checks.PATIENCE)
 LATE_S = 0.4
@@ -28,7 +28,6 @@ NOISE = b"\x00\xff"
 #: how long the queue pretends to be full, and an input stays active
 QUEUE_FULL_S = 0.3
 INTERRUPT_S = 0.3
-SECOND = 1_000_000_000
 
 
 class Context(Protocol):

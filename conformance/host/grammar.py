@@ -1,8 +1,8 @@
 """A host's command frame judged against spec 3 and 10: address, command, parameters,
 checksum and length, each problem naming the rule it breaks (fixtures/rules.toml).
 
-Written from the spec. The parameter table is data (``commands.toml`` next to this file);
-the ranges come from the addressed unit's profile.
+Written from the spec. The parameters are the suite's command catalogue
+(conformance/protocol/commands.toml); the ranges come from the addressed unit's profile.
 """
 
 from __future__ import annotations
@@ -10,18 +10,16 @@ from __future__ import annotations
 import math
 import re
 import struct
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
-from pathlib import Path
 
-from conformance.link.framing import byte_sum
+from conformance.protocol.catalogue import Command, Field, classes, commands
+from conformance.protocol.parse import parse
+from conformance.protocol.wire import byte_sum
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import MAX_FRAME
 from gve_fixtures.rules import load_rules
-
-COMMANDS_FILE = Path(__file__).with_name("commands.toml")
 
 _DEC = re.compile(r"-?[0-9]+\Z")
 _HEX = re.compile(r"[0-9A-Fa-f]+\Z")
@@ -30,53 +28,13 @@ _SUM = re.compile(rb",([0-9A-Fa-f]{2})\Z")
 _PRINTABLE = re.compile(rb"[\x20-\x7e]*")
 #: what a host might put between parameters instead of a comma (spec 3 [M] "commas")
 _SEPARATORS = re.compile(r"[ ;:\t]")
-#: commands only units with checksums and packets have (spec 1: the GVE54 lacks them)
-_CHECKSUM_COMMANDS = ("%", "*S", "*E")
 _SYNTAX_RULE = {"dec": "3.params.decimal", "hex": "3.params.hex-fields",
                 "float": "3.params.float-syntax", "word": "5.code.syntax"}
 
 
-@dataclass(frozen=True)
-class Field:
-    kind: str                                   # dec, hex, float, word
-    range: str | tuple[int, int] | None = None
-    choices: tuple[str, ...] = ()
-    syntax: str = ""                            # the rule its format breaks, if not the kind's
-
-
-@dataclass(frozen=True)
-class Command:
-    name: str
-    fields: tuple[Field, ...] = ()
-    repeat: str | None = None                   # "axes": the last field repeats
-    glued: bool = False
-    rules: tuple[str, ...] = ()
-    profile_name: str = ""
-    count_rule: str = "5.code.syntax"           # the rule a wrong number of parameters breaks
-
-    @property
-    def known_as(self) -> str:
-        """The name a profile's command set uses."""
-        return self.profile_name or self.name
-
-
-@cache
-def command_table(path: Path = COMMANDS_FILE) -> dict[str, Command]:
-    raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    table = {}
-    for name, entry in raw["command"].items():
-        fields = tuple(Field(f["kind"], _range(f.get("range")), tuple(f.get("choices", ())),
-                             f.get("syntax", "")) for f in entry.get("fields", ()))
-        table[name] = Command(name, fields, entry.get("repeat"), entry.get("glued", False),
-                              tuple(entry.get("rules", ())), entry.get("profile", ""),
-                              entry.get("count", "5.code.syntax"))
-    return table
-
-
-def _range(value: object) -> str | tuple[int, int] | None:
-    if isinstance(value, list):
-        return (int(value[0]), int(value[1]))
-    return value if isinstance(value, str) else None
+def command_table() -> dict[str, Command]:
+    """The commands of spec 10 by wire name (the suite's catalogue)."""
+    return commands()
 
 
 @dataclass(frozen=True)
@@ -94,7 +52,8 @@ class ParsedFrame:
     raw: bytes
     address: int | None = None
     body: str = ""                  # without the checksum
-    command: str | None = None      # a name of the command table
+    command: str | None = None      # the command's wire name, read strictly (spec 3)
+    key: str = ""                   # the frame's class, read leniently (`SW6`: writes ST6)
     params: list[str] = field(default_factory=list)
     checksum: str | None = None
     problems: list[Problem] = field(default_factory=list)
@@ -129,7 +88,7 @@ def command_of(raw: bytes, units: dict[int, Profile]) -> str | None:
     digit = raw[1:2]
     if not (digit.isdigit() and int(digit) <= 7 and int(digit) in units):
         return None
-    return _longest_prefix(raw[2:5].decode("latin-1"), command_table())
+    return parse(raw[2:].decode("latin-1"), strict=True).name
 
 
 class LineGrammar:
@@ -183,9 +142,13 @@ def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFram
 
 def _command(f: ParsedFrame, profile: Profile) -> None:
     table = command_table()
-    name = _longest_prefix(f.body, table)
-    upper = _longest_prefix(f.body.upper(), table)
+    name = parse(f.body, strict=True).name
+    classed = parse(f.body)
+    upper = classed.name
     lower = name is None and upper is not None
+    # the frame's class is every reader's (lower case too); what the unit does with it
+    # (``command``) is read as spec 3 writes it, as the conforming units behind the relay read it
+    f.key = classed.key
     f.check(not lower, "3.frame.upper-case",
             lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
     if not f.check(name is not None or lower, "1.profile.command-set",
@@ -195,20 +158,13 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
     f.command = name
     spindle = profile.spindle is not None and f.address == profile.spindle.address
     allowed = profile.spindle.commands if spindle else profile.commands
-    family_lacks = name in _CHECKSUM_COMMANDS and profile.family == "GVE54"
+    family_lacks = name in classes(checksums=True) and profile.family == "GVE54"
     where = f"address {f.address} of the {profile.name}" if spindle else profile.name
     if not f.check(command.known_as in allowed,
                    "1.profile.gve54-no-checksums" if family_lacks else "1.profile.command-set",
                    lambda: f"`{name}`: the {where} has no such command"):
         return
     _params(f, command, f.body[len(name):], profile, spindle)
-
-
-def _longest_prefix(body: str, table: dict[str, Command]) -> str | None:
-    for n in (3, 2, 1):
-        if body[:n] in table:
-            return body[:n]
-    return None
 
 
 def _params(f: ParsedFrame, command: Command, text: str, profile: Profile,

@@ -1,5 +1,5 @@
 """The judge's reading of each frame and the units' views, kept from the wire when asked
-(issue 11 item 5).
+(the host benchmark and the reports ask).
 
 Reading a frame against the grammar (grammar.py) and booking an exchange on the units'
 views (unitview.py) take longer than a 921,600-baud line leaves the relay for a frame,

@@ -1,4 +1,4 @@
-"""Grading one scenario (issue 11 item 3): the host rules found on the wire, and the
+"""Grading one scenario: the host rules found on the wire, and the
 executed motion against the clean run's.
 
 - On the clean line the host must finish its own job (exit 0): a host that cannot is a
@@ -29,13 +29,14 @@ from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.unitview import VECTORS, Step, UnitView
+from conformance.protocol.catalogue import classes
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
 from gve_fixtures.rules import load_rules
 
 NS = 1e9
 #: commands by which a host shows it noticed an interrupt (spec 10.4, 10.5)
-REACTIONS = ("G", "D", "K", "R", "H")
+REACTIONS = classes(reaction=True)
 
 
 @dataclass
@@ -280,7 +281,7 @@ def result(g: Grader, out: Outcome, profile: str, target: str) -> HostResult:
              *(f"unit {a}: {f.note}" for a, f in out.finals.items() if f.note), *g.notes]
     return HostResult(
         id=sc.id, section=sc.section, rule=sc.title, tag="D-info" if sc.info else "M",
-        source="issue 11; spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
+        source="spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
         verdict=g.verdict(), checks=[asdict(c) for c in g.checks], notes=notes,
         wire_log=rec.wire_log(), artifacts={"host output": out.output} if out.output else {},
         seconds=out.seconds, frames=len(rec.exchanges), scenario=sc.name,
@@ -292,5 +293,5 @@ def skipped(sc: Scenario, verdict: str, why: str, profile: str, target: str) -> 
     """A scenario that did not run: MISSING (the job has no point for it) or
     COULD-NOT-TEST."""
     return HostResult(id=sc.id, section=sc.section, rule=sc.title, tag="M",
-                      source="issue 11", profile=profile, target=target, verdict=verdict,
-                      notes=[why], scenario=sc.name)
+                      source="spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
+                      verdict=verdict, notes=[why], scenario=sc.name)

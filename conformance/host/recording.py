@@ -8,8 +8,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from conformance.host.framer import Fragment, HostFrame
 from conformance.host.grammar import ParsedFrame
+from conformance.protocol.framer import Fragment, HostFrame
 from gve_fixtures.transcript import ACTION, HOST, UNIT, Record, escape
 
 #: a relay loop turn later than this (ns) is a stall of the relay itself, booked in

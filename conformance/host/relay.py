@@ -1,4 +1,4 @@
-"""The relay: the suite plays the unit to a host program (issue 11 item 1).
+"""The relay: the suite plays the unit to a host program.
 
 The host's bytes come in on a port (pty, TCP, serial device), are timed as they arrive and
 passed on at once to emulated units; the units' answers go back to the host. The units'
@@ -30,16 +30,17 @@ from dataclasses import dataclass
 import serial
 
 from conformance.host.faults import Fault
-from conformance.host.framer import HostFrame, HostFramer
 from conformance.host.grammar import command_of
 from conformance.host.ledger import Ledger
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
 from conformance.link.virtual import line_of
+from conformance.protocol.catalogue import classes
+from conformance.protocol.framer import HostFrame, HostFramer
+from gve_fixtures.protocol import SECOND
 
 MS = 1_000_000
-SECOND = 1_000_000_000
 #: the longest answer line (the two lines of `>` hold a whole frame each)
 MAX_LINE = 2 * 96 + 16
 #: most answers are this short or shorter (`0,5C`, `0,-1000,2000,50,xx`)
@@ -49,7 +50,7 @@ IDLE_S = 0.02
 #: how far the line's clock may lag the wall clock before the relay brings it up
 LAG = MS // 2
 #: commands that answer when the motion has stopped (spec 2)
-DEFERRED = ("H", "W")
+DEFERRED = classes(deferred=True)
 
 
 @dataclass

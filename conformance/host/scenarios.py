@@ -1,4 +1,4 @@
-"""The scenarios of a host certification (issue 11 item 3): the clean run, whose executed
+"""The scenarios of a host certification: the clean run, whose executed
 motion is the baseline, and one run per fault, each at its point of the job.
 
 A scenario is filed under the spec section whose rule it exercises most (8: recovery with

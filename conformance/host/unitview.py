@@ -15,17 +15,18 @@ from dataclasses import dataclass, field
 
 from conformance.host.grammar import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
-MODAL = ("V", "A", "B", "$", "T", "VK", "VN", "VL", "XM")
-#: settings a fault scenario may target ("a setting", issue 11 item 3)
-SETTINGS = (*MODAL, "SW", "O", "M")
+MODAL = classes(modal=True)
+#: settings a fault scenario may target: the modal ones, status words, outputs, motor mode
+SETTINGS = MODAL | classes(setting=True)
 #: commands that change the motion or the counters: kept in the executed sequence
-MARKERS = ("D", "N", "NX", "NY", "NZ", "NA", "K", "R", "W", "H", "M", "XA", "XU", "XD", "J")
+MARKERS = classes(marks=True)
 #: inside an open packet these are executed at once and discard it (spec 7)
-BREAKERS = ("H", "@", ">", "J")
-VECTORS = ("L", "C")
+BREAKERS = classes(packet="breaker")
+VECTORS = classes(vector=True)
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The motion envelope of a run (issue 8 item 1): where each axis may physically be, in
+"""The motion envelope of a run: where each axis may physically be, in
 counter units from where the run began, kept from the frames the unit accepted.
 
 Pure bookkeeping, no I/O. Every axis is a :class:`Span` (an interval: a position known
@@ -119,6 +119,8 @@ class Envelope:
         self.factor = Span(min(factors), max(factors))   # counter units per commanded step
         self.reset_factor = reset_factor
         self.seen = [ZERO] * axes                # every place an axis may have been
+        self.set_counters = False                # N/N<axis> taken since the last read at rest
+        self.unheld: list[int] = []              # axes whose set counter read back otherwise
 
     # -- what the unit may do ---------------------------------------------------------------
     def reach(self) -> list[Span]:
@@ -214,6 +216,7 @@ class Envelope:
             here = self.start[axis] + self.queue[axis].total
             new = UNKNOWN if value is None else here - point(value)
             self.offset[axis] = new if outcome is Outcome.ACCEPTED else self.offset[axis].hull(new)
+        self.set_counters = self.set_counters or bool(values)
 
     def reference(self, axis: int, travel: Span, outcome: Outcome, *, zeroed: bool) -> None:
         """`W`: the axis moves anywhere within ``travel`` (to the switch and back); the
@@ -261,7 +264,18 @@ class Envelope:
             if not self.offset[axis].bounded:
                 continue
             read = point(value) + self.offset[axis]
-            self.start[axis] = self.start[axis].meet(read) or read
+            met = self.start[axis].meet(read)
+            if met is None and self.set_counters and self.outside([read]) is not None:
+                # a counter set since the last read at rest reads the axis beyond the
+                # envelope the guard never let it leave: taken for a counter that does
+                # not hold the value set (a narrow one wraps), not for axes moved
+                # millions of steps; the frames' bookkeeping stays and the counter is
+                # anchored to it again
+                self.offset[axis] = self.start[axis] - point(value)
+                self.unheld.append(axis)
+                continue
+            self.start[axis] = met or read
+        self.set_counters = False
         self._see()
 
     def _see(self) -> None:

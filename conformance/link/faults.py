@@ -1,4 +1,4 @@
-"""Fault injection at the byte and frame level (issue 4 item 6).
+"""Fault injection at the byte and frame level.
 
 A fault transforms the bytes of one frame (host side: what the suite sends) or of one
 response (unit side: what comes back, on emulator targets). Each injector is a pure

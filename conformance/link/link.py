@@ -10,7 +10,7 @@ goes out and booked with its answer afterwards: frames built by :meth:`Link.send
 bytes of :meth:`Link.send_raw` (golden replays, noise) and frames changed by an injected
 fault alike.
 
-Answers belong to their frame (issue 8 item 5): bytes that arrive before a frame is
+Answers belong to their frame: bytes that arrive before a frame is
 sent are logged as unsolicited and never read as its answer; after a frame timed out
 the link waits for a quiet line before the next one (real time), so a late answer is
 not taken for a later frame's; bytes after a complete answer are recorded in
@@ -34,10 +34,9 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-SECOND = 1_000_000_000
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next
@@ -45,6 +44,9 @@ MARGIN = 0.25
 QUIET = 2.5
 #: real time: at the end of a case, how long to listen for bytes still on their way
 END_QUIET = 0.05
+
+#: answers summed after the command whatever the mode before (spec 6, 10 J)
+_MODE_AFTER = {"%+": True, "%-": False, "J": False}
 
 # what the last frame left on the line
 _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
@@ -61,6 +63,9 @@ class Link:
         self.guard = guard
         self.rig = rig
         self.checksums = False
+        #: real time: the line's round trip as the session measured it at its start
+        #: (``SessionReport.line``; empty when it was not), for the timing bands
+        self.round_trip: dict[str, float] = {}
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[str] = []
@@ -84,6 +89,18 @@ class Link:
     def byte_seconds(self, n: int) -> float:
         return n * 10 / self.baud
 
+    def answer_timeout(self, body: str, size: int) -> float:
+        """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
+        the frame's and an answer's bytes, a margin, and what the command itself takes
+        when it answers at its end."""
+        slow = self.guard.answer_seconds(body) or 0.0
+        return MARGIN + self.byte_seconds(size + 64) + slow
+
+    def summed_after(self, body: str) -> bool:
+        """Whether the answer to ``body`` carries a checksum: iff the mode is on after
+        the command (spec 6, 10 J)."""
+        return _MODE_AFTER.get(body, self.checksums)
+
     def wait(self, seconds: float) -> bytes:
         """Let ``seconds`` pass; returns whatever arrived meanwhile."""
         self.guard.check_idle()
@@ -96,6 +113,10 @@ class Link:
             self._record(UNIT, data)
             self._after_answer(data, "during a wait")
         self._last = (_UNASKED, b"", b"")
+        # raw frames not read for an answer: booked as unanswered now, not only when a
+        # later frame goes out on this link (there may be none: a `*S` that ends an
+        # example must still leave the guard knowing that a packet may be open)
+        self._book_unbooked(None)
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool) -> bytes:
@@ -156,7 +177,7 @@ class Link:
             if piece:
                 self._write(piece)
         if frames:
-            self._last = (_UNASKED, frames[-1].raw, b"")
+            self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -190,12 +211,9 @@ class Link:
             self._book(sent, None)
             return None
         if timeout is None:
-            slow = self.guard.answer_seconds(body)
-            timeout = MARGIN + self.byte_seconds(len(data) + 64) + (slow or 0.0)
-        # the answer is summed iff the mode is on after the command (spec 6, 10 J)
-        after = {"%+": True, "%-": False, "J": False}.get(body, self.checksums)
+            timeout = self.answer_timeout(body, len(data))
         self._unbooked = sent
-        r = self.read_response(timeout, lines, summed=after)
+        r = self.read_response(timeout, lines, summed=self.summed_after(body))
         if r is not None:
             r.sent_at = sent_at
         return r
@@ -222,7 +240,10 @@ class Link:
             self.checksums = False
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
-                      summed: bool | None = None) -> Response | None:
+                      summed: bool | None = None, settle: bool = True) -> Response | None:
+        """The next answer (``lines`` lines); in real time bytes right behind it are
+        taken as a second answer unless ``settle`` is false (the caller may take them as
+        :meth:`rest_of_answer`)."""
         timeout = MARGIN if timeout is None else timeout
         raw = bytearray()
         self.port.timeout = timeout
@@ -242,7 +263,7 @@ class Link:
         # a frame an injected fault dropped cannot be answered late
         self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
                       self._last[1], data)
-        if not self.virtual and data and self.port.in_waiting:
+        if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
         self._book_unbooked(real)
         r = real
@@ -257,6 +278,22 @@ class Link:
         if not self._dropped:
             self.guard.answered(real)
         return r
+
+    def rest_of_answer(self, seconds: float = MARGIN) -> bytes:
+        """The lines that follow an answer at once, taken as part of it (not as a
+        second answer): a unit reading a [D] point otherwise may answer a frame with
+        more lines than expected (`>` after `@`, if `@` is remembered)."""
+        raw = bytearray()
+        self.port.timeout = seconds
+        while True:
+            chunk = self.port.read_until(CR)
+            raw += chunk
+            if not chunk.endswith(CR):
+                break
+            self.port.timeout = self.byte_seconds(64)
+        if raw:
+            self._record(UNIT, bytes(raw), "the rest of the answer")
+        return bytes(raw)
 
     def settle(self, *, final: bool = False) -> bytes:
         """Take what arrived although nothing was asked, before the next frame (or, with
@@ -291,11 +328,14 @@ class Link:
                                    f"{readable(data)} late")
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
-             every: float = 0.05) -> Response | None:
-        """Send ``body`` until ``until(response)`` holds; the last response, or None."""
+             every: float = 0.05, *, send: Callable[[str], Response | None] | None = None
+             ) -> Response | None:
+        """Send ``body`` until ``until(response)`` holds; the last response, or None.
+        ``send``: what sends each frame (a caller that books them), else :meth:`send`."""
+        send = self.send if send is None else send
         deadline = self.now + max_seconds * SECOND
         while True:
-            r = self.send(body)
+            r = send(body)
             if r is not None and until(r):
                 return r
             if self.now > deadline:

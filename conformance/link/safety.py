@@ -1,4 +1,4 @@
-"""The run-wide guard on a real unit (issue 8): every frame is judged here before it is
+"""The run-wide guard on a real unit: every frame is judged here before it is
 sent and booked here after its answer, whoever sends it (a case, a machine, a golden
 replay's raw bytes, the diff runner, the session itself).
 
@@ -31,6 +31,9 @@ from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outco
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
+from conformance.protocol.catalogue import classes, eeprom_width
+from conformance.protocol.parse import parse
+from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import St6
 
@@ -51,19 +54,16 @@ class TargetNotResponding(BaseException):
     """Several frames in a row got no answer: the run stops for this target."""
 
 
-#: commands of spec 10 whose names are longer than one letter, longest first
-_NAMES = ("EFW", "EUW", "EFR", "EUR", "EW", "ER", "*S", "*E", "VL", "VK", "VN", "XA", "XU",
-          "XD", "XM", "PF", "SR", "SW", "NX", "NY", "NZ", "NA", "I0", "I1", "I2")
 #: frames that can start an axis moving (and so ask the operator first)
-MOTION = frozenset({"L", "C", "*E", "G", "R", "W", "SW6"})
+MOTION = classes(motion=True)
 #: frames that change what outlives the run: restart, reference run, EEPROM
-DESTRUCTIVE = frozenset({"J", "W", "EW", "EFW", "EUW"})
-_EEPROM_WIDTH = {"EW": 1, "EFW": 4, "EUW": 4}
+DESTRUCTIVE = classes(destructive=True)
 #: the longest an answer is waited for (a `W` whose run would take longer: the unit
 #: refuses such a travel or rate, or the run is not one a test should wait out)
 LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
-_PACKET_BREAKERS = frozenset({"H", "@", ">", "J"})
+_PACKET_BREAKERS = classes(packet="breaker")
+_PACKET_MEMBERS = classes(packet="member")
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
 
@@ -78,16 +78,10 @@ class Command:
 
     @classmethod
     def parse(cls, body: str) -> Command:
-        text = body.upper()
-        for name in _NAMES:
-            if text.startswith(name):
-                params = text[len(name):]
-                if name == "SW" and _number(params.split(",")[0]) == point(6):
-                    name = "SW6"             # writing ST6 may resume motion (spec 10.3)
-                return cls(name, params)
-        if text.startswith("N"):
-            return cls("N", text[1:])        # N followed by junk: N with a bad parameter
-        return cls(text[:1], text[1:])
+        """The frame's class (``SW6`` for a write of ST6, "" for no command of spec 10)
+        and its parameters, read leniently."""
+        parsed = parse(body)
+        return cls(parsed.key, parsed.params)
 
     def fields(self, count: int) -> list[Span]:
         """The first ``count`` comma-separated integers (missing ones 0, unreadable ones
@@ -227,7 +221,7 @@ class Guard:
         if not self.allow_destructive:
             raise SafetyStop(f"{body} restarts the unit, runs to a switch or writes EEPROM: "
                              "needs --allow-destructive")
-        width = _EEPROM_WIDTH.get(command.name)
+        width = eeprom_width(command.name)
         if width:
             touched = self._eeprom_bytes(command, width)
             lost = [a for a in touched if not self.eeprom.backed_up(a)] if touched else [-1]
@@ -287,7 +281,7 @@ class Guard:
             return
         command = Command.parse(body)
         outcome = outcome_of(response)
-        if command.name in ("C", "B") and self.packet_open:
+        if command.name in _PACKET_MEMBERS and self.packet_open:
             steps = command.fields(self.envelope.axes)
             if command.name == "C":
                 self.packet.append(steps)
@@ -325,6 +319,10 @@ class Guard:
         steps = command.fields(self.envelope.axes)
         if command.name == "*E" or (command.name == "C" and self.packet_open):
             members = list(self.packet) + ([steps] if command.name == "C" else [])
+            if command.name == "*E" and outcome is Outcome.REFUSED:
+                # all-or-nothing is our reading [D]: a unit may have committed the
+                # members as they arrived, so a refused *E leaves them maybe committed
+                outcome = Outcome.UNCLEAR
             return lambda e: _commit(e, members, outcome)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
@@ -378,15 +376,17 @@ class Guard:
             self.packet_open = False
             if outcome is not Outcome.UNCLEAR:
                 self.packet = []
-        elif name in _PACKET_BREAKERS:
+        elif name in _PACKET_BREAKERS and r is not None:
+            # unanswered, it may have been taken as a member: that a breaker closes the
+            # packet is our reading [D], and only *E is sure to (spec 7)
             self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
             st6 = r.values[0] if r.values else ""
-            if re.fullmatch(r"[0-9A-F]{2}", st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
+            if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
                 self.envelope.ended()
-        elif name in ("P", "PF"):
+        elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
                 self.envelope.observe({i: int(r.values[i]) for i in range(axes)})

@@ -1,9 +1,14 @@
-"""What every machine shares: a fresh link per example and the model's index check."""
+"""What every machine shares: made for its case's context, a fresh link per example,
+every frame sent through :meth:`UnitMachine.send` (which books it in the model), and the
+model's index check for the machines that take it as an invariant."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from hypothesis.stateful import RuleBasedStateMachine, invariant
 
+from conformance.case import CaseContext
 from conformance.link.framing import Response
 from conformance.model.unit import ModelUnit
 
@@ -24,15 +29,15 @@ def holds(ok: object, rule: str, message: str) -> None:
 
 
 class UnitMachine(RuleBasedStateMachine):
-    ctx = None      # set by run_machine
-    #: the rule the index invariant checks (a machine whose frames include what only our
-    #: reading counts names that reading's rule)
-    INDEX_RULE = "8.index.counts"
+    """A machine on one unit: a fresh link for each example, and a model that books
+    every frame sent. It keeps no invariant of its own: a machine takes the index check
+    with :func:`index_invariant`."""
 
-    def __init__(self) -> None:
+    def __init__(self, ctx: CaseContext) -> None:
         super().__init__()
-        self.link = self.ctx.fresh_link()
-        p = self.ctx.profile
+        self.ctx = ctx
+        self.link = ctx.fresh_link()
+        p = ctx.profile
         # PF reports X, Y, Z on every profile (spec 10: GVE114 PF also 3 values)
         self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0])
         # a real unit is not fresh: start the bookkeeping from where it is
@@ -44,9 +49,12 @@ class UnitMachine(RuleBasedStateMachine):
             self.model.uncounted = ()
         self.model.index = again
 
-    def send(self, body: str, **kw) -> Response | None:
+    def send(self, body: str, *, checksum_ok: bool = True, **kw) -> Response | None:
+        """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
+        the model (``checksum_ok``: whether its sum lets it count)."""
         r = self.link.send(body, **kw)
-        self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1])
+        self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1],
+                                 checksum_ok=checksum_ok)
         return r
 
     def fits(self, body: str) -> bool:
@@ -55,27 +63,34 @@ class UnitMachine(RuleBasedStateMachine):
         return self.link.guard.fits(body)
 
     def idle(self) -> None:
-        r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120)
-        self.model.frame_arrived("L")
+        r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120,
+                           send=self.send)
         holds(r is not None, "10.1.queue.wait-idiom", "the unit never became idle")
-        # the polls counted too: resynchronize with what the unit says the index is
+        # a poll that got no answer in time may still have counted: resynchronize with
+        # what the unit says the index is
         self.model.index = self.index()
 
     def index(self) -> int:
-        r = self.link.send("@")
+        r = self.send("@")
         holds(r is not None and r.code == 0 and r.values, "8.index.answer", f"@ answered {r}")
-        self.model.frame_arrived("@")
         return r.dec()
 
     def position(self) -> list[int]:
-        r = self.link.send("PF")
-        self.model.frame_arrived("P")
+        r = self.send("PF")
         holds(r is not None and r.code == 0, "10.cmd.positions", f"PF answered {r}")
         return r.decs()
 
+
+def index_invariant(rule: str = "8.index.counts") -> Callable[[UnitMachine], None]:
+    """The invariant a machine takes (``index_is_the_models = index_invariant()``) when
+    every frame it sends is one the model can count: outside a packet the unit's index
+    is the model's. ``rule``: the rule it checks (a machine whose frames include what
+    only our reading counts names that reading's rule)."""
+
     @invariant()
-    def index_is_the_models(self) -> None:
+    def index_is_the_models(self: UnitMachine) -> None:
         if self.model.packet is None:
             got = self.index()
-            holds(got == self.model.index, self.INDEX_RULE,
-                  f"index {got}, model {self.model.index}")
+            holds(got == self.model.index, rule, f"index {got}, model {self.model.index}")
+
+    return index_is_the_models

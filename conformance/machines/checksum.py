@@ -7,7 +7,7 @@ from hypothesis.stateful import rule
 
 from conformance.case import CaseContext, case
 from conformance.link.framing import byte_sum
-from conformance.machines.base import UnitMachine, holds
+from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
 
 # bodies and the code each gets when framed correctly (spec 10, 5)
@@ -16,11 +16,11 @@ BODIES = {"V1000": 0, "T5": 0, "SR2": 0, "A100": 0, "Z": 3, "T99": 5}
 
 class ChecksumMachine(UnitMachine):
     # a frame that fails its sum, counted or not, is our reading [D]
-    INDEX_RULE = "8.index.uncounted"
+    index_is_the_models = index_invariant("8.index.uncounted")
+
     @rule(on=st.booleans())
     def toggle(self, on: bool) -> None:
-        r = self.link.send("%+" if on else "%-", checksum=self.model.checksums)
-        self.model.frame_arrived("%")
+        r = self.send("%+" if on else "%-", checksum=self.model.checksums)
         self.model.checksums = on
         holds(r is not None and r.code == 0, "6.checksum.mode-commands",
               f"%{'+' if on else '-'} answered {r}")
@@ -39,9 +39,8 @@ class ChecksumMachine(UnitMachine):
                 "missing": False, "lower": right.lower()}[state]
         if not m.checksums and state != "missing":
             return               # without the mode a sum is just a bad parameter
-        r = self.link.send(body, checksum=sent)
+        r = self.send(body, checksum=sent, checksum_ok=m.checksum_answer(state) == 0)
         expected = BODIES[body] if m.checksum_answer(state) == 0 else 4
-        m.frame_arrived(body[:1], checksum_ok=m.checksum_answer(state) == 0)
         # a frame with its right sum is the manual's; what a wrong one gets is ours [D]
         rule = "6.checksum.sum" if state == "good" or not m.checksums else \
             "6.checksum.bad-refused"

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine, holds
+from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
 from gve_fixtures.protocol import St6
 
@@ -37,9 +37,10 @@ CODE_RULES = {"V+1": "3.params.decimal", "A0": "10.cmd.accel-range", "N": "5.cod
 
 
 class ErrorMachine(UnitMachine):
+    index_is_the_models = index_invariant()
+
     def observe(self) -> tuple[bool, bool, bool]:
-        r = self.link.send("SR6")
-        self.model.frame_arrived("S")
+        r = self.send("SR6")
         holds(r is not None and r.code == 0 and r.values, "10.cmd.status-words",
               f"SR6 answered {r}")
         st6 = r.hex()
@@ -52,14 +53,12 @@ class ErrorMachine(UnitMachine):
     def motion(self, steps: int) -> None:
         if not self.fits(f"C{steps},0,0"):
             return
-        r = self.link.send(f"C{steps},0,0")
-        self.model.frame_arrived("C")
+        r = self.send(f"C{steps},0,0")
         holds(r is not None and r.code in (0, 1), "10.1.queue.cont-buffer", f"C answered {r}")
 
     @rule()
     def halt(self) -> None:
-        r = self.link.send("H")
-        self.model.frame_arrived("H")
+        r = self.send("H")
         holds(r is not None and r.code == 0 and r.inta, "4.response.inta-bit",
               f"H answered {r}")
 
@@ -73,8 +72,7 @@ class ErrorMachine(UnitMachine):
         moving, run, inta = self.observe()
         if body == "C1,0,0" and not inta:
             return                      # would start motion the model cannot time
-        r = self.link.send(body)
-        self.model.frame_arrived(body[:1])
+        r = self.send(body)
         want = expected_code(body, moving, run, inta)
         holds(r is not None, "5.code.ok", f"{body} got no answer")
         # G with INTA = 1 and nothing pending may answer 6 as well (spec 5, both readings)
@@ -84,8 +82,7 @@ class ErrorMachine(UnitMachine):
               f"expected {want}")
         after = {"G": False, "D": False}.get(body, inta) if r.code == 0 else inta
         if r.code == 6 and inta:
-            self.link.send("D")             # nothing started: clear INTA the manual's way
-            self.model.frame_arrived("D")
+            self.send("D")                  # nothing started: clear INTA the manual's way
             after = r.inta
         holds(r.inta == after, "4.response.inta-after-command",
               f"{body}: INTA bit {r.inta}, expected {after}")

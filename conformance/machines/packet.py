@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine, holds
+from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
 
 # member frame -> (kind, code it fails the packet with, steps it commits)
@@ -16,8 +16,10 @@ MEMBERS = {"C1,0,0": ("C", 0, (1, 0, 0)), "C0,2,0": ("C", 0, (0, 2, 0)),
 
 
 class PacketMachine(UnitMachine):
-    def __init__(self) -> None:
-        super().__init__()
+    index_is_the_models = index_invariant()
+
+    def __init__(self, ctx: CaseContext) -> None:
+        super().__init__(ctx)
         self.pending: list[str] = []          # the members sent since *S
 
     @initialize(summed=st.booleans())
@@ -36,9 +38,8 @@ class PacketMachine(UnitMachine):
     @precondition(lambda self: self.model.packet is not None and len(self.model.packet) < 8)
     @rule(body=st.sampled_from(sorted(MEMBERS)))
     def member(self, body: str) -> None:
-        self.link.send(body, answer=False)
+        self.send(body, answer=False)
         kind, code, _ = MEMBERS[body]
-        self.model.frame_arrived(kind)
         self.model.member(kind, code)
         self.pending = [*self.pending, body]
 
@@ -62,8 +63,7 @@ class PacketMachine(UnitMachine):
     @precondition(lambda self: self.model.packet is not None)
     @rule()
     def breaker(self) -> None:
-        r = self.link.send("@")
-        self.model.frame_arrived("@")
+        r = self.send("@")
         holds(r is not None and r.code == 0, "7.packet.breakers",
               f"@ inside a packet answered {r}")
         self.model.packet = None

@@ -7,15 +7,17 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine, holds
+from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
 
 WAITING = "10.1.queue.wait-for-go"
 
 
 class QueueMachine(UnitMachine):
-    def __init__(self) -> None:
-        super().__init__()
+    index_is_the_models = index_invariant()
+
+    def __init__(self, ctx: CaseContext) -> None:
+        super().__init__(ctx)
         # set before any rule runs: the teardown reads them even when a rule failed
         self.queued = 0
         self.status: dict[int, int] = {}

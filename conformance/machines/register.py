@@ -1,3 +1,11 @@
 """Importing this registers every machine's case."""
 
-from conformance.machines import checksum, errors, index, keep, packet, queue  # noqa: F401
+from conformance.machines import (  # noqa: F401
+    checksum,
+    errors,
+    index,
+    keep,
+    packet,
+    queue,
+    readback,
+)

@@ -1,27 +1,43 @@
-"""Running a RuleBasedStateMachine as a case: the machine gets the case context, every
-example starts from a fresh link, a failing example's wire log is saved as a transcript."""
+"""Running a RuleBasedStateMachine as a case: the machine is made for the case context by
+a factory, every example starts from a fresh link, a failing example's wire log is saved
+as a transcript."""
 
 from __future__ import annotations
 
 from hypothesis import seed
 from hypothesis.errors import Flaky, FlakyFailure
-from hypothesis.stateful import RuleBasedStateMachine, run_state_machine_as_test
+from hypothesis.stateful import run_state_machine_as_test
 
 from conformance import settings as settings_profiles
 from conformance.case import CaseContext, CouldNotTest
+from conformance.machines.base import UnitMachine
 from gve_fixtures.rules import load_rules
 
 
-def run_machine(ctx: CaseContext, machine: type[RuleBasedStateMachine]) -> None:
+class Factory:
+    """Makes ``machine`` for ``ctx``, one machine per example. Hypothesis keys a
+    machine's examples in its database by the factory: an object (no source of its own,
+    unlike a lambda written once here for every machine) is keyed by its name, the
+    machine's, so each machine keeps its own examples."""
+
+    def __init__(self, machine: type[UnitMachine], ctx: CaseContext) -> None:
+        self.machine = machine
+        self.ctx = ctx
+        self.__name__ = machine.__name__
+
+    def __call__(self) -> UnitMachine:
+        return self.machine(self.ctx)
+
+
+def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
     """Run ``machine`` with ctx.settings, the run's seed and its example database (the
     failing examples found before are tried first); a failure becomes a failed check."""
-    machine.ctx = ctx  # type: ignore[attr-defined]
     run_settings, run_seed = settings_profiles.machine_run(ctx.settings, ctx.profile.name,
                                                            ctx.seed)
     # every run sets the seed: None lets Hypothesis draw one
-    seed(run_seed)(machine)
+    factory = seed(run_seed)(Factory(machine, ctx))
     try:
-        run_state_machine_as_test(machine, settings=run_settings)
+        run_state_machine_as_test(factory, settings=run_settings)
     except FlakyFailure as err:
         # failed once and not when replayed (a real line's timing): the failure seen is
         # the finding, graded by its rule, with the replay noted

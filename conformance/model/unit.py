@@ -8,8 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-UNCOUNTED = ("@", ">")       # spec 8
-PACKET_MEMBERS = ("C", "B")  # spec 7
+from conformance.protocol.catalogue import classes
+
+UNCOUNTED = tuple(sorted(classes(indexed=False)))       # spec 8
+PACKET_MEMBERS = classes(packet="member")               # spec 7
 
 
 @dataclass

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from math import isqrt
 
-SECOND = 1_000_000_000
+from gve_fixtures.protocol import SECOND
+
 #: an instant that never comes (saturation, as the model's)
 NEVER = 2**63 // 4
 _TWO_S = 2 * SECOND

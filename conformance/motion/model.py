@@ -69,9 +69,10 @@ class Vector:
 
 
 class MotionModel:
-    def __init__(self, origin: list[int], xm: int = 100) -> None:
+    def __init__(self, origin: list[int], xm: int = 100, *, next_brake: bool = False) -> None:
         self.origin = list(origin)
         self.xm = xm
+        self.next_brake = next_brake       # a junction at the next C's B: another reading
         self.queue: list[Vector] = []
         self.history: list[Vector] = []
         self.halted = False
@@ -142,7 +143,8 @@ class MotionModel:
         if head.kind != "C" or nxt is None or nxt.kind != "C" or nxt.n == 0:
             return 0
         vc_next = cruise_rate(nxt.d, nxt.p, self.xm)
-        return junction_rate(vc, head.p, vc_next, nxt.p.A, nxt.n)
+        return junction_rate(vc, nxt.p if self.next_brake else head.p, vc_next, nxt.p.A,
+                             nxt.n)
 
     def _replan(self, t: int) -> None:
         """Plan the head again from ``t`` (an override, or a C joining it)."""

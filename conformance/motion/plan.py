@@ -12,7 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from math import isqrt
 
-from conformance.motion.arith import SECOND, acc_count, acc_time
+from conformance.motion.arith import acc_count, acc_time
+from gve_fixtures.protocol import SECOND
 
 
 @dataclass(frozen=True)

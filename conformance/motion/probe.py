@@ -14,12 +14,13 @@ XD`` act on the queue at once, ``H`` and ``G`` halt and resume. On the GVE54 vec
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, replace
 
 from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
-from conformance.motion.arith import SECOND
+from conformance.link.line_band import EXACT, LineBand, line_band
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
@@ -29,7 +30,9 @@ from conformance.motion.tolerance import (
     late_window,
     processing_window,
     tolerance,
+    widened,
 )
+from gve_fixtures.protocol import SECOND
 
 #: dense model points per trace
 TRACE_POINTS = 60
@@ -71,6 +74,8 @@ class Probe:
         self.readings: list[Reading] = []
         self.params: dict = {}
         self.round_trip = 0
+        self.next_brake = False    # model the junctions at the next C's B (a [D] reading)
+        self.trips: list[int] = []          # ns: the round trips of frames answered at once
         self.link.wait(SETTLE)
         start = self.read("start")
         if start is None:
@@ -88,6 +93,7 @@ class Probe:
         if body[:1] == "H":
             return late_window(r.sent_at, n, self.link.baud, self.round_trip, **kw), answered
         self.round_trip = max(self.round_trip, r.received_at - r.sent_at)
+        self.trips.append(r.received_at - r.sent_at)
         return processing_window(r.sent_at, r.received_at, n, len(r.raw), self.link.baud,
                                  **kw), answered
 
@@ -131,6 +137,11 @@ class Probe:
         """Run a scenario and judge it: a string is a frame to send, a number the seconds
         to sample PF for (every ``every`` s; a pair: seconds and how often), a list the
         position (in commanded steps) to poll PF until (every 2 ms)."""
+        self.run(steps, every)
+        return self.judge()
+
+    def run(self, steps: list, every: float = 0.05) -> None:
+        """Run a scenario (as :meth:`script`) without judging it yet."""
         for step in steps:
             if isinstance(step, str):
                 self.send(step)
@@ -141,7 +152,6 @@ class Probe:
                            UNTIL_SECONDS, 0.002)
             else:
                 self.sample(step, every)
-        return self.judge()
 
     # -- the frames' meaning (spec 10) --------------------------------------------------
     def _book(self, body: str, w: Window, answered: Window) -> None:
@@ -189,7 +199,7 @@ class Probe:
         """The model fed with every event at its instant: the middle of its window, or
         for the events in ``shift`` (index -> instant) that instant; and the instant it
         comes to rest after each H."""
-        model = MotionModel(self.origin)
+        model = MotionModel(self.origin, next_brake=self.next_brake)
         rests = []
         for i, e in enumerate(self.events):
             t = (shift or {}).get(i, (e.window.lo + e.window.hi) // 2)
@@ -215,47 +225,93 @@ class Probe:
                 out += [self.model({i: e.window.lo}), self.model({i: e.window.hi})]
         return out
 
+    def fits(self) -> bool:
+        """Whether every reading after the first event lies within the model's band, the
+        line's band included (as :meth:`judge` would find), recording nothing."""
+        line = self.line()
+        events, readings = self.events, self.readings
+        self._widen(line)
+        try:
+            (model, _), variants = self.model(), self._variants()
+            virtual = self.link.virtual
+            t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
+                  ) + line.ns
+            spread = sum(e.window.hi - e.window.lo for e in self.events)
+            for reading in self.readings:
+                w = reading.window
+                if w.hi - line.ns < t0:
+                    continue
+                tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
+                band = _band(model, variants, w, tol.steps)
+                got = reading.positions[:len(band)]
+                if not all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True)):
+                    return False
+            return True
+        finally:
+            self.events, self.readings = events, readings
+
+    def line(self) -> LineBand:
+        """The line's band: zero in virtual time; in real time from the round trip the
+        session measured and those the scenario saw."""
+        if self.link.virtual:
+            return EXACT
+        return line_band(self.link.round_trip, [t / 1e6 for t in self.trips])
+
+    def _widen(self, line: LineBand) -> None:
+        """Every event's and reading's window widened by the line's band: the unit may
+        have acted (or read its counters) that much either side of what the host saw."""
+        if line.exact:
+            return
+        self.events = [replace(e, window=widened(e.window, line),
+                               answer=e.answer and widened(e.answer, line))
+                       for e in self.events]
+        self.readings = [replace(r, window=widened(r.window, line)) for r in self.readings]
+
     def judge(self) -> bool:
         """Judge every reading taken after the first event, and the instant each H
-        answered; record the trace, with the faults marked on it."""
+        answered, with the line's band; record the trace, with the faults marked on it."""
+        line = self.line()
+        self._widen(line)
         (model, rests), variants = self.model(), self._variants()
         virtual = self.link.virtual
-        t0 = self.events[0].window.lo if self.events else self.readings[0].window.lo
+        # instants are printed from the first event as the host saw it, the band left out
+        t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo) + line.ns
         spread = sum(e.window.hi - e.window.lo for e in self.events)
         ok_all = True
         faults: list[dict] = []
-        widest = tolerance(Window(0, spread), virtual=virtual)
+        widest = tolerance(Window(0, spread), virtual=virtual, line=line)
         halts = [e for e in self.events if e.kind == "halt"]
         for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
             # what each event's window can change, added up (as for positions)
             lo = rest + sum(min(0, v[1][n] - rest) for v in variants)
             hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
             a = e.answer
-            tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual)
+            tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual, line=line)
             ok = self.ctx.expect(
                 lo <= a.hi and a.lo <= hi,
                 f"{self.name}: H answered when the motion came to rest{_within(tol)}",
-                observed=f"answer at {(a.lo - t0) / 1e6:.3f} ms",
+                observed=f"answer at {(a.lo + line.ns - t0) / 1e6:.3f} ms",
                 expected=f"at rest at {(rest - t0) / 1e6:.3f} ms", rule=self.rule)
             ok_all &= ok
             if not ok:
                 faults.append({"kind": "instant", "what": "H answered",
-                               "observed": (a.lo - t0) / SECOND,
+                               "observed": (a.lo + line.ns - t0) / SECOND,
                                "expected": [(lo - t0) / SECOND, (hi - t0) / SECOND],
                                "expected_what": "at rest"})
         for reading in self.readings:
             w = reading.window
-            if w.hi < t0:
+            if w.hi - line.ns < t0:
                 continue
-            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual)
-            widest = max(widest, tol, key=lambda x: x.seconds)
+            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
             band = _band(model, variants, w, tol.steps)
+            tol = replace(tol, band=max(math.ceil((b1 - b0) / 2) for b0, b1 in band))
+            widest = max(widest, tol, key=lambda x: x.seconds)
             got = reading.positions[:len(band)]
             ok = all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True))
             expected = [b0 + tol.steps if b0 + tol.steps == b1 - tol.steps else f"{b0}..{b1}"
                         for b0, b1 in band]
             ok_all &= self.ctx.expect(
-                ok, f"{self.name}: PF at {(w.lo - t0) / 1e6:.3f} ms"
+                ok, f"{self.name}: PF at {(w.lo + line.ns - t0) / 1e6:.3f} ms"
                 f"{' ' + reading.label if reading.label else ''}{_within(tol)}",
                 observed=got, expected=expected, rule=self.rule)
             if not ok:

@@ -18,10 +18,17 @@ frame's bytes on the wire, the unit's processing and the answer's bytes:
 - On an unpaced line (a pty or TCP, where bytes may take no time) only
   ``[sent_at, received_at]`` is sure.
 
+On a real line the unit may act on a frame a little outside even that window (an
+adapter's latency timer delays the answer, not only the frame; a unit's own loop acts a
+tick after it answered): every window is widened on both sides by the line's band
+(:mod:`conformance.link.line_band`, from the round trip measured at the session's start
+and the case's own), zero in virtual time.
+
 A position judged against the model is accepted within the model's positions over the
 whole window (the model is evaluated at both ends and at every vector boundary inside),
 widened by ``steps`` (one step of placement on real targets, none in virtual time):
-:class:`Tolerance` carries both figures, which every motion check prints.
+:class:`Tolerance` carries the figures, which every motion check prints (the line's band
+and the steps either side it allowed, e.g. ``±1.8 ms line, ±7 steps``).
 
 The differential fuzzer compares two targets' readings the same way:
 :func:`reading_band` is how many steps two readings taken in two windows may differ by
@@ -33,7 +40,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-SECOND = 1_000_000_000
+from conformance.link.line_band import EXACT, LineBand
+from gve_fixtures.protocol import SECOND
+
 #: bits per byte on an 8N1 line (spec 2): start, 8 data, stop
 BITS_PER_BYTE = 10
 #: steps a real target may differ by from the model at a known instant (step placement)
@@ -62,20 +71,29 @@ class Window:
 
 @dataclass(frozen=True)
 class Tolerance:
-    """The band a check used: the width of the time window, and steps on top."""
+    """The band a check used: the width of the time window (the line's band included),
+    steps of placement on top, the line's band (± seconds) and, for a position, the
+    steps either side of the model it allowed."""
 
     seconds: float
     steps: int
+    line: float = 0.0
+    band: int | None = None
 
     @property
     def exact(self) -> bool:
         return self.seconds == 0 and self.steps == 0
 
     def as_dict(self) -> dict:
-        return {"seconds": self.seconds, "steps": self.steps}
+        return {"seconds": self.seconds, "steps": self.steps,
+                **({"line_seconds": self.line} if self.line else {})}
 
     def __str__(self) -> str:
-        return f"±{self.steps} step(s) over a window of {self.seconds * 1e3:.3f} ms"
+        if self.band is not None:
+            allowed = f"±{self.band} step{'' if self.band == 1 else 's'}"
+        else:
+            allowed = f"±{self.seconds * 1e3 / 2:.1f} ms"
+        return f"{LineBand(self.line)}, {allowed}"
 
 
 def processing_window(sent_at: int, received_at: int, frame_bytes: int, answer_bytes: int,
@@ -119,9 +137,16 @@ def late_window(sent_at: int, frame_bytes: int, baud: int, round_trip: int, *,
     return Window(lo, max(lo, sent_at + round_trip))
 
 
-def tolerance(window: Window, *, virtual: bool) -> Tolerance:
-    """The tolerance a position read in ``window`` is judged with."""
-    return Tolerance(window.seconds, 0 if virtual else PLACEMENT_STEPS)
+def tolerance(window: Window, *, virtual: bool, line: LineBand = EXACT,
+              band: int | None = None) -> Tolerance:
+    """The tolerance a position read in ``window`` is judged with (``line``: the line's
+    band the window was widened by; ``band``: the steps either side it allowed)."""
+    return Tolerance(window.seconds, 0 if virtual else PLACEMENT_STEPS, line.seconds, band)
+
+
+def widened(window: Window, line: LineBand) -> Window:
+    """``window`` widened on both sides by the line's band."""
+    return Window(*line.widen(window.lo, window.hi))
 
 
 def since(sample: Window, start: Window) -> Window:

@@ -1,4 +1,4 @@
-"""Run reports (issue 12): JUnit XML, JSON and one self-contained HTML page, written per
+"""Run reports: JUnit XML, JSON and one self-contained HTML page, written per
 run into ``<folder>/<run id>/``. ``write_reports(run, folder) -> Path`` is the one entry
 point (the suite's run, host certification and fleets call it per target or per run)."""
 

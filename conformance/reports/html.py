@@ -1,4 +1,4 @@
-"""One self-contained HTML page (issue 12 items 4-6): the banner PASSED/FAILED and, right
+"""One self-contained HTML page: the banner PASSED/FAILED and, right
 under it, what failed (each failing case with the check that failed it, linked to the
 case); then the run's metadata, the units (as found and as left), a chart and a matrix of
 verdicts by spec section (cells link to the cases), filters (a little inline script:

@@ -19,7 +19,7 @@ from conformance.reports.sections import section_title
 from conformance.reports.text import clean
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import (COULD_NOT_TEST, ERROR, FAIL, MISSING, NON_STRICT, ORDER, PASS,
-                                 TAGS, grade)
+                                 CHECK_TAGS, grade)
 from gve_fixtures.rules import load_rules
 
 
@@ -27,7 +27,7 @@ def _deciding(r: CaseResult) -> dict | None:
     """The failed check that gave the case its verdict: the worst graded, the first of
     those."""
     def rank(c: dict) -> int:
-        return ORDER.index(grade(c["tag"], False)) if c["tag"] in TAGS else 0
+        return ORDER.index(grade(c["tag"], False)) if c["tag"] in CHECK_TAGS else 0
     return min(r.failed_checks, key=rank, default=None)
 
 

@@ -1,5 +1,5 @@
-"""What the reports keep of a case (issue 12 item 6; the default run's three reports must
-stay under 2 MB): a case that did not PASS whole; of a passing case the head and tail of
+"""What the reports keep of a case (the default run's three reports must stay
+under 2 MB): a case that did not PASS whole; of a passing case the head and tail of
 its wire log, its first check and how many more passed (a GVE114's full queue is 2048 of
 them) and no trace data (the page draws its traces). ``--full-logs`` keeps everything."""
 

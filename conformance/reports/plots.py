@@ -1,4 +1,4 @@
-"""Pictures for the HTML report (issue 12 item 4), as inline SVG drawn by matplotlib
+"""Pictures for the HTML report, as inline SVG drawn by matplotlib
 (the optional extra ``[plots]``; no pyplot, no display: figures are rendered straight
 to SVG text). Without matplotlib every function returns None and the report says that
 plots are off.

@@ -24,9 +24,9 @@ from collections.abc import Iterator
 from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
+from gve_fixtures.protocol import SECOND
 
 VERSION = 1
-SECOND = 1_000_000_000
 CR = b"\r"
 #: wall-clock seconds within which every reply must be complete
 REPLY_SECONDS = 10.0

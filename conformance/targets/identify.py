@@ -1,4 +1,4 @@
-"""Who is on the line (issue 12 item 1): ask a unit `?` and `Q` — two questions that move
+"""Who is on the line: ask a unit `?` and `Q` — two questions that move
 nothing — and pick its profile for ``--profile auto``; ``ports --probe`` asks `?` alone.
 
 The family comes from the firmware string: a profile whose `?` answer is exactly that

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
-from conformance.link.framing import HostFramer, Response
+from conformance.link.framing import HostFramer, Response, frame
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
@@ -49,6 +49,8 @@ class Reachable(Protocol):
 
     def connect(self, address: int | None) -> tuple[Any, int, bool, Any]: ...
 
+#: the `*E` that closes a packet left open: -1 is no count of members, so it is refused
+PACKET_CLOSER = "*E-1"
 #: status words restored at the end, polarity before causes before enables (an enable
 #: written last finds its polarity and cause already in place)
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
@@ -222,6 +224,7 @@ class RealSession(Session):
         link = super()._new_link(address)
         if before is not None:                      # the same unit: its mode too
             link.checksums = before.checksums
+        link.round_trip = self.report.line
         return link
 
     def open_link(self, address: int | None = None) -> Link:
@@ -319,16 +322,39 @@ class RealSession(Session):
                                         "they are not written")
 
     # -- the known state --------------------------------------------------------------------------
-    def _halt(self, link: Link, timeout: float | None = None) -> Response | None:
+    def _halt(self, link: Link, timeout: float | None = None, *,
+              urgent: bool = False) -> Response | None:
         """`H` in the mode the unit is in: refused (4) or unanswered in the mode the link
-        believes, it is sent in the other."""
+        believes, it is sent in the other. A packet that may be open is closed first;
+        ``urgent`` (Ctrl-C, a unit gone quiet) sends `H` first all the same, and closes
+        the packet and sends `H` again only when that `H` went unanswered."""
+        if not urgent:
+            self._close_packet(link, timeout)
         r = link.send("H", timeout=timeout)
+        if r is None and urgent and self.guard.packet_open:
+            self._close_packet(link, timeout)
+            r = link.send("H", timeout=timeout)
         if r is None or r.code == 4:
             other = link.send("H", checksum=not link.checksums, timeout=timeout)
             if other is not None and other.code == 0:
                 link.checksums = not link.checksums
                 return other
         return r
+
+    def _close_packet(self, link: Link, timeout: float | None = None) -> None:
+        """Close a packet a case may have left open, in a way every reading ends one:
+        that `H`, `@`, `>` and `J` close it is our reading [D]; only `*E` is sure to
+        (spec 7). Its count is no count, so every unit refuses it and the packet's members
+        are not committed by it (a unit that committed them as they arrived already has:
+        the guard books them as maybe committed). Unanswered in the mode the link believes
+        (a failing member), it is sent in the other."""
+        if not self.guard.packet_open or "*E" not in self.profile.commands:
+            return
+        r = link.send(PACKET_CLOSER, timeout=timeout)
+        if r is None:
+            other = link.send(PACKET_CLOSER, checksum=not link.checksums, timeout=timeout)
+            if other is not None:
+                link.checksums = not link.checksums
 
     def _reset_frames(self) -> list[str]:
         """What cannot be read, set to the reset state (spec 9)."""
@@ -372,7 +398,16 @@ class RealSession(Session):
     def _go_back(self, link: Link) -> None:
         """Move the axes back to where the run began (known exactly only at rest)."""
         self._position(link)
-        here = self.guard.envelope.position()
+        envelope = self.guard.envelope
+        if envelope.unheld:
+            axes = ", ".join(sorted({self.profile.axes[i] for i in envelope.unheld}))
+            why = (f"position counters ({axes}) set with N<axis> read back other values at "
+                   "rest: taken for counters that do not hold them, the axes where the "
+                   "frames put them")
+            if why not in self.report.problems:
+                self.report.problems.append(why)
+            envelope.unheld.clear()
+        here = envelope.position()
         back = [0 if h is None else -int(h) for h in here]
         if not any(back):
             return
@@ -401,7 +436,7 @@ class RealSession(Session):
             wait = None if self.guard.responding else MARGIN
             try:
                 with self.guard.emergency():
-                    self._halt(self._link, timeout=wait)
+                    self._halt(self._link, timeout=wait, urgent=True)
                     self._link.send("D", timeout=wait)
             except TargetNotResponding as err:          # gone (its port, its program)
                 self.report.problems.append(f"H and D after Ctrl-C not sent: {err}")
@@ -430,7 +465,7 @@ class RealSession(Session):
         if not self.guard.responding:
             self.report.not_responding = "the target stopped responding"
             with self.guard.emergency():              # once, without waiting long
-                self._halt(link, timeout=MARGIN)
+                self._halt(link, timeout=MARGIN, urgent=True)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
         self._settle(link)
@@ -550,14 +585,17 @@ ROUND_TRIPS = 5
 
 
 def _round_trip(link: Link) -> dict[str, float]:
-    """The round trip of a harmless `?` in ms (min, median, max) and one byte's time at
-    the link's baud rate: what the line adds to every exchange."""
-    trips = sorted((r.received_at - r.sent_at) / 1e6 for r in
-                   (link.send("?") for _ in range(ROUND_TRIPS)) if r is not None)
+    """The round trip of a harmless `?` in ms (min, median, max), one byte's time at the
+    link's baud rate and the time of one exchange's bytes (frame and answer): what the
+    line adds to every exchange (conformance/link/line_band.py)."""
+    answers = [r for r in (link.send("?") for _ in range(ROUND_TRIPS)) if r is not None]
+    trips = sorted((r.received_at - r.sent_at) / 1e6 for r in answers)
     if not trips:
         return {}
+    sent = len(frame("?", link.address, link.checksums))
     return {"min_ms": trips[0], "median_ms": trips[len(trips) // 2], "max_ms": trips[-1],
-            "byte_ms": link.byte_seconds(1) * 1e3}
+            "byte_ms": link.byte_seconds(1) * 1e3,
+            "bytes_ms": link.byte_seconds(sent + len(answers[0].raw)) * 1e3}
 
 
 def _hex_ok(r: Response | None) -> bool:

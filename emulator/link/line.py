@@ -17,9 +17,8 @@ from typing import IO
 from emulator.link.clock import RealClock, VirtualClock
 from emulator.motion.arith import NEVER
 from emulator.protocol.unit import Unit
+from gve_fixtures.protocol import SECOND
 from gve_fixtures.transcript import TranscriptWriter
-
-SECOND = 1_000_000_000
 
 
 class TimeRangeError(ValueError):

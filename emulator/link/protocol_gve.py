@@ -10,8 +10,9 @@ import time
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
 from emulator.link.clock import RealClock
-from emulator.link.line import SECOND, Line, byte_time
+from emulator.link.line import Line, byte_time
 from emulator.link.url import parse_url
+from gve_fixtures.protocol import SECOND
 
 
 class Serial(SerialBase):

@@ -26,7 +26,8 @@ import tty
 from collections.abc import Callable
 
 from emulator.link.control import Quit, handle
-from emulator.link.line import SECOND, Line
+from emulator.link.line import Line
+from gve_fixtures.protocol import SECOND
 
 #: answers held for a host that does not read; beyond this they are lost
 OUTPUT_LIMIT = 1 << 16

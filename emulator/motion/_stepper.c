@@ -16,6 +16,8 @@
 #define DEV_JUNCTION_STOPS 8
 #define DEV_HALT_DEAD 16
 #define DEV_GO_AT_SPEED 32
+#define DEV_NEXT_BRAKE 64
+#define DEV_JUNCTION_UNBRAKED 128
 
 /* ---- the exported arithmetic (tests, tools) ------------------------------------------ */
 
@@ -197,7 +199,9 @@ static i64 junction(const stepper *m, const entry_t *e, const entry_t *nxt, i64 
     if (!nxt || !(e->vec.continuous && nxt->vec.continuous) || nxt->n == 0) return 0;
     if (e->n == 0 && !(m->dev & DEV_ZERO_LENGTH_JUNCTION)) return 0;
     if (m->dev & DEV_JUNCTION_STOPS) return 0;
-    i128 v = min128(min128(e->vec.brake, vc), cruise(m, nxt));
+    i64 brake = (m->dev & DEV_NEXT_BRAKE) ? nxt->vec.brake : e->vec.brake;
+    if (m->dev & DEV_JUNCTION_UNBRAKED) brake = vc;
+    i128 v = min128(min128(brake, vc), cruise(m, nxt));
     v = min128(v, isqrt((i128)2 * nxt->vec.accel * nxt->n));
     return (i64)max128(0, v);
 }

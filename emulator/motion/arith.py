@@ -12,7 +12,8 @@ from __future__ import annotations
 
 from math import isqrt
 
-SECOND = 1_000_000_000
+from gve_fixtures.protocol import SECOND
+
 _S2 = 2 * SECOND * SECOND          # 2e18: positions are counted in 1/(2e18) steps
 #: "Never": instants saturate here, far beyond any run (about 73 years).
 NEVER = (1 << 63) // 4

@@ -16,9 +16,6 @@ from dataclasses import dataclass
 from enum import IntFlag
 from typing import Protocol, runtime_checkable
 
-#: One second in clock units.
-SECOND = 1_000_000_000
-
 
 @dataclass(frozen=True)
 class Vector:
@@ -71,7 +68,8 @@ EMPTY_SAVE = KeepSave()
 
 class Deviation(IntFlag):
     """Deliberate deviations from the motion model a core can be built with: the
-    mutants of ``emulator/mutants.py`` whose behaviour lives in the stepper core. Both
+    mutants of ``emulator/mutants.py`` (and the readings of ``emulator/readings.py``)
+    whose behaviour lives in the stepper core. Both
     cores implement every flag alike; a clean core has none."""
 
     NONE = 0
@@ -82,6 +80,8 @@ class Deviation(IntFlag):
     JUNCTION_STOPS = 8         # B ignored: every C brakes to rest at its end
     HALT_DEAD = 16             # H stops at once, without a ramp
     GO_AT_SPEED = 32           # G resumes at the cruise rate instead of from rest
+    NEXT_BRAKE = 64            # a junction is passed at the next C's B (a reading)
+    JUNCTION_UNBRAKED = 128    # B caps no junction: a C exits at the rate the next allows
 
 
 @runtime_checkable

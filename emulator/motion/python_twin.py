@@ -114,8 +114,10 @@ class PythonMotion:
             return 0
         if self.deviations & Deviation.JUNCTION_STOPS:
             return 0
-        return max(0, min(e.vector.brake, vc, self._cruise(nxt),
-                          isqrt(2 * nxt.vector.accel * nxt.n)))
+        brake = nxt.vector.brake if self.deviations & Deviation.NEXT_BRAKE else e.vector.brake
+        if self.deviations & Deviation.JUNCTION_UNBRAKED:
+            brake = vc
+        return max(0, min(brake, vc, self._cruise(nxt), isqrt(2 * nxt.vector.accel * nxt.n)))
 
     def _plan(self, e: Entry, t: int, vin: int, join: bool) -> None:
         """Plan the rest of ``e`` from ``t`` at rate ``vin``."""

@@ -18,7 +18,8 @@ from __future__ import annotations
 from math import isqrt
 from typing import NamedTuple
 
-from emulator.motion.arith import SECOND, acc_count, acc_time, sat
+from emulator.motion.arith import acc_count, acc_time, sat
+from gve_fixtures.protocol import SECOND
 
 FWD = 0
 REV = 1

@@ -93,7 +93,10 @@ def cmd_output(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 def read_input(port: int) -> Handler:
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
-        return ["%02X" % dev.inputs[port]]
+        value = dev.inputs[port]
+        if dev.mutant.active("input-bits-swapped"):
+            value = value & 0xF9 | (value & 2) << 1 | (value & 4) >> 1
+        return ["%02X" % value]
     handler.__name__ = f"cmd_input_{port}"
     return handler
 
@@ -108,6 +111,8 @@ def cmd_status_read(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_status_write(dev: Device, ses: Session, p: str, t: int) -> Reply:
     a, x = fields(p, (2,))
     n, value = dec(a), hexa(x)
+    if value > 0xFF and 0 <= n <= 5 and dev.mutant.active("refused-status-write-stored"):
+        dev.write_status(n, value & 0xFF, t)
     dev.write_status(within(n, 0, 6), within(value, 0, 0xFF), t)
     return []
 
@@ -124,5 +129,7 @@ def cmd_spindle(dev: Device, ses: Session, p: str, t: int) -> Reply:
     assert sp is not None
     value = within(dec(p), sp.range.lo, sp.range.hi)
     dev.state.spindle = value
+    if value and dev.mutant.active("spindle-sets-feed-rate"):
+        dev.state.modal.V = value
     dev.state.outputs = dev.state.outputs & 0xFE if value else dev.state.outputs | 0x01
     return []

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from emulator.motion.interface import EMPTY_SAVE, SECOND, KeepSave
+from emulator.motion.interface import EMPTY_SAVE, KeepSave
 from emulator.protocol.device import Device
 from emulator.protocol.params import CommandError, dec, fields, within
 from emulator.protocol.reply import Deferred, Reply
 from emulator.protocol.session import Session
 from emulator.protocol.state import INTA, INTCOM, Saved
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import SECOND, ErrorCode
 
 Handler = Callable[[Device, Session, str, int], Reply]
 
@@ -75,6 +75,8 @@ def cmd_axis_limits(dev: Device, ses: Session, p: str, t: int) -> Reply:
     values = [dec(x) for x in fields(p, (3, 4) if axes == 4 else (axes,))]
     r = dev.profile.ranges["VL"]
     limits = [min(within(v, r.lo, r.hi), dev.profile.max_rate) for v in values]
+    if dev.mutant.active("axis-limit-x-for-all"):
+        limits = limits[:1] * len(limits)
     dev.state.modal.VL[: len(limits)] = limits
     return []
 

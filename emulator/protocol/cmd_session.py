@@ -57,6 +57,23 @@ def member(dev: Device, name: str | None, params: str) -> Member:
         return Member(name, None, err.code)
 
 
+def commit_on_arrival(dev: Device, m: Member, t: int) -> Member:
+    """The reading packet-committed-on-arrival: a valid member takes effect as it
+    arrives (B sets the modal B, C is queued); a C the queue cannot take, or takes only
+    alone (after K) or not at all (the MPG), fails with the code `*E` would give."""
+    if m.code:
+        return m
+    if m.name == "B":
+        dev.state.modal.B = m.value  # type: ignore[assignment]
+        return m
+    code = ErrorCode.SYNTAX if dev.state.kept_single else ErrorCode.BUSY if dev.mpg_active() \
+        else ErrorCode.QUEUE_FULL if dev.motion.queued(t) >= dev.profile.buffer else None
+    if code is not None:
+        return Member(m.name, None, code)
+    dev.push(m.value, True, t)  # type: ignore[arg-type]
+    return m
+
+
 def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
     """*E n: commit every member only if all k are valid, k = n and the queue has room
     for the C members; the answer is always ``code,k`` (spec 7)."""
@@ -73,6 +90,8 @@ def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
         code = ErrorCode.COUNT_MISMATCH
     if not code:
         code = next((m.code for m in members if m.code), ErrorCode.OK)
+    if dev.readings.active("packet-committed-on-arrival"):
+        return Answer(code, [str(k)])            # each member took effect as it arrived
     vectors = sum(1 for m in members if m.name == "C" and not m.code)
     if not code and vectors:
         if dev.state.kept_single:

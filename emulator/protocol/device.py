@@ -38,12 +38,13 @@ class Device:
         self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
-                             deviations=mutant.deviations)
+                             deviations=mutant.deviations | readings.deviations)
         self.motion.advance(origin)
         self.inputs = dict(UNCONNECTED)
         self.switches: dict[str, int | None] = {}
         self.state: DeviceState = reset_state(profile)
         self.deaf_until = origin          # restarting (power-on, J) until then
+        self._was_active = self._active()  # the reading edge-triggered-inputs: last seen
 
     # -- power ------------------------------------------------------------------------
     def reset(self, t: int) -> None:
@@ -57,13 +58,19 @@ class Device:
         self.motion.set_multiplier(self.state.xm, t)
         if self.mutant.active("restart-resets-inputs"):
             self.inputs = dict(UNCONNECTED)
+        self._was_active = self._active()
         self.deaf_until = t + p.restart_ms * MS
 
     # -- derived state ----------------------------------------------------------------
     def factor(self) -> int:
         """Counter units per commanded step (GVE54 micro-stepping, spec 10.7)."""
         ms = self.profile.microstep
-        return ms.factors[self.state.microstep] if ms is not None else 1
+        if ms is None:
+            return 1
+        mode = self.state.microstep
+        if self.mutant.active("microstep-modes-swapped"):
+            mode = {"2": "8", "8": "2"}.get(mode, mode)
+        return ms.factors[mode]
 
     def mpg_active(self) -> bool:
         """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""
@@ -151,15 +158,27 @@ class Device:
     def override(self, percent: int, t: int) -> None:
         """XM: an override of every vector, held and later ones (spec 10 XM)."""
         self.state.xm = percent
+        if self.mutant.active("override-rewrites-velocity"):
+            r, modal = self.profile.ranges["V"], self.state.modal
+            modal.V = max(r.lo, min(r.hi, modal.V * percent // 100))
         if not self.mutant.active("override-late"):
             self.motion.set_multiplier(percent, t)
 
     # -- interrupts (spec 10.3) ---------------------------------------------------------
+    def _active(self) -> tuple[int, int]:
+        """The inputs that are active now (level equals polarity), per word."""
+        s, i = self.state.status, self.inputs
+        return ~(i[1] ^ s[2]) & 0xFF, ~(i[2] ^ s[3]) & 0xFF
+
     def _hits(self) -> tuple[int, int]:
-        """The enabled inputs that are active now (level equals polarity), per word."""
-        s, i, p = self.state.status, self.inputs, self.profile
-        active1 = ~(i[1] ^ s[2]) & 0xFF
-        active2 = ~(i[2] ^ s[3]) & 0xFF
+        """The enabled inputs that are active now, per word; with the reading
+        edge-triggered-inputs only those that became active since last looked at."""
+        s, p = self.state.status, self.profile
+        active1, active2 = self._active()
+        if self.readings.active("edge-triggered-inputs"):
+            was1, was2 = self._was_active
+            self._was_active = (active1, active2)
+            active1, active2 = active1 & ~was1, active2 & ~was2
         return s[0] & active1 & p.low_mask, s[1] & active2 & p.high_mask
 
     def check_inputs(self, t: int) -> None:

@@ -6,7 +6,7 @@ the next '!'. If a frame has started and its next byte does not come within the
 watchdog time, the frame is dropped: :meth:`Framer.expire` gives its first bytes so that
 the unit answers error 2 (nothing when only the '!' arrived).
 
-The framer never holds more than :data:`MAX_FRAME` bytes of a frame: beyond that it
+The framer never holds more than its limit (:data:`MAX_FRAME` bytes) of a frame: beyond that it
 keeps only the byte sum and the last three bytes, which is all a checksum needs, so a
 stream without CR costs constant memory, and each byte is looked at once.
 """
@@ -30,15 +30,17 @@ class Frame(NamedTuple):
     length: int
     total: int
     tail: bytes
+    limit: int = MAX_FRAME        # the longest frame the unit takes whole
 
     @property
     def too_long(self) -> bool:
-        return self.length > MAX_FRAME
+        return self.length > self.limit
 
 
 class Framer:
-    def __init__(self, watchdog_ns: int | None) -> None:
+    def __init__(self, watchdog_ns: int | None, limit: int = MAX_FRAME) -> None:
         self.watchdog_ns = watchdog_ns        # None: the watchdog never fires
+        self.limit = limit                    # bytes of a frame the unit holds
         self.buf: bytearray | None = None     # None: no frame open
         self.last = 0                         # instant of the frame's last byte
         self._length = 0                      # bytes beyond MAX_FRAME: counted, summed,
@@ -76,7 +78,7 @@ class Framer:
             return
         buf = self.buf
         assert buf is not None
-        room = MAX_FRAME - len(buf)
+        room = self.limit - len(buf)
         if room > 0:
             buf += data[:room]
         if len(data) > room:
@@ -88,10 +90,10 @@ class Framer:
     def _finish(self) -> Frame:
         raw = bytes(self.buf or b"")
         self.buf = None
-        if self._length <= MAX_FRAME:
-            return Frame(raw, self._length, 0, b"")
+        if self._length <= self.limit:
+            return Frame(raw, self._length, 0, b"", self.limit)
         tail = (raw + self._tail)[-3:]
-        return Frame(raw, self._length, (sum(raw) + self._extra) & 0xFF, tail)
+        return Frame(raw, self._length, (sum(raw) + self._extra) & 0xFF, tail, self.limit)
 
     def step(self, data: bytes, i: int, t: int, byte_ns: int) -> tuple[Frame | None, int, int]:
         """Consume bytes from index ``i`` up to the end of the next frame.
@@ -106,9 +108,9 @@ class Framer:
                 return None, n, 0
             found = _NEXT.search(data, j + 1)
             if found is not None and data[found.start()] == 0x0D \
-                    and found.start() - j <= MAX_FRAME:
+                    and found.start() - j <= self.limit:
                 cr = found.start()
-                return Frame(data[j:cr], cr - j, 0, b""), cr + 1, t + cr * byte_ns
+                return Frame(data[j:cr], cr - j, 0, b"", self.limit), cr + 1, t + cr * byte_ns
         while i < n:
             if self.buf is None:
                 j = data.find(b"!", i)

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from emulator.mutants import Mutant
 from emulator.protocol.checksum import checksum
-from emulator.protocol.cmd_session import member
+from emulator.protocol.cmd_session import commit_on_arrival, member
 from emulator.protocol.device import MS, Device
 from emulator.protocol.framer import Frame, Framer
 from emulator.protocol.params import CommandError
@@ -34,7 +35,7 @@ from emulator.protocol.tables import (
 )
 from emulator.readings import Readings
 from gve_fixtures.profile import Profile, load_profile
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import MAX_FRAME, ErrorCode
 
 _HEX = frozenset(b"0123456789ABCDEFabcdef")
 _LONG_DECIMAL = re.compile(r"[0-9]{13}")
@@ -43,6 +44,10 @@ _PLUS = re.compile(r"(^|,)\+(?=[0-9])")
 _LOWER_HEX = re.compile(r"[a-f]")
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 _LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
+#: the reading slow-watchdog: a second, the time a reader may take for "in time"
+SLOW_WATCHDOG_MS = 1000
+#: the reading longer-frames: the longest frame a unit with a byte-wide length counter holds
+LONG_FRAME = 255
 
 
 def _discard(data: bytes, t: int) -> None:
@@ -68,7 +73,10 @@ class Unit:
             self.tables[profile.spindle.address] = spindle_table(profile)
         self.addresses = frozenset(self.tables)
         wd = profile.watchdog_ms if watchdog_ms is None else watchdog_ms
-        self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS)
+        if watchdog_ms is None and self.readings.active("slow-watchdog"):
+            wd = SLOW_WATCHDOG_MS
+        self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS,
+                             LONG_FRAME if self.readings.active("longer-frames") else MAX_FRAME)
         self.emit: Callable[[bytes, int], None] = _discard
         self.now = origin
         self._pending: list[tuple[bytes, Deferred, bool]] = []   # (frame, answer, remembered)
@@ -216,8 +224,11 @@ class Unit:
                 self._answer(raw, ErrorCode.SYNTAX, [], t, remember=known.remembered)
             return
         command = self.tables[address].get(name or "")
-        if ses.packet is not None and (command is None or command.packet not in (DISCARD, CLOSE)):
-            ses.packet.append(member(self.device, name if command else None, params))
+        if ses.packet is not None and not self._leaves_packet(command, name):
+            m = member(self.device, name if command else None, params)
+            if self.readings.active("packet-committed-on-arrival"):
+                m = commit_on_arrival(self.device, m, t)
+            ses.packet.append(m)
             return
         if command is None:
             lacking = self.readings.active("missing-letter-range") and _LACKING.match(name or "")
@@ -228,10 +239,21 @@ class Unit:
             ses.packet = None
         self._run(raw, command, name, params, t)
 
+    def _leaves_packet(self, command: Command | None, name: str | None) -> bool:
+        """Whether a frame inside an open packet is run rather than taken as a member:
+        `*E`, and the breakers H, @, >, J (the reading packet-closed-only-by-end makes
+        them members; a second *S still restarts the packet)."""
+        if command is None or command.packet not in (DISCARD, CLOSE):
+            return False
+        return command.packet == CLOSE or name == "*S" \
+            or not self.readings.active("packet-closed-only-by-end")
+
     def _run(self, raw: bytes, command: Command, name: str | None, params: str,
              t: int) -> None:
         act = self.mutant.active
         reads = self.readings.active
+        if name == "@" and reads("index-remembered"):
+            command = replace(command, remembered=True)
         try:
             if reads("plus-sign"):
                 params = _PLUS.sub(r"\1", params)
@@ -271,7 +293,7 @@ class Unit:
         last, answer = history
         silent, self.emit = self.emit, _discard
         try:
-            self._frame(Frame(last, len(last), 0, b""), self.now)
+            self._frame(Frame(last, len(last), 0, b"", self.framer.limit), self.now)
         finally:
             self.emit = silent
         self.session.history = (last, answer)

@@ -1,5 +1,5 @@
 """`python -m emulator` refuses what it cannot serve with one line on stderr and exit
-status 2, before it serves anything, never with a traceback (issue 8 item 9)."""
+status 2, before it serves anything, never with a traceback."""
 
 from __future__ import annotations
 
@@ -116,3 +116,28 @@ def test_piping_to_head_ends_quietly() -> None:
                           shell=True, capture_output=True, text=True, timeout=30)
     assert done.stdout.startswith("/dev/")
     assert done.stderr == ""
+
+
+class _Log:
+    closed = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+@pytest.mark.parametrize("gone", [True, False])
+def test_serving_ends_quietly_when_stdout_goes_and_closes_the_transcript(monkeypatch, gone):
+    import types
+
+    import emulator.__main__ as program
+    from emulator.link.server import StdoutGone
+
+    silenced: list[bool] = []
+    monkeypatch.setattr(program, "silence_stdout", lambda: silenced.append(True))
+    line = types.SimpleNamespace(log=_Log())
+    with program._ending_quietly(line):
+        if gone:
+            raise StdoutGone
+    assert silenced == ([True] if gone else []) and line.log.closed
+    with pytest.raises(KeyboardInterrupt), program._ending_quietly(line):
+        raise KeyboardInterrupt             # anything else is not swallowed

@@ -34,6 +34,8 @@ PROBES: dict[str, tuple[str, str]] = {
     "packet-count-ignored": ("d4-checksum-in-packet", "GVE114-500"),
     "failed-packet-keeps-b": ("p07-failed-packet-b", "GVE84-100"),
     "refused-vector-queued": ("p06-refused-vector", "GVE84-15"),
+    "refused-status-write-stored": ("p08-refused-status-write", "GVE54"),
+    "input-bits-swapped": ("p09-input-bits", "GVE84-100"),
     "narrow-counters": ("p04-counter-range-ends", "GVE114-500"),
     "eeprom-7-bit-address": ("p05-eeprom-every-address", "GVE54"),
     "index-skips-refused": ("e10-bare-commands", "GVE84-100"),
@@ -68,10 +70,15 @@ PROBES: dict[str, tuple[str, str]] = {
     "accel-ignored": ("m06-acceleration", "GVE84-100"),
     "dwell-ignored": ("m07-dwell", "GVE84-100"),
     "junction-stops": ("m08-junction", "GVE84-100"),
+    "junction-brake-ignored": ("m12-junction-brake", "GVE114-500"),
+    "spindle-sets-feed-rate": ("m13-spindle-apart-from-feed", "GVE114-500"),
+    "axis-limit-x-for-all": ("m14-axis-limit-own-axis", "GVE84-100"),
+    "override-rewrites-velocity": ("m15-override-leaves-v", "GVE114-500"),
     "short-vector-ignored": ("m09-short-vector", "GVE84-100"),
     "halt-without-ramp": ("m10-halt-ramp", "GVE84-100"),
     "go-at-speed": ("m10-halt-ramp", "GVE114-500"),
     "microstep-rates-unscaled": ("m11-microstep-rates", "GVE54"),
+    "microstep-modes-swapped": ("m16-each-microstep-mode", "GVE54"),
 }
 
 

@@ -1,6 +1,6 @@
 """`python -m emulator --pty` as a separate process, driven with pyserial exactly as a
 third-party program would: the golden KEEP/RESTORE scenario and packet example, the
-watchdog, the control channel, the TCP server, and the transcripts of the emulator issue
+watchdog, the control channel, the TCP server, and the error and decision transcripts
 (those that wait more than 1 s are marked slow)."""
 
 from __future__ import annotations
@@ -99,11 +99,11 @@ def _waits(path) -> float:
 
 
 def _over_the_pty():
-    """The issue's transcripts (errors e*, decisions d*) on one profile each; those that
+    """The transcripts of errors (e*, decisions d*) on one profile each; those that
     wait long are slow."""
     chosen: dict[str, tuple] = {}
-    issue = sorted([*TRANSCRIPTS.glob("e*.gvt"), *TRANSCRIPTS.glob("d*.gvt")])
-    for param in transcript_cases(issue):
+    chosen_files = sorted([*TRANSCRIPTS.glob("e*.gvt"), *TRANSCRIPTS.glob("d*.gvt")])
+    for param in transcript_cases(chosen_files):
         path, profile = param.values
         if path.stem not in chosen or profile in ("GVE84-100", "GVE114-500"):
             chosen.setdefault(path.stem, (path, profile))

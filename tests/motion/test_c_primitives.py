@@ -1,5 +1,5 @@
 """The C core's exact arithmetic primitives against their mathematical definitions
-(issue 3; docs/motion-model.md), over the full ranges of the profiles.
+(docs/motion-model.md), over the full ranges of the profiles.
 
 The references are written here from the definitions with Python integers (no square
 root, no shared code with the cores), so a rounding slip on either side shows up.

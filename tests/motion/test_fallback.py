@@ -1,5 +1,5 @@
 """Without the C core the emulator uses the Python twin and says so once on stderr;
-GVE_STEPPER forces a core (issue 3 item 4)."""
+GVE_STEPPER forces a core."""
 
 from __future__ import annotations
 

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from emulator.motion.arith import acc_count, acc_time
 from emulator.motion.factory import c_available, create
-from emulator.motion.interface import SECOND, Vector
+from emulator.motion.interface import Vector
+from gve_fixtures.protocol import SECOND
 
 MAX_RATE = 100_000
 AXES = 3

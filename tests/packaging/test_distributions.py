@@ -1,4 +1,4 @@
-"""Distributions that install (issue 13 item 1): ``python -m build`` makes an sdist that
+"""Distributions that install: ``python -m build`` makes an sdist that
 carries the whole tracked tree and a wheel that carries every file of the packages; each
 installs into a fresh virtual environment, with the C stepper core, and passes a smoke
 run; docs/ci.md's job runs from the wheel; ``tox`` passes on a fresh clone. Slow

@@ -150,6 +150,7 @@ def test_colour_always_colours_a_pipe_even_with_no_color():
     assert re.search(r"\x1b\[[0-9;]*mPASS", done.stdout), done.stdout
 
 
+@pytest.mark.pty
 def test_colour_never_and_no_color_leave_a_terminal_plain(monkeypatch):
     for extra, env in (([], {"NO_COLOR": "1"}), (["--color", "never"], {})):
         for key, value in {"NO_COLOR": "", **env}.items():
@@ -160,6 +161,7 @@ def test_colour_never_and_no_color_leave_a_terminal_plain(monkeypatch):
         assert "PASSED" in shown and not re.search(r"\x1b\[[0-9;]*m", shown), shown
 
 
+@pytest.mark.pty
 def test_a_terminal_is_coloured_by_default(monkeypatch):
     monkeypatch.setenv("NO_COLOR", "")
     monkeypatch.setenv("TERM", "xterm")

@@ -15,7 +15,7 @@ from conformance.cli.progress import Progress
 from conformance.verdict import COULD_NOT_TEST, MISSING, PASS
 from tests.conformance.reports.toy import result
 
-#: issue 12 item 6: the default run writes at most this much
+#: the default run's three reports together stay under this
 LIMIT = 2 * 1024 * 1024
 
 

@@ -1,9 +1,10 @@
 """Two answers compared: exact in virtual time, positions within the band in real time
 while the axes may move, exact at rest; the index from where each side began."""
 
-from conformance.diff.compare import Judge, difference
+from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.sides import Exchange
 from conformance.link.framing import parse_response
+from conformance.link.line_band import LineBand
 
 MS = 1_000_000
 
@@ -50,6 +51,25 @@ def test_real_time_at_rest_after_a_course_change_within_its_latency():
     assert difference("PF", ex(b"8,308,0,0\r"), at_rest, judge) == "position"
     assert difference("PF", ex(b"8,301,0,0\r"), at_rest, Judge(exact=False, rate=1000)) \
         == "position"
+
+
+def test_real_time_the_line_band_widens_the_target_s_window_and_its_lateness():
+    """Behind a line with a 4 ms band the target may have read its counters 4 ms either
+    side of its exchange, and acted on a course change 4 ms later still."""
+    judge = Judge(exact=False, rate=1000, line=LineBand(4e-3))
+    far = ex(b"0,103,0,0\r", 0, 0)
+    # 2 ms window + 4 ms either side: 6 ms from the reference's instant, + placement
+    assert difference("PF", ex(b"0,96,0,0\r", 0, 2 * MS), far, judge, moving=True) is None
+    assert difference("PF", ex(b"0,95,0,0\r", 0, 2 * MS), far, judge, moving=True) \
+        == "position"
+    at_rest = ex(b"8,300,0,0\r", 0, 0)
+    late = Judge(exact=False, rate=1000, slack_ns=6 * MS, line=LineBand(4e-3))  # 10 steps
+    assert difference("PF", ex(b"8,311,0,0\r"), at_rest, late) is None      # placement
+    assert difference("PF", ex(b"8,312,0,0\r"), at_rest, late) == "position"
+    # at rest with nothing that changed the course: still exact, whatever the line
+    assert difference("PF", ex(b"8,301,0,0\r"), at_rest, judge) == "position"
+    assert alike_because("PF", ex(b"0,96,0,0\r", 0, 2 * MS), far, judge, moving=True) == \
+        "within ±7 step(s) (±4.0 ms line), read while the axes may have moved"
 
 
 def test_real_time_index_compared_from_where_each_side_began():

@@ -7,11 +7,12 @@ import itertools
 import pytest
 
 from conformance.cli.diff import DEFAULT_EXAMPLES
-from conformance.diff.engine import Budget, Pair, Record, search
+from conformance.diff import engine
+from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options, probes
 from conformance.diff.gvt import steps_of, transcript
-from conformance.diff.sides import Exchange, Side
-from conformance.diff.steps import FILL, FRAME, Step
+from conformance.diff.sides import Side
+from conformance.diff.steps import FILL
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
 from gve_fixtures.rules import load_rules
@@ -30,7 +31,8 @@ QUICK = ("lower-case-command", "packet-count-ignored", "params-ignored-on-bare-c
 FRAMES = {"dwell-between-continuous": 12}
 #: where a mutant shows only on one family
 PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "GVE54",
-           "mpg-not-moving": "GVE114-500"}
+           "mpg-not-moving": "GVE114-500", "microstep-modes-swapped": "GVE54",
+           "spindle-sets-feed-rate": "GVE114-500"}
 EVERYTHING = Options(destructive=True, rig=True)
 
 
@@ -130,24 +132,17 @@ def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
     assert again.frames == first.frames
 
 
-def test_in_real_time_a_course_change_while_moving_widens_later_readings():
-    """The latency is the slowest immediate answer so far (an H answers when stopped: not
-    a latency); what changes a running motion's course adds it to the readings while it
-    runs, what stops it short to the positions at rest too; a setting at rest adds
-    nothing."""
-    p = pair(None)
-    p.exact = False                                  # as with a target in real time
-    ms = 1_000_000
-
-    def sent(command: str, took_ms: int) -> tuple[int, int, int]:
-        reply = Exchange(command.encode(), b"0\r", 0, took_ms * ms, None)
-        p._retimed(command, Record(Step(FRAME, command), target=reply))
-        return p._latency_ns // ms, p._slack_ns // ms, p._cut_ns // ms
-
-    p._idle_since = None                             # the reference was moving
-    assert sent("V", 2) == (2, 0, 0)
-    assert sent("XM", 1) == (2, 2, 0)
-    assert sent("H", 200) == (2, 4, 2)
-    p._idle_since = 5                                # at rest since
-    assert sent("XM", 3) == (3, 4, 2)
-    assert not p._lost and sent("D", 1) == (3, 4, 2) and p._lost
+def test_without_hypothesis_internals_the_search_runs_as_it_is(monkeypatch):
+    """Where Hypothesis's internals moved, its pool of constants is left alone and the
+    search still runs; where they are, the pool is empty only while it runs."""
+    providers = engine._providers
+    pool = providers._get_local_constants
+    with engine._seed_alone():
+        assert providers._get_local_constants is not pool
+        assert not list(providers._get_local_constants())
+    assert providers._get_local_constants is pool
+    monkeypatch.setattr(engine, "_providers", None)
+    with engine._seed_alone():
+        assert providers._get_local_constants is pool
+    p = pair("go-without-inta")
+    assert search(p, EVERYTHING, Budget(examples=40), stop_after=1, with_probes=False)

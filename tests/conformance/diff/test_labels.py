@@ -72,3 +72,16 @@ def test_both_answers_allowed_by_the_spec_are_no_finding():
     assert allowed("G", "code", set(), set(), 6, 0) is None      # G with INTA = 0 → 6 [M]
     assert allowed("NA", "code", set(), set(), 3, 5)
     assert allowed("L", "code", set(), set(), 3, 5) is None
+
+
+def test_a_breaker_unanswered_inside_a_packet_is_the_breakers_rule():
+    # a unit that closes a packet only with *E takes H, @, >, J as members
+    for command in ("H", "@", ">", "J"):
+        assert label(command, "silence", {"in-packet"}, {"*S"}, 0) == "7.packet.breakers"
+    assert label("H", "silence", {"bad-checksum", "in-packet"}, {"*S"}, 4) == \
+        "7.packet.bad-checksum-member"
+
+
+def test_a_repeat_after_an_index_is_whether_the_index_is_remembered():
+    assert label(">", "data", set(), {"V", "@"}, 0, 0) == "8.repeat.remembered"
+    assert label(">", "data", set(), {"V"}, 0, 0) == "8.repeat.answer"

@@ -1,4 +1,4 @@
-"""docs/ci.md's CI job for a firmware-clone author (issue 13 item 3), run as written
+"""docs/ci.md's CI job for a firmware-clone author, run as written
 against the emulator standing in for the clone's simulator: the suite runs, the JUnit
 XML and the HTML report are published, the job ends with the suite's status. The
 install block runs in the slow packaging tests (a fresh environment from the wheel)."""

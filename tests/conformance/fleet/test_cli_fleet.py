@@ -1,4 +1,4 @@
-"""``gve-conformance --target A --target B --jobs N`` (issue 13 item 2): targets in
+"""``gve-conformance --target A --target B --jobs N``: targets in
 parallel processes, one report per target and a summary across them; an interrupt halts
 every target's unit (H, then D) and still reports."""
 

@@ -1,4 +1,4 @@
-"""The machines' example database (issue 12 item 7, issue 13 item 2): a failing example
+"""The machines' example database: a failing example
 found by one run is the first example of the next one, from a directory by default or
 from a Redis server that several benches share; keys are per profile; a database that
 cannot be used is a usage error before anything runs."""

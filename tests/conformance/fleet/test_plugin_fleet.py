@@ -1,4 +1,4 @@
-"""Fleets under pytest-xdist (issue 13 item 2): with several --gve-target, each target
+"""Fleets under pytest-xdist: with several --gve-target, each target
 that holds a port runs on one worker only, and two emulated units on two TCP ports run
 in parallel under ``pytest -n 2`` with no errors."""
 

@@ -4,10 +4,10 @@
 from __future__ import annotations
 
 from conformance.host.checks import LineFacts, judge
-from conformance.host.framer import HostFrame
 from conformance.host.grammar import parse_frame
 from conformance.host.recording import Exchange, Recording
 from conformance.host.unitview import line_views
+from conformance.protocol.framer import HostFrame
 from gve_fixtures.profile import load_profile
 
 MS = 1_000_000

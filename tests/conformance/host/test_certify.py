@@ -1,6 +1,6 @@
 """The reference host passes every scenario: with checksums and packets on the GVE84, in
-plain frames on the GVE54, one byte at a time at 921 600 baud on the GVE114 (issue 11
-Tests). Real time: the job is about a second of motion; the scenarios run side by side.
+plain frames on the GVE54, one byte at a time at 921 600 baud on the GVE114.
+Real time: the job is about a second of motion; the scenarios run side by side.
 The whole matrix (every profile, every mode, every scenario) is marked slow."""
 
 from __future__ import annotations

@@ -106,3 +106,14 @@ def test_the_relays_command_is_the_judges(raw, checksums, units):
        st.booleans())
 def test_the_relays_command_is_the_judges_for_any_bytes(raw, checksums):
     assert command_of(raw, GVE114) == parse_frame(raw, GVE114, checksums).command
+
+
+def test_a_frame_is_classed_as_every_reader_classes_it_and_judged_strictly():
+    lower = parse_frame(b"!0sw6,00", GVE84, False)
+    assert (lower.command, lower.key) == (None, "SW6")      # the unit takes no command
+    assert [p.rule for p in lower.problems] == ["3.frame.upper-case"]
+    plus = parse_frame(b"!0SW+6,00", GVE84, False)
+    assert (plus.command, plus.key) == ("SW", "SW6")
+    assert [p.rule for p in plus.problems] == ["3.params.decimal"]
+    assert parse_frame(b"!0SW0,80", GVE84, False).key == "SW"
+    assert command_of(b"!0H", GVE84) == "H" and command_of(b"!0h", GVE84) is None

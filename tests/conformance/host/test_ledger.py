@@ -3,11 +3,11 @@ the same readings and the same executed motion as reading and booking each at on
 
 from __future__ import annotations
 
-from conformance.host.framer import HostFrame
 from conformance.host.grammar import byte_sum, parse_frame
 from conformance.host.ledger import Ledger
 from conformance.host.recording import Exchange
 from conformance.host.unitview import line_views
+from conformance.protocol.framer import HostFrame
 from tests.conformance.host.records import MS, PROFILE, UNITS
 
 

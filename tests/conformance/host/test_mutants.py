@@ -1,6 +1,6 @@
-"""Every deliberate bug of the reference host FAILs, with the rule or scenario it breaks
-(issue 11 item 4). Each runs on a tiny job against the scenario that shows it; the test
-prints the rules that failed it."""
+"""Every deliberate bug of the reference host FAILs, with the rule or scenario it breaks.
+Each runs on a tiny job against the scenario that shows it; the test prints the rules
+that failed it."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """A host that is not a Python program — a few lines of shell around the port — is judged
-the same way (issue 11 Tests)."""
+the same way."""
 
 from __future__ import annotations
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+import re
 
 import pytest
 
@@ -15,6 +16,7 @@ from tests.emulator.process import Emulator
 from tests.usb_relay import UsbRelay
 
 REPEATS = int(os.environ.get("GVE_MEASURED_REPEATS", "20"))
+BAND = re.compile(r"\(±([\d.]+) ms line, ±(\d+) steps?\)")
 
 
 @pytest.mark.slow
@@ -24,17 +26,23 @@ def test_measured_family_repeated_gets_no_fail(latency_ms: int | None) -> None:
     emu = Emulator("--model", "GVE84-100", "--pty")
     relay = UsbRelay(emu.first, latency_ms=latency_ms, jitter_ms=3) if latency_ms else None
     failed: dict[str, int] = {}
+    bands: list[tuple[float, int]] = []
     try:
         path = relay.path if relay else emu.first
         for _ in range(REPEATS):
             target = parse_target(f"serial:{path}?baud=115200", profile="GVE84-100",
                                   allow_destructive=True, max_travel=100_000)
             for r in run([target], select(["10.*measured*"])).results:
+                bands += [(float(m.group(1)), int(m.group(2))) for c in r.checks
+                          if (m := BAND.search(c["what"]))]
                 if r.verdict == FAIL:
                     failed[r.id] = failed.get(r.id, 0) + 1
     finally:
         if relay:
             relay.close()
         emu.stop()
-    print(f"latency {latency_ms} ms: {REPEATS} runs, FAILs {failed}")
-    assert not failed
+    lines, steps = sorted(b[0] for b in bands), sorted(b[1] for b in bands)
+    print(f"latency {latency_ms} ms: {REPEATS} runs, FAILs {failed}; line band median "
+          f"±{lines[len(lines) // 2]:.1f} ms, widest ±{lines[-1]:.1f} ms; steps median "
+          f"±{steps[len(steps) // 2]}, widest ±{steps[-1]}")
+    assert bands and not failed

@@ -7,9 +7,10 @@ import math
 
 import pytest
 
-from conformance.motion.arith import SECOND, acc_count, acc_time, axis_steps
+from conformance.motion.arith import acc_count, acc_time, axis_steps
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params, cruise_rate, junction_rate, plan
+from gve_fixtures.protocol import SECOND
 
 MS = 1_000_000
 

@@ -13,13 +13,14 @@ import pytest
 import conformance.cases  # noqa: F401  (registers the cases)
 from conformance.case import REGISTRY, Case
 from conformance.hands import HandRig, cannot_by_hand, wording
+from conformance.link.framing import parse_response
 from conformance.link.safety import Guard, SafetyStop
 from conformance.link.virtual import Rig
 from conformance.operator import Console, HandStep
 from conformance.runner import CaseResult, run
 from conformance.targets import parse_target
 from conformance.targets.rig import ControlRig
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdict import COULD_NOT_TEST, PASS, CouldNotTest
 from gve_fixtures.profile import load_profile
 from tests.conformance.operator.terminal import EmulatedUnit
 
@@ -160,3 +161,93 @@ def test_a_hand_case_whose_input_is_already_so_asks_nothing(unit):
     operator = ScriptedOperator(unit)
     r = _run(unit, REGISTRY["10.3.interrupt.polarity"], operator)   # IN0 reads 1 as found
     assert r.verdict == PASS and operator.asked == []
+
+
+class _Unit:
+    """A link to a unit whose SR6 reads ``st6`` and whose I1 reads ``inputs`` (a step
+    done by the technician changes it): what HandRig sees of a link."""
+
+    def __init__(self, st6: str, inputs: str = "FF") -> None:
+        self.guard = Guard(load_profile(PROFILE), 0, max_travel=2000, allow_destructive=True)
+        self.st6, self.inputs = st6, inputs
+
+    def _answer(self, body: str):
+        value = self.st6 if body == "SR6" else self.inputs
+        return parse_response(f"0,{value}\r".encode(), summed=False)
+
+    def send(self, body: str):
+        return self._answer(body)
+
+    def poll(self, body: str, until, max_seconds: float = 30.0):
+        r = self._answer(body)
+        return r if until(r) else None
+
+
+class _Hand(Console):
+    """Grounds IN0 when asked, and tries to move the unit meanwhile."""
+
+    def __init__(self, unit: _Unit) -> None:
+        super().__init__(stdin=io.StringIO(), stdout=io.StringIO(), interactive=True)
+        self.unit, self.asked, self.refused = unit, 0, ""
+
+    def hand_step(self, step: HandStep) -> bool:
+        self.asked += 1
+        with pytest.raises(SafetyStop) as refused:
+            self.unit.guard.check("L100,0,0")
+        self.refused = str(refused.value)
+        self.unit.inputs = "FE"
+        return True
+
+
+def test_no_step_is_asked_while_the_unit_moves():
+    unit = _Unit(st6="40")                        # RUN = 1, INTA = 0: moving (spec 5)
+    hand = _Hand(unit)
+    with pytest.raises(CouldNotTest, match="did not come to rest"):
+        HandRig(lambda: unit, hand).set_input(1, 0xFE)
+    assert hand.asked == 0
+
+
+def test_a_step_is_asked_with_halted_vectors_and_no_motion_meanwhile():
+    unit = _Unit(st6="C0")                        # RUN held by INTA: at rest
+    hand = _Hand(unit)
+    HandRig(lambda: unit, hand).set_input(1, 0xFE)
+    assert hand.asked == 1 and "while a hand step is open" in hand.refused
+    unit.guard.check("L100,0,0")                  # the prompt answered: motion again
+
+
+class _Eyes(Console):
+    """Answers the outputs question with ``answers``, one after the other."""
+
+    def __init__(self, *answers: str) -> None:
+        super().__init__(stdin=io.StringIO(), stdout=io.StringIO(), interactive=True)
+        self.answers = list(answers)
+
+    def observe(self, step: HandStep) -> str | None:
+        return self.answers.pop(0)
+
+
+def test_the_outputs_are_read_as_the_technician_sees_them():
+    unit = _Unit(st6="00")
+    assert HandRig(lambda: unit, _Eyes("2")).outputs() == 0xFB          # OUT2 on: active low
+    assert HandRig(lambda: unit, _Eyes("0, 7")).outputs() == 0x7E
+    assert HandRig(lambda: unit, _Eyes("none")).outputs() == 0xFF
+    eyes = _Eyes("lots", "9", "2 3")                                     # asked again
+    assert HandRig(lambda: unit, eyes).outputs() == 0xF3
+    assert eyes.stdout.getvalue().count("please answer") == 2
+    with pytest.raises(CouldNotTest, match="reading the outputs: skipped by the operator"):
+        HandRig(lambda: unit, _Eyes("s")).outputs()
+
+
+def test_a_power_cycle_not_done_is_caught_by_the_index(unit):
+    class NoPower(ScriptedOperator):
+        def hand_step(self, step: HandStep) -> bool:
+            if step.kind == "power-on":
+                self.asked.append(step)
+                return True                     # Enter, the power never cycled
+            return super().hand_step(step)
+    operator = NoPower(unit)
+    r = _run(unit, REGISTRY["10.3.inputs.physical-across-restart"], operator)
+    assert r.verdict == COULD_NOT_TEST
+    assert [s.kind for s in operator.asked].count("power-on") == wording()["attempts"]
+    assert any("not verified, the index reads" in n for n in r.notes), r.notes
+    assert json.loads(unit.rig("state"))["inputs"]["1"] == "FF"      # the hands came off

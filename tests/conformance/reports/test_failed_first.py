@@ -64,7 +64,7 @@ def test_the_fault_is_drawn_on_its_motion_plot(mutant_page):
 
 def test_no_zero_width_band_in_virtual_time(mutant_page):
     page = mutant_page
-    assert "step(s) over a window" not in page and "±0" not in page
+    assert "ms line" not in page and "±0" not in page
     for id in (FAILING, PASSING):
         case = _case(page, id)
         assert "<svg" in case

@@ -1,4 +1,4 @@
-"""Issue 8 item 9: every mistake a user makes first gets one clear line and exit status
+"""Every mistake a user makes first gets one clear line and exit status
 2 before anything is sent — through the command line and through the pytest plugin (a
 usage error, not an INTERNALERROR or a failed test per case)."""
 

@@ -71,6 +71,28 @@ def test_counter_resets_do_not_reset_the_odometer():
     assert x(g) == (-500, -500)
 
 
+def test_a_set_counter_read_back_otherwise_is_a_counter_not_a_move():
+    g = guard()
+    sent(g, "L300,0,0")
+    sent(g, "L0,0,0")                      # at rest at 300
+    sent(g, "NX2147483647")
+    # a 24-bit counter: 2^31 - 1 reads -1; no frame moved X, so X rests at 300 still
+    sent(g, "PF", "0,-1,0,0")
+    assert x(g) == (300, 300) and g.envelope.unheld == [0]
+    sent(g, "L-300,0,0")                   # back where the run began, inside the envelope
+    sent(g, "L0,0,0")
+    sent(g, "PF", "0,-301,0,0")            # the counter anchored to the read: -1 - 300
+    assert x(g) == (0, 0)
+
+
+def test_without_a_counter_set_a_read_that_contradicts_the_frames_wins():
+    g = guard()
+    sent(g, "L300,0,0")
+    sent(g, "L0,0,0")
+    sent(g, "PF", "0,450,0,0")             # moved by other means (a hand-wheel)
+    assert x(g) == (450, 450) and g.envelope.unheld == []
+
+
 def test_a_halted_and_deleted_vector_leaves_the_axis_anywhere_on_it_until_read():
     g = guard()
     sent(g, "C400,0,0")
@@ -112,8 +134,10 @@ def test_a_packet_is_judged_whole_before_its_end_is_sent():
     sent(g, "*S", None)
     sent(g, "C100,0,0", None)
     assert "X could reach 0..600" in refused(g, "C100,0,0")
-    sent(g, "*E1", "2,1")                  # refused: nothing committed
-    assert x(g) == (0, 400)
+    # refused: nothing committed by our reading, but a unit may have committed the
+    # member as it arrived (all-or-nothing is [D]), so it may have moved
+    sent(g, "*E1", "2,1")
+    assert x(g) == (0, 500)
 
 
 def test_gve54_vectors_are_in_the_micro_step_mode_and_positions_in_sixteenths():

@@ -1,4 +1,4 @@
-"""Done-when of issue 8: a run against a unit behind a man in the middle stays within its
+"""A run against a unit behind a man in the middle stays within its
 envelope for the whole run. The emulator on a pty counts where its axes physically went
 (its control channel's `excursion`, which N, N<axis>, J and W do not reset); the proxy
 sees every frame. No J, W or EEPROM write goes out without --allow-destructive, and the

@@ -176,6 +176,16 @@ def test_silence_inside_an_open_packet_is_no_silence():
         g.answered(None)
 
 
+def test_an_unanswered_breaker_leaves_the_packet_open():
+    # that H closes a packet is our reading [D]: a unit may take it as a member
+    g = guard()
+    g.accepted("*S", None)
+    g.accepted("H", None)
+    assert g.packet_open
+    g.accepted("H", parse_response(b"8\r", summed=False))
+    assert not g.packet_open
+
+
 def test_the_bytes_named_are_those_of_the_silence_that_gave_up():
     g = guard()
     g.answered(parse_response(b"!0C1,0,167\r", summed=False))    # not an answer

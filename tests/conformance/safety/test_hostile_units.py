@@ -1,4 +1,4 @@
-"""Hostile units on a pty (issue 8 item 5, 6, 7): a unit that says nothing, answers
+"""Hostile units on a pty: a unit that says nothing, answers
 twice, answers garbage, answers with markup and NUL bytes, or answers 2 s late. The run
 ends by itself in bounded time, no PASS comes from a stale or doubled answer, nothing is
 an ERROR, and the three reports stay well-formed. The emulator behind a proxy gives the

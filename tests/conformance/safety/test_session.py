@@ -113,6 +113,25 @@ def _after_ctrl_c(unit, pressed) -> list[bytes]:
     return after
 
 
+def test_ctrl_c_inside_a_packet_on_a_unit_that_ends_packets_only_with_e():
+    # H goes first; taken as a member (no answer), the packet is closed with a *E every
+    # unit refuses and H goes again, then D
+    unit = in_process_unit("GVE84-100", readings=("packet-closed-only-by-end",))
+    members = []
+
+    def trigger(i: int, frame: bytes) -> bool:
+        if frame.startswith(b"!0*S"):
+            members.append(i)
+        return bool(members) and frame.startswith(b"!0C")
+    pressed = _ctrl_c_at(unit, trigger)
+    result = run([unit], select(["7.packet.commits-all"]))
+    assert pressed and result.interrupted
+    after = [f[2:-1] for f in unit.frames[pressed[0] + 1:]]
+    assert after[:4] == [b"H", b"*E-1", b"H", b"D"], after[:6]
+    assert unit.state()["physical"] == [0, 0, 0]
+    assert unit.state()["packet_open"] is False
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_ctrl_c_inside_a_hypothesis_machine_halts_first(tmp_path, seed):
     unit = in_process_unit("GVE84-100", max_travel=500)
@@ -175,3 +194,12 @@ def test_the_line_round_trip_is_measured_at_the_start():
     assert line["byte_ms"] == pytest.approx(10 / 115200 * 1e3)
     # a `?` frame (4 bytes) and its answer take at least their bytes' time
     assert 4 * line["byte_ms"] < line["min_ms"] <= line["median_ms"] <= line["max_ms"]
+    # the `?` exchange's bytes: `!0?\r` and `0,IP84 v3 27.1.2010\r`
+    assert line["bytes_ms"] == pytest.approx((4 + 20) * line["byte_ms"])
+
+
+def test_every_link_of_a_real_session_carries_the_measured_line():
+    unit = in_process_unit("GVE84-100", max_travel=500)
+    link = unit.open_link()
+    assert link.round_trip == unit.session.report.line and link.round_trip["max_ms"] > 0
+    unit.session.finish()

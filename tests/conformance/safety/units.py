@@ -73,8 +73,10 @@ class InProcessUnit(PortTarget):
 
 
 def in_process_unit(profile: str = "GVE84-100", *, max_travel: int = 2000,
-                    allow_destructive: bool = False, eeprom: str | None = None) -> InProcessUnit:
+                    allow_destructive: bool = False, eeprom: str | None = None,
+                    readings: tuple[str, ...] = ()) -> InProcessUnit:
     p = load_profile(profile)
-    url = f"gve://?model={profile}&realtime=1" + (f"&eeprom={eeprom}" if eeprom else "")
+    url = f"gve://?model={profile}&realtime=1" + (f"&eeprom={eeprom}" if eeprom else "") \
+        + (f"&reading={','.join(readings)}" if readings else "")
     info = TargetInfo("serial", f"serial:{url}", False, False, allow_destructive, max_travel)
     return InProcessUnit(info, p, p.address, p.default_baud, url)

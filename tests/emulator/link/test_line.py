@@ -8,7 +8,8 @@ import io
 
 import pytest
 
-from emulator.link.line import SECOND, Line, byte_time
+from emulator.link.line import Line, byte_time
+from gve_fixtures.protocol import SECOND
 from gve_fixtures.transcript import HOST, UNIT, parse
 from tests.emulator.link.fake_unit import DELAY_NS, FakeUnit
 

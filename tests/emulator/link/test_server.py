@@ -1,5 +1,5 @@
-"""The real-time server cannot be frozen or exhausted by a host or a controller (the
-emulator issue's server section; spec 3 for the frame bound). Every test runs
+"""The real-time server cannot be frozen or exhausted by a host or a controller (docs/decisions.md
+on the real-time server; spec 3 for the frame bound). Every test runs
 `python -m emulator` on loopback or a pty and is bounded by deadlines."""
 
 from __future__ import annotations

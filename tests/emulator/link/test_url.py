@@ -9,8 +9,8 @@ import pytest
 import serial
 
 import emulator  # noqa: F401  (registers gve://)
-from emulator.link.line import SECOND
 from emulator.link.url import parse_url
+from gve_fixtures.protocol import SECOND
 from gve_fixtures.transcript import HOST, UNIT, load
 
 

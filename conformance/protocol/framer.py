@@ -1,16 +1,23 @@
-"""Cutting a host's byte stream into frames, keeping the instant of every byte (spec 3).
+"""Cutting a host's byte stream into frames as a unit does (spec 3), keeping the instant
+of every byte when asked.
 
-A frame runs from `!` to CR. Whatever else the host sends is a *fragment*: a frame that
-a new `!` (or the end of the run) cut short, bytes outside any frame, or a LF right
-after a CR (which units ignore, spec 3 [D]). The framer judges nothing; it only keeps
-what the host sent, and when.
+A frame runs from `!` to CR: bytes before `!` are ignored, a `!` restarts an unfinished
+frame, CR ends one (a LF after it is noise). Whatever else the host sends is a
+*fragment*: a frame that a new `!` (or the end of the run) cut short, bytes outside any
+frame, or a LF right after a CR (which units ignore, spec 3 [D]). The framer judges
+nothing; it only keeps what the host sent, and when. The same framer serves the suite
+as a host (the link and its guard: :meth:`HostFramer.frames`, no instants) and the
+suite playing the unit to a host (the relay: :meth:`HostFramer.feed` with instants).
 """
 
 from __future__ import annotations
 
+import copy
 import re
 from dataclasses import dataclass, field
 from itertools import pairwise
+
+from conformance.protocol.wire import is_hex_byte
 
 CR, LF, BANG = 0x0D, 0x0A, 0x21
 _SPECIAL = re.compile(rb"[!\r]")
@@ -30,6 +37,33 @@ class HostFrame:
     @property
     def start(self) -> int:
         return self.times[0]
+
+    @property
+    def address(self) -> int | None:
+        """The digit after `!` (None: not a digit)."""
+        digit = self.raw[1:2]
+        return int(digit) if digit.isdigit() else None
+
+    @property
+    def text(self) -> str:
+        """From the byte after the address to the byte before CR."""
+        return self.raw[2:].decode("latin-1")
+
+    @property
+    def wire(self) -> bytes:
+        """The frame's bytes from `!` through CR."""
+        return self.raw + b"\r"
+
+    def bodies(self, summed: bool | None) -> list[str]:
+        """The frame's possible bodies: without the checksum when ``summed``, as it is
+        when not, and both when the checksum mode is not known."""
+        head, comma, tail = self.text.rpartition(",")
+        stripped = head if comma and is_hex_byte(tail, either_case=True) else None
+        if summed is True:
+            return [stripped if stripped is not None else self.text]
+        if summed is False or stripped is None:
+            return [self.text]
+        return [self.text, stripped]
 
     @property
     def pauses(self) -> list[tuple[int, int]]:
@@ -75,6 +109,15 @@ class HostFramer:
 
     def last_byte_at(self) -> int | None:
         return self._times[-1] if self._times else None
+
+    def frames(self, data: bytes, *, commit: bool = True, t: int = 0) -> list[HostFrame]:
+        """The frames ``data`` completes (fragments are not kept); with ``commit=False``
+        the state is unchanged (to judge bytes before they are written)."""
+        framer = self if commit else copy.deepcopy(self)
+        kept = len(framer.out)
+        done = [e for _, e in framer.feed(data, t) if isinstance(e, HostFrame)]
+        del framer.out[kept:]
+        return done
 
     def feed(self, data: bytes, t: int) -> list[tuple[int, HostFrame | Fragment]]:
         """A chunk of bytes that arrived at ``t``; returns what it completed, each with

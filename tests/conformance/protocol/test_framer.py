@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conformance.host.framer import KEEP, Fragment, HostFrame, HostFramer
+from conformance.protocol.framer import KEEP, Fragment, HostFrame, HostFramer
 
 
 def feed(framer: HostFramer, *chunks: tuple[bytes, int]) -> list:

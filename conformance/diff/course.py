@@ -1,0 +1,112 @@
+"""What the reference has been given so far in an example, as far as a difference
+reads it: the dwell a frame may have met, the fastest its axes can have stepped, the
+last vector it queued and whether a packet is open. One tracker, fed every accepted
+frame and every step."""
+
+from __future__ import annotations
+
+import math
+import re
+
+from conformance.diff.sides import Exchange
+from conformance.diff.steps import Step
+from conformance.protocol.catalogue import classes
+from gve_fixtures.profile import Profile
+
+#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
+_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
+#: a vector that moves nothing (and so waits no dwell)
+_ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
+#: frames that change the course of a motion: a difference after them is theirs
+_COURSE_CHANGERS = classes(course=True)
+
+
+class Course:
+    """The reference's course through one example.
+
+    - The modal dwell T and when the reference last took a vector: a frame sent less than
+      T after it may have met the vector still in its dwell (spec 10.2), which is what a
+      difference there points at, whatever command showed it.
+    - The fastest its axes can have stepped (steps/s): the highest V it took, raised by
+      the highest override (XM) and by 17/16 for each XU; a reference run (W) or the hand
+      wheel (Y) may step at the variant's top rate. A reading taken while moving is
+      uncertain by this rate times its window, not by the top rate (spec 10.2: a vector
+      cruises at V at most, a short one at B if lower, and no ramp or junction exceeds
+      the cruise; B lowers a rate, it never raises one).
+    - The last vector it queued: ``C+C`` when a C followed a C (the two meet at a
+      junction, spec 10.2); a D empties the queue.
+    - Whether a packet is open (`*S` to the unit's own address, until a breaker).
+    """
+
+    def __init__(self, profile: Profile) -> None:
+        self.t_ns = profile.reset.T * 1_000_000
+        self.vector_at: int | None = None
+        self.top = profile.max_rate
+        self.speed = profile.reset.V
+        self.override = max(100, profile.reset.XM) / 100
+        self.up = 1.0
+        self.queued: str | None = None
+        self.in_packet = False
+
+    # -- what it was given -----------------------------------------------------------------
+    def took(self, command: str, body: str, reference: Exchange, *, first: bool = True
+             ) -> None:
+        """The reference answered ``body``; ``first``: not a later frame of a fill (whose
+        vectors join the first: no dwell)."""
+        if reference.code != 0:
+            return
+        if first:
+            self._dwell(command, body, reference)
+        self._queue(command, body)
+        self._ceiling(command, body)
+
+    def stepped(self, command: str, step: Step) -> None:
+        """A step's frames all went: a packet opens or closes."""
+        if command == "*S" and step.address is None:
+            self.in_packet = True
+        elif command in _PACKET_BREAKERS:
+            self.in_packet = False
+
+    def _dwell(self, command: str, body: str, reference: Exchange) -> None:
+        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+            self.vector_at = reference.sent_at
+        elif command in _COURSE_CHANGERS:
+            self.vector_at = None          # what follows is the halt's, the resume's...
+        elif command == "T" and body[1:].isdigit():
+            self.t_ns = int(body[1:]) * 1_000_000
+
+    def _queue(self, command: str, body: str) -> None:
+        if command == "D":
+            self.queued = None
+        elif command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+            self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
+
+    def _ceiling(self, command: str, body: str) -> None:
+        value = _first_number(body[len(command):])
+        if command == "V" and value is not None:
+            self.speed = max(self.speed, value)
+        elif command == "XM" and value is not None:
+            self.override = max(self.override, value / 100)
+        elif command == "XU":          # each XU scales the held vectors again
+            self.up *= 17 / 16
+        elif command in ("W", "Y"):
+            self.speed = self.top
+
+    # -- what a difference reads ---------------------------------------------------------
+    def within_dwell(self, t: int) -> bool:
+        return self.vector_at is not None and t - self.vector_at < self.t_ns
+
+    @property
+    def rate(self) -> int:
+        return min(self.top, math.ceil(self.speed * self.override * self.up))
+
+    @property
+    def junction(self) -> bool:
+        return self.queued == "C+C"
+
+
+def _first_number(params: str) -> int | None:
+    try:
+        return int(params.split(",")[0])
+    except ValueError:
+        return None

@@ -1,0 +1,202 @@
+"""What a refused frame or a failed packet leaves behind, read back at rest: the whole
+observable state (positions, ST0..ST6, F with the queue-full bit, the outputs where a rig
+reads them, the index) is as it was before each one, and `>` shows the refused frame with
+the answer it got (spec 4, 5, 7, 8). The state it is refused in is built by the machine:
+status words, counters, small moves, outputs, a queue halted with INTA = 1."""
+
+from __future__ import annotations
+
+from hypothesis import strategies as st
+from hypothesis.stateful import precondition, rule
+
+from conformance.case import CaseContext, case
+from conformance.machines.base import UnitMachine, holds, index_invariant
+from conformance.machines.runner import run_machine
+
+IDLE, HALTED = "idle", "halted"
+
+#: a frame refused whatever the state, or only in one: body -> (code, state, rule)
+REFUSALS: dict[str, tuple[int, str | None, str]] = {
+    "Z": (3, None, "5.code.unknown"),
+    "T5,5": (4, None, "5.code.syntax"),
+    "L1,2": (4, None, "5.code.syntax"),
+    "T99": (5, None, "5.code.range"),
+    "SW8,F1": (5, None, "5.code.range"),
+    "SW2,1A5": (5, None, "5.code.range"),
+    "O0,1A5": (5, None, "5.code.range"),
+    "G": (6, IDLE, "5.code.nothing-to-go"),
+    "L5,0,0": (1, HALTED, "5.code.queue-full"),
+    "N": (7, HALTED, "5.code.busy-run"),
+    "NY5": (7, HALTED, "5.code.busy-run"),
+}
+#: packets that fail (members, *E's n, the code): their B and C must leave no trace
+FAILED_PACKETS = (
+    (("B10", "C0,5,0", "C0,5,0"), 4, 2),     # the count differs
+    (("C0,5,0", "V100"), 2, 4),              # a member that may not be one
+    (("B20", "B1", "C0,5,0"), 3, 5),         # a member out of range
+)
+#: the machine's moves and halted queues (counter units on the GVE84/114; GVE54 1/16)
+MOVE = st.integers(-30, 30)
+#: the frame that the watchdog drops (a byte held back past its time): answered 2
+STALLED = ("V500", 4)
+
+
+class ReadBackMachine(UnitMachine):
+    index_is_the_models = index_invariant()
+
+    def __init__(self, ctx: CaseContext) -> None:
+        super().__init__(ctx)
+        self.halted = False
+
+    # -- the state the refusals meet ------------------------------------------------------
+    @rule(word=st.integers(2, 5), value=st.integers(0, 255))
+    def status(self, word: int, value: int) -> None:
+        """ST2..ST5 (polarities and causes): with ST0/ST1 left 00 none of them can start
+        an interrupt, whatever a real unit's inputs read."""
+        r = self.send(f"SW{word},{value:02X}")
+        holds(r is not None and r.code == 0, "10.3.status.all-bits", f"SW answered {r}")
+
+    @precondition(lambda self: not self.halted)
+    @rule(axis=st.sampled_from("XYZ"), value=st.integers(-2147483647, 2147483647))
+    def counter(self, axis: str, value: int) -> None:
+        if f"N{axis}" not in self.ctx.profile.commands:
+            return
+        r = self.send(f"N{axis}{value}")
+        holds(r is not None and r.code == 0, "10.cmd.set-axis", f"N{axis} answered {r}")
+
+    @precondition(lambda self: not self.halted)
+    @rule(dx=MOVE, dy=MOVE, dz=MOVE)
+    def move(self, dx: int, dy: int, dz: int) -> None:
+        body = f"L{dx},{dy},{dz}"
+        if not self.fits(body):
+            return
+        r = self.send(body)
+        holds(r is not None and r.code == 0, "10.1.queue.line-alone", f"{body} answered {r}")
+        self.idle()
+
+    @rule(value=st.integers(0, 255))
+    def output(self, value: int) -> None:
+        """Outputs only where a rig reads them back (on a real unit they drive the
+        machine's spindle and coolant)."""
+        if self.link.rig is None:
+            return
+        r = self.send(f"O0,{value:02X}")
+        holds(r is not None and r.code == 0, "10.cmd.output", f"O0 answered {r}")
+
+    @precondition(lambda self: not self.halted)
+    @rule()
+    def halt_queue(self) -> None:
+        """Two C queued and halted at once: INTA = 1, RUN = 1, the rest waiting."""
+        if not (self.fits("C40,0,0") and self.fits("C80,0,0")):
+            return
+        for body in ("C40,0,0", "C40,0,0"):
+            r = self.send(body)
+            holds(r is not None and r.code == 0, "10.1.queue.cont-buffer", f"C answered {r}")
+        r = self.send("H")
+        holds(r is not None and r.inta, "10.4.halt.ramp", f"H answered {r}")
+        self.halted = True
+
+    @precondition(lambda self: self.halted)
+    @rule()
+    def delete(self) -> None:
+        r = self.send("D")
+        holds(r is not None and r.code == 0, "10.4.delete", f"D after H answered {r}")
+        self.halted = False
+
+    # -- what a refusal leaves ------------------------------------------------------------
+    def state(self) -> dict[str, object]:
+        """Everything a host reads at rest (the reads count in the index as any frame)."""
+        got: dict[str, object] = {"PF": self.position()}
+        for n in range(7):
+            r = self.send(f"SR{n}")
+            got[f"ST{n}"] = r.text if r is not None else None
+        r = self.send("F")
+        got["F"] = r.text if r is not None else None
+        if self.link.rig is not None:
+            got["outputs"] = self.link.rig.outputs()
+        return got
+
+    def unchanged(self, before: dict[str, object], what: str, rule_id: str) -> None:
+        after = self.state()
+        changed = {k: (before[k], after[k]) for k in before if before[k] != after[k]}
+        holds(not changed, rule_id, f"{what} changed {changed} (before, after)")
+
+    def repeated(self, body: str, answer: bytes) -> None:
+        """`>` shows the last answered frame as received and the answer it got."""
+        r = self.send(">", lines=2)
+        holds(r is not None and len(r.lines) == 2, "8.repeat.answer", f"> answered {r}")
+        want = [f"!{self.link.address}{body}".encode(), answer.rstrip(b"\r")]
+        holds(r.lines == want, "8.repeat.remembered", f"> shows {r.lines}, expected {want}")
+
+    @rule(body=st.sampled_from(sorted(REFUSALS)))
+    def refused(self, body: str) -> None:
+        want, state, code_rule = REFUSALS[body]
+        if state is not None and state != (HALTED if self.halted else IDLE):
+            return
+        if body[:2] == "NY" and "NY" not in self.ctx.profile.commands:
+            return
+        before = self.state()
+        r = self.send(body)
+        holds(r is not None and r.code == want, code_rule, f"{body} answered {r}, "
+              f"expected code {want}")
+        self.repeated(body, r.raw)
+        self.unchanged(before, f"{body} refused with {want}", "4.response.failed-not-executed")
+
+    @rule(which=st.integers(0, len(FAILED_PACKETS) - 1))
+    def failed_packet(self, which: int) -> None:
+        if "*S" not in self.ctx.profile.commands:
+            return
+        members, n, want = FAILED_PACKETS[which]
+        before = self.state()
+        self.send("*S", answer=False)
+        self.model.open_packet()
+        for m in members:
+            self.send(m, answer=False)
+        self.model.packet = None
+        r = self.send(f"*E{n}")
+        holds(r is not None and r.code == want, "7.packet.codes",
+              f"{', '.join(members)}, *E{n} answered {r}, expected code {want}")
+        self.repeated(f"*E{n}", r.raw)
+        self.unchanged(before, f"the packet {', '.join(members)}, *E{n}",
+                       "7.packet.all-or-nothing")
+
+    @rule()
+    def stalled(self) -> None:
+        """A frame the watchdog drops: answered 2, not counted, not remembered by `>`."""
+        body, at = STALLED
+        before = self.state()
+        before_repeat = self.link.send(">", lines=2)
+        self.link.inject("host", "delay", at=at, seconds=self.ctx.profile.watchdog_ms / 1000
+                         + 0.2)
+        r = self.link.send(body, timeout=1.0)
+        # the watchdog's time is not the manuals' (a slower one is a reading)
+        holds(r is not None and r.code == 2, "3.frame.watchdog-time",
+              f"{body} stalled {self.ctx.profile.watchdog_ms + 200} ms answered {r}")
+        self.link.wait(0.1)                # the rest of the frame: no frame of its own
+        again = self.link.send(">", lines=2)
+        holds(again is not None and before_repeat is not None
+              and again.lines == before_repeat.lines, "8.repeat.remembered",
+              f"> after a dropped frame shows {again}, before it {before_repeat}")
+        # > and the stalled frame count in the index only on a unit whose @ counts itself
+        if not self.model.uncounted:
+            self.model.index = (self.model.index + 2) % 256
+        self.unchanged(before, f"{body} dropped by the watchdog",
+                       "4.response.failed-not-executed")
+
+    def teardown(self) -> None:
+        if self.halted:
+            self.send("D")
+
+
+@case("4.machine.refusals-read-back",
+      rules=("4.response.failed-not-executed", "7.packet.all-or-nothing", "7.packet.codes",
+             "8.repeat.remembered", "8.repeat.answer", "8.index.counts", "5.code.unknown",
+             "5.code.syntax", "5.code.range", "5.code.nothing-to-go", "5.code.queue-full",
+             "5.code.busy-run", "3.frame.watchdog-time", "10.3.status.all-bits", "10.cmd.set-axis",
+             "10.1.queue.line-alone", "10.cmd.output", "10.1.queue.cont-buffer",
+             "10.4.halt.ramp", "10.4.delete"),
+      tag="M", source="M84 12.6; spec 4, 5, 7, 8",
+      rule="After every refused frame and every failed packet the state read back at rest "
+           "is as before; > shows the refused frame and its answer")
+def readback_machine(ctx: CaseContext) -> None:
+    run_machine(ctx, ReadBackMachine)

@@ -1,0 +1,73 @@
+"""The reference's course through an example: the dwell a frame may meet, the fastest
+rate its axes can have stepped at, the junction of two C and the open packet."""
+
+from conformance.diff.course import Course
+from conformance.diff.sides import Exchange
+from conformance.diff.steps import FRAME, Step
+from conformance.link.framing import parse_response
+from conformance.targets import parse_target
+
+MS = 1_000_000
+
+
+def course() -> Course:
+    return Course(parse_target("emu:GVE84-100").profile)     # T5, V1000, XM100
+
+
+def ok(at_ms: int = 0, code: int = 0) -> Exchange:
+    """The reference's answer ``code``, the frame sent ``at_ms`` into the example."""
+    answer = f"{code}\r".encode()
+    return Exchange(b"", answer, at_ms * MS, at_ms * MS, parse_response(answer, summed=False))
+
+
+def test_a_frame_within_t_of_a_vector_may_meet_its_dwell():
+    c = course()
+    c.took("C", "C5,0,0", ok(10))
+    assert c.within_dwell(14 * MS) and not c.within_dwell(15 * MS)
+    c.took("T", "T20", ok(11))
+    assert c.within_dwell(29 * MS)
+    c.took("H", "H", ok(12))                    # what follows is the halt's
+    assert not c.within_dwell(13 * MS)
+
+
+def test_a_vector_that_moves_nothing_or_is_refused_sets_no_dwell():
+    c = course()
+    c.took("L", "L0,-0,+0", ok(10))
+    c.took("C", "C5,0,0", ok(10, code=1))
+    c.took("C", "C5,0,0", ok(10), first=False)   # a fill's later frame joins the first
+    assert not c.within_dwell(11 * MS)
+
+
+def test_the_rate_ceiling_follows_v_xm_xu_and_the_top_rate():
+    c = course()
+    assert c.rate == 1000
+    c.took("V", "V2000", ok())
+    c.took("V", "V500", ok())                   # the highest V taken stands
+    c.took("XM", "XM150", ok())
+    assert c.rate == 3000
+    c.took("XU", "XU", ok())
+    assert c.rate == 3188                       # 3000 * 17/16, rounded up
+    c.took("W", "W", ok())
+    assert c.rate == 100000
+
+
+def test_two_c_meet_at_a_junction_until_d():
+    c = course()
+    c.took("C", "C1,0,0", ok())
+    assert not c.junction
+    c.took("C", "C0,1,0", ok())
+    assert c.junction
+    c.took("D", "D", ok())
+    c.took("C", "C1,0,0", ok())
+    assert not c.junction
+
+
+def test_a_packet_opens_on_the_units_own_star_s_and_closes_on_a_breaker():
+    c = course()
+    c.stepped("*S", Step(FRAME, "*S", address=3))
+    assert not c.in_packet
+    c.stepped("*S", Step(FRAME, "*S"))
+    c.stepped("C", Step(FRAME, "C1,0,0"))
+    assert c.in_packet
+    c.stepped("@", Step(FRAME, "@"))
+    assert not c.in_packet

@@ -1,0 +1,66 @@
+"""The timing a pair is run with: exact between two sides in virtual time, the real-time
+allowance (latency, slack, cut) as soon as one side is not."""
+
+from conformance.diff.engine import Pair
+from conformance.diff.sides import Exchange, Side
+from conformance.diff.timing import RealTime, Timing
+from conformance.targets import parse_target
+
+MS = 1_000_000
+
+
+def sides() -> tuple[Side, Side]:
+    return Side(parse_target("emu:GVE84-100")), Side(parse_target("emu:GVE84-100"))
+
+
+def test_two_virtual_sides_are_compared_exactly():
+    target, reference = sides()
+    p = Pair(target, reference, target.target.profile)
+    assert type(p.timing) is Timing and p.exact and p.timing.repeatable
+    reply = Exchange(b"H", b"0\r", 0, 200 * MS, None)
+    p.timing.retimed("H", reply)
+    assert p.timing.allowance("P", reply, reply) == (False, 0)
+
+
+def test_in_real_time_a_course_change_while_moving_widens_later_readings():
+    """The latency is the slowest immediate answer so far (an H answers when stopped: not
+    a latency); what changes a running motion's course adds it to the readings while it
+    runs, what stops it short to the positions at rest too; a setting at rest adds
+    nothing."""
+    t = RealTime(*sides())
+    assert not t.exact and not t.repeatable
+
+    def sent(command: str, took_ms: int) -> tuple[int, int, int]:
+        reply = Exchange(command.encode(), b"0\r", 0, took_ms * MS, None)
+        t.retimed(command, reply)
+        return t.latency_ns // MS, t.slack_ns // MS, t.cut_ns // MS
+
+    t.idle_since = None                              # the reference was moving
+    assert sent("V", 2) == (2, 0, 0)
+    assert sent("XM", 1) == (2, 2, 0)
+    assert sent("H", 200) == (2, 4, 2)
+    t.idle_since = 5                                 # at rest since
+    assert sent("XM", 3) == (3, 4, 2)
+    assert not t.lost and sent("D", 1) == (3, 4, 2) and t.lost
+    t.begin()                                        # a new example forgets it all
+    assert (t.latency_ns, t.slack_ns, t.cut_ns, t.lost, t.idle_since) == (0, 0, 0, False, 0)
+
+
+def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
+    """Exact in virtual time; in real time from the round trip the target's session
+    measured, its min and max widened by the example's immediate answers (not an H's)."""
+    target, reference = sides()
+    assert Timing(target, reference).line().exact
+    t = RealTime(target, reference)
+    target.open()
+    target.link.round_trip = {"min_ms": 1.0, "median_ms": 3.0, "max_ms": 4.0,
+                              "byte_ms": 0.5, "bytes_ms": 1.0}
+    assert t.line().seconds == 4.5e-3                # 1 one way + 3 jitter + 0.5 a byte
+    t.retimed("V", Exchange(b"V", b"0\r", 0, 6 * MS, None))
+    t.retimed("H", Exchange(b"H", b"8\r", 0, 300 * MS, None))
+    assert abs(t.line().seconds - 6.5e-3) < 1e-12     # jitter 6 - 1 (the session's min)
+    t.retimed("V", Exchange(b"V", b"0\r", 0, 5 * MS, None))
+    assert abs(t.line().seconds - 2.5e-3) < 1e-12     # two of its own: jitter 6 - 5
+    t.begin()
+    assert t.line().seconds == 4.5e-3
+    target.close_example()

@@ -1,0 +1,90 @@
+"""The suite's machinery assumes only what the manuals state: through the co-simulating
+emulator (a unit the suite does not own, so every case starts from the known state the
+session sets, over the same unit) a unit taking a reading runs the whole catalogue to the
+end, with no FAIL and no case lost to a wedged unit; what it changes is graded
+NON-STRICT or INFO, naming the rule read otherwise."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+
+import pytest
+
+from conformance.catalogue import select
+from conformance.diff.engine import Budget, Pair, search
+from conformance.diff.grammar import Options
+from conformance.diff.sides import Side
+from conformance.runner import run
+from conformance.targets import parse_target
+from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
+from emulator.readings import READINGS
+from gve_fixtures.profile import load_profile
+from gve_fixtures.rules import load_rules
+
+#: reading -> the rules its differences must name (at least one of them shows)
+MACHINERY = {
+    "packet-closed-only-by-end": {"7.packet.breakers"},
+    "slow-watchdog": {"3.frame.watchdog-time"},
+}
+
+
+def cosim_target(profile: str, readings: list[str]):
+    command = [sys.executable, "-m", "emulator", "--model", profile, "--cosim"]
+    for name in readings:
+        command += ["--reading", name]
+    target = parse_target("exec:" + shlex.join(command), profile=profile,
+                          allow_destructive=True,
+                          max_travel=load_profile(profile).vector_range)
+    target.preflight()
+    return target
+
+
+def differences(readings: list[str]) -> set[str]:
+    """The whole catalogue through the co-simulator taking ``readings``: it ends, with
+    no FAIL, no ERROR and no case lost to a silent unit; the rules its differences name."""
+    result = run([cosim_target("GVE84-100", readings)], select([]))
+    assert result.problems == []
+    assert len(result.results) == len(select([]))
+    unfair = [(r.id, r.verdict, r.notes[:1]) for r in result.results
+              if r.verdict in (FAIL, ERROR)]
+    assert unfair == []
+    lost = [r.id for r in result.results if any("not responding" in n for n in r.notes)]
+    assert lost == []
+    named = {c["rule"] for r in result.results if r.verdict in (NON_STRICT, INFO)
+             for c in r.failed_checks}
+    assert None not in named
+    return named
+
+
+@pytest.mark.parametrize("reading", sorted(MACHINERY))
+def test_a_reading_runs_the_whole_catalogue_through_a_session(reading):
+    named = differences([reading])
+    assert MACHINERY[reading] & named, named
+    assert named <= set(READINGS[reading].rules), named
+
+
+@pytest.mark.slow
+def test_every_reading_at_once_runs_the_whole_catalogue_through_a_session():
+    named = differences(sorted(READINGS))
+    rules = load_rules()
+    # the golden exchanges name their own rule, graded by their record's [D] tag
+    assert all(rules[r].tag.startswith("D") or r.startswith("11.golden.") for r in named), \
+        named
+
+
+@pytest.mark.parametrize("reading", sorted(MACHINERY))
+def test_diff_runs_its_budget_through_a_session_taking_a_reading(reading):
+    target = cosim_target("GVE84-100", [reading])
+    pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                target.profile)
+    try:
+        budget = Budget(examples=300)
+        found = search(pair, Options(destructive=True, rig=True), budget)
+        assert budget.used == 300
+    finally:
+        pair.target.session.finish()
+        pair.target.target.close()
+    graded = [(f.disagreement.rule, f.disagreement.verdict) for f in found]
+    assert graded and all(verdict in (NON_STRICT, INFO) and rule in READINGS[reading].rules
+                          for rule, verdict in graded), graded
