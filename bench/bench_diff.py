@@ -56,9 +56,12 @@ def _search(pair: Pair, frames: int) -> tuple[float, float, int]:
     # the next goes on
     while budget.frames < frames:
         first = budget.used == 0
+        sent = budget.frames
         budget.examples = budget.used + 500
         found += len(search(pair, Options(destructive=True, rig=True), budget,
                             seed=budget.used, with_probes=first))
+        if budget.frames == sent:
+            break               # a target that stopped responding sends no more
     total = budget.elapsed
     return budget.frames / total, budget.used / total, found
 

@@ -215,13 +215,11 @@ class Pair:
         self.target.wait(self.profile.range("T").hi / 1000)
         indexes = []
         for side in (self.target, self.reference):
-            side.link.send("SR0")
-            r = side.link.send("@")
+            r = side.link.send_each(["SR0", "@", "SR0"])[1]
             try:
                 indexes.append(r.dec(0) if r is not None else 0)
             except AssertionError:
                 indexes.append(0)
-            side.link.send("SR0")
         self.judge = replace(self.judge, index_offset=(indexes[0] - indexes[1]) % 256)
 
     def _same_eeprom(self) -> None:

@@ -20,7 +20,7 @@ not taken for a later frame's; bytes after a complete answer are recorded in
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from conformance.link.faults import FrameFault
 from conformance.link.framing import (
@@ -223,6 +223,17 @@ class Link:
         if r is not None:
             r.sent_at = sent_at
         return r
+
+    def send_each(self, bodies: Sequence[str]) -> list[Response | None]:
+        """:meth:`send` each frame in turn, in the mode the link believes. A port that can
+        take frames it is told ahead (a co-simulator's, docs/cosim.md: `batch`) is told
+        them first: what goes on the line, and when, is the same."""
+        expect = getattr(self.port, "expect", None)
+        if expect is not None and not self._faults:
+            framed = [frame(body, self.address, self.checksums) for body in bodies]
+            expect([(data, self.answer_timeout(body, len(data))) for body, data in
+                    zip(bodies, framed, strict=True)])
+        return [self.send(body) for body in bodies]
 
     def _book(self, frames: list[HostFrame], answer: Response | None) -> None:
         """Book frames with the answer to the last one (the others got none)."""

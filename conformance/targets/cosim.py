@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Iterator
+from collections import deque
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
@@ -58,11 +60,30 @@ class Channel(Protocol):
 
 
 def announced(first: str) -> int | None:
-    """The protocol version a program's first line announces (None: not ``cosim N``)."""
+    """The protocol version a program's first line announces (None: not ``cosim N``,
+    which the names of the extensions it offers may follow)."""
     words = first.split()
-    if len(words) == 2 and words[0] == "cosim" and words[1].isdigit():
+    if len(words) >= 2 and words[0] == "cosim" and words[1].isdigit():
         return int(words[1])
     return None
+
+
+def offered(first: str) -> frozenset[str]:
+    """The optional extensions a program's first line ``cosim N NAME...`` offers."""
+    return frozenset(first.split()[2:]) if announced(first) is not None else frozenset()
+
+
+@dataclass(frozen=True)
+class Ahead:
+    """A frame told the simulator ahead (`batch`): where the suite will send it, the
+    instant its answer was awaited until, and what the simulator did."""
+
+    data: bytes
+    start: int
+    goal: int
+    rx: bytes
+    now: int
+    cr: bool
 
 
 def byte_ns(baud: int) -> int:
@@ -72,13 +93,16 @@ def byte_ns(baud: int) -> int:
 class CosimLine:
     """The simulator's line, driven in virtual time (see the module's docstring)."""
 
-    def __init__(self, program: Channel, baud: int) -> None:
+    def __init__(self, program: Channel, baud: int, extensions: frozenset[str] = frozenset()
+                 ) -> None:
         self.program = program
+        self.extensions = extensions
         self.baud = baud
         self.byte_ns = byte_ns(baud)
         self.now = 0                          # the simulator's clock, as it last said
         self._rx = bytearray()                # bytes to the host, not read yet
         self._tx: tuple[bytes, int] | None = None   # a write not sent yet, and its start
+        self._ahead: deque[Ahead] = deque()   # frames the simulator has run, to be sent
         self.broken = ""
 
     # -- the channel -------------------------------------------------------------------------
@@ -140,6 +164,7 @@ class CosimLine:
     def ask(self, command: str) -> str:
         """A rig command (docs/rig.md) at the current instant: its one reply line."""
         self._flush()
+        self._catch_up()
         with self._exchange(command):
             return self._reply(command, time.monotonic() + REPLY_SECONDS, "")
 
@@ -243,10 +268,61 @@ class CosimLine:
             self._tx = None
             end = self.now
             goal = min(max(t, end), end + STEP_NS)
+            if self._ahead:
+                head = self._ahead.popleft()
+                if (head.data, head.start, head.goal) == (data, start, goal):
+                    self._rx += head.rx
+                    self.now = head.now
+                    return head.cr
+                self._ahead.appendleft(head)
+                wait = goal - end
+                self._catch_up()                  # the bytes go out from where it is
+                start, end = self.now, self.now + len(data) * self.byte_ns
+                self.now, goal = end, end + wait
             command = f"tx {data.hex().upper()}" + (f" {goal}" if goal > end else "")
             return self._move(command, start, end, goal)
-        goal = min(t, self.now + STEP_NS)
+        self._catch_up()
+        goal = max(self.now, min(t, self.now + STEP_NS))
         return self._move(f"until {goal}", self.now, self.now, goal)
+
+    # -- frames told ahead (the `batch` extension) ---------------------------------------------
+    def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
+        """The frames the host is about to send one after the other, each with the seconds
+        its answer is to be awaited. A simulator that offers `batch` runs them all in one
+        exchange; each frame's write and read then take their part of its reply, checked,
+        timed and read exactly as one exchange a frame would be."""
+        if ("batch" not in self.extensions or self._tx is not None or self._rx
+                or self._ahead):
+            return
+        self._usable()
+        plan: list[tuple[bytes, int]] = []
+        for data, timeout in frames:
+            wait = round(timeout * SECOND)
+            if not data or wait > STEP_NS:
+                break
+            plan.append((bytes(data), wait))
+        if len(plan) < 2:
+            return
+        command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
+        here, ahead = self.now, []
+        with self._exchange(command):
+            for i, (data, wait) in enumerate(plan):
+                start = self.now
+                end = start + len(data) * self.byte_ns
+                label = f"batch (frame {i + 1}: tx {data.hex().upper()} {end + wait})"
+                cr = self._moved(label, start, end, end + wait)
+                ahead.append(Ahead(data, start, end + wait, bytes(self._rx), self.now, cr))
+                self._rx.clear()
+        self.now = here
+        self._ahead.extend(ahead)
+
+    def _catch_up(self) -> None:
+        """Frames told ahead and then not sent as told (Ctrl-C, a frame the guard
+        refused, a target given up): the simulator has run them all the same. The clock
+        catches up with its clock, their answers are dropped."""
+        if self._ahead:
+            self.now = self._ahead[-1].now
+            self._ahead.clear()
 
     def _flush(self) -> None:
         """Send the write not sent yet (its clock to the end of its bytes)."""
@@ -256,6 +332,7 @@ class CosimLine:
     def advance_to(self, t: int) -> None:
         """Let virtual time pass up to the instant ``t``."""
         self._flush()
+        self._catch_up()
         while self.now < t:
             self._step(t)
 
@@ -279,6 +356,8 @@ class CosimLine:
         (sent with the next operation)."""
         self._flush()
         self._usable()
+        if self._ahead and (self._ahead[0].data, self._ahead[0].start) != (data, self.now):
+            self._catch_up()
         if data:
             self._tx = (bytes(data), self.now)
             self.now += len(data) * self.byte_ns
@@ -298,6 +377,8 @@ class CosimLine:
         """Up to ``size`` bytes (stopping after ``terminator``), waiting at most
         ``timeout`` seconds of virtual time: the clock stops when the terminator is there
         (a CR, as every answer ends) or at the timeout."""
+        if self._tx is None:
+            self._catch_up()
         deadline = self.now + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
         out = bytearray(self._take(size, terminator))
         while len(out) < size and not (terminator and out.endswith(terminator)):
@@ -352,6 +433,10 @@ class CosimPort:
 
     def write(self, data: bytes) -> int:
         return self.line.write(bytes(data))
+
+    def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
+        """The frames about to be sent, each with its answer's timeout (CosimLine.expect)."""
+        self.line.expect(frames)
 
     def read(self, size: int = 1) -> bytes:
         return self.line.read(size, self.timeout)

@@ -21,7 +21,14 @@ from typing import NoReturn
 
 from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
-from conformance.targets.cosim import VERSION, CosimLine, CosimPort, ProtocolBroken, announced
+from conformance.targets.cosim import (
+    VERSION,
+    CosimLine,
+    CosimPort,
+    ProtocolBroken,
+    announced,
+    offered,
+)
 from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
@@ -59,7 +66,7 @@ class ProcessTarget(PortTarget):
             first = self._start()
             version = announced(first)
             if version is not None:
-                self._port = self._cosim(version)
+                self._port = self._cosim(version, offered(first))
                 return self._port
             url = self._serve_port(first)
             try:
@@ -100,14 +107,14 @@ class ProcessTarget(PortTarget):
         self._found_rig(virtual=False)
         return url
 
-    def _cosim(self, version: int) -> CosimPort:
+    def _cosim(self, version: int, extensions: frozenset[str]) -> CosimPort:
         """The co-simulation's line and port, its rig when `state` answers one. A
         simulator that breaks the protocol here leaves the line broken: the run's first
         frame finds it so (a FAIL), nothing is refused before the run."""
         if version != VERSION:
             self._fail(f"the program speaks co-simulation version {version}; this suite "
                        f"speaks version {VERSION} (docs/cosim.md)")
-        line = CosimLine(self.program, self.baud)     # its replies read as they are due
+        line = CosimLine(self.program, self.baud, extensions)   # replies read as they are due
         try:
             self.rig = ControlRig.found_in(line.start(), line.ask, self.address,
                                            self._restarted)

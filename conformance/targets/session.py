@@ -25,7 +25,7 @@ real unit's (:class:`RealSession`) does all of the above; :func:`open_session` p
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
@@ -367,37 +367,35 @@ class RealSession(Session):
             frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
         return frames
 
-    def _stop(self, link: Link) -> None:
+    def _stop(self, link: Link, then: Sequence[str] = ()) -> None:
         """`H`, checksums off, interrupts off (ST0..ST5 = 00), then `D`: the queue empty
-        and ST6 clear (an input still enabled would set INTA again at once)."""
+        and ST6 clear (an input still enabled would set INTA again at once); then the
+        frames ``then``."""
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        for n in range(6):
-            link.send(f"SW{n},00")
-        link.send("D")
+        link.send_each([*(f"SW{n},00" for n in range(6)), "D", *then])
 
-    def _settle(self, link: Link) -> None:
+    def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
         interrupts off, queue and save empty, the reset values of what cannot be read. A
         KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
-        the empty queue over it and R restores that, which moves nothing."""
+        the empty queue over it and R restores that, which moves nothing. Then the
+        frames ``then``."""
         if link.rig is not None:
             link.rig.hands_off()
-        self._stop(link)
-        for body in self._reset_frames():
-            link.send(body)
-        link.send("K")
-        link.send("R")
+        self._stop(link, [*self._reset_frames(), "K", "R", *then])
 
     def _known_state(self, link: Link) -> None:
-        self._settle(link)
-        self._go_back(link)
+        self._settle(link, ["PF"])                 # where the axes are, for the way back
+        self._go_back(link, read=False)
         link.send("N")
 
-    def _go_back(self, link: Link) -> None:
-        """Move the axes back to where the run began (known exactly only at rest)."""
-        self._position(link)
+    def _go_back(self, link: Link, *, read: bool = True) -> None:
+        """Move the axes back to where the run began (known exactly only at rest; the
+        counters read first unless ``read`` is False: just read)."""
+        if read:
+            self._position(link)
         envelope = self.guard.envelope
         if envelope.unheld:
             axes = ", ".join(sorted({self.profile.axes[i] for i in envelope.unheld}))
@@ -424,7 +422,9 @@ class RealSession(Session):
         r = link.send(body)
         if r is None or r.code != 0:
             raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
-        seconds = max(abs(b) for b in back) / speed * 2 + 2 * self.guard.stop_seconds() + 2
+        cruise = max(abs(b) for b in back) / speed        # the least the way back takes
+        seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
+        link.wait(cruise)                                  # asking before it ends is moot
         if link.poll("L0,0,0", lambda r: r.code == 0, seconds) is None:
             raise CouldNotTest("the return to where the run began did not end in time")
         self._position(link)

@@ -7,6 +7,8 @@ in-process `gve://` line would give it.
                    (then, with T and no CR to the host meanwhile, on as `until T`)
     until T        advance to the instant T (ns), stopping at a CR to the host
     next           the next instant anything happens (`next T`, `next none`)
+    batch D HEX .. frames in turn, each as `tx HEX T` with T its bytes' end + D ns (the
+                   extension `batch`, offered on the first line: `cosim 1 batch`)
     baud N         the line's rate
     in, switch, power-on, state, quit, help: the test rig (docs/rig.md)
 
@@ -25,9 +27,12 @@ from emulator.link.line import Line, TimeRangeError, byte_time
 from emulator.link.server import CONTROL_LIMIT, StdoutGone
 
 VERSION = 1
+#: the optional extensions this simulator speaks, named on its first line (docs/cosim.md)
+EXTENSIONS = ("batch",)
 CR = b"\r"
-HELP = ("commands: tx HEX [T] | until T | next | baud N | in PORT HEX | switch AXIS POS|none "
-        "| power-on | state | quit  [@ADDRESS on in, switch, power-on, state]")
+HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
+        "| in PORT HEX | switch AXIS POS|none | power-on | state | quit  "
+        "[@ADDRESS on in, switch, power-on, state]")
 
 
 class CosimError(ValueError):
@@ -79,8 +84,9 @@ class Cosim:
     def _tx(self, args: list[str]) -> list[str]:
         if len(args) not in (1, 2):
             raise CosimError("tx HEX [T]")
-        data = _hex(args[0])
-        until = _instant(args[1]) if len(args) == 2 else None
+        return self._send(_hex(args[0]), _instant(args[1]) if len(args) == 2 else None)
+
+    def _send(self, data: bytes, until: int | None) -> list[str]:
         line = self.line
         end = line.now + len(data) * line.byte_ns
         if until is not None and until < end:
@@ -91,6 +97,17 @@ class Cosim:
             self._run_to(until)
             out += line.take_timed()
         return [*_rx_lines(out), f"now {line.now}"]
+
+    def _batch(self, args: list[str]) -> list[str]:
+        """Each frame in turn as `tx HEX T`, T the end of its bytes + D: the replies
+        those would give one after the other, in one exchange."""
+        if not args or len(args) % 2:
+            raise CosimError("batch D HEX [D HEX ...]")
+        frames = [(_instant(args[i]), _hex(args[i + 1])) for i in range(0, len(args), 2)]
+        out: list[str] = []
+        for wait, data in frames:
+            out += self._send(data, self.line.now + len(data) * self.line.byte_ns + wait)
+        return out
 
     def _until(self, args: list[str]) -> list[str]:
         if len(args) != 1:
@@ -136,8 +153,8 @@ def _rx_lines(runs: list[tuple[int, bytes]]) -> list[str]:
     return [f"rx {t} {data.hex().upper()}" for t, data in runs]
 
 
-_COMMANDS = {"tx": Cosim._tx, "until": Cosim._until, "next": Cosim._next,
-             "baud": Cosim._baud, "help": Cosim._help}
+_COMMANDS = {"tx": Cosim._tx, "until": Cosim._until, "batch": Cosim._batch,
+             "next": Cosim._next, "baud": Cosim._baud, "help": Cosim._help}
 
 
 def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None = None
@@ -155,7 +172,7 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
         except BrokenPipeError:
             raise StdoutGone from None
 
-    say([f"cosim {VERSION}"])
+    say([" ".join(("cosim", str(VERSION), *EXTENSIONS))])
     while True:
         raw = stdin.readline(CONTROL_LIMIT + 1)
         if not raw:

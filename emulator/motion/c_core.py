@@ -18,8 +18,6 @@ from __future__ import annotations
 import struct
 from typing import Any
 
-import numpy as np
-
 from emulator.motion.build_stepper import AXES
 from emulator.motion.rebuild import ensure_fresh
 
@@ -186,6 +184,9 @@ class CMotion:
         n = lib.st_pulses(self._m, t0, t1, ffi.NULL, ffi.NULL, 0)
         if n < 0:
             raise MemoryError("st_pulses")
+        # only pulse trains need numpy: a unit (a co-simulator's) starts without it
+        import numpy as np
+
         times = np.empty(n, dtype=np.int64)
         masks = np.empty(n, dtype=np.uint8)
         if n and lib.st_pulses(self._m, t0, t1, ffi.from_buffer("int64_t[]", times),

@@ -17,8 +17,6 @@ from collections import deque
 from dataclasses import dataclass, replace
 from math import isqrt
 
-import numpy as np
-
 import emulator.motion.segment as seg
 from emulator.motion.arith import NEVER, axis_count, first_step_reaching, stop_distance
 from emulator.motion.interface import Deviation, KeepSave, MotionFlags, Vector
@@ -301,6 +299,9 @@ class PythonMotion:
                         mask |= (1 << i) | ((d < 0) << (4 + i))
                 times.append(_step_instant(p, k))
                 masks.append(mask)
+        # only pulse trains need numpy: a unit (a co-simulator's) starts without it
+        import numpy as np
+
         return np.array(times, dtype=np.int64), np.array(masks, dtype=np.uint8)
 
     def _ghost(self) -> PythonMotion:

@@ -263,3 +263,69 @@ def test_a_co_simulator_is_graded_as_a_target_other_than_the_reference(strict):
         assert target.info.virtual_time and target.info.strict is strict
     finally:
         target.close()
+
+
+def test_the_first_line_may_name_the_extensions_it_speaks():
+    assert cosim_module.announced("cosim 1 batch") == 1
+    assert cosim_module.offered("cosim 1 batch later") == {"batch", "later"}
+    assert cosim_module.offered("cosim 1") == frozenset()
+    assert cosim_module.offered("/dev/pts/7") == frozenset()
+
+
+#: frames whose answers come at once, and H, which answers once the axis has stopped
+#: (awaited longer than the 1 s one frame of a batch may take: sent on its own)
+FRAMES = ["?", "SW0,00", "D", "V1000", "L500,0,0", "SR6", "PF", "H"]
+
+
+def _sent(batch: bool):
+    """The records, answers, clock and commands sent of FRAMES by Link.send_each on a
+    co-simulated emulator, with `batch` or without."""
+    from conformance.link.link import Link
+
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port, baud, virtual, _ = target.connect(None)
+        if not batch:
+            port.line.extensions = frozenset()
+        commands = []
+        send = port.line.program.send
+        port.line.program.send = lambda text: commands.append(text) or send(text)
+        link = Link(port, target.session.guard, baud=baud, virtual=virtual)
+        target.session.guard.motion_confirmed = True
+        answers = link.send_each(FRAMES)
+        records = [(r.direction, r.data, r.t) for r in link.log]
+        return records, [a and a.raw for a in answers], port.line.now, list(commands)
+    finally:
+        target.close()
+
+
+def test_frames_told_ahead_go_in_one_exchange_and_read_as_one_a_frame():
+    batched, answers, now, commands = _sent(batch=True)
+    single, single_answers, single_now, single_commands = _sent(batch=False)
+    assert (batched, answers, now) == (single, single_answers, single_now)
+    assert [c.split()[0] for c in commands] == ["batch", "tx"]
+    assert [c.split()[0] for c in single_commands] == ["tx"] * len(FRAMES)
+    assert answers[FRAMES.index("H")] is not None, "H answered once the axis stopped"
+
+
+def test_frames_told_ahead_and_not_sent_as_told_leave_the_clock_on_the_simulator_s():
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        line = port.line
+        port.timeout = 0.25
+        frames = [b"!0V1000\r", b"!0A20\r", b"!0?\r"]
+        port.expect([(f, 0.25) for f in frames])
+        port.write(frames[0])
+        assert port.read_until(b"\r") == b"0\r"
+        simulator = line._ahead[-1].now
+        port.write(b"!0SR6\r")                    # not what was told: A20 and ? ran
+        assert port.read_until(b"\r") == b"0,00\r"
+        assert line.now > simulator, "the clock went on from the simulator's"
+        port.write(b"!0?\r")
+        assert port.read_until(b"\r").startswith(b"0,IP84"), "the line goes on, in step"
+        assert not line.broken and not line._ahead
+    finally:
+        target.close()
