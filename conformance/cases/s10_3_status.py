@@ -18,8 +18,17 @@ def _interrupted_by_input(ctx: CaseContext) -> None:
 
 def _after_clearing(ctx: CaseContext, body: str) -> None:
     _interrupted_by_input(ctx)
-    code(ctx, ctx.link.send(body), 0, f"{body} with the input still active → 8", inta=True,
-         rule="4.response.inta-level")
+    r = ctx.link.send(body)
+    if body == "R":
+        # nothing was kept: what R answers then is the restore rule's reading, the INTA
+        # bit on that answer this case's
+        code(ctx, r, 0, "R with nothing kept → 0", rule="10.5.restore.pops")
+        ctx.expect(r is not None and r.inta is True, "R with the input still active: INTA "
+                   "set on the answer", observed=show(r), expected="INTA bit set",
+                   rule="4.response.inta-level")
+    else:
+        code(ctx, r, 0, f"{body} with the input still active → 8", inta=True,
+             rule="4.response.inta-level")
     for n, value in ((6, "80"), (4, "01")):
         r = ctx.link.send(f"SR{n}")
         ctx.expect(r is not None and r.inta and r.values == [value],
@@ -53,7 +62,7 @@ def f_idle(ctx: CaseContext) -> None:
 
 
 @case("10.3.inputs.level-after-clearing", hands=True,
-      rules=("10.3.inputs.level-triggered", "4.response.inta-level"))
+      rules=("10.3.inputs.level-triggered", "4.response.inta-level", "10.5.restore.pops"))
 def level_after_clearing(ctx: CaseContext) -> None:
     for body in ("G", "D", "K", "R"):
         ctx.fresh_link()

@@ -1,9 +1,14 @@
-"""`gve-conformance fairness`: the fairness score — the whole catalogue against the
-emulator taking each of its readings (the other answers a careful reader of the manuals
-could give where they are silent; emulator/readings.py), one at a time on one profile
-per family and all at once on every profile, graded as any unit is (by the tags). A
-reading is fair when no case FAILs or ERRs and every difference it makes names its
-rule; the score is fair readings / readings, and CI fails below 100 %."""
+"""`gve-conformance fairness`: the fairness score — the whole catalogue and `diff` (its
+probes and a bounded search) against the emulator taking each of its readings (the
+other answers a careful reader of the manuals could give where they are silent;
+emulator/readings.py), one at a time on one profile per family and all at once on
+every profile, graded as any unit is (by the tags). A reading is fair when no case FAILs
+or ERRs, diff finds no FAIL and runs to its end, and every difference either makes names
+its rule; the score is fair readings / readings, and CI fails below 100 %.
+
+diff runs on one profile per family (all at once too: the catalogue covers every
+profile), its budget its probes and DIFF_DRAWN drawn sequences from seed DIFF_SEED: the
+same sequences on every run, a few seconds a profile."""
 
 from __future__ import annotations
 
@@ -13,12 +18,16 @@ from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
 from conformance.cli.usage import Parser, UsageError, positive, summary
+from conformance.link.framing import readable
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
 
 PROG = "gve-conformance fairness"
 #: one profile per family for the readings one at a time
 FIRST = ("GVE84-100", "GVE54", "GVE114-500")
 ALL = "all"
+#: sequences diff draws after its probes on each profile, and the seed they come from
+DIFF_DRAWN = 50
+DIFF_SEED = 0
 
 
 @dataclass
@@ -29,6 +38,7 @@ class Trial:
     profiles: list[str]
     unfair: list[str] = field(default_factory=list)       # FAIL, ERROR, an unnamed check
     differences: list[str] = field(default_factory=list)  # NON-STRICT, INFO with the rule
+    diffs: list[str] = field(default_factory=list)        # what diff said, per profile
     seconds: float = 0.0
 
     @property
@@ -60,8 +70,46 @@ def trial(reading: str, readings: list[str], profiles: list[str],
                                          f"{unnamed[0]['what']}")
                 rules = sorted({ch["rule"] for ch in failed if ch.get("rule")})
                 result.differences.append(f"{r.verdict} {where} ({', '.join(rules)})")
+        if p in FIRST:
+            diff_trial(p, readings, result)
     result.seconds = time.perf_counter() - start
     return result
+
+
+def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
+    """`diff` of the emulator taking ``readings`` against the reference on ``profile``:
+    the probes, then DIFF_DRAWN drawn sequences; its findings go to ``result``."""
+    from conformance.diff.engine import Budget, Pair, search
+    from conformance.diff.grammar import Options, probes
+    from conformance.diff.sides import Side
+    from conformance.link.safety import TargetNotResponding
+    from conformance.targets import SessionError, parse_target
+    target = parse_target(f"emu:{profile}?reading={','.join(readings)}",
+                          allow_destructive=True)
+    reference = parse_target(f"emu:{profile}")
+    options = Options(destructive=True, rig=target.info.has_rig and reference.info.has_rig)
+    budget = Budget(examples=len(probes(target.profile, options)) + DIFF_DRAWN)
+    pair = Pair(Side(target), Side(reference), target.profile)
+    where = f"diff [{profile}]"
+    try:
+        findings = search(pair, options, budget, seed=DIFF_SEED)
+    except (TargetNotResponding, SessionError) as err:
+        result.unfair.append(f"{FAIL} {where}: stopped after {budget.used} sequences: {err}")
+        result.diffs.append(f"{profile}: stopped after {budget.used} sequences")
+        return
+    said = []
+    for f in findings:
+        d = f.disagreement
+        line = (f"{d.verdict} {where}: {d.rule or '(no known rule)'}: "
+                f"{readable(d.target.sent)} target {readable(d.target.answer) or '(none)'}"
+                f" / reference {readable(d.reference.answer) or '(none)'} ({d.kind})")
+        if d.verdict in (FAIL, ERROR) or d.rule is None:
+            result.unfair.append(line + ("" if d.rule else ": names no rule"))
+        else:
+            result.differences.append(line)
+        said.append(f"{d.verdict} {d.rule or '(no known rule)'}")
+    result.diffs.append(f"{profile}: {budget.used} sequences, "
+                        + (", ".join(said) if said else "no difference"))
 
 
 def _trial(args: tuple[str, list[str], list[str], list[str] | None]) -> Trial:
@@ -115,6 +163,8 @@ def _show(t: Trial, verbose: bool) -> None:
     print(f"{head}  {t.reading:24} {len(t.differences)} difference(s) on "
           f"{', '.join(t.profiles) if t.reading != ALL else 'every profile'} "
           f"in {t.seconds:.1f} s", flush=True)
+    for line in t.diffs:
+        print(f"        diff {line}", flush=True)
     for line in t.unfair:
         print(f"        {line}", flush=True)
     for line in t.differences if verbose else []:

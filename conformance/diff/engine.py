@@ -21,7 +21,8 @@ from hypothesis.errors import Flaky, NoSuchExample
 from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
-from conformance.diff.labels import command_of, label, verdict_of
+from conformance.diff.index import QUERIES, IndexBase
+from conformance.diff.labels import allowed, command_of, label, verdict_of
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
@@ -100,6 +101,7 @@ class Pair:
         self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor)
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
+        self._index = IndexBase()
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
 
@@ -136,6 +138,7 @@ class Pair:
             return False
         self.reference.open()
         self.timing.begin()
+        self._index = IndexBase()
         if self.target.real:
             self._prelude()
         self.course = Course(self.profile)
@@ -163,6 +166,8 @@ class Pair:
             rec.repeat, rec.place = i, place
             out.records.append(rec)
             self.timing.retimed(command, rec.target)
+            if command in QUERIES:
+                self._base_index(command, self._context(step, self.course.in_packet), rec)
             kind = self._difference(command, rec)
             if kind is not None:
                 out.disagreement = self._disagreement(step, command, kind, out, earlier)
@@ -183,12 +188,20 @@ class Pair:
         return False
 
     def _disagreement(self, step: Step, command: str, kind: str, out: ExampleRun,
-                      earlier: set[str]) -> Disagreement:
-        """The last record's difference, in its context, labelled and graded."""
+                      earlier: set[str]) -> Disagreement | None:
+        """The last record's difference, in its context, labelled and graded (None: the
+        spec allows both answers, and the example ends there)."""
         rec = out.records[-1]
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+        if command == "@" and self._index.counts_queries(_values(rec.target),
+                                                         _values(rec.reference)):
+            context.add("queries-counted")
+        why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target))
+        if why is not None:
+            out.ended = f"both answers allowed: {why}"
+            return None
         d = Disagreement(len(out.records) - 1, command, kind, rec.target, rec.reference,
                          frozenset(context), frozenset(earlier))
         d.rule = label(command, kind, context, earlier, _code(rec.reference),
@@ -220,7 +233,13 @@ class Pair:
                 indexes.append(r.dec(0) if r is not None else 0)
             except AssertionError:
                 indexes.append(0)
-        self.judge = replace(self.judge, index_offset=(indexes[0] - indexes[1]) % 256)
+        self._index = IndexBase((indexes[0] - indexes[1]) % 256)
+        self.judge = replace(self.judge, index_offset=self._index.offset)
+
+    def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
+        """The index is compared from each side's first reading of it (index.py)."""
+        self._index.note(command, context, _values(rec.target), _values(rec.reference))
+        self.judge = replace(self.judge, index_offset=self._index.offset or 0)
 
     def _same_eeprom(self) -> None:
         """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
@@ -280,7 +299,9 @@ class Pair:
         flags = {
             "other-address": step.address is not None,
             "stalled": step.stall is not None,
-            "lower": any("a" <= ch <= "z" for ch in step.body),
+            "lower": _has_lower(step.body[:len(name)] if name else step.body),
+            "lower-param": bool(name) and _has_lower(step.body[len(name):]),
+            "plus": name != "%" and "+" in step.body[len(name):],
             "bad-checksum": step.checksum == "bad" and self.target.link.checksums,
             "no-checksum": step.checksum == "none" and self.target.link.checksums,
             "in-packet": in_packet,
@@ -289,6 +310,14 @@ class Pair:
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
         }
         return {k for k, on in flags.items() if on}
+
+
+def _has_lower(text: str) -> bool:
+    return any("a" <= ch <= "z" for ch in text)
+
+
+def _values(exchange: RoundTrip) -> list[str]:
+    return [] if exchange.response is None else list(exchange.response.values)
 
 
 def _code(exchange: RoundTrip) -> int | None:

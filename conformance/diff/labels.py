@@ -1,7 +1,9 @@
 """A disagreement labelled with the rule it touches (``labels.toml``) and graded by that
 rule's tag, as the suite grades a failed check (M, M-ex: FAIL; D: NON-STRICT, or FAIL
 on a profile that implements the project's decisions; D-info: INFO); a disagreement
-touching no known rule is INFO."""
+touching no known rule is INFO. Where the spec allows both answers (``[[allowed]]`` in
+the same file) the two sides differ without either being wrong: no finding, the
+sequence ends there (the states differ from then on)."""
 
 from __future__ import annotations
 
@@ -52,11 +54,27 @@ def load_labels(path: Path = LABELS_FILE) -> tuple[Label, ...]:
         rule = entry.get("rule")
         if rule not in rules:
             raise ValueError(f"{path.name}: label #{i + 1}: unknown rule {rule!r}")
-        unknown = set(entry) - {"rule", *_FIELDS}
-        if unknown:
-            raise ValueError(f"{path.name}: label #{i + 1}: unknown field(s) {sorted(unknown)}")
-        out.append(Label(rule, {k: entry[k] for k in _FIELDS if k in entry}))
+        out.append(Label(rule, _conditions(path, f"label #{i + 1}", entry, "rule")))
     return tuple(out)
+
+
+@cache
+def load_allowed(path: Path = LABELS_FILE) -> tuple[Label, ...]:
+    """The differences the spec allows both ways; ``rule`` holds why (the spec's words)."""
+    raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    out = []
+    for i, entry in enumerate(raw.get("allowed", [])):
+        if not entry.get("why"):
+            raise ValueError(f"{path.name}: allowed #{i + 1}: no why")
+        out.append(Label(entry["why"], _conditions(path, f"allowed #{i + 1}", entry, "why")))
+    return tuple(out)
+
+
+def _conditions(path: Path, where: str, entry: dict, name: str) -> dict:
+    unknown = set(entry) - {name, *_FIELDS}
+    if unknown:
+        raise ValueError(f"{path.name}: {where}: unknown field(s) {sorted(unknown)}")
+    return {k: entry[k] for k in _FIELDS if k in entry}
 
 
 def label(command: str, kind: str, context: set[str], earlier: set[str],
@@ -66,6 +84,17 @@ def label(command: str, kind: str, context: set[str], earlier: set[str],
     facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
              "reference": reference, "target": target}
     for entry in load_labels():
+        if entry.matches(facts):
+            return entry.rule
+    return None
+
+
+def allowed(command: str, kind: str, context: set[str], earlier: set[str],
+            reference: int | None, target: int | None) -> str | None:
+    """Why the spec allows both answers (None: it does not); the fields as :func:`label`."""
+    facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
+             "reference": reference, "target": target}
+    for entry in load_allowed():
         if entry.matches(facts):
             return entry.rule
     return None

@@ -160,6 +160,10 @@ class Envelope:
         moves = [s.times(self.factor) for s in steps]
         if all(m == ZERO for m in moves):
             return              # a zero-length vector completes as it becomes current
+        if outcome is Outcome.UNCLEAR:
+            # maybe never taken: once the unit shows all ended, the axis is where the
+            # vector leads or where it began, and only a read at rest tells which
+            moves = [m.hull(ZERO) for m in moves]
         self.queue = [q.then(m) for q, m in zip(self.queue, moves, strict=True)]
         self.settled = False
         self._see()

@@ -105,8 +105,11 @@ class ReadBackMachine(UnitMachine):
 
     # -- what a refusal leaves ------------------------------------------------------------
     def state(self) -> dict[str, object]:
-        """Everything a host reads at rest (the reads count in the index as any frame)."""
-        got: dict[str, object] = {"PF": self.position()}
+        """Everything a host reads at rest (the reads count in the index as any frame).
+        The position last: ST6 and F have shown the unit at rest by then, so on a real
+        unit the read pins where the axes stand, which a refused packet (maybe taken as
+        it arrived) leaves open until a read at rest."""
+        got: dict[str, object] = {}
         for n in range(7):
             r = self.send(f"SR{n}")
             got[f"ST{n}"] = r.text if r is not None else None
@@ -114,6 +117,7 @@ class ReadBackMachine(UnitMachine):
         got["F"] = r.text if r is not None else None
         if self.link.rig is not None:
             got["outputs"] = self.link.rig.outputs()
+        got["PF"] = self.position()
         return got
 
     def unchanged(self, before: dict[str, object], what: str, rule_id: str) -> None:

@@ -10,7 +10,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.diff.grammar import Options, probes
-from conformance.targets.emu import mutants
+from conformance.targets.emu import emulator_readings, mutants
 from gve_fixtures.profile import load_profile
 from tests.conformance.diff.test_engine import PROFILE, in_area
 from tests.emulator.process import Emulator
@@ -109,3 +109,20 @@ def test_every_mutant_is_named_over_exec_by_the_probes(mutant, tmp_path):
              if in_area(r["checks"][0]["rule"], mutant)]
     assert status == 1 and found, mutant
     assert "# rules: " in Path(found[0]["artifacts"]["transcript"]).read_text()
+
+
+@pytest.mark.slow
+def test_over_exec_an_emulator_taking_every_reading_gets_no_fail(capsys):
+    """A clone that reads every silence of the manuals its own way (all the readings at
+    once, over `exec:`, real time): the probes name each difference's rule and none
+    grades FAIL (about a minute and a half)."""
+    written = len(probes(load_profile("GVE84-100"), Options(destructive=True)))
+    chosen = " ".join(f"--reading {name}" for name in sorted(emulator_readings()))
+    target = f"exec:{sys.executable} -m emulator --pty --model GVE84-100 {chosen}"
+    status = main(["diff", "--target", target, "--profile", "GVE84-100", "--examples",
+                   str(written), "--allow-destructive", "--yes", "--no-reports"])
+    out = capsys.readouterr().out
+    findings = [line for line in out.splitlines() if line.startswith(("FAIL", "NON-STRICT",
+                                                                      "INFO"))]
+    assert status == 0 and findings, out
+    assert not [f for f in findings if f.startswith("FAIL") or "(no known rule)" in f], out

@@ -1,6 +1,6 @@
 """Labels name rules that exist and pick the most specific one."""
 
-from conformance.diff.labels import command_of, label, load_labels, verdict_of
+from conformance.diff.labels import allowed, command_of, label, load_labels, verdict_of
 from conformance.verdict import FAIL, INFO, NON_STRICT
 from gve_fixtures.rules import load_rules
 
@@ -48,6 +48,30 @@ def test_a_modal_setting_the_sequence_needs_wins_over_the_command_and_packet():
 def test_a_position_after_go_is_the_resume_even_after_restore():
     assert label("PF", "position", set(), {"L", "H", "K", "R", "G"}, 0) == "10.4.go.resume"
     assert label("SR", "data", set(), {"L", "H", "K", "R"}, 0) == "10.5.restore.exact"
+
+
+def test_a_plus_sign_or_a_lower_case_digit_names_the_parameter_rule():
+    assert label("ER", "code", {"plus"}, set(), 4, 0) == "3.params.hex-digits"
+    assert label("T", "code", {"plus"}, set(), 4, 0) == "3.params.decimal"
+    assert label("EW", "code", {"lower-param"}, set(), 0, 4) == "3.params.hex-digits"
+    # only the command's own letters make it the upper-case rule
+    assert label("EW", "code", {"lower"}, set(), 3, 0) == "3.frame.upper-case"
+
+
+def test_the_index_off_by_the_queries_is_the_counting_rule():
+    assert label("@", "data", {"queries-counted"}, {"@"}, 0) == "8.index.queries-uncounted"
+    assert label("@", "data", set(), {"@", "L"}, 0) == "8.index.counts"
+
+
+def test_the_firmware_string_is_the_version_rule():
+    assert label("?", "data", set(), set(), 0) == "1.profile.version"
+
+
+def test_both_answers_allowed_by_the_spec_are_no_finding():
+    assert allowed("G", "code", set(), {"H", "K"}, 0, 6)
+    assert allowed("G", "code", set(), set(), 6, 0) is None      # G with INTA = 0 → 6 [M]
+    assert allowed("NA", "code", set(), set(), 3, 5)
+    assert allowed("L", "code", set(), set(), 3, 5) is None
 
 
 def test_a_breaker_unanswered_inside_a_packet_is_the_breakers_rule():

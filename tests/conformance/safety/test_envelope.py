@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from conformance.link.envelope import Span
 from conformance.link.framing import parse_response
 from conformance.link.safety import Guard, SafetyStop
 from gve_fixtures.profile import load_profile
@@ -138,6 +139,29 @@ def test_a_packet_is_judged_whole_before_its_end_is_sent():
     # member as it arrived (all-or-nothing is [D]), so it may have moved
     sent(g, "*E1", "2,1")
     assert x(g) == (0, 500)
+
+
+def test_a_refused_packet_ends_where_it_began_or_where_it_leads_until_a_read_at_rest():
+    g = guard()
+    sent(g, "*S", None)
+    sent(g, "C0,5,0", None)
+    sent(g, "C0,5,0", None)
+    sent(g, "*E4", "2,3")                  # refused: the members maybe taken as they came
+    sent(g, "SR6", "0,00")                 # all ended: Y at 0 (not taken) or 10 (taken)
+    assert g.envelope.reach()[1] == Span(0, 10) and g.envelope.position()[1] is None
+    sent(g, "PF", "0,0,0,0")               # read at rest: not taken
+    assert g.envelope.position() == [0, 0, 0]
+
+
+def test_a_counter_set_where_the_axis_is_not_known_leaves_the_way_back_unknown():
+    g = guard()
+    sent(g, "*S", None)
+    sent(g, "C0,5,0", None)
+    sent(g, "*E2", "4,2")
+    sent(g, "SR6", "0,00")
+    sent(g, "NY-1205")                     # set at 0 or at 5: the counter no longer tells
+    sent(g, "PF", "0,0,-1205,0")
+    assert g.envelope.reach()[1] == Span(0, 5) and g.envelope.position()[1] is None
 
 
 def test_gve54_vectors_are_in_the_micro_step_mode_and_positions_in_sixteenths():
