@@ -12,6 +12,7 @@ from conformance.catalogue import select
 from conformance.runner import run_case
 from conformance.targets import parse_target
 from conformance.verdict import FAIL, NON_STRICT, PASS
+from tests.conformance.cases.catching import assert_catches
 
 #: mutant -> (the case made to catch it, the rule of its failing check, the profiles)
 CATCHES = {
@@ -47,12 +48,7 @@ READ = {
                          [(m, p) for m, (_, _, ps) in CATCHES.items() for p in ps])
 def test_the_case_catches_its_mutant(mutant: str, profile: str) -> None:
     case_id, rule, _ = CATCHES[mutant]
-    (c,) = select([case_id])
-    broken = run_case(c, parse_target(f"emu:{profile}", mutant=mutant), "mutation")
-    assert broken.verdict == FAIL
-    failed = {k["rule"] for k in broken.checks if not k["ok"]}
-    assert rule in failed and failed <= set(c.rules)
-    assert run_case(c, parse_target(f"emu:{profile}"), "mutation").verdict == PASS
+    assert_catches(case_id, rule, mutant, profile, only=False)
 
 
 @pytest.mark.parametrize(("reading", "profile"),
