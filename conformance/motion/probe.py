@@ -15,6 +15,7 @@ XD`` act on the queue at once, ``H`` and ``G`` halt and resume. On the GVE54 vec
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
 from conformance.case import CaseContext, CouldNotTest
@@ -225,6 +226,16 @@ class Probe:
                 out += [self.model({i: e.window.lo}), self.model({i: e.window.hi})]
         return out
 
+    def _banded(self, model: MotionModel, variants: list, line: LineBand, t0: int,
+                spread: int, virtual: bool) -> Iterator[tuple[Reading, Tolerance, list]]:
+        """Each reading taken after the first event, with its tolerance and its band."""
+        for reading in self.readings:
+            w = reading.window
+            if w.hi - line.ns < t0:
+                continue
+            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
+            yield reading, tol, _band(model, variants, w, tol.steps)
+
     def fits(self) -> bool:
         """Whether every reading after the first event lies within the model's band, the
         line's band included (as :meth:`judge` would find), recording nothing."""
@@ -237,12 +248,7 @@ class Probe:
             t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
                   ) + line.ns
             spread = sum(e.window.hi - e.window.lo for e in self.events)
-            for reading in self.readings:
-                w = reading.window
-                if w.hi - line.ns < t0:
-                    continue
-                tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
-                band = _band(model, variants, w, tol.steps)
+            for reading, _, band in self._banded(model, variants, line, t0, spread, virtual):
                 got = reading.positions[:len(band)]
                 if not all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True)):
                     return False
@@ -298,12 +304,8 @@ class Probe:
                                "observed": (a.lo + line.ns - t0) / SECOND,
                                "expected": [(lo - t0) / SECOND, (hi - t0) / SECOND],
                                "expected_what": "at rest"})
-        for reading in self.readings:
+        for reading, tol, band in self._banded(model, variants, line, t0, spread, virtual):
             w = reading.window
-            if w.hi - line.ns < t0:
-                continue
-            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
-            band = _band(model, variants, w, tol.steps)
             tol = replace(tol, band=max(math.ceil((b1 - b0) / 2) for b0, b1 in band))
             widest = max(widest, tol, key=lambda x: x.seconds)
             got = reading.positions[:len(band)]
