@@ -9,8 +9,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-#: what a query of the index is; the unit may count these (spec 8 [D])
-QUERIES = ("@", ">")
+from conformance.protocol.catalogue import classes
+
+#: what a query of the index is (what the index leaves out); a unit may count these
+#: (spec 8 [D])
+QUERIES = classes(indexed=False)
 #: how a frame was sent that no unit counts (spec 8): see engine._context
 UNCOUNTED = {"other-address", "stalled", "bad-checksum", "no-checksum"}
 
