@@ -81,7 +81,7 @@ def test_could_not_test_says_why_on_its_line(no_plots):
 
 def test_passing_logs_and_checks_are_folded_unless_full_logs(no_plots):
     page = render_html(toy_run())
-    assert "96 lines left out" in page and "and 49 more passed checks" in page
+    assert "98 lines left out" in page and "and 49 more passed checks" in page
     assert "0.000000050 &gt; !0@" not in page
     full = render_html(toy_run(full_logs=True))
     assert "lines left out" not in full and "0.000000050 &gt; !0@" in full
