@@ -69,8 +69,9 @@ class Interrupts:
         # so the handlers are swapped for a recorder too, and what it recorded is handed
         # to the real handlers when the block ends.
         caught: list[int] = []
-        handlers = {sig: signal.signal(sig, lambda sig, _: caught.append(sig))
-                    for sig in STOPPING}
+        alone = threading.active_count() == 1      # no other thread: the mask holds them
+        handlers = {} if alone else {
+            sig: signal.signal(sig, lambda sig, _: caught.append(sig)) for sig in STOPPING}
         previous = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
         try:
             yield
