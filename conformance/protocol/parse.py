@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import lru_cache
 
 from conformance.protocol.catalogue import ST6_WRITE, catalogue, names_longest_first
 
@@ -46,6 +47,7 @@ class Parsed:
         return self.name or ""
 
 
+@lru_cache(maxsize=4096)     # every reader parses each frame; Parsed is immutable
 def parse(body: str, *, strict: bool = False, address: int | None = None) -> Parsed:
     """Read ``body`` (the frame from the byte after its address, without the checksum)."""
     text = body if strict else body.upper()
