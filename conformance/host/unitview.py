@@ -27,6 +27,7 @@ MARKERS = classes(marks=True)
 #: inside an open packet these are executed at once and discard it (spec 7)
 BREAKERS = classes(packet="breaker")
 VECTORS = classes(vector=True)
+SWITCHES = classes(switch=True)
 
 
 @dataclass(frozen=True)
@@ -134,7 +135,7 @@ class UnitView:
                 modal = tuple((k, self.modal[k]) for k in sorted(self.modal))
                 self.executed.append(Executed(name, values, modal))
                 self.vectors += 1
-        elif name in ("VK", "VN"):
+        elif name in SWITCHES:
             self.modal["VK"] = name == "VK"
         elif name == "VL":
             values = tuple(int(p) for p in params)

@@ -11,6 +11,7 @@ from hypothesis.stateful import RuleBasedStateMachine, invariant
 from conformance.case import CaseContext
 from conformance.link.framing import Response
 from conformance.model.unit import ModelUnit
+from conformance.protocol.parse import parse
 
 
 class Broken(AssertionError):
@@ -53,8 +54,7 @@ class UnitMachine(RuleBasedStateMachine):
         """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
         the model (``checksum_ok``: whether its sum lets it count)."""
         r = self.link.send(body, **kw)
-        self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1],
-                                 checksum_ok=checksum_ok)
+        self.model.frame_arrived(parse(body).name or body[:1], checksum_ok=checksum_ok)
         return r
 
     def fits(self, body: str) -> bool:

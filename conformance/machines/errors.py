@@ -9,6 +9,7 @@ from hypothesis.stateful import rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
 RUN, INTA = St6.RUN, St6.INTA
@@ -20,7 +21,7 @@ def expected_code(body: str, moving: bool, run: bool, inta: bool) -> int:
              "C1,0,0": 0, "A0": 5, "T5,5": 4}
     if body == "N":
         return 7 if run else 0
-    if body in ("D", "K"):
+    if body in classes(still=True):
         return 7 if moving else 0
     if body == "G":
         return 0 if inta else 6
