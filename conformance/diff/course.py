@@ -19,6 +19,9 @@ _PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
 _COURSE_CHANGERS = classes(course=True)
+_VECTORS = classes(vector=True)
+#: moves at a speed of its own (the profile's top speed bounds it), not the modal V
+_OWN_SPEED = classes(own_speed=True)
 
 
 class Course:
@@ -68,7 +71,7 @@ class Course:
             self.in_packet = False
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
-        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+        if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
@@ -78,7 +81,7 @@ class Course:
     def _queue(self, command: str, body: str) -> None:
         if command == "D":
             self.queued = None
-        elif command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+        elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
 
     def _ceiling(self, command: str, body: str) -> None:
@@ -89,7 +92,7 @@ class Course:
             self.override = max(self.override, value / 100)
         elif command == "XU":          # each XU scales the held vectors again
             self.up *= 17 / 16
-        elif command in ("W", "Y"):
+        elif command in _OWN_SPEED:
             self.speed = self.top
 
     # -- what a difference reads ---------------------------------------------------------
