@@ -148,6 +148,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                 link.settle(final=True)
             for violation in link.violations:
                 ctx.expect(False, violation, tag=ALWAYS)
+            for late in link.late:
+                ctx.note(f"late answer (the spec sets no deadline): {late}")
         if ended and hand_rig is not None and ctx.links:
             _hands_off(hand_rig, ctx)
         if ended:
