@@ -155,7 +155,7 @@ def no_room(ctx: CaseContext) -> None:
     if not fill_queue(ctx, ctx.profile.buffer - 1, rule="5.code.queue-full"):
         return
     r = _packet(ctx, ["C" + vector(ctx, 1), "C" + vector(ctx, -1)], 2)
-    ctx.expect(r is not None and (r.code, r.values) == (1, ["2"]),
+    ctx.expect(r is not None and (r.code, r.values) == (ErrorCode.QUEUE_FULL, ["2"]),
                "2 vectors into 1 free place → 1,2 (9,2 while INTA)", observed=r,
                expected="9,2", rule="7.packet.codes")
     r = ctx.link.send("F")
