@@ -154,7 +154,7 @@ class HandRig:
     # -- the power -------------------------------------------------------------------------
     def _index(self) -> int | None:
         r = self._link().send("@")
-        if r is None or r.code != 0 or not r.values:
+        if r is None or not r.ok or not r.values:
             return None
         try:
             return int(r.values[0])
