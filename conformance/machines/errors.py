@@ -50,7 +50,7 @@ class ErrorMachine(UnitMachine):
         holds(r.inta == bool(st6 & INTA), "4.response.inta-bit",
               f"the INTA bit of {r.text} disagrees with ST6")
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
-        return (run and not inta) or bool(st6 & 0x01), run, inta
+        return (run and not inta) or bool(st6 & St6.STOP), run, inta
 
     @rule(steps=st.integers(500, 1500))
     def motion(self, steps: int) -> None:

@@ -9,7 +9,7 @@ from hypothesis.stateful import initialize, rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import ErrorCode, St6
 
 WAITING = "10.1.queue.wait-for-go"
 
@@ -78,9 +78,9 @@ class QueueMachine(UnitMachine):
     def flags(self) -> None:
         r = self.send("F")
         holds(r is not None and r.ok and r.values, "10.cmd.flags", f"F answered {r}")
-        full = 0x20 if self.queued >= self.model.buffer else 0
-        run = 0x40 if self.queued else 0
-        holds(r.hex() & 0x60 == full | run, WAITING,
+        full = St6.QUEUE_FULL if self.queued >= self.model.buffer else 0
+        run = St6.RUN if self.queued else 0
+        holds(r.hex() & (St6.QUEUE_FULL | St6.RUN) == full | run, WAITING,
               f"F = {r.values[0]}, {self.queued} of {self.model.buffer} queued")
 
     def teardown(self) -> None:
