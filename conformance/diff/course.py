@@ -12,6 +12,7 @@ from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 #: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
 _PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
@@ -67,7 +68,7 @@ class Course:
              ) -> None:
         """The reference answered ``body``; ``first``: not a later frame of a fill (whose
         vectors join the first: no dwell)."""
-        if reference.code != 0:
+        if reference.code != ErrorCode.OK:
             return
         if first:
             self._dwell(command, body, reference)

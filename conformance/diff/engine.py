@@ -28,6 +28,7 @@ from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 try:
     # internals of Hypothesis, used only to empty its pool of constants while a search
@@ -175,7 +176,7 @@ class Pair:
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
-            if step.kind == FILL and rec.reference.code != 0:
+            if step.kind == FILL and rec.reference.code != ErrorCode.OK:
                 break
         if out.ended:
             return True

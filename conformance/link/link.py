@@ -241,7 +241,7 @@ class Link:
             r = answer if i == len(frames) - 1 else None
             body = f.bodies(self.checksums)[0]
             address = self.address if f.address is None else f.address
-            if r is not None and r.code == 0 and address in self.guard.addresses:
+            if r is not None and r.ok and address in self.guard.addresses:
                 self._learn(body)
             self.guard.accepted(body, r, address)
 
@@ -361,7 +361,7 @@ class Link:
 
     def wait_idle(self, max_seconds: float = 60.0) -> bool:
         """Poll SR6 until RUN = 0 (spec 10.3)."""
-        r = self.poll("SR6", lambda r: r.code == 0 and idle_st6(r), max_seconds)
+        r = self.poll("SR6", lambda r: r.ok and idle_st6(r), max_seconds)
         return r is not None
 
     def transcript_lines(self) -> list[str]:

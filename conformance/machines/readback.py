@@ -12,28 +12,29 @@ from hypothesis.stateful import precondition, rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import ErrorCode
 
 IDLE, HALTED = "idle", "halted"
 
 #: a frame refused whatever the state, or only in one: body -> (code, state, rule)
-REFUSALS: dict[str, tuple[int, str | None, str]] = {
-    "Z": (3, None, "5.code.unknown"),
-    "T5,5": (4, None, "5.code.syntax"),
-    "L1,2": (4, None, "5.code.syntax"),
-    "T99": (5, None, "5.code.range"),
-    "SW8,F1": (5, None, "5.code.range"),
-    "SW2,1A5": (5, None, "5.code.range"),
-    "O0,1A5": (5, None, "5.code.range"),
-    "G": (6, IDLE, "5.code.nothing-to-go"),
-    "L5,0,0": (1, HALTED, "5.code.queue-full"),
-    "N": (7, HALTED, "5.code.busy-run"),
-    "NY5": (7, HALTED, "5.code.busy-run"),
+REFUSALS: dict[str, tuple[ErrorCode, str | None, str]] = {
+    "Z": (ErrorCode.UNKNOWN, None, "5.code.unknown"),
+    "T5,5": (ErrorCode.SYNTAX, None, "5.code.syntax"),
+    "L1,2": (ErrorCode.SYNTAX, None, "5.code.syntax"),
+    "T99": (ErrorCode.RANGE, None, "5.code.range"),
+    "SW8,F1": (ErrorCode.RANGE, None, "5.code.range"),
+    "SW2,1A5": (ErrorCode.RANGE, None, "5.code.range"),
+    "O0,1A5": (ErrorCode.RANGE, None, "5.code.range"),
+    "G": (ErrorCode.NOTHING_TO_GO, IDLE, "5.code.nothing-to-go"),
+    "L5,0,0": (ErrorCode.QUEUE_FULL, HALTED, "5.code.queue-full"),
+    "N": (ErrorCode.BUSY, HALTED, "5.code.busy-run"),
+    "NY5": (ErrorCode.BUSY, HALTED, "5.code.busy-run"),
 }
 #: packets that fail (members, *E's n, the code): their B and C must leave no trace
 FAILED_PACKETS = (
-    (("B10", "C0,5,0", "C0,5,0"), 4, 2),     # the count differs
-    (("C0,5,0", "V100"), 2, 4),              # a member that may not be one
-    (("B20", "B1", "C0,5,0"), 3, 5),         # a member out of range
+    (("B10", "C0,5,0", "C0,5,0"), 4, ErrorCode.COUNT_MISMATCH),
+    (("C0,5,0", "V100"), 2, ErrorCode.SYNTAX),           # a member that may not be one
+    (("B20", "B1", "C0,5,0"), 3, ErrorCode.RANGE),       # a member out of range
 )
 #: the machine's moves and halted queues (counter units on the GVE84/114; GVE54 1/16)
 MOVE = st.integers(-30, 30)
@@ -54,7 +55,7 @@ class ReadBackMachine(UnitMachine):
         """ST2..ST5 (polarities and causes): with ST0/ST1 left 00 none of them can start
         an interrupt, whatever a real unit's inputs read."""
         r = self.send(f"SW{word},{value:02X}")
-        holds(r is not None and r.code == 0, "10.3.status.all-bits", f"SW answered {r}")
+        holds(r is not None and r.ok, "10.3.status.all-bits", f"SW answered {r}")
 
     @precondition(lambda self: not self.halted)
     @rule(axis=st.sampled_from("XYZ"), value=st.integers(-2147483647, 2147483647))
@@ -62,7 +63,7 @@ class ReadBackMachine(UnitMachine):
         if f"N{axis}" not in self.ctx.profile.commands:
             return
         r = self.send(f"N{axis}{value}")
-        holds(r is not None and r.code == 0, "10.cmd.set-axis", f"N{axis} answered {r}")
+        holds(r is not None and r.ok, "10.cmd.set-axis", f"N{axis} answered {r}")
 
     @precondition(lambda self: not self.halted)
     @rule(dx=MOVE, dy=MOVE, dz=MOVE)
@@ -71,7 +72,7 @@ class ReadBackMachine(UnitMachine):
         if not self.fits(body):
             return
         r = self.send(body)
-        holds(r is not None and r.code == 0, "10.1.queue.line-alone", f"{body} answered {r}")
+        holds(r is not None and r.ok, "10.1.queue.line-alone", f"{body} answered {r}")
         self.idle()
 
     @rule(value=st.integers(0, 255))
@@ -81,7 +82,7 @@ class ReadBackMachine(UnitMachine):
         if self.link.rig is None:
             return
         r = self.send(f"O0,{value:02X}")
-        holds(r is not None and r.code == 0, "10.cmd.output", f"O0 answered {r}")
+        holds(r is not None and r.ok, "10.cmd.output", f"O0 answered {r}")
 
     @precondition(lambda self: not self.halted)
     @rule()
@@ -91,7 +92,7 @@ class ReadBackMachine(UnitMachine):
             return
         for body in ("C40,0,0", "C40,0,0"):
             r = self.send(body)
-            holds(r is not None and r.code == 0, "10.1.queue.cont-buffer", f"C answered {r}")
+            holds(r is not None and r.ok, "10.1.queue.cont-buffer", f"C answered {r}")
         r = self.send("H")
         holds(r is not None and r.inta, "10.4.halt.ramp", f"H answered {r}")
         self.halted = True
@@ -100,7 +101,7 @@ class ReadBackMachine(UnitMachine):
     @rule()
     def delete(self) -> None:
         r = self.send("D")
-        holds(r is not None and r.code == 0, "10.4.delete", f"D after H answered {r}")
+        holds(r is not None and r.ok, "10.4.delete", f"D after H answered {r}")
         self.halted = False
 
     # -- what a refusal leaves ------------------------------------------------------------
@@ -174,7 +175,7 @@ class ReadBackMachine(UnitMachine):
                          + 0.2)
         r = self.link.send(body, timeout=1.0)
         # the watchdog's time is not the manuals' (a slower one is a reading)
-        holds(r is not None and r.code == 2, "3.frame.watchdog-time",
+        holds(r is not None and r.code == ErrorCode.WATCHDOG, "3.frame.watchdog-time",
               f"{body} stalled {self.ctx.profile.watchdog_ms + 200} ms answered {r}")
         self.link.wait(0.1)                # the rest of the frame: no frame of its own
         again = self.link.send(">", lines=2)
