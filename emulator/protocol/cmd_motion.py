@@ -64,7 +64,11 @@ def modal(key: str, attr: str) -> Handler:
     """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
-        setattr(dev.state.modal, attr, within(dec(p), r.lo, r.hi))
+        value = dec(p)
+        if key == "V" and not r.lo <= value <= r.hi and dev.mutant.active(
+                "velocity-refused-stored"):
+            setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))
+        setattr(dev.state.modal, attr, within(value, r.lo, r.hi))
         return []
     handler.__name__ = f"cmd_{attr}"
     return handler

@@ -36,6 +36,8 @@ PROBES: dict[str, tuple[str, str]] = {
     "refused-vector-queued": ("p06-refused-vector", "GVE84-15"),
     "refused-status-write-stored": ("p08-refused-status-write", "GVE54"),
     "input-bits-swapped": ("p09-input-bits", "GVE84-100"),
+    "velocity-refused-stored": ("p10-refused-velocity", "GVE84-100"),
+    "failed-packet-applies-v": ("p11-failed-packet-v", "GVE114-500"),
     "narrow-counters": ("p04-counter-range-ends", "GVE114-500"),
     "eeprom-7-bit-address": ("p05-eeprom-every-address", "GVE54"),
     "index-skips-refused": ("e10-bare-commands", "GVE84-100"),

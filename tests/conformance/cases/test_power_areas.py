@@ -27,6 +27,11 @@ CATCHES = {
     "microstep-modes-swapped": ("10.7.microstep.each-mode", "10.7.motor.modes", ("GVE54",)),
     "refused-status-write-stored": ("4.machine.refusals-read-back",
                                     "4.response.failed-not-executed", ("GVE84-100",)),
+    "velocity-refused-stored": ("4.machine.refusals-read-back",
+                                "4.response.failed-not-executed",
+                                ("GVE84-100", "GVE114-500", "GVE54")),
+    "failed-packet-applies-v": ("4.machine.refusals-read-back", "7.packet.all-or-nothing",
+                                ("GVE84-100", "GVE114-500")),
     "input-bits-swapped": ("10.cmd.ports.bit-by-bit", "10.cmd.port-bits",
                            ("GVE84-100", "GVE114-500", "GVE54")),
 }
