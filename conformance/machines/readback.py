@@ -59,6 +59,7 @@ class ReadBackMachine(UnitMachine):
         super().__init__(ctx)
         self.halted = False
         self.v = ctx.profile.reset.V
+        self.resumed_end: list[int] = []
 
     # -- the state the refusals meet ------------------------------------------------------
     @rule(word=st.integers(2, 5), value=st.integers(0, 255))
@@ -110,9 +111,32 @@ class ReadBackMachine(UnitMachine):
         for body in ("C40,0,0", "C40,0,0"):
             r = self.send(body)
             holds(r is not None and r.ok, "10.1.queue.cont-buffer", f"C answered {r}")
+        ends = self.position()
+        ends[0] += 80 * self.per_step()
         r = self.send("H")
         holds(r is not None and r.inta, "10.4.halt.ramp", f"H answered {r}")
         self.halted = True
+        self.resumed_end = ends
+
+    @precondition(lambda self: self.halted)
+    @rule()
+    def resume(self) -> None:
+        """G runs what the halt left queued to its end: the two C, and nothing a refusal
+        (an L answered 1, a failed packet's C) may have left in the queue."""
+        r = self.send("G")
+        holds(r is not None and r.ok, "10.4.go.resume", f"G after H answered {r}")
+        self.halted = False
+        self.idle()
+        at = self.position()
+        holds(at == self.resumed_end, "4.response.failed-not-executed",
+              f"after G the queue ended at {at}, the two C end at {self.resumed_end}: "
+              "the queue was not as the halt left it")
+
+    def per_step(self) -> int:
+        """Counter units per commanded step (the GVE54 counts sixteenths; the machine
+        keeps the reset's micro-step mode)."""
+        m = self.ctx.profile.microstep
+        return 1 if m is None else m.factors[m.reset_mode]
 
     @precondition(lambda self: self.halted)
     @rule()
@@ -180,9 +204,7 @@ class ReadBackMachine(UnitMachine):
             return
         after = self.v_effect()
         assert after is not None
-        m = self.ctx.profile.microstep
-        per_step = 1 if m is None else m.factors[m.reset_mode]
-        slack = 2 * line_band(self.link.round_trip).steps(self.v * per_step)
+        slack = 2 * line_band(self.link.round_trip).steps(self.v * self.per_step())
         off = max(abs(a - b) for a, b in zip(after, before, strict=True))
         holds(off <= slack, rule_id, f"after {what} a move under V{self.v} stands at "
               f"{after} {V_PROBE_SECONDS} s on, before it at {before} (±{slack}): "
@@ -273,7 +295,7 @@ class ReadBackMachine(UnitMachine):
              "5.code.syntax", "5.code.range", "5.code.nothing-to-go", "5.code.queue-full",
              "5.code.busy-run", "3.frame.watchdog-time", "10.3.status.all-bits", "10.cmd.set-axis",
              "10.1.queue.line-alone", "10.cmd.output", "10.1.queue.cont-buffer",
-             "10.4.halt.ramp", "10.4.delete", "10.cmd.modal"))
+             "10.4.halt.ramp", "10.4.delete", "10.cmd.modal", "10.4.go.resume"))
 def readback_machine(ctx: CaseContext) -> None:
     """After every refused frame and every failed packet the state read back at rest is
     as before; > shows the refused frame and its answer."""

@@ -39,6 +39,8 @@ def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if dev.state.reference_until > t:
         raise CommandError(ErrorCode.QUEUE_FULL, "a reference run is in progress")
     if dev.motion.queued(t) and not dev.mutant.active("line-while-busy"):
+        if dev.mutant.active("refused-line-queued"):
+            dev.push(steps, False, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "L waits until nothing is queued or running")
     dev.push(steps, False, t)
     return []

@@ -34,6 +34,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "packet-count-ignored": ("d4-checksum-in-packet", "GVE114-500"),
     "failed-packet-keeps-b": ("p07-failed-packet-b", "GVE84-100"),
     "refused-vector-queued": ("p06-refused-vector", "GVE84-15"),
+    "refused-line-queued": ("p12-refused-line", "GVE84-100"),
     "refused-status-write-stored": ("p08-refused-status-write", "GVE54"),
     "input-bits-swapped": ("p09-input-bits", "GVE84-100"),
     "velocity-refused-stored": ("p10-refused-velocity", "GVE84-100"),

@@ -32,6 +32,9 @@ CATCHES = {
                                 ("GVE84-100", "GVE114-500", "GVE54")),
     "failed-packet-applies-v": ("4.machine.refusals-read-back", "7.packet.all-or-nothing",
                                 ("GVE84-100", "GVE114-500")),
+    "refused-line-queued": ("4.machine.refusals-read-back",
+                            "4.response.failed-not-executed",
+                            ("GVE84-100", "GVE114-500", "GVE54")),
     "input-bits-swapped": ("10.cmd.ports.bit-by-bit", "10.cmd.port-bits",
                            ("GVE84-100", "GVE114-500", "GVE54")),
 }
