@@ -1,8 +1,11 @@
 """What a refused frame or a failed packet leaves behind, read back at rest: the whole
 observable state (positions, ST0..ST6, F with the queue-full bit, the outputs where a rig
 reads them, the index) is as it was before each one, and `>` shows the refused frame with
-the answer it got (spec 4, 5, 7, 8). The state it is refused in is built by the machine:
-status words, counters, small moves, outputs, a queue halted with INTA = 1."""
+the answer it got (spec 4, 5, 7, 8). The modal V, A, VL and XM are read by their effect
+after the refusals that would have set them (a move from rest stands where it stood
+before), the queue by where G takes a halted one. The state it is refused in is built by
+the machine: status words, counters, small moves, outputs, V, a queue halted with
+INTA = 1."""
 
 from __future__ import annotations
 
@@ -25,6 +28,9 @@ REFUSALS: dict[str, tuple[ErrorCode, str | None, str]] = {
     "T99": (ErrorCode.RANGE, None, "5.code.range"),
     "V{over}": (ErrorCode.RANGE, None, "5.code.range"),     # one above the profile's V
     "V700,5": (ErrorCode.SYNTAX, None, "5.code.syntax"),
+    "A0": (ErrorCode.RANGE, None, "10.cmd.accel-range"),
+    "XM0": (ErrorCode.RANGE, None, "5.code.range"),
+    "VL5,5,5": (ErrorCode.RANGE, None, "10.cmd.axis-limits"),
     "SW8,F1": (ErrorCode.RANGE, None, "5.code.range"),
     "SW2,1A5": (ErrorCode.RANGE, None, "5.code.range"),
     "O0,1A5": (ErrorCode.RANGE, None, "5.code.range"),
@@ -33,6 +39,8 @@ REFUSALS: dict[str, tuple[ErrorCode, str | None, str]] = {
     "N": (ErrorCode.BUSY, HALTED, "5.code.busy-run"),
     "NY5": (ErrorCode.BUSY, HALTED, "5.code.busy-run"),
 }
+#: the refusals only a profile with their command meets
+REQUIRES = {"NY5": "NY", "XM0": "XM", "VL5,5,5": "VL"}
 #: packets that fail (members, *E's n, the code): their B, C and V must leave no trace
 FAILED_PACKETS = (
     (("V700", "C0,5,0"), 1, ErrorCode.COUNT_MISMATCH),   # a V that may not be a member
@@ -50,6 +58,12 @@ VELOCITIES = (500, 1000, 2000)
 #: reset's A every velocity above stands at its own place then, none at the move's end)
 V_PROBE, V_PROBE_SECONDS = 400, 0.15
 DWELL_PAST = 0.03
+
+
+def _touches_motion(body: str) -> bool:
+    """Whether ``body`` would set what a move from rest shows by where it stands a
+    while after it was sent: V, A, VL or XM (not VK/VN, whose move runs along X)."""
+    return body[:2] in ("VL", "XM") or (body[:1] in ("V", "A") and body[1:2].isdigit())
 
 
 class ReadBackMachine(UnitMachine):
@@ -197,7 +211,8 @@ class ReadBackMachine(UnitMachine):
         return at
 
     def v_unchanged(self, before: list[int] | None, what: str, rule_id: str) -> None:
-        """The move under V stands where it stood before the refusal: exactly in virtual
+        """The move under V (and A, VL, XM) stands where it stood before the refusal:
+        exactly in virtual
         time, within twice the line's band at V over a real line (each reading has its
         own latency)."""
         if before is None:
@@ -208,21 +223,21 @@ class ReadBackMachine(UnitMachine):
         off = max(abs(a - b) for a, b in zip(after, before, strict=True))
         holds(off <= slack, rule_id, f"after {what} a move under V{self.v} stands at "
               f"{after} {V_PROBE_SECONDS} s on, before it at {before} (±{slack}): "
-              "the modal V changed")
+              "a setting of the move (V, A, VL, XM) changed")
 
     @rule(first=st.integers(0, len(REFUSALS) - 1))
     def refused(self, first: int) -> None:
         """Every frame refused in this state, one after the other from a drawn one on:
         each leaves the state read back as it was (the state after one is the state
-        before the next), and those that would have set the modal V leave V as a move
-        under it shows, read once after them all."""
+        before the next), and those that would have set V, A, VL or XM leave them as a
+        move under them shows, read once after them all."""
         bodies = sorted(REFUSALS)
         now = HALTED if self.halted else IDLE
         todo = [b for b in bodies[first:] + bodies[:first]
                 if REFUSALS[b][1] in (None, now)
-                and (b[:2] != "NY" or "NY" in self.ctx.profile.commands)]
+                and (b not in REQUIRES or REQUIRES[b] in self.ctx.profile.commands)]
         sent = [b.format(over=self.ctx.profile.ranges["V"].hi + 1) for b in todo]
-        touching_v = [b for b in sent if b[:1] == "V"]
+        touching_v = [b for b in sent if _touches_motion(b)]
         reference = self.v_effect() if touching_v else None
         before = self.state()
         for key, body in zip(todo, sent, strict=True):
@@ -239,11 +254,11 @@ class ReadBackMachine(UnitMachine):
     @rule(first=st.integers(0, len(FAILED_PACKETS) - 1))
     def failed_packet(self, first: int) -> None:
         """Every failing packet, one after the other from a drawn one on: each leaves
-        the state read back as it was, those with a V leave V as a move shows."""
+        the state read back as it was, those with a V leave it as a move shows."""
         if "*S" not in self.ctx.profile.commands:
             return
         packets = FAILED_PACKETS[first:] + FAILED_PACKETS[:first]
-        touching_v = [p for p in packets if any(m[:1] == "V" for m in p[0])]
+        touching_v = [p for p in packets if any(_touches_motion(m) for m in p[0])]
         reference = self.v_effect() if touching_v else None
         before = self.state()
         for members, n, want in packets:

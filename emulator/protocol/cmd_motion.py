@@ -67,8 +67,9 @@ def modal(key: str, attr: str) -> Handler:
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
         value = dec(p)
-        if key == "V" and not r.lo <= value <= r.hi and dev.mutant.active(
-                "velocity-refused-stored"):
+        if not r.lo <= value <= r.hi and (
+                (key == "V" and dev.mutant.active("velocity-refused-stored"))
+                or (key == "A" and dev.mutant.active("accel-refused-stored"))):
             setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))
         setattr(dev.state.modal, attr, within(value, r.lo, r.hi))
         return []

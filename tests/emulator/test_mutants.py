@@ -38,6 +38,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "refused-status-write-stored": ("p08-refused-status-write", "GVE54"),
     "input-bits-swapped": ("p09-input-bits", "GVE84-100"),
     "velocity-refused-stored": ("p10-refused-velocity", "GVE84-100"),
+    "accel-refused-stored": ("p13-refused-accel", "GVE114-500"),
     "failed-packet-applies-v": ("p11-failed-packet-v", "GVE114-500"),
     "narrow-counters": ("p04-counter-range-ends", "GVE114-500"),
     "eeprom-7-bit-address": ("p05-eeprom-every-address", "GVE54"),
