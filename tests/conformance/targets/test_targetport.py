@@ -4,12 +4,15 @@ once: never an ERROR of the suite, never a wait for frames nobody answers."""
 
 from __future__ import annotations
 
+import os
+import pty
 import time
 
 import pytest
 import serial
 
 from conformance.catalogue import select
+from conformance.link.exclusive import open_serial
 from conformance.link.safety import TargetNotResponding
 from conformance.runner import run
 from conformance.targets import parse_target
@@ -43,6 +46,41 @@ def test_every_use_of_a_failed_port_is_the_target_gone(use):
                        r"|Input/output error)"):
         use(TargetPort(Unplugged()))
     TargetPort(Unplugged()).close()           # closing what is gone is no error
+
+
+class Ended:
+    """A program that was killed: what TargetPort asks of the program behind it."""
+
+    alive = False
+
+    def wait(self, seconds: float) -> bool:
+        return True
+
+    def ended(self) -> str:
+        return "clone-sim --pty was killed by signal 9"
+
+
+@pytest.mark.pty
+@pytest.mark.parametrize("use", [
+    lambda p: p.read(1), lambda p: p.read_until(b"\r"), lambda p: p.write(b"!0?\r"),
+    lambda p: p.in_waiting, lambda p: p.reset_input_buffer(), lambda p: p.flush(),
+    lambda p: setattr(p, "timeout", 0.3)], ids=[
+    "read", "read_until", "write", "in_waiting", "reset_input_buffer", "flush", "timeout"])
+@pytest.mark.parametrize("program", [None, Ended()], ids=["port", "program"])
+def test_every_use_of_a_hung_up_pty_is_the_target_gone(use, program):
+    """The pseudo-terminal of a program that ended is hung up: every ioctl on it fails
+    (termios' as termios.error, which is no OSError), also the one pyserial makes when a
+    link sets the port's timeout between a frame and its answer."""
+    master, slave = pty.openpty()
+    path = os.ttyname(slave)
+    os.close(slave)
+    port = TargetPort(open_serial(path, baudrate=115200, timeout=0.5), program)
+    os.close(master)                         # the program's end: its side of the pty closed
+    why = (r"the target's program ended: clone-sim --pty was killed by signal 9"
+           if program else r"the target's port failed: .*(disconnected|Input/output error)")
+    with pytest.raises(TargetNotResponding, match=why):
+        use(port)
+    port.close()
 
 
 @pytest.mark.pty
