@@ -131,6 +131,39 @@ def test_a_program_that_dies_at_any_instant_of_a_case_fails_that_case(body, when
     assert target.program is None and gone(pid)
 
 
+@pytest.mark.parametrize(("body", "nth"), [
+    ("H", 2),           # the second case's known state (the first `H` is the first case's)
+    ("Z", 1)])          # the second case's own first frame
+@pytest.mark.parametrize("stepper", ["c", "python"])
+def test_a_program_killed_as_a_frame_is_written_fails_that_case(stepper, body, nth):
+    """Killed and reaped the instant a frame of the second case is on its pty, before
+    the link asks for the answer (which sets the port's timeout first): once a rare ERROR
+    under load (in the known state, before the case has its link), now the case's
+    FAIL."""
+    target = exec_target([*EMULATOR, "--pty", "--stepper", stepper])
+    process_ = target.program.process
+    serial_port = target._port._port             # pyserial's port under the target's
+    write = serial_port.write
+    seen = []
+
+    def write_then_killed(data: bytes) -> int | None:
+        n = write(data)
+        if data[2:].split(b",")[0].rstrip(b"\r") == body.encode():
+            seen.append(data)
+            if len(seen) == nth:
+                process_.kill()
+                process_.wait()
+        return n
+
+    serial_port.write = write_then_killed
+    result = run([target], select(["5.errors.ok", "5.errors.unknown", "6.*"]))
+    got = [r.verdict for r in result.results]
+    assert got[:2] == [PASS, FAIL] and set(got[2:]) == {COULD_NOT_TEST}, [
+        (r.id, r.verdict, r.notes) for r in result.results]
+    why = result.results[1].failed_checks[-1]["what"]
+    assert "program ended" in why and "killed by signal 9" in why, why
+
+
 def test_a_program_that_dies_as_its_case_ends_fails_that_case():
     """Killed once the case's last answer was judged, before the case's end (where the
     link listens for bytes still on their way): that case FAILs, the rest is not run."""

@@ -13,11 +13,13 @@ import serial
 
 from conformance.catalogue import select
 from conformance.link.exclusive import open_serial
-from conformance.link.safety import TargetNotResponding
+from conformance.link.link import Link
+from conformance.link.safety import EmulatorGuard, TargetNotResponding
 from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.targets.targetport import TargetPort
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from gve_fixtures.profile import load_profile
 from tests.emulator.process import Emulator
 
 
@@ -81,6 +83,48 @@ def test_every_use_of_a_hung_up_pty_is_the_target_gone(use, program):
     with pytest.raises(TargetNotResponding, match=why):
         use(port)
     port.close()
+
+
+class DiesOnTheFrame:
+    """A program killed the instant a frame reaches it: its pty hung up once the frame
+    is written, before the link asks for the answer."""
+
+    def __init__(self, master: int) -> None:
+        self.master = master
+        self.alive = True
+
+    def written(self) -> None:
+        os.close(self.master)
+        self.alive = False
+
+    def wait(self, seconds: float) -> bool:
+        return True
+
+    def ended(self) -> str:
+        return "" if self.alive else "clone-sim --pty was killed by signal 9"
+
+
+@pytest.mark.pty
+def test_a_program_killed_as_its_frame_is_written_ends_the_frame_with_the_target_gone():
+    """Between the frame's write and the answer's read the link sets the port's timeout:
+    the program dead by then is the target gone there too (it was an ERROR)."""
+    master, slave = pty.openpty()
+    path = os.ttyname(slave)
+    os.close(slave)
+    program = DiesOnTheFrame(master)
+    serial_port = open_serial(path, baudrate=115200, timeout=0.5)
+    write = serial_port.write
+
+    def write_then_die(data: bytes) -> int | None:
+        n = write(data)
+        program.written()
+        return n
+
+    serial_port.write = write_then_die
+    link = Link(TargetPort(serial_port, program), EmulatorGuard(load_profile("GVE84-100"), 0))
+    with pytest.raises(TargetNotResponding, match="program ended: clone-sim --pty was killed"):
+        link.send("?")
+    serial_port.close()
 
 
 @pytest.mark.pty
