@@ -132,7 +132,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
                 queued += 1
             elif body == "D":
                 queued = 0
-            if body in ("%+", "%-") and r is not None and r.code == 0:
+            if body in ("%+", "%-") and r is not None and r.ok:
                 summed = body == "%+"
     return None if math.isinf(need) else math.ceil(need)
 

@@ -112,7 +112,7 @@ class AnswerFault(Fault):
 
     def answer(self, ex: Exchange, ctx: Context) -> Delivery:
         data = b"".join(ex.answer)
-        if self.injected or ex.code != 0 or not self.target.matches(ex.frame.raw, ctx):
+        if self.injected or ex.code != ErrorCode.OK or not self.target.matches(ex.frame.raw, ctx):
             return Delivery(data)
         self.injected = True
         ex.fault = self.kind

@@ -17,6 +17,7 @@ from conformance.host.grammar import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
 MODAL = classes(modal=True)
@@ -107,11 +108,11 @@ class UnitView:
             return
         if name == "*E":
             members, self.packet = self.packet or [], None
-            if code == 0:
+            if code == ErrorCode.OK:
                 for member in members:
                     self._accept(member)
             return
-        if code == 0:
+        if code == ErrorCode.OK:
             self._accept(f)
             if name == "J":
                 t = ex.answered_at or 0

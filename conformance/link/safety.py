@@ -34,7 +34,7 @@ from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import ErrorCode, St6
 
 
 class SafetyStop(BaseException):
@@ -121,7 +121,7 @@ def _number(text: str, base: int = 10) -> Span:
 def outcome_of(r: Response | None) -> Outcome:
     if r is None or r.code is None:
         return Outcome.UNCLEAR
-    return Outcome.ACCEPTED if r.code == 0 else Outcome.REFUSED
+    return Outcome.ACCEPTED if r.ok else Outcome.REFUSED
 
 
 class Guard:
@@ -357,9 +357,9 @@ class Guard:
         names = self.profile.axes
         axis = command.params[:1]
         n2, _, n4, _ = Body("W", command.params[1:].lstrip(",")).fields(4)
-        if code == 5:
+        if code == ErrorCode.RANGE:
             outcome = Outcome.ACCEPTED
-        zeroed = code == 0
+        zeroed = code == ErrorCode.OK
         if axis not in names or not (n2.exact and n4.exact):
             every = range(len(names))
             return lambda e: [e.reference(i, UNKNOWN, outcome, zeroed=True) for i in every]

@@ -108,7 +108,7 @@ class Probe:
         """Send a frame the scenario needs (the case cannot judge when it is refused) and
         book what it does."""
         r = self.link.send(body)
-        self.ctx.require(r is not None and r.code == 0, f"{body} answered "
+        self.ctx.require(r is not None and r.ok, f"{body} answered "
                          f"{'nothing' if r is None else r.text}, expected 0")
         self._book(body, *self._timing(body, r))
         return r
@@ -117,7 +117,7 @@ class Probe:
         """Read PF and keep the reading (None when the unit did not answer with positions;
         bytes that are not decimals fail the case through the response's accessor)."""
         r = self.link.send("PF")
-        if r is None or r.code != 0 or len(r.values) < 3:
+        if r is None or not r.ok or len(r.values) < 3:
             return None
         values = r.decs()
         self.readings.append(Reading(self._timing("PF", r)[0], values, label))

@@ -65,6 +65,7 @@ class Command:
     position: bool = False
     optional: bool = False
     exchanges: bool = False
+    paces: bool = False
     own_speed: bool = False
     empties: bool = False
     still: bool = False

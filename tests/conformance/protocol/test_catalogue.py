@@ -41,6 +41,7 @@ def test_answers_follow_spec_2_and_8():
 def test_what_commands_do_to_a_motion_follows_spec_10():
     assert cat.classes(vector=True) == {"L", "C"}
     assert cat.classes(exchanges=True) == {"XA", "XU", "XD"}
+    assert cat.classes(paces=True) == {"V", "A", "VL", "XM"}
     assert cat.classes(own_speed=True) == {"W", "Y"}
     assert cat.classes(empties=True) == {"D", "K"}
     assert cat.classes(still=True) == {"D", "K", "R"}
