@@ -185,6 +185,8 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
+            if command == "SW" and rec is not None and (rec.reference.code or 0) & 7:
+                earlier.add("SW-refused")
         self.course.stepped(command, step)
         return False
 
@@ -196,6 +198,10 @@ class Pair:
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+        if kind == "position" and self.course.beyond_reach(_values(rec.target)):
+            context.add("beyond-reach")
+        if self.course.capped_elsewhere:
+            context.add("capped-elsewhere")
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")

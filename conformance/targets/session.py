@@ -363,18 +363,27 @@ class RealSession(Session):
                  "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
+        if self._has_mpg():
+            frames.append(f"Y{p.mpg.reset_mode}")
         if p.microstep:
             frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
         return frames
 
+    def _has_mpg(self) -> bool:
+        return self.profile.mpg is not None and "Y" in self.profile.commands
+
     def _stop(self, link: Link, then: Sequence[str] = ()) -> None:
-        """`H`, checksums off, interrupts off (ST0..ST5 = 00), then `D`: the queue empty
-        and ST6 clear (an input still enabled would set INTA again at once); then the
-        frames ``then``."""
+        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00),
+        then `D`: the queue empty and ST6 clear (an input still enabled would set INTA
+        again at once); then the frames ``then``. An MPG that EEPROM 06 made effective
+        holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
+        the INTA of `H` outlive the stop, so it is off until the reset frames set its
+        reset mode again."""
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        link.send_each([*(f"SW{n},00" for n in range(6)), "D", *then])
+        mpg = ["Y-"] if self._has_mpg() else []
+        link.send_each([*mpg, *(f"SW{n},00" for n in range(6)), "D", *then])
 
     def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
