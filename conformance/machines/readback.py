@@ -313,8 +313,10 @@ class ReadBackMachine(UnitMachine):
              "5.code.syntax", "5.code.range", "5.code.nothing-to-go", "5.code.queue-full",
              "5.code.busy-run", "3.frame.watchdog-time", "10.3.status.all-bits", "10.cmd.set-axis",
              "10.1.queue.line-alone", "10.cmd.output", "10.1.queue.cont-buffer",
-             "10.4.halt.ramp", "10.4.delete", "10.cmd.modal", "10.4.go.resume"))
+             "10.4.halt.ramp", "10.4.delete", "10.cmd.modal", "10.4.go.resume",
+             "10.cmd.accel-range", "10.cmd.axis-limits"))
 def readback_machine(ctx: CaseContext) -> None:
     """After every refused frame and every failed packet the state read back at rest is
-    as before; > shows the refused frame and its answer."""
+    as before (V, A, VL and XM by a move's effect, the queue by where G ends it); > shows
+    the refused frame and its answer."""
     run_machine(ctx, ReadBackMachine)
