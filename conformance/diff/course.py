@@ -21,6 +21,7 @@ _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
 _COURSE_CHANGERS = classes(course=True)
 _VECTORS = classes(vector=True)
+_EMPTIES = classes(empties=True)
 #: moves at a speed of its own (the profile's top speed bounds it), not the modal V
 _OWN_SPEED = classes(own_speed=True)
 #: frames besides vectors that move the axes or set their counters (J restarts them;
@@ -95,7 +96,7 @@ class Course:
             self.t_ns = int(body[1:]) * 1_000_000
 
     def _queue(self, command: str, body: str) -> None:
-        if command == "D":
+        if command in _EMPTIES:      # D and K alike, as the timing takes them
             self.queued = None
         elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
