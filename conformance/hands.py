@@ -51,7 +51,7 @@ def _at_rest(r: Response) -> bool:
     """Whether an answer to `SR6` shows the unit not moving (spec 5: moving is RUN = 1
     with INTA = 0, or a stop ramp in progress): halted vectors holding RUN are at rest."""
     try:
-        st6 = r.hex() if r.code is not None and not r.code & 7 and r.values else None
+        st6 = r.hex() if r.ok and r.values else None
     except UnitDataError:
         return False
     return st6 is not None and not st6 & St6.STOP and (not st6 & St6.RUN or bool(st6 & St6.INTA))
@@ -107,7 +107,7 @@ class HandRig:
     # -- inputs ------------------------------------------------------------------------------
     def _read(self, port: int) -> int | None:
         r = self._link().send(f"I{port}")
-        if r is None or r.code is None or r.code & 7 or not r.values:
+        if r is None or not r.ok or not r.values:
             return None
         try:
             return int(r.values[0], 16)
@@ -154,7 +154,7 @@ class HandRig:
     # -- the power -------------------------------------------------------------------------
     def _index(self) -> int | None:
         r = self._link().send("@")
-        if r is None or r.code != 0 or not r.values:
+        if r is None or not r.ok or not r.values:
             return None
         try:
             return int(r.values[0])

@@ -145,9 +145,16 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
     finally:
         for link in ctx.links:
             if ended:
-                link.settle(final=True)
+                try:
+                    link.settle(final=True)
+                except TargetNotResponding as err:    # ended with the case: its failure
+                    ended = False
+                    result.stopped = str(err)
+                    ctx.expect(False, str(err), tag=ALWAYS)
             for violation in link.violations:
                 ctx.expect(False, violation, tag=ALWAYS)
+            for late in link.late:
+                ctx.note(f"late answer (the spec sets no deadline): {late}")
         if ended and hand_rig is not None and ctx.links:
             _hands_off(hand_rig, ctx)
         if ended:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 import time
 
+from gve_fixtures.protocol import ErrorCode
 from gve_host.job import Step
 from gve_host.session import Session, UnitLost
 from gve_host.wire import Answer
@@ -78,11 +79,11 @@ class Driver:
             answer = self.s.transact(body)
             assert answer is not None
             self._checked(body, answer)
-            if answer.code == 1 and body[:1] in ("L", "C") and not \
+            if answer.code == ErrorCode.QUEUE_FULL and body[:1] in ("L", "C") and not \
                     self.s.bugs.on("queue-full-ignored"):
                 time.sleep(RETRY_S)
                 continue
-            if answer.code not in (0, 1):
+            if answer.code not in (ErrorCode.OK, ErrorCode.QUEUE_FULL):
                 raise JobFailed(f"`{body}` refused: {answer}")
             return
 
@@ -103,13 +104,14 @@ class Driver:
             if answer is None:
                 continue                   # `*E` never arrived; `@` closed the packet
             self._checked("*E", answer)
-            if answer.code == 0 or (answer.code == 1 and self.s.bugs.on("queue-full-ignored")):
+            if answer.code == ErrorCode.OK or (answer.code == ErrorCode.QUEUE_FULL and
+                                               self.s.bugs.on("queue-full-ignored")):
                 return
             if start is not None:          # the unit counted *S, k members and *E
                 self.s.index = (start + 2 + int(answer.values[0])) % 256
-            if answer.code == 1:
+            if answer.code == ErrorCode.QUEUE_FULL:
                 time.sleep(RETRY_S)        # queue full: try again later, as often as it takes
-            elif answer.code in (2, 4):
+            elif answer.code in (ErrorCode.COUNT_MISMATCH, ErrorCode.SYNTAX):
                 tries += 1                 # a member lost or damaged on the line
             else:
                 raise JobFailed(f"packet {members} refused: {answer}")
@@ -121,9 +123,9 @@ class Driver:
             answer = self.s.transact("L0,0,0")
             assert answer is not None
             self._checked("L0,0,0", answer)
-            if answer.code == 0:
+            if answer.code == ErrorCode.OK:
                 return
-            if answer.code != 1:
+            if answer.code != ErrorCode.QUEUE_FULL:
                 raise JobFailed(f"`L0,0,0` refused: {answer}")
             time.sleep(POLL_S)
 
@@ -147,6 +149,7 @@ class Driver:
             time.sleep(HOLD_POLL_S)
             answer = self.s.transact("G")
             assert answer is not None
-            if answer.code == 6 or (answer.code == 0 and not answer.inta):
+            if answer.code == ErrorCode.NOTHING_TO_GO or (answer.code == ErrorCode.OK and
+                                                          not answer.inta):
                 return
         raise UnitLost(f"held by an interrupt for more than {self.hold_limit:g} s")

@@ -22,6 +22,7 @@ from collections.abc import Callable
 
 import serial
 
+from gve_fixtures.protocol import ErrorCode
 from gve_host import wire
 from gve_host.bugs import Bugs
 from gve_host.wire import Answer
@@ -138,7 +139,7 @@ class Session:
                 continue
             if answer is not None:
                 self._count(body, answer)
-                if answer.code == 2 and body[:2] != "*E":
+                if answer.code == ErrorCode.WATCHDOG and body[:2] != "*E":
                     continue          # the watchdog cut it: nothing ran (spec 3)
                 return answer
             answer = self.recover(data, before, summed)
@@ -150,7 +151,8 @@ class Session:
     def _count(self, body: str, answer: Answer) -> None:
         if body in UNCOUNTED or self.index is None:
             return
-        if answer.code in (0, 1) or (answer.code == 2 and body[:2] == "*E"):
+        if answer.code in (ErrorCode.OK, ErrorCode.QUEUE_FULL) or \
+                (answer.code == ErrorCode.COUNT_MISMATCH and body[:2] == "*E"):
             self.index = (self.index + 1) % 256
         else:
             self.index = None         # a 2 from the watchdog, a 4 for a sum: ask again
@@ -204,7 +206,7 @@ class Session:
     def _index_of(self, line: bytes) -> int | None:
         """The index in an answer to `@` (`0,<index>`), None for any other line."""
         parsed = wire.parse(line, self.summed)
-        if parsed is None or parsed.code != 0 or len(parsed.values) != 1:
+        if parsed is None or parsed.code != ErrorCode.OK or len(parsed.values) != 1:
             return None
         return int(parsed.values[0]) if parsed.values[0].isdigit() else None
 
@@ -239,4 +241,4 @@ def _shaped(body: str, answer: Answer, values: int) -> bool:
     answers its code and k; an OK answer has its values; a failed one none."""
     if body[:2] == "*E":
         return len(answer.values) == 1
-    return len(answer.values) == (values if answer.code == 0 else 0)
+    return len(answer.values) == (values if answer.code == ErrorCode.OK else 0)

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from gve_fixtures.protocol import INTA_BIT
+
 CR = b"\r"
-INTA = 0x8
 
 
 def checksum(data: bytes) -> int:
@@ -58,4 +59,4 @@ def parse(line: bytes, summed: bool, *, trust_checksum: bool = False) -> Answer 
             return None
         values = values[:-1]
     value = int(head, 16)
-    return Answer(value & 7, bool(value & INTA), tuple(values), bytes(text))
+    return Answer(value & 7, bool(value & INTA_BIT), tuple(values), bytes(text))

@@ -3,7 +3,10 @@ relayed to another serial device (an emulator's pty) as a USB-serial adapter del
 bytes. Towards the host, bytes wait in a buffer until it holds a full chunk (62 bytes,
 an FTDI packet less its two status bytes) or the latency timer (1..16 ms) has run since
 the buffer's first byte; every transfer, in both directions, is late by a random jitter
-of up to ``jitter_ms`` (order kept). A background thread; :meth:`close` ends it."""
+of up to ``jitter_ms`` (order kept). ``stall_ms``: every ``stall_every``-th transfer
+towards the host after the first ``stall_from`` is held that much longer, ``stalls``
+times at most (an adapter's host under load). A background
+thread; :meth:`close` ends it."""
 
 from __future__ import annotations
 
@@ -20,8 +23,12 @@ CHUNK = 62
 
 class UsbRelay:
     def __init__(self, device: str, *, latency_ms: float = 16.0, jitter_ms: float = 2.0,
-                 chunk: int = CHUNK, seed: int = 0) -> None:
+                 chunk: int = CHUNK, seed: int = 0, stall_every: int = 0,
+                 stall_ms: float = 0.0, stall_from: int = 0, stalls: int = 0) -> None:
         self.latency, self.jitter, self.chunk = latency_ms / 1e3, jitter_ms / 1e3, chunk
+        self.stall_every, self.stall, self.stall_from = stall_every, stall_ms / 1e3, stall_from
+        self.stalls = stalls            # stalls still to come
+        self.pieces = 0                 # transfers towards the host so far
         self._random = random.Random(seed)
         self.master, self._slave = os.openpty()
         tty.setraw(self._slave)
@@ -61,7 +68,12 @@ class UsbRelay:
             while len(buffered) >= self.chunk or (buffered and now >= since + self.latency):
                 piece, buffered = bytes(buffered[:self.chunk]), buffered[self.chunk:]
                 last = to_host[-1][0] if to_host else now
-                to_host.append((max(last, self._late(now)), piece))
+                self.pieces += 1
+                held = 0.0
+                if self.stalls and self.pieces > self.stall_from and \
+                        self.pieces % self.stall_every == 0:
+                    held, self.stalls = self.stall, self.stalls - 1
+                to_host.append((max(last, self._late(now) + held), piece))
                 since = now
             for queue, fd in ((to_device, self.device), (to_host, self.master)):
                 while queue and queue[0][0] <= now:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.link.framing import Response
 from conformance.motion.probe import Probe
+from gve_fixtures.protocol import INTA_BIT, ErrorCode
 
 
 def show(r: Response | None) -> str:
@@ -18,10 +19,10 @@ def answers(ctx: CaseContext, r: Response | None, text: str, what: str, *,
                       observed=show(r), expected=text, tag=tag, rule=rule)
 
 
-def code(ctx: CaseContext, r: Response | None, value: int, what: str, *,
+def code(ctx: CaseContext, r: Response | None, value: ErrorCode, what: str, *,
          tag: str | None = None, inta: bool | None = None, rule: str | None = None) -> bool:
     ok = r is not None and r.code == value and (inta is None or r.inta == inta)
-    shown = f"{value + (8 if inta else 0):X}" if inta is not None else str(value)
+    shown = f"{value | (INTA_BIT if inta else 0):X}" if inta is not None else str(value)
     return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag, rule=rule)
 
 
@@ -48,7 +49,7 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> N
         setup(ctx, "C" + vector(ctx, steps))
     ctx.link.wait(0.5)
     r = ctx.link.send("H")
-    ctx.require(r is not None and r.code == 0 and r.inta, f"H answered {show(r)}")
+    ctx.require(r is not None and r.ok and r.inta, f"H answered {show(r)}")
 
 
 def halted_line(ctx: CaseContext, steps: int, seconds: float) -> None:
@@ -66,7 +67,7 @@ def fresh_reset(ctx: CaseContext) -> None:
         return
     ctx.require(ctx.target.allow_destructive, "needs a reset (J): run with --allow-destructive")
     r = ctx.link.send("J")
-    ctx.require(r is not None and r.code == 0, f"J answered {show(r)}")
+    ctx.require(r is not None and r.ok, f"J answered {show(r)}")
     ctx.link.wait(2.5)
 
 
@@ -83,7 +84,7 @@ def queries_counted(ctx: CaseContext, address: int | None = None) -> bool:
 
 def _read_index(ctx: CaseContext, address: int | None) -> int | None:
     r = ctx.link.send("@", address=address)
-    if r is None or r.code != 0:
+    if r is None or not r.ok:
         return None
     return r.dec()
 
@@ -93,7 +94,7 @@ def index(ctx: CaseContext, address: int | None = None) -> int | None:
     it is wherever the unit's use left it, so cases judge how far it moves."""
     queries_counted(ctx, address)
     r = ctx.link.send("@", address=address)
-    if r is None or r.code != 0:
+    if r is None or not r.ok:
         return None
     return r.dec()
 
@@ -121,7 +122,7 @@ def fill_queue(ctx: CaseContext, count: int | None = None, *,
     ctx.require(r is not None and r.inta, f"H answered {show(r)}")
     for i in range(ctx.profile.buffer if count is None else count):
         r = ctx.link.send("C" + vector(ctx, 1 if i % 2 == 0 else -1))
-        if not ctx.expect(r is not None and r.code == 0, f"vector {i + 1} is accepted",
+        if not ctx.expect(r is not None and r.ok, f"vector {i + 1} is accepted",
                           observed=show(r), expected="code 0", rule=rule):
             return False
     return True
@@ -129,7 +130,7 @@ def fill_queue(ctx: CaseContext, count: int | None = None, *,
 
 def position(ctx: CaseContext) -> list[int] | None:
     r = ctx.link.send("PF")
-    if r is None or r.code != 0 or len(r.values) < 3:
+    if r is None or not r.ok or len(r.values) < 3:
         return None
     return r.decs()
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, setup, show
+from gve_fixtures.protocol import ErrorCode
 
 # parameter -> (frame template, the rule its range belongs to on GVE54 / on GVE84, GVE114)
 RANGES = {
@@ -24,9 +25,9 @@ RANGES = {
 def axes(ctx: CaseContext) -> None:
     four = len(ctx.profile.axes) == 4
     setup(ctx, "H", expect="8")              # vectors wait in the queue while INTA = 1
-    code(ctx, ctx.link.send("C0,0,0,1"), 0 if four else 4,
+    code(ctx, ctx.link.send("C0,0,0,1"), ErrorCode.OK if four else ErrorCode.SYNTAX,
          f"a fourth component: {'the A axis' if four else 'no such axis'}", inta=True)
-    code(ctx, ctx.link.send("C1,0"), 4, "two components are too few", inta=True)
+    code(ctx, ctx.link.send("C1,0"), ErrorCode.SYNTAX, "two components are too few", inta=True)
     setup(ctx, "D")
 
 
@@ -40,12 +41,12 @@ def wired(ctx: CaseContext) -> None:
         for bit in range(8):
             link = ctx.fresh_link()
             r = link.send("SW%d,%02X" % (enable, 1 << bit))
-            ctx.require(r is not None and r.code == 0, f"SW{enable} answered {show(r)}")
+            ctx.require(r is not None and r.ok, f"SW{enable} answered {show(r)}")
             # grounded once enabled: an interrupt whether inputs are level- or
             # edge-triggered (level is our reading [D])
             link.rig.set_input(port, 0xFF ^ (1 << bit))
             r = link.send(f"SR{cause}")
-            ctx.require(r is not None and r.code == 0, f"SR{cause} answered {show(r)}")
+            ctx.require(r is not None and r.ok, f"SR{cause} answered {show(r)}")
             wired = bool(mask >> bit & 1)
             ctx.expect(r.inta == wired, f"IN{bit} of port I{port} "
                        f"{'interrupts' if wired else 'has no input behind it'}",
@@ -67,16 +68,18 @@ def ranges(ctx: CaseContext) -> None:
         if rule is None or name not in p.ranges:
             continue
         lo, hi = p.ranges[name].lo, p.ranges[name].hi
-        for value, want in ((lo - 1, 5), (lo, 0), (hi, 0), (hi + 1, 5)):
+        for value, want in ((lo - 1, ErrorCode.RANGE), (lo, ErrorCode.OK), (hi, ErrorCode.OK),
+                            (hi + 1, ErrorCode.RANGE)):
             body = template.format(*[value] * template.count("{}"))
             code(ctx, ctx.link.send(body), want, f"{body} → {want}", rule=rule)
     if "VL" in p.commands and p.ranges["VL"].hi > p.max_rate:
         hi = p.ranges["VL"].hi
-        code(ctx, ctx.link.send(f"VL{hi},{hi},{hi}"), 0,
+        code(ctx, ctx.link.send(f"VL{hi},{hi},{hi}"), ErrorCode.OK,
              f"VL above the variant's {p.max_rate} is accepted (clamped)",
              rule="10.cmd.axis-limits-clamped")
     else:
-        code(ctx, ctx.link.send("VL1000,1000,1000" if "VL" in p.commands else "V1000"), 0,
+        code(ctx, ctx.link.send("VL1000,1000,1000" if "VL" in p.commands else "V1000"),
+             ErrorCode.OK,
              "a rate in pulses/s within the variant's maximum is accepted as it is",
              rule="10.cmd.axis-limits-clamped" if "VL" in p.commands else "10.cmd.modal")
 
@@ -86,9 +89,11 @@ def ranges(ctx: CaseContext) -> None:
 def vector_range(ctx: CaseContext) -> None:
     top = ctx.profile.vector_range
     setup(ctx, "H", expect="8")              # vectors wait in the queue while INTA = 1
-    code(ctx, ctx.link.send(f"C{top},0,0"), 0, f"a component of {top} is in range", inta=True)
-    code(ctx, ctx.link.send(f"C0,{-top},0"), 0, f"and of {-top}", inta=True)
-    code(ctx, ctx.link.send(f"C{top + 1},0,0"), 5, f"{top + 1} is out of range", inta=True)
+    code(ctx, ctx.link.send(f"C{top},0,0"), ErrorCode.OK,
+         f"a component of {top} is in range", inta=True)
+    code(ctx, ctx.link.send(f"C0,{-top},0"), ErrorCode.OK, f"and of {-top}", inta=True)
+    code(ctx, ctx.link.send(f"C{top + 1},0,0"), ErrorCode.RANGE,
+         f"{top + 1} is out of range", inta=True)
     setup(ctx, "D")
 
 

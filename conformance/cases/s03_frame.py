@@ -8,6 +8,7 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, setup, show
 from conformance.link.framing import Response
+from gve_fixtures.protocol import ErrorCode
 
 #: a stall every watchdog ends, whatever the time a unit chose for it (the manuals give
 #: none: 3.frame.watchdog-time [D]); sent only to a unit that let half a second pass
@@ -78,10 +79,10 @@ def lone_bang(ctx: CaseContext) -> None:
       rules=("3.frame.upper-case", "5.code.unknown"))
 def lower(ctx: CaseContext) -> None:
     """Command letters are upper case: a lower-case command is unknown (3)"""
-    code(ctx, ctx.link.send("v1000"), 3, "v1000 is an unknown command",
+    code(ctx, ctx.link.send("v1000"), ErrorCode.UNKNOWN, "v1000 is an unknown command",
          rule="3.frame.upper-case")
     r = ctx.link.send("?")
-    ctx.expect(r is not None and r.code == 0, "still answering", observed=show(r),
+    ctx.expect(r is not None and r.ok, "still answering", observed=show(r),
                expected="0,<version>", rule="3.frame.upper-case")
 
 
@@ -101,13 +102,13 @@ def syntax(ctx: CaseContext) -> None:
     for body, rule in (("V+100", "3.params.decimal"), ("V 100", "3.params.decimal"),
                        ("V", "5.code.syntax"), ("V1x", "5.code.syntax"),
                        ("T5,5", "5.code.syntax"), ("L1,,2", "3.params.decimal")):
-        code(ctx, ctx.link.send(body), 4, f"{body} → 4", rule=rule)
+        code(ctx, ctx.link.send(body), ErrorCode.SYNTAX, f"{body} → 4", rule=rule)
 
 
 @case("3.frame.too-long",
       rules=("3.frame.max-length",))
 def too_long(ctx: CaseContext) -> None:
-    code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), 4, "a 106-byte frame → 4")
+    code(ctx, ctx.link.send("V" + "0" * 100 + "1000"), ErrorCode.SYNTAX, "a 106-byte frame → 4")
 
 
 @case("3.frame.watchdog",
@@ -118,12 +119,12 @@ def watchdog(ctx: CaseContext) -> None:
     """A frame left unfinished longer than the watchdog time is dropped and answered 2."""
     before = index(ctx)
     r, rest = _stalled(ctx, 0.5)
-    if r is None or r.code != 2:
-        code(ctx, r, 2, "a frame stalled 0.5 s is answered 2 (a 100 ms watchdog)",
+    if r is None or r.code != ErrorCode.WATCHDOG:
+        code(ctx, r, ErrorCode.WATCHDOG, "a frame stalled 0.5 s is answered 2 (a 100 ms watchdog)",
              rule="3.frame.watchdog-time")
         before = index(ctx)
         r, rest = _stalled(ctx, WATCHDOG_CEILING_S)
-    code(ctx, r, 2, "the unfinished frame is answered 2", rule="5.code.watchdog")
+    code(ctx, r, ErrorCode.WATCHDOG, "the unfinished frame is answered 2", rule="5.code.watchdog")
     ctx.expect(b"0\r" not in rest, "the rest of the frame is not executed",
                observed=rest, expected="no further answer except an error", tag="always")
     index_moved(ctx, before, 0, "a frame dropped by the watchdog does not count",
@@ -151,7 +152,7 @@ def hex_fields(ctx: CaseContext) -> None:
             rule="3.params.hex-fields")
     # the EEPROM holds the owner's bytes: the same address written three ways reads alike
     forms = {body: ctx.link.send(body) for body in ("ER0D", "ERD", "ER00D")}
-    ok = all(r is not None and r.code == 0 and len(r.values) == 1 for r in forms.values())
+    ok = all(r is not None and r.ok and len(r.values) == 1 for r in forms.values())
     read = {r.hex() for r in forms.values()} if ok else set()
     ctx.expect(ok and len(read) == 1, "ER's address is hex: ER0D, ERD and ER00D read one byte",
                observed=", ".join(f"{b} → {show(r)}" for b, r in forms.items()),

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, halted_with_queue, show
+from gve_fixtures.protocol import ErrorCode
 
 
 @case("4.response.hex-values",
@@ -23,7 +24,8 @@ def hex_values(ctx: CaseContext) -> None:
 def inta_bit(ctx: CaseContext) -> None:
     """While ST6.INTA = 1 every response carries bit 3 (8..F)"""
     halted_with_queue(ctx)
-    for body, value in (("V1000", 0), ("T99", 5), ("Z", 3), ("SR6", 0), ("PF", 0)):
+    for body, value in (("V1000", ErrorCode.OK), ("T99", ErrorCode.RANGE), ("Z", ErrorCode.UNKNOWN),
+                        ("SR6", ErrorCode.OK), ("PF", ErrorCode.OK)):
         r = ctx.link.send(body)
         code(ctx, r, value, f"{body} while interrupted", inta=True)
 

@@ -15,6 +15,7 @@ from conformance.cases._kit import (
     setup,
     vector,
 )
+from gve_fixtures.protocol import ErrorCode
 
 
 @case("5.code.busy-while-halted", rules=("5.code.busy-run-decided",), requires=("NX",))
@@ -38,7 +39,7 @@ def busy(ctx: CaseContext) -> None:
     ctx.link.wait(0.3)
     for body, rule in (("D", "5.code.busy-moving"), ("K", "5.code.busy-moving"),
                        ("R", "5.code.busy-moving"), ("N", "5.code.busy-run")):
-        code(ctx, ctx.link.send(body), 7, f"{body} while moving → 7", rule=rule)
+        code(ctx, ctx.link.send(body), ErrorCode.BUSY, f"{body} while moving → 7", rule=rule)
     ctx.link.send("H")
 
 
@@ -46,7 +47,7 @@ def busy(ctx: CaseContext) -> None:
       rules=("5.code.nothing-to-go", "10.4.go.without-inta"))
 def go_idle(ctx: CaseContext) -> None:
     """G while INTA = 0 answers 6 and does nothing."""
-    code(ctx, ctx.link.send("G"), 6, "G on an idle unit → 6")
+    code(ctx, ctx.link.send("G"), ErrorCode.NOTHING_TO_GO, "G on an idle unit → 6")
 
 
 @case("5.errors.n-while-run",
@@ -54,7 +55,7 @@ def go_idle(ctx: CaseContext) -> None:
 def n_run(ctx: CaseContext) -> None:
     """N is refused (7) while interrupted vectors still hold RUN = 1."""
     halted_with_queue(ctx)
-    code(ctx, ctx.link.send("N"), 7, "N after H with the rest queued", inta=True,
+    code(ctx, ctx.link.send("N"), ErrorCode.BUSY, "N after H with the rest queued", inta=True,
          rule="5.code.busy-run")
 
 
@@ -72,7 +73,7 @@ def out_of_range(ctx: CaseContext) -> None:
     # A0: the accelerations' range is our reading [D]; the others the manual's
     for body, rule in (("SW8,F1", "5.code.range"), ("T25", "10.cmd.modal"),
                        ("A0", "10.cmd.accel-range"), ("SR7", "10.cmd.status-words")):
-        code(ctx, ctx.link.send(body), 5, f"{body} → 5", rule=rule)
+        code(ctx, ctx.link.send(body), ErrorCode.RANGE, f"{body} → 5", rule=rule)
 
 
 @case("5.errors.queue-full",
@@ -81,7 +82,8 @@ def queue_full(ctx: CaseContext) -> None:
     """C with no room in the CONT buffer answers 1; the buffer holds the profile's size."""
     n = ctx.profile.buffer
     if fill_queue(ctx):
-        code(ctx, ctx.link.send("C" + vector(ctx, 1)), 1, f"vector {n + 1} answers 1")
+        code(ctx, ctx.link.send("C" + vector(ctx, 1)), ErrorCode.QUEUE_FULL,
+             f"vector {n + 1} answers 1")
     ctx.link.send("D")
 
 
@@ -94,8 +96,8 @@ def refused_not_executed(ctx: CaseContext) -> None:
     r = ctx.link.send("SR0")
     answers(ctx, r, "0,00", "SW0,1FF (out of range) did not write ST0", tag="M")
     setup(ctx, "L" + vector(ctx, 10))
-    code(ctx, ctx.link.send("L" + vector(ctx, 20)), 1, "L while busy → 1")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    code(ctx, ctx.link.send("L" + vector(ctx, 20)), ErrorCode.QUEUE_FULL, "L while busy → 1")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     r = ctx.link.send("PF")
     ctx.expect(r is not None and r.values[:1] == ["10"], "only the accepted L moved",
                observed=r, expected="0,10,0,0", tag="always")
@@ -106,4 +108,4 @@ def refused_not_executed(ctx: CaseContext) -> None:
 def unknown(ctx: CaseContext) -> None:
     """An unknown command answers 3."""
     for body in ("Z", "E", "XQ"):
-        code(ctx, ctx.link.send(body), 3, f"{body} → 3")
+        code(ctx, ctx.link.send(body), ErrorCode.UNKNOWN, f"{body} → 3")

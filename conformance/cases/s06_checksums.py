@@ -7,6 +7,7 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, setup, show
 from conformance.link.framing import byte_sum
+from gve_fixtures.protocol import ErrorCode
 
 
 def _gve114(p) -> bool:
@@ -18,7 +19,7 @@ def _gve114(p) -> bool:
       absent=("%",))
 def absent(ctx: CaseContext) -> None:
     """A unit without checksums answers % with 3."""
-    code(ctx, ctx.link.send("%+"), 3, "%+ → 3")
+    code(ctx, ctx.link.send("%+"), ErrorCode.UNKNOWN, "%+ → 3")
 
 
 @case("6.checksum.address-7-shares", requires=("%",), applies=_gve114,
@@ -28,11 +29,11 @@ def spindle_shares(ctx: CaseContext) -> None:
     before = index(ctx)                      # a used unit's index is wherever it is
     ctx.require(before is not None, "@ at address 0 gave no index")
     setup(ctx, "%+", checksum=False)
-    code(ctx, link.send("?", address=7, checksum=False), 4,
+    code(ctx, link.send("?", address=7, checksum=False), ErrorCode.SYNTAX,
          "address 7 is in checksum mode too: a frame without one → 4")
     r = link.send("@", address=7)
     want = (before + 1) % 256
-    ctx.expect(r is not None and r.checksum_ok is True and r.code == 0 and r.dec() == want,
+    ctx.expect(r is not None and r.checksum_ok is True and r.ok and r.dec() == want,
                "address 7 counts the index of address 0 (%+ counted, the unsummed ? not)",
                observed=show(r), expected=f"0,{want},XX")
     setup(ctx, "V1000")
@@ -46,7 +47,7 @@ def bad_sum(ctx: CaseContext) -> None:
     """In checksum mode a wrong checksum is not executed and answers 4."""
     setup(ctx, "%+", checksum=False)
     r = ctx.link.send("SW0,0F", checksum="00")
-    code(ctx, r, 4, "a wrong checksum → 4", rule="6.checksum.bad-refused")
+    code(ctx, r, ErrorCode.SYNTAX, "a wrong checksum → 4", rule="6.checksum.bad-refused")
     ctx.expect(r is not None and bool(r.checksum_ok), "the error carries a checksum",
                observed=r, expected="4,60", rule="6.checksum.bad-refused")
     r = ctx.link.send("SR0")
@@ -79,7 +80,7 @@ def lower(ctx: CaseContext) -> None:
 def missing(ctx: CaseContext) -> None:
     """In checksum mode a frame without a checksum answers 4."""
     setup(ctx, "%+", checksum=False)
-    code(ctx, ctx.link.send("A100", checksum=False), 4, "no checksum → 4")
+    code(ctx, ctx.link.send("A100", checksum=False), ErrorCode.SYNTAX, "no checksum → 4")
 
 
 @case("6.checksum.mode-on-off",

@@ -18,6 +18,7 @@ from conformance.cases._kit import (
 )
 from conformance.link.framing import byte_sum
 from conformance.motion.probe import Probe
+from gve_fixtures.protocol import ErrorCode
 
 
 def _packet(ctx: CaseContext, members: list[str], count: int):
@@ -64,7 +65,7 @@ def commits(ctx: CaseContext) -> None:
     """*E<n> commits every member in order and answers code,k."""
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
     answers(ctx, r, "0,3", "a good packet → 0,3", rule="7.packet.exchange")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     ctx.expect(position(ctx) == [10, 20, 0], "both vectors ran", observed=position(ctx),
                expected=[10, 20, 0], rule="7.packet.exchange")
 
@@ -103,7 +104,8 @@ def failed_packet(ctx: CaseContext) -> None:
     link.wait(0.3)
     ctx.expect(position(ctx) == start, "no C member moved", observed=position(ctx),
                expected=start, rule="7.packet.all-or-nothing")
-    code(ctx, link.send("L" + vector(ctx, 0)), 0, "nothing was queued: L0,0,0 → 0 at once",
+    code(ctx, link.send("L" + vector(ctx, 0)), ErrorCode.OK,
+         "nothing was queued: L0,0,0 → 0 at once",
          rule="7.packet.all-or-nothing")
     # B is the junction's rate: at the reset B two C pass their junction at speed, at
     # B10..B30 they would all but stop there
@@ -124,7 +126,7 @@ def breakers(ctx: CaseContext) -> None:
     # takes it as a member answers nothing, and the session closes the packet with *E
     counted = queries_counted(ctx)
     r = link.send("@")
-    if not ctx.expect(r is not None and r.code == 0, "@ inside a packet is answered at once",
+    if not ctx.expect(r is not None and r.ok, "@ inside a packet is answered at once",
                       observed=r, expected="0,<index>", rule="7.packet.breakers"):
         return
     expected = None if before is None else (before + 2 + counted) % 256
@@ -153,7 +155,7 @@ def no_room(ctx: CaseContext) -> None:
     if not fill_queue(ctx, ctx.profile.buffer - 1, rule="5.code.queue-full"):
         return
     r = _packet(ctx, ["C" + vector(ctx, 1), "C" + vector(ctx, -1)], 2)
-    ctx.expect(r is not None and (r.code, r.values) == (1, ["2"]),
+    ctx.expect(r is not None and (r.code, r.values) == (ErrorCode.QUEUE_FULL, ["2"]),
                "2 vectors into 1 free place → 1,2 (9,2 while INTA)", observed=r,
                expected="9,2", rule="7.packet.codes")
     r = ctx.link.send("F")
@@ -178,5 +180,5 @@ def summed(ctx: CaseContext) -> None:
     """Packets work in checksum mode, each member with its own checksum."""
     setup(ctx, "%+", checksum=False)
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 2)
-    ctx.expect(r is not None and r.code == 0 and r.values == ["2"] and r.checksum_ok,
+    ctx.expect(r is not None and r.ok and r.values == ["2"] and r.checksum_ok,
                "a summed packet → 0,2 with its checksum", observed=r, expected="0,2,XX")

@@ -17,6 +17,7 @@ from conformance.cases._kit import (
     vector,
 )
 from conformance.motion.probe import Probe
+from gve_fixtures.protocol import ErrorCode
 
 
 @case("9.reset.after-j",
@@ -28,7 +29,7 @@ def after_j(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "SW2,2B")
     setup(ctx, "L" + vector(ctx, 16))
-    link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5)
     answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
@@ -40,7 +41,7 @@ def after_j(ctx: CaseContext) -> None:
 def gve54_reset(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     setup(ctx, "L3,0,0")
-    ctx.link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    ctx.link.poll("L0,0,0", lambda r: r.ok, 10)
     ctx.expect(position(ctx) == [3, 0, 0], "after reset a step is a sixteenth (MF)",
                observed=position(ctx), expected=[3, 0, 0])
     answers(ctx, ctx.link.send("MD"), "0", "half current (MD) is a mode it takes")
@@ -68,9 +69,10 @@ def mpg_moving(ctx: CaseContext) -> None:
     r = link.send("SR6")
     ctx.expect(r is not None and r.values == ["40"], "after J the MPG holds RUN = 1",
                observed=show(r), expected="0,40", rule="9.reset.mpg")
-    code(ctx, link.send("L" + vector(ctx, 10)), 7, "vectors are refused: 7", rule="9.reset.mpg")
+    code(ctx, link.send("L" + vector(ctx, 10)), ErrorCode.BUSY,
+         "vectors are refused: 7", rule="9.reset.mpg")
     for body in ("D", "K", "R", "EW40,00", "EFW44,1", "EUW48,1"):
-        code(ctx, link.send(body), 7, f"{body} while the MPG holds RUN → 7",
+        code(ctx, link.send(body), ErrorCode.BUSY, f"{body} while the MPG holds RUN → 7",
              rule="5.moving.definition")
     answers(ctx, link.send("Y-"), "0,Y-", "Y- turns the MPG off", rule="10.cmd.mpg")
     answers(ctx, link.send("SR6"), "0,00", "and RUN clears", rule="10.cmd.mpg")

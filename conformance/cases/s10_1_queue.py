@@ -16,6 +16,7 @@ from conformance.cases._kit import (
     step_factor,
     vector,
 )
+from gve_fixtures.protocol import ErrorCode
 
 #: the vectors refused for want of room, then sent again until accepted: along Y and Z,
 #: where the queue's back-and-forth vectors along X never go
@@ -40,8 +41,8 @@ for _id, (_rules, _requires, _families, _scenario) in SCENARIOS.items():
 def l_busy(ctx: CaseContext) -> None:
     """L is accepted only when nothing is queued or running; otherwise 1."""
     setup(ctx, "C" + vector(ctx, 500))
-    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 1, "L while a C runs → 1")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.QUEUE_FULL, "L while a C runs → 1")
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     ctx.expect(position(ctx) == [500, 0, 0], "the refused L did not move",
                observed=position(ctx), expected=[500, 0, 0], tag="always")
 
@@ -50,9 +51,9 @@ def l_busy(ctx: CaseContext) -> None:
       rules=("10.1.queue.wait-idiom",))
 def idiom(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 300))
-    code(ctx, ctx.link.send("L" + vector(ctx, 0)), 1, "L0,0,0 while moving → 1")
-    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
-    code(ctx, r, 0, "L0,0,0 once idle → 0")
+    code(ctx, ctx.link.send("L" + vector(ctx, 0)), ErrorCode.QUEUE_FULL, "L0,0,0 while moving → 1")
+    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    code(ctx, r, ErrorCode.OK, "L0,0,0 once idle → 0")
     ctx.expect(position(ctx) == [300, 0, 0], "the first L completed",
                observed=position(ctx), expected=[300, 0, 0])
 
@@ -77,9 +78,11 @@ def refused_vector(ctx: CaseContext) -> None:
     if not fill_queue(ctx):                  # H, then the buffer's size of ±1 along X
         return
     before = link.send("F")
-    code(ctx, link.send("C" + vector(ctx, *REFUSED_C)), 1, "C into a full queue → 1 (9)",
+    code(ctx, link.send("C" + vector(ctx, *REFUSED_C)), ErrorCode.QUEUE_FULL,
+         "C into a full queue → 1 (9)",
          inta=True, rule="5.code.queue-full")
-    code(ctx, link.send("L" + vector(ctx, *REFUSED_L)), 1, "L while vectors wait → 1 (9)",
+    code(ctx, link.send("L" + vector(ctx, *REFUSED_L)), ErrorCode.QUEUE_FULL,
+         "L while vectors wait → 1 (9)",
          inta=True, rule="5.code.queue-full")
     after = link.send("F")
     ctx.expect(after is not None and before is not None and after.raw == before.raw,
@@ -88,11 +91,12 @@ def refused_vector(ctx: CaseContext) -> None:
     answers(ctx, link.send("G"), "0", "G runs the queue", rule="10.1.queue.cont-buffer")
     # the host's retry: each refused vector is sent again until the unit takes it
     for kind, d in (("C", REFUSED_C), ("L", REFUSED_L)):
-        r = link.poll(kind + vector(ctx, *d), lambda r: r.code != 1, 120)
-        code(ctx, r, 0, f"{kind}{vector(ctx, *d)} sent again is taken once there is room",
+        r = link.poll(kind + vector(ctx, *d), lambda r: r.code != ErrorCode.QUEUE_FULL, 120)
+        code(ctx, r, ErrorCode.OK,
+             f"{kind}{vector(ctx, *d)} sent again is taken once there is room",
              rule="5.code.queue-full")
-    r = link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
-    ctx.require(r is not None and r.code == 0, "the queue did not run out within 30 s")
+    r = link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    ctx.require(r is not None and r.ok, "the queue did not run out within 30 s")
     drift = sum(1 if i % 2 == 0 else -1 for i in range(ctx.profile.buffer))
     moved = [drift, REFUSED_C[1], REFUSED_L[2]]
     expected = None if start is None else [s + m * step_factor(ctx)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, halted_line, position, setup, show, vector
+from gve_fixtures.protocol import ErrorCode
 
 IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 10.3)
 
@@ -13,7 +14,7 @@ IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 
 def _interrupted_by_input(ctx: CaseContext) -> None:
     """Setup: IN0 enabled and active, so the unit is interrupted (INTA, ST4 bit 0)."""
     r = ctx.link.send("SW0,01")
-    ctx.require(r is not None and r.code == 0 and r.inta, f"SW0,01 answered {show(r)}")
+    ctx.require(r is not None and r.ok and r.inta, f"SW0,01 answered {show(r)}")
 
 
 def _after_clearing(ctx: CaseContext, body: str) -> None:
@@ -22,19 +23,19 @@ def _after_clearing(ctx: CaseContext, body: str) -> None:
     if body == "R":
         # nothing was kept: what R answers then is the restore rule's reading, the INTA
         # bit on that answer this case's
-        code(ctx, r, 0, "R with nothing kept → 0", rule="10.5.restore.pops")
+        code(ctx, r, ErrorCode.OK, "R with nothing kept → 0", rule="10.5.restore.pops")
         ctx.expect(r is not None and r.inta is True, "R with the input still active: INTA "
                    "set on the answer", observed=show(r), expected="INTA bit set",
                    rule="4.response.inta-level")
     else:
-        code(ctx, r, 0, f"{body} with the input still active → 8", inta=True,
+        code(ctx, r, ErrorCode.OK, f"{body} with the input still active → 8", inta=True,
              rule="4.response.inta-level")
     for n, value in ((6, "80"), (4, "01")):
         r = ctx.link.send(f"SR{n}")
         ctx.expect(r is not None and r.inta and r.values == [value],
                    f"after {body}: ST{n} set again at once", observed=show(r),
                    expected=f"8,{value}", rule="10.3.inputs.level-triggered")
-    code(ctx, ctx.link.send("L" + vector(ctx, 300)), 0,
+    code(ctx, ctx.link.send("L" + vector(ctx, 300)), ErrorCode.OK,
          f"after {body}: L is accepted and waits", inta=True,
          rule="10.3.inputs.level-triggered")
     ctx.link.wait(0.5)
@@ -58,7 +59,8 @@ def _in0_was_the_cause(ctx: CaseContext, what: str, *, rule: str) -> None:
       rules=("10.cmd.flags", "3.params.none-expected"))
 def f_idle(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("F"), "0,00", "F when idle", rule="10.cmd.flags")
-    code(ctx, ctx.link.send("F1"), 4, "F takes no parameters", rule="3.params.none-expected")
+    code(ctx, ctx.link.send("F1"), ErrorCode.SYNTAX,
+         "F takes no parameters", rule="3.params.none-expected")
 
 
 @case("10.3.inputs.level-after-clearing", hands=True,
@@ -93,7 +95,7 @@ def polarity(ctx: CaseContext) -> None:
     # IN0 active at log. 1: the unconnected input becomes active, an interrupt whether
     # inputs are level- or edge-triggered (level is our reading [D])
     r = ctx.link.send("SW2,01")
-    ctx.expect(r is not None and r.code == 0 and r.inta, "making it active interrupts at once",
+    ctx.expect(r is not None and r.ok and r.inta, "making it active interrupts at once",
                observed=show(r), expected="8", rule="4.response.inta-level")
     _in0_was_the_cause(ctx, "an unconnected input with polarity 1 interrupts at once",
                       rule="10.3.inputs.polarity")
@@ -123,7 +125,7 @@ def all_bits(ctx: CaseContext) -> None:
     """Every status word stores all 8 bits as written."""
     for n, value in ((2, "2B"), (3, "FF"), (5, "80"), (1, "3F"), (0, "A2")):
         r = ctx.link.send(f"SW{n},{value}")     # may interrupt: only the code matters here
-        ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {show(r)}")
+        ctx.require(r is not None and r.ok, f"SW{n},{value} answered {show(r)}")
         r = ctx.link.send(f"SR{n}")
         ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
                    observed=show(r), expected=value, rule="10.3.status.all-bits")
@@ -144,12 +146,12 @@ def register_ends(ctx: CaseContext) -> None:
     for n in WORDS:
         for value in ("FF", "00", "FF"):
             r = link.send(f"SW{n},{value}")     # may interrupt: only the code matters here
-            ctx.require(r is not None and r.code == 0, f"SW{n},{value} answered {r}")
+            ctx.require(r is not None and r.ok, f"SW{n},{value} answered {r}")
             r = link.send(f"SR{n}")
             ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
                        observed=r.text if r else None, expected=value,
                        rule="10.3.status.all-bits")
-        code(ctx, link.send(f"SW{n},100"), 5, f"SW{n},100: one beyond FF → 5",
+        code(ctx, link.send(f"SW{n},100"), ErrorCode.RANGE, f"SW{n},100: one beyond FF → 5",
              inta=None, rule="5.code.range")
         r = link.send(f"SR{n}")
         ctx.expect(r is not None and r.values == ["FF"], f"ST{n} still FF after the refusal",
@@ -158,7 +160,8 @@ def register_ends(ctx: CaseContext) -> None:
         link.send("D")                          # whatever an interrupt left
     answers(ctx, link.send("SW6,00"), "0", "SW6,00 when idle", rule="10.cmd.status-words")
     answers(ctx, link.send("SR6"), "0,00", "SR6: ST6 idle", rule="10.cmd.status-words")
-    code(ctx, link.send("SW6,100"), 5, "SW6,100: one beyond FF → 5", rule="5.code.range")
+    code(ctx, link.send("SW6,100"), ErrorCode.RANGE,
+         "SW6,100: one beyond FF → 5", rule="5.code.range")
 
 
 @case("10.3.status.run-bit",
@@ -169,26 +172,28 @@ def run_bit(ctx: CaseContext) -> None:
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
                observed=show(r), expected="0,40")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     answers(ctx, ctx.link.send("SR6"), "0,00", "idle again")
 
 
 @case("10.3.sw6.writing-st6", rules=("10.3.sw6.acts", "10.3.sw6.live-bits"))
 def sw6(ctx: CaseContext) -> None:
     link = ctx.link
-    code(ctx, link.send("SW6,80"), 0, "SW6,80 sets INTA", inta=True, rule="10.3.sw6.acts")
-    code(ctx, link.send("L" + vector(ctx, 100)), 0, "L is accepted while INTA = 1", inta=True,
-         rule="10.3.sw6.acts")
+    code(ctx, link.send("SW6,80"), ErrorCode.OK,
+         "SW6,80 sets INTA", inta=True, rule="10.3.sw6.acts")
+    code(ctx, link.send("L" + vector(ctx, 100)), ErrorCode.OK,
+         "L is accepted while INTA = 1", inta=True, rule="10.3.sw6.acts")
     link.wait(0.5)
     ctx.expect(position(ctx) == [0, 0, 0], "the vector waits for G", observed=position(ctx),
                expected=[0, 0, 0], rule="10.3.sw6.acts")
     link = ctx.fresh_link()
     halted_line(ctx, 300, 0.1)
-    code(ctx, link.send("SW6,00"), 0, "SW6,00 clears INTA", inta=False, rule="10.3.sw6.acts")
+    code(ctx, link.send("SW6,00"), ErrorCode.OK,
+         "SW6,00 clears INTA", inta=False, rule="10.3.sw6.acts")
     r = link.poll("SR6", lambda r: r.values == ["00"], 10)
     ctx.expect(r is not None, "RUN clears when the resumed vector ends", observed=show(r),
                expected="0,00", rule="10.3.sw6.live-bits")
     ctx.expect(position(ctx) == [300, 0, 0], "the vector resumed to its target",
                observed=position(ctx), expected=[300, 0, 0], rule="10.3.sw6.acts")
-    code(ctx, link.send("L" + vector(ctx, 0)), 0, "idle again: L0,0,0 → 0",
+    code(ctx, link.send("L" + vector(ctx, 0)), ErrorCode.OK, "idle again: L0,0,0 → 0",
          rule="10.3.sw6.live-bits")

@@ -15,6 +15,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from gve_fixtures.protocol import ErrorCode
 
 # id -> (rules (the first judges the readings), commands it requires, families, scenario)
 SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], list]] = {
@@ -55,7 +56,7 @@ def delete_moving(ctx: CaseContext) -> None:
     """D while moving answers 7."""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
-    code(ctx, ctx.link.send("D"), 7, "D while moving → 7")
+    code(ctx, ctx.link.send("D"), ErrorCode.BUSY, "D while moving → 7")
     ctx.link.send("H")
 
 
@@ -65,7 +66,7 @@ def go_empty(ctx: CaseContext) -> None:
     setup(ctx, "H", expect="8")
     answers(ctx, link.send("G"), "0", "G with an empty queue clears INTA")
     answers(ctx, link.send("SR6"), "0,00", "INTA and INTCOM cleared")
-    code(ctx, link.send("G"), 6, "and there is nothing more to resume")
+    code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "and there is nothing more to resume")
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", observed=position(ctx),
                expected=[0, 0, 0])
 
@@ -76,7 +77,7 @@ def go(ctx: CaseContext) -> None:
     """G resumes the interrupted vector from the exact step: no step lost or gained."""
     halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
                observed=position(ctx), expected=[990, 0, 0])
 

@@ -16,6 +16,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from gve_fixtures.protocol import ErrorCode
 
 
 @case("10.5.keep.gve54-full-queue", applies=lambda p: p.keep == "full",
@@ -28,7 +29,7 @@ def gve54_full(ctx: CaseContext) -> None:
     for i in range(3):
         answers(ctx, link.send("C" + vector(ctx, 1)), "0", f"C {i + 1} after K is accepted")
     answers(ctx, link.send("F"), "0,40", "three vectors do not fill the queue")
-    link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    link.poll("L0,0,0", lambda r: r.ok, 10)
     answers(ctx, link.send("L" + vector(ctx, 2)), "0", "and L is accepted once idle")
 
 
@@ -50,12 +51,12 @@ def partial(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     setup(ctx, "K")
     setup(ctx, "L" + vector(ctx, 0, 0, -100))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     setup(ctx, "L" + vector(ctx, 0, 0, 100))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 30)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     ctx.link.send("R")
     ctx.link.send("G")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code == 0, 60)
+    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
                observed=position(ctx), expected=[990, 0, 0])
 
@@ -66,8 +67,8 @@ def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
-    code(ctx, ctx.link.send("K"), 7, "K while moving")
-    code(ctx, ctx.link.send("R"), 7, "R while moving")
+    code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving")
+    code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving")
     ctx.link.send("H")
 
 
@@ -77,12 +78,12 @@ def saves(ctx: CaseContext) -> None:
     """K saves the queue and ST4..ST6 and clears them; R brings them back."""
     halted_with_queue(ctx)
     r = ctx.link.send("K")
-    code(ctx, r, 0, "K is accepted", rule="10.5.keep.saves")
+    code(ctx, r, ErrorCode.OK, "K is accepted", rule="10.5.keep.saves")
     ctx.expect(r is not None and not r.inta, "K's answer shows INTA cleared",
                observed=show(r), expected="0", rule="4.response.inta-after-command")
     answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared after K", rule="10.5.keep.saves")
     r = ctx.link.send("R")
-    code(ctx, r, 0, "R is accepted", rule="10.5.restore.exact")
+    code(ctx, r, ErrorCode.OK, "R is accepted", rule="10.5.restore.exact")
     ctx.expect(r is not None and r.inta, "R's answer shows the INTA it restored",
                observed=show(r), expected="8", rule="4.response.inta-after-command")
     r = ctx.link.send("SR6")
@@ -97,9 +98,9 @@ def single_l(ctx: CaseContext) -> None:
     """After K the GVE84/GVE114 queue takes only L (a C answers 4)"""
     halted_with_queue(ctx)
     setup(ctx, "K")
-    code(ctx, ctx.link.send("C" + vector(ctx, 10)), 4, "C after K → 4",
+    code(ctx, ctx.link.send("C" + vector(ctx, 10)), ErrorCode.SYNTAX, "C after K → 4",
          rule="10.5.keep.c-refused")
-    code(ctx, ctx.link.send("L" + vector(ctx, 10)), 0, "L after K → 0",
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.OK, "L after K → 0",
          rule="10.5.keep.single-l")
 
 
@@ -121,7 +122,7 @@ def save_emptied(ctx: CaseContext) -> None:
     setup(ctx, "G")
     link.poll("SR6", lambda r: r.values == ["00"], 10)
     answers(ctx, link.send("R"), "0", "a second R restores the empty save")
-    code(ctx, link.send("G"), 6, "nothing to resume: G → 6")
+    code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "nothing to resume: G → 6")
     link.wait(1.0)
     ctx.expect(position(ctx) == [1000, 0, 0], "the remainder ran once",
                observed=position(ctx), expected=[1000, 0, 0])

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, setup, show, vector
+from gve_fixtures.protocol import ErrorCode
 
 #: bytes no profile gives a default to (spec 10.6)
 UNWRITTEN = (0x00, 0x20, 0x7F, 0xFF)
@@ -14,7 +15,7 @@ UNWRITTEN = (0x00, 0x20, 0x7F, 0xFF)
 def _restart(ctx: CaseContext, how: str = "J") -> None:
     if how == "J":
         r = ctx.link.send("J")
-        ctx.require(r is not None and r.code == 0, "J answered")
+        ctx.require(r is not None and r.ok, "J answered")
     else:
         ctx.link.rig.power_on()
     ctx.link.wait(2.5)
@@ -35,7 +36,7 @@ def as_shipped(ctx: CaseContext) -> None:
     for address in UNWRITTEN:
         answers(ctx, ctx.link.send("ER%02X" % address), "0,FF",
                 f"EEPROM {address:02X} never written: erased", rule="10.6.eeprom.erased")
-    code(ctx, ctx.link.send("ER100"), 5, "256 bytes: 100 is out of range",
+    code(ctx, ctx.link.send("ER100"), ErrorCode.RANGE, "256 bytes: 100 is out of range",
          rule="10.6.eeprom.defaults")
 
 
@@ -48,7 +49,7 @@ def every_address(ctx: CaseContext) -> None:
         refused = []
         for address in range(size):
             r = link.send("EW%02X,%02X" % (address, address ^ key))
-            if r is None or r.code != 0:
+            if r is None or not r.ok:
                 refused.append(f"EW{address:02X} → {show(r)}")
         ctx.expect(not refused, f"EW writes every address (byte = address XOR {key:02X})",
                    observed="; ".join(refused) or "every one answered 0",
@@ -64,9 +65,11 @@ def every_address(ctx: CaseContext) -> None:
                    or "every byte as written",
                    expected="0,<address XOR %02X> at each address" % key,
                    rule="10.cmd.eeprom-bytes")
-    code(ctx, link.send("EW%X,00" % size), 5, f"{size} bytes: EW{size:X} is out of range",
+    code(ctx, link.send("EW%X,00" % size), ErrorCode.RANGE,
+         f"{size} bytes: EW{size:X} is out of range",
          rule="10.6.eeprom.defaults")
-    code(ctx, link.send("ER%X" % size), 5, f"and ER{size:X}", rule="10.6.eeprom.defaults")
+    code(ctx, link.send("ER%X" % size), ErrorCode.RANGE,
+         f"and ER{size:X}", rule="10.6.eeprom.defaults")
 
 
 @case("10.6.eeprom.kept-across-restarts", destructive=True, rig=True,
@@ -89,7 +92,7 @@ def kept(ctx: CaseContext) -> None:
 def busy(ctx: CaseContext) -> None:
     link = ctx.link
     r = link.send("ER41")
-    ctx.require(r is not None and r.code == 0 and r.values, "ER41 answered")
+    ctx.require(r is not None and r.ok and r.values, "ER41 answered")
     before = r.hex()
     setup(ctx, "L" + vector(ctx, 1000))
     link.wait(0.1)
@@ -97,7 +100,7 @@ def busy(ctx: CaseContext) -> None:
     writes = ["EW41,%02X" % (before ^ 0xFF)]
     writes += [body for body, name in words if name in ctx.profile.commands]
     for body in writes:
-        code(ctx, link.send(body), 7, f"{body} while moving → 7")
+        code(ctx, link.send(body), ErrorCode.BUSY, f"{body} while moving → 7")
     link.send("H")
     answers(ctx, link.send("ER41"), f"8,{before:02X}", "the refused write changed nothing")
 
@@ -109,7 +112,7 @@ def eeprom(ctx: CaseContext) -> None:
     """EW writes a byte that ER reads back (kept, then restored by the suite)"""
     link = ctx.link
     r = link.send("ER40")
-    ctx.require(r is not None and r.code == 0, "ER40 answered")
+    ctx.require(r is not None and r.ok, "ER40 answered")
     old = r.hex()
     new = old ^ 0x5A
     answers(ctx, link.send("EW40,%02X" % new), "0", "EW40 → 0")
@@ -128,4 +131,4 @@ def words(ctx: CaseContext) -> None:
     answers(ctx, link.send("ER33"), "0,3E", "the float's top byte at 33 (little-endian)")
     answers(ctx, link.send("EUW40,305419896"), "0", "EUW40")
     answers(ctx, link.send("ER40"), "0,78", "the uint's low byte first")
-    code(ctx, link.send("EFRFD"), 5, "a word past FF → 5")
+    code(ctx, link.send("EFRFD"), ErrorCode.RANGE, "a word past FF → 5")

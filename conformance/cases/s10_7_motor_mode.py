@@ -7,6 +7,7 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, measured_case, position, setup, vector
 from conformance.motion.probe import Probe
+from gve_fixtures.protocol import ErrorCode
 
 #: the move each micro-step mode makes (commanded steps): a factor of another mode ends
 #: elsewhere on every axis
@@ -14,8 +15,8 @@ MODE_MOVE = (60, -30, 15)
 
 
 def _rest(ctx: CaseContext) -> None:
-    r = ctx.link.poll("L0,0,0", lambda r: r.code != 1, 30)
-    ctx.require(r is not None and r.code == 0, "the move did not end within 30 s")
+    r = ctx.link.poll("L0,0,0", lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    ctx.require(r is not None and r.ok, "the move did not end within 30 s")
 
 
 # id -> (rules (the first judges the readings), commands it requires, families, scenario)
@@ -68,9 +69,9 @@ def microstep(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "M4")
     setup(ctx, "L100,100,100")
-    link.poll("L0,0,0", lambda r: r.code == 0, 60)
+    link.poll("L0,0,0", lambda r: r.ok, 60)
     answers(ctx, link.send("PF"), "0,400,400,400", "PF after M4 and L100,100,100")
-    code(ctx, link.send("MQ"), 4, "an unknown mode → 4", tag="D")
+    code(ctx, link.send("MQ"), ErrorCode.SYNTAX, "an unknown mode → 4", tag="D")
 
 
 @case("10.7.motor.modes-while-moving", requires=("M",),
@@ -79,15 +80,15 @@ def motor_busy(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "V5000")
     setup(ctx, "L1001,500,399")
-    code(ctx, link.send("M4"), 7, "M while moving → 7", rule="10.7.motor.busy")
-    link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    code(ctx, link.send("M4"), ErrorCode.BUSY, "M while moving → 7", rule="10.7.motor.busy")
+    link.poll("L0,0,0", lambda r: r.ok, 10)
     ctx.expect(position(ctx) == [1001, 500, 399], "in MF the counters count the steps",
                observed=position(ctx), expected=[1001, 500, 399], rule="10.7.motor.any-position")
     answers(ctx, link.send("M2"), "0", "a coarser mode at a position not divisible by 8",
             rule="10.7.motor.any-position")
     setup(ctx, "MF")
     setup(ctx, "L-1,0,1")
-    link.poll("L0,0,0", lambda r: r.code == 0, 10)
+    link.poll("L0,0,0", lambda r: r.ok, 10)
     ctx.expect(position(ctx) == [1000, 500, 400], "the manual's example: L-1,0,1",
                observed=position(ctx), expected=[1000, 500, 400], rule="10.7.motor.any-position")
     answers(ctx, link.send("M4"), "0", "then M4", rule="10.7.motor.any-position")

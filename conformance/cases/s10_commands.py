@@ -27,13 +27,13 @@ from conformance.cases._kit import (
 from conformance.motion.probe import Probe
 from conformance.protocol.catalogue import classes
 from conformance.protocol.wire import HEX_BYTE
-from gve_fixtures.protocol import SECOND
+from gve_fixtures.protocol import SECOND, ErrorCode
 
 #: steps of the moves that end on a counter's end (well inside the directed envelope)
 RUN_IN = 100
 
 
-def _set(ctx: CaseContext, axis: str, value: int, want: int, rule: str) -> None:
+def _set(ctx: CaseContext, axis: str, value: int, want: ErrorCode, rule: str) -> None:
     code(ctx, ctx.link.send(f"N{axis}{value}"), want, f"N{axis}{value} → {want}", rule=rule)
 
 
@@ -43,8 +43,8 @@ def _reads(ctx: CaseContext, expected: list[int], what: str) -> None:
 
 
 def _settle(ctx: CaseContext) -> None:
-    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != 1, 30)
-    ctx.require(r is not None and r.code == 0, "the moves did not end within 30 s")
+    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    ctx.require(r is not None and r.ok, "the moves did not end within 30 s")
 
 
 #: per-axis limits, each its own: a limit taken from another axis changes every move
@@ -200,7 +200,8 @@ def ports(ctx: CaseContext) -> None:
         seen = link.rig.outputs()
         ctx.expect(seen == level, f"the outputs read {level:08b}", observed=f"{seen:08b}",
                    expected=f"{level:08b}", rule=rule)
-    code(ctx, link.send("O0,100"), 5, "O0,100: one beyond FF → 5", rule="10.cmd.output")
+    code(ctx, link.send("O0,100"), ErrorCode.RANGE,
+         "O0,100: one beyond FF → 5", rule="10.cmd.output")
     seen = link.rig.outputs()
     ctx.expect(seen == 0xFF, "the refused O0,100 left the outputs off", observed=seen,
                expected=0xFF, rule="10.cmd.output")
@@ -263,10 +264,10 @@ def absent(ctx: CaseContext) -> None:
     for name in lacking:
         r = ctx.link.send(REFUSAL_FRAMES[name])
         # an axis or port the unit lacks may be a parameter out of range instead (spec 5)
-        if LACKING_LETTER.match(name) and r is not None and r.code == 5:
+        if LACKING_LETTER.match(name) and r is not None and r.code == ErrorCode.RANGE:
             ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks")
             continue
-        code(ctx, r, 3, f"{name} → 3")
+        code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3")
 
 
 @case("10.commands.counter-range-ends", requires=("NX",),
@@ -284,12 +285,12 @@ def range_ends(ctx: CaseContext) -> None:
     # come back whatever it reads
     near = [hi - RUN_IN, lo + RUN_IN, hi - RUN_IN]
     for axis, value in zip(shown, near, strict=True):
-        _set(ctx, axis, value, 0, "10.cmd.set-axis")
+        _set(ctx, axis, value, ErrorCode.OK, "10.cmd.set-axis")
     for d, there, what in (((RUN_IN, -RUN_IN, RUN_IN), [hi, lo, hi], "a move counted up to "
                             "the ends"), ((-RUN_IN, RUN_IN, -RUN_IN), near, "and back")):
         setup(ctx, "L" + vector(ctx, *d))
         want = [v * scale for v in there]
-        r = ctx.link.poll("PF", lambda r, want=want: r.code == 0 and r.values == [
+        r = ctx.link.poll("PF", lambda r, want=want: r.ok and r.values == [
             str(v) for v in want], 5.0, every=0.02)
         got = r.decs() if r is not None else position(ctx)
         ctx.expect(r is not None, what, observed=got, expected=want, rule="10.cmd.positions")
@@ -297,18 +298,20 @@ def range_ends(ctx: CaseContext) -> None:
     # then each axis at each end, its neighbours at the other: every reading tells them apart
     for ends in ((hi, lo, hi), (lo, hi, lo)):
         for axis, value in zip(shown, ends, strict=True):
-            _set(ctx, axis, value, 0, "10.cmd.set-axis")
+            _set(ctx, axis, value, ErrorCode.OK, "10.cmd.set-axis")
         _reads(ctx, [v * scale for v in ends], f"PF reads the counters at {ends}")
         for axis, value in zip(shown, ends, strict=True):
             beyond = value + (1 if value > 0 else -1)
-            _set(ctx, axis, beyond, 5, "5.code.range")
+            _set(ctx, axis, beyond, ErrorCode.RANGE, "5.code.range")
         _reads(ctx, [v * scale for v in ends], "the refused N<axis> changed no counter")
     if "NA" in p.commands:                   # the A counter: set and refused, not read
-        for value, want in ((hi, 0), (hi + 1, 5), (lo, 0), (lo - 1, 5), (0, 0)):
-            _set(ctx, "A", value, want, "10.cmd.set-axis" if want == 0 else "5.code.range")
+        for value, want in ((hi, ErrorCode.OK), (hi + 1, ErrorCode.RANGE), (lo, ErrorCode.OK),
+                            (lo - 1, ErrorCode.RANGE), (0, ErrorCode.OK)):
+            _set(ctx, "A", value, want,
+                 "10.cmd.set-axis" if want == ErrorCode.OK else "5.code.range")
     # back where the case began
     for axis, value in zip(shown, start, strict=True):
-        _set(ctx, axis, value // scale, 0, "10.cmd.set-axis")
+        _set(ctx, axis, value // scale, ErrorCode.OK, "10.cmd.set-axis")
     _reads(ctx, start, "the counters are back where the case found them")
 
 

@@ -12,6 +12,8 @@ from pathlib import Path
 from conformance.case import CaseContext, case
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
+from conformance.protocol.catalogue import classes
+from conformance.protocol.parse import parse
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import TAGS
@@ -126,11 +128,11 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
             body = f.bodies(summed)[0]
             r = None if answer is None else parse_response(answer, summed=summed)
             guard.accepted(body, r, f.address)
-            if body[:1] in ("L", "C") and answer == b"0\r":
+            if parse(body).name in classes(vector=True) and answer == b"0\r":
                 queued += 1
             elif body == "D":
                 queued = 0
-            if body in ("%+", "%-") and r is not None and r.code == 0:
+            if body in ("%+", "%-") and r is not None and r.ok:
                 summed = body == "%+"
     return None if math.isinf(need) else math.ceil(need)
 

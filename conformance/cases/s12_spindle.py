@@ -7,12 +7,13 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, show
 from conformance.motion.probe import Probe
+from gve_fixtures.protocol import ErrorCode
 
 
 def spindle(ctx: CaseContext, value: int) -> None:
     """Setup: the spindle at ``value`` (its answer is judged by 12.spindle.address-7)."""
     r = ctx.link.send(f"V{value}", address=7)
-    ctx.require(r is not None and r.code == 0, f"!7V{value} answered {show(r)}")
+    ctx.require(r is not None and r.ok, f"!7V{value} answered {show(r)}")
 
 
 @case("12.spindle.address-7",
@@ -29,7 +30,7 @@ def address_7(ctx: CaseContext) -> None:
     ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs(), rule=speed)
     answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)
     ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
-    code(ctx, link.send("L1,0,0", address=7), 3, "address 7 takes no vectors",
+    code(ctx, link.send("L1,0,0", address=7), ErrorCode.UNKNOWN, "address 7 takes no vectors",
          rule="12.spindle.commands")
 
 

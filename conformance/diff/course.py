@@ -12,6 +12,7 @@ from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 #: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
 _PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
@@ -19,6 +20,12 @@ _PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
 _COURSE_CHANGERS = classes(course=True)
+_VECTORS = classes(vector=True)
+#: moves at a speed of its own (the profile's top speed bounds it), not the modal V
+_OWN_SPEED = classes(own_speed=True)
+#: frames besides vectors that move the axes or set their counters (J restarts them;
+#: a packet's vectors are answered by its `*E`)
+_MOVERS = _OWN_SPEED | classes(restart=True) | classes(packet="closes")
 
 
 class Course:
@@ -36,6 +43,12 @@ class Course:
     - The last vector it queued: ``C+C`` when a C followed a C (the two meet at a
       junction, spec 10.2); a D empties the queue.
     - Whether a packet is open (`*S` to the unit's own address, until a breaker).
+    - How far from where the example began each axis can be (the counter units of every
+      vector it took, in the micro-step mode of its time; unknown after anything else
+      that moves or sets a counter): a position beyond is not a matter of *when* (a rate)
+      but of *where* the vectors go (their unit, the mode's step).
+    - The VL it took and the axes its vectors moved: VL capping only axes the vectors
+      never moved, below the rate they ran at, changed nothing on the reference.
     """
 
     def __init__(self, profile: Profile) -> None:
@@ -47,18 +60,24 @@ class Course:
         self.up = 1.0
         self.queued: str | None = None
         self.in_packet = False
+        self.factors = dict(profile.microstep.factors) if profile.microstep else {}
+        self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
+        self.reach: list[int] | None = [0] * len(profile.axes)
+        self.caps: list[int] | None = None
+        self.moved: set[int] = set()
 
     # -- what it was given -----------------------------------------------------------------
     def took(self, command: str, body: str, reference: RoundTrip, *, first: bool = True
              ) -> None:
         """The reference answered ``body``; ``first``: not a later frame of a fill (whose
         vectors join the first: no dwell)."""
-        if reference.code != 0:
+        if reference.code != ErrorCode.OK:
             return
         if first:
             self._dwell(command, body, reference)
         self._queue(command, body)
         self._ceiling(command, body)
+        self._where(command, body)
 
     def stepped(self, command: str, step: Step) -> None:
         """A step's frames all went: a packet opens or closes."""
@@ -68,7 +87,7 @@ class Course:
             self.in_packet = False
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
-        if command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+        if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
@@ -78,7 +97,7 @@ class Course:
     def _queue(self, command: str, body: str) -> None:
         if command == "D":
             self.queued = None
-        elif command in ("L", "C") and not _ZERO_VECTOR.fullmatch(body.upper()):
+        elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
 
     def _ceiling(self, command: str, body: str) -> None:
@@ -89,8 +108,26 @@ class Course:
             self.override = max(self.override, value / 100)
         elif command == "XU":          # each XU scales the held vectors again
             self.up *= 17 / 16
-        elif command in ("W", "Y"):
+        elif command in _OWN_SPEED:
             self.speed = self.top
+
+    def _where(self, command: str, body: str) -> None:
+        params = body[len(command):]
+        if command in _VECTORS:
+            d = _numbers(params)
+            if d is None or self.reach is None:
+                self.reach = None
+                return
+            for i, n in enumerate(d[:len(self.reach)]):
+                self.reach[i] += abs(n) * self.factor
+                if n:
+                    self.moved.add(i)
+        elif command == "M" and params in self.factors:
+            self.factor = self.factors[params]
+        elif command == "VL":
+            self.caps = _numbers(params)
+        elif command in _MOVERS or command.startswith("N"):
+            self.reach = None
 
     # -- what a difference reads ---------------------------------------------------------
     def within_dwell(self, t: int) -> bool:
@@ -100,9 +137,32 @@ class Course:
     def rate(self) -> int:
         return min(self.top, math.ceil(self.speed * self.override * self.up))
 
+    def beyond_reach(self, position: list[str]) -> bool:
+        """Whether ``position`` (a `P`/`PF` answer's values) has an axis farther from
+        where the example began than every vector taken could carry it."""
+        values = _numbers(",".join(position))
+        return (self.reach is not None and values is not None
+                and any(abs(v) > r for v, r in zip(values, self.reach, strict=False)))
+
+    @property
+    def capped_elsewhere(self) -> bool:
+        """VL capped some axis below the rate the vectors ran at, and only axes none of
+        them moved (so the reference's motion owes VL nothing)."""
+        if self.caps is None or not self.moved:
+            return False
+        low = {i for i, cap in enumerate(self.caps) if cap < self.rate}
+        return bool(low) and not low & self.moved
+
     @property
     def junction(self) -> bool:
         return self.queued == "C+C"
+
+
+def _numbers(params: str) -> list[int] | None:
+    try:
+        return [int(p) for p in params.split(",")]
+    except ValueError:
+        return None
 
 
 def _first_number(params: str) -> int | None:

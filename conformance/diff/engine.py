@@ -29,6 +29,7 @@ from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 try:
     # internals of Hypothesis, used only to empty its pool of constants while a search
@@ -176,7 +177,7 @@ class Pair:
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
-            if step.kind == FILL and rec.reference.code != 0:
+            if step.kind == FILL and rec.reference.code != ErrorCode.OK:
                 break
         if out.ended:
             return True
@@ -185,6 +186,8 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
+            if command == "SW" and rec is not None and (rec.reference.code or 0) & 7:
+                earlier.add("SW-refused")
         self.course.stepped(command, step)
         return False
 
@@ -196,6 +199,10 @@ class Pair:
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+        if kind == "position" and self.course.beyond_reach(_values(rec.target)):
+            context.add("beyond-reach")
+        if self.course.capped_elsewhere:
+            context.add("capped-elsewhere")
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from conformance.diff.labels import command_of
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
-from conformance.protocol.catalogue import Command, Field, commands
+from conformance.protocol.catalogue import Command, Field, classes, commands
 from gve_fixtures.profile import Profile
 
 GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
@@ -129,8 +129,7 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
         # EEPROM addresses and bytes from a few values, so a write is read back
         numbers = st.one_of(st.sampled_from([lo, min(lo + 1, hi), hi]), numbers)
         return numbers.map(lambda n: "%02X" % n)
-    if head == "range" and rest in ("V", "B", "VL"):
-        # rates low enough that a short move lasts long enough to be read moving
+    if head == "range" and rest in moves["slow_rates"]:
         numbers = st.one_of(numbers, st.integers(lo, min(hi, max(lo, 5000))))
     return numbers.map(str)
 
@@ -186,7 +185,7 @@ class Grammar:
         self.valid = {k: _valid(profile, k, g) for k in kinds}
         self.invalid_chance = round(g["invalid"]["chance"] * 100)
         self.modal = [n for n in g["motion"]["modal"] if n in self.names]
-        self.vectors = [n for n in ("L", "C") if n in self.names]
+        self.vectors = [n for n in self.names if n in classes(vector=True)]
         self.events = [e for e in g["motion"]["events"]
                        if e.rstrip("0123456789,") in profile.commands]
         self.checksums = "%" in profile.commands
@@ -210,8 +209,9 @@ class Grammar:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
         ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
         self.ports = ports or [1]
-        self.member_names = [n for n in ("C", "B") if n in profile.commands]
-        self.other_members = [n for n in ("L", "V", "PF") if n in profile.commands]
+        self.member_names = [n for n, c in commands().items()
+                             if c.packet == "member" and n in profile.commands]
+        self.other_members = [n for n in g["packet"]["others"] if n in profile.commands]
 
     def _can(self, idiom: list[str]) -> bool:
         """Whether every step of an idiom can be sent on this profile and run."""

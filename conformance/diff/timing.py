@@ -31,6 +31,7 @@ _STOPPING = classes(stops=True) | {"input"}
 _DEFERRED = classes(deferred=True) | classes(restart=True)
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
 _READINGS = classes(position=True) | {">"}
+_EMPTIES = classes(empties=True)
 
 
 class Timing:
@@ -121,7 +122,7 @@ class RealTime(Timing):
         if target is not None and command not in _DEFERRED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
             self.trips.append(target.received_at - target.sent_at)
-        if command in ("D", "K") and self.cut_ns:
+        if command in _EMPTIES and self.cut_ns:
             self.lost = True
         if command in _RETIMING and self.idle_since is None:
             self.slack_ns += self.latency_ns

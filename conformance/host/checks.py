@@ -203,7 +203,7 @@ def summed(ex: Exchange) -> bool:
 def restarts(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """After `J` the host sends nothing until the unit is ready again (spec 2)."""
     for ex in rec.exchanges:
-        if ex.parsed.command != "J" or ex.code != 0 or ex.delivered_at is None:
+        if ex.parsed.command != "J" or ex.code != ErrorCode.OK or ex.delivered_at is None:
             continue
         out.judged.add("2.link.ready-after-restart")
         profile = line.units[ex.parsed.address or 0]

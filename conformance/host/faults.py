@@ -18,6 +18,7 @@ from typing import Protocol
 
 from conformance.host.grammar import byte_sum
 from conformance.host.recording import Exchange, show
+from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode
 
 #: how late a late answer is: longer than a host's least patience (checks.PATIENCE)
@@ -111,7 +112,7 @@ class AnswerFault(Fault):
 
     def answer(self, ex: Exchange, ctx: Context) -> Delivery:
         data = b"".join(ex.answer)
-        if self.injected or ex.code != 0 or not self.target.matches(ex.frame.raw, ctx):
+        if self.injected or ex.code != ErrorCode.OK or not self.target.matches(ex.frame.raw, ctx):
             return Delivery(data)
         self.injected = True
         ex.fault = self.kind
@@ -208,7 +209,7 @@ class QueueFull(Fault):
         if not self._active(ctx) or f.command is None:
             return raw
         packet = ctx.in_packet(f.address)
-        if f.command in ("L", "C") and not packet:
+        if f.command in classes(vector=True) and not packet:
             frame = b"!%dF" % f.address
         elif f.command == "*E" and packet and f.params:
             frame = b"!%d*E%d" % (f.address, int(f.params[0]) + 1)

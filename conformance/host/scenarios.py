@@ -26,6 +26,7 @@ from conformance.host.faults import (
 from conformance.host.probe import Final
 from conformance.host.recording import Exchange
 from conformance.host.unitview import SETTINGS, VECTORS, Executed
+from gve_fixtures.protocol import ErrorCode
 
 
 @dataclass
@@ -58,7 +59,7 @@ class Baseline:
 def point_of(ex: Exchange) -> str | None:
     """Which point of a job an exchange is, when the unit took it (answered 0)."""
     f = ex.parsed
-    if ex.code != 0 or f.command is None:
+    if ex.code != ErrorCode.OK or f.command is None:
         return None
     if f.command in VECTORS and any(p.lstrip("-0") for p in f.params):
         return "vector"

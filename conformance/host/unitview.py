@@ -17,6 +17,7 @@ from conformance.host.grammar import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
+from gve_fixtures.protocol import ErrorCode
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
 MODAL = classes(modal=True)
@@ -27,6 +28,7 @@ MARKERS = classes(marks=True)
 #: inside an open packet these are executed at once and discard it (spec 7)
 BREAKERS = classes(packet="breaker")
 VECTORS = classes(vector=True)
+SWITCHES = classes(switch=True)
 
 
 @dataclass(frozen=True)
@@ -106,11 +108,11 @@ class UnitView:
             return
         if name == "*E":
             members, self.packet = self.packet or [], None
-            if code == 0:
+            if code == ErrorCode.OK:
                 for member in members:
                     self._accept(member)
             return
-        if code == 0:
+        if code == ErrorCode.OK:
             self._accept(f)
             if name == "J":
                 t = ex.answered_at or 0
@@ -134,7 +136,7 @@ class UnitView:
                 modal = tuple((k, self.modal[k]) for k in sorted(self.modal))
                 self.executed.append(Executed(name, values, modal))
                 self.vectors += 1
-        elif name in ("VK", "VN"):
+        elif name in SWITCHES:
             self.modal["VK"] = name == "VK"
         elif name == "VL":
             values = tuple(int(p) for p in params)

@@ -30,11 +30,11 @@ from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outco
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
-from conformance.protocol.catalogue import classes, eeprom_width
+from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import ErrorCode, St6
 
 
 class SafetyStop(BaseException):
@@ -63,6 +63,8 @@ LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
 _PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
+#: what a command sets moving again, by name: "queue" or "save"
+_RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
 
@@ -119,7 +121,7 @@ def _number(text: str, base: int = 10) -> Span:
 def outcome_of(r: Response | None) -> Outcome:
     if r is None or r.code is None:
         return Outcome.UNCLEAR
-    return Outcome.ACCEPTED if r.code == 0 else Outcome.REFUSED
+    return Outcome.ACCEPTED if r.ok else Outcome.REFUSED
 
 
 class Guard:
@@ -259,9 +261,8 @@ class Guard:
                 f"{body}: axis {self.profile.axes[axis]} could reach "
                 f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
-        # G and SW6 resume the queue, R the save: they move only when something waits
-        waiting = e.saved if command.name == "R" else e.queue if command.name in ("G", "SW6") \
-            else None
+        # G and a write of ST6 resume the queue, R the save: they move only when something waits
+        waiting = {"queue": e.queue, "save": e.saved}.get(_RESUMES.get(command.name, ""))
         if reach != e.reach() or (waiting and any(p != EMPTY for p in waiting)):
             if self.interrupts.stopped:
                 raise SafetyStop(f"{body}: no motion after Ctrl-C")
@@ -356,9 +357,9 @@ class Guard:
         names = self.profile.axes
         axis = command.params[:1]
         n2, _, n4, _ = Body("W", command.params[1:].lstrip(",")).fields(4)
-        if code == 5:
+        if code == ErrorCode.RANGE:
             outcome = Outcome.ACCEPTED
-        zeroed = code == 0
+        zeroed = code == ErrorCode.OK
         if axis not in names or not (n2.exact and n4.exact):
             every = range(len(names))
             return lambda e: [e.reference(i, UNKNOWN, outcome, zeroed=True) for i in every]

@@ -11,6 +11,8 @@ from hypothesis.stateful import RuleBasedStateMachine, invariant
 from conformance.case import CaseContext
 from conformance.link.framing import Response
 from conformance.model.unit import ModelUnit
+from conformance.protocol.parse import parse
+from gve_fixtures.protocol import ErrorCode
 
 
 class Broken(AssertionError):
@@ -53,8 +55,7 @@ class UnitMachine(RuleBasedStateMachine):
         """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
         the model (``checksum_ok``: whether its sum lets it count)."""
         r = self.link.send(body, **kw)
-        self.model.frame_arrived(body[:2] if body[:2] in ("*S", "*E") else body[:1],
-                                 checksum_ok=checksum_ok)
+        self.model.frame_arrived(parse(body).name or body[:1], checksum_ok=checksum_ok)
         return r
 
     def fits(self, body: str) -> bool:
@@ -63,7 +64,8 @@ class UnitMachine(RuleBasedStateMachine):
         return self.link.guard.fits(body)
 
     def idle(self) -> None:
-        r = self.link.poll("L0,0,0", lambda r: r.code is not None and r.code != 1, 120,
+        r = self.link.poll("L0,0,0",
+                           lambda r: r.code is not None and r.code != ErrorCode.QUEUE_FULL, 120,
                            send=self.send)
         holds(r is not None, "10.1.queue.wait-idiom", "the unit never became idle")
         # a poll that got no answer in time may still have counted: resynchronize with
@@ -72,12 +74,12 @@ class UnitMachine(RuleBasedStateMachine):
 
     def index(self) -> int:
         r = self.send("@")
-        holds(r is not None and r.code == 0 and r.values, "8.index.answer", f"@ answered {r}")
+        holds(r is not None and r.ok and r.values, "8.index.answer", f"@ answered {r}")
         return r.dec()
 
     def position(self) -> list[int]:
         r = self.send("PF")
-        holds(r is not None and r.code == 0, "10.cmd.positions", f"PF answered {r}")
+        holds(r is not None and r.ok, "10.cmd.positions", f"PF answered {r}")
         return r.decs()
 
 

@@ -9,9 +9,11 @@ from conformance.case import CaseContext, case
 from conformance.link.framing import byte_sum
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import ErrorCode
 
 # bodies and the code each gets when framed correctly (spec 10, 5)
-BODIES = {"V1000": 0, "T5": 0, "SR2": 0, "A100": 0, "Z": 3, "T99": 5}
+BODIES = {"V1000": ErrorCode.OK, "T5": ErrorCode.OK, "SR2": ErrorCode.OK, "A100": ErrorCode.OK,
+          "Z": ErrorCode.UNKNOWN, "T99": ErrorCode.RANGE}
 
 
 class ChecksumMachine(UnitMachine):
@@ -22,7 +24,7 @@ class ChecksumMachine(UnitMachine):
     def toggle(self, on: bool) -> None:
         r = self.send("%+" if on else "%-", checksum=self.model.checksums)
         self.model.checksums = on
-        holds(r is not None and r.code == 0, "6.checksum.mode-commands",
+        holds(r is not None and r.ok, "6.checksum.mode-commands",
               f"%{'+' if on else '-'} answered {r}")
         holds((r.checksum is not None) == on, "6.checksum.mode-commands",
               f"response checksum presence: {r}")
@@ -39,8 +41,9 @@ class ChecksumMachine(UnitMachine):
                 "missing": False, "lower": right.lower()}[state]
         if not m.checksums and state != "missing":
             return               # without the mode a sum is just a bad parameter
-        r = self.send(body, checksum=sent, checksum_ok=m.checksum_answer(state) == 0)
-        expected = BODIES[body] if m.checksum_answer(state) == 0 else 4
+        r = self.send(body, checksum=sent, checksum_ok=m.checksum_answer(state) == ErrorCode.OK)
+        expected = BODIES[body] if m.checksum_answer(state) == ErrorCode.OK else \
+            ErrorCode.SYNTAX
         # a frame with its right sum is the manual's; what a wrong one gets is ours [D]
         rule = "6.checksum.sum" if state == "good" or not m.checksums else \
             "6.checksum.bad-refused"

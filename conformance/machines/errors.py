@@ -9,30 +9,34 @@ from hypothesis.stateful import rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
-from gve_fixtures.protocol import St6
+from conformance.protocol.catalogue import classes
+from gve_fixtures.protocol import ErrorCode, St6
 
 RUN, INTA = St6.RUN, St6.INTA
 
 
-def expected_code(body: str, moving: bool, run: bool, inta: bool) -> int:
+def expected_code(body: str, moving: bool, run: bool, inta: bool) -> ErrorCode:
     """The code of spec 5 for ``body`` in a state (moving; RUN; INTA)."""
-    table = {"V1000": 0, "T99": 5, "Z": 3, "V+1": 4, "SW8,F1": 5, "F": 0, "SR6": 0,
-             "C1,0,0": 0, "A0": 5, "T5,5": 4}
+    table = {"V1000": ErrorCode.OK, "T99": ErrorCode.RANGE, "Z": ErrorCode.UNKNOWN,
+             "V+1": ErrorCode.SYNTAX, "SW8,F1": ErrorCode.RANGE, "F": ErrorCode.OK,
+             "SR6": ErrorCode.OK, "C1,0,0": ErrorCode.OK, "A0": ErrorCode.RANGE,
+             "T5,5": ErrorCode.SYNTAX}
     if body == "N":
-        return 7 if run else 0
-    if body in ("D", "K"):
-        return 7 if moving else 0
+        return ErrorCode.BUSY if run else ErrorCode.OK
+    if body in classes(still=True):
+        return ErrorCode.BUSY if moving else ErrorCode.OK
     if body == "G":
-        return 0 if inta else 6
+        return ErrorCode.OK if inta else ErrorCode.NOTHING_TO_GO
     if body == "L0,0,0":
-        return 1 if run else 0
+        return ErrorCode.QUEUE_FULL if run else ErrorCode.OK
     return table[body]
 
 
 #: the rule each code checks; a probe whose code is our reading names that reading
-CODE_RULE = {0: "5.code.ok", 1: "10.1.queue.wait-idiom", 3: "5.code.unknown",
-             4: "5.code.syntax", 5: "5.code.range", 6: "5.code.nothing-to-go",
-             7: "5.code.busy-moving"}
+CODE_RULE = {ErrorCode.OK: "5.code.ok", ErrorCode.QUEUE_FULL: "10.1.queue.wait-idiom",
+             ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
+             ErrorCode.RANGE: "5.code.range", ErrorCode.NOTHING_TO_GO: "5.code.nothing-to-go",
+             ErrorCode.BUSY: "5.code.busy-moving"}
 CODE_RULES = {"V+1": "3.params.decimal", "A0": "10.cmd.accel-range", "N": "5.code.busy-run"}
 
 
@@ -41,25 +45,26 @@ class ErrorMachine(UnitMachine):
 
     def observe(self) -> tuple[bool, bool, bool]:
         r = self.send("SR6")
-        holds(r is not None and r.code == 0 and r.values, "10.cmd.status-words",
+        holds(r is not None and r.ok and r.values, "10.cmd.status-words",
               f"SR6 answered {r}")
         st6 = r.hex()
         holds(r.inta == bool(st6 & INTA), "4.response.inta-bit",
               f"the INTA bit of {r.text} disagrees with ST6")
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
-        return (run and not inta) or bool(st6 & 0x01), run, inta
+        return (run and not inta) or bool(st6 & St6.STOP), run, inta
 
     @rule(steps=st.integers(500, 1500))
     def motion(self, steps: int) -> None:
         if not self.fits(f"C{steps},0,0"):
             return
         r = self.send(f"C{steps},0,0")
-        holds(r is not None and r.code in (0, 1), "10.1.queue.cont-buffer", f"C answered {r}")
+        holds(r is not None and r.code in (ErrorCode.OK, ErrorCode.QUEUE_FULL),
+              "10.1.queue.cont-buffer", f"C answered {r}")
 
     @rule()
     def halt(self) -> None:
         r = self.send("H")
-        holds(r is not None and r.code == 0 and r.inta, "4.response.inta-bit",
+        holds(r is not None and r.ok and r.inta, "4.response.inta-bit",
               f"H answered {r}")
 
     @rule(seconds=st.sampled_from([0.01, 0.3, 1.5]))
@@ -76,12 +81,13 @@ class ErrorMachine(UnitMachine):
         want = expected_code(body, moving, run, inta)
         holds(r is not None, "5.code.ok", f"{body} got no answer")
         # G with INTA = 1 and nothing pending may answer 6 as well (spec 5, both readings)
-        allowed = {want} | ({6} if body == "G" and inta and not run else set())
+        also = {ErrorCode.NOTHING_TO_GO} if body == "G" and inta and not run else set()
+        allowed = {want} | also
         holds(r.code in allowed, CODE_RULES.get(body, CODE_RULE.get(want, "5.code.ok")),
               f"{body} (moving={moving}, RUN={run}, INTA={inta}): code {r.code}, "
               f"expected {want}")
-        after = {"G": False, "D": False}.get(body, inta) if r.code == 0 else inta
-        if r.code == 6 and inta:
+        after = {"G": False, "D": False}.get(body, inta) if r.ok else inta
+        if r.code == ErrorCode.NOTHING_TO_GO and inta:
             self.send("D")                  # nothing started: clear INTA the manual's way
             after = r.inta
         holds(r.inta == after, "4.response.inta-after-command",

@@ -32,7 +32,7 @@ class RecoveryMachine(UnitMachine):
             direction, kind, params = FAULTS[fault]
             self.link.inject(direction, kind, **params)
         r = self.send(body)
-        if r is not None and r.well_formed and r.code == 0:
+        if r is not None and r.well_formed and r.ok:
             self.model.book(tuple(move))
         else:
             self.recover(body, move, before)
@@ -57,12 +57,12 @@ class RecoveryMachine(UnitMachine):
             holds(shown == f"!{self.link.address}{body}".encode(),
                   "8.repeat.remembered" if shown == f"!{self.link.address}@".encode()
                   else "8.repeat.answer", f"> shows {shown!r}, not the last frame {body}")
-            if r.code == 0:
+            if r.ok:
                 self.model.book(tuple(move))
                 return
         self.idle()
         r = self.send(body)
-        holds(r is not None and r.code == 0, "8.index.counts", f"resent {body}: {r}")
+        holds(r is not None and r.ok, "8.index.counts", f"resent {body}: {r}")
         self.model.book(tuple(move))
 
 

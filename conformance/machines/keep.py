@@ -9,6 +9,7 @@ from hypothesis.stateful import initialize, precondition, rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import ErrorCode
 
 
 class KeepMachine(UnitMachine):
@@ -24,7 +25,7 @@ class KeepMachine(UnitMachine):
     @initialize()
     def speed(self) -> None:
         r = self.send("V2000")
-        assert r is not None and r.code == 0
+        assert r is not None and r.ok
 
     @precondition(lambda self: not self.kept)
     @rule(steps=st.integers(200, 1500), count=st.integers(1, 3))
@@ -36,7 +37,7 @@ class KeepMachine(UnitMachine):
                 return
             r = self.send(f"C{steps},0,0")
             assert r is not None, "C got no answer"
-            if r.code == 0:
+            if r.ok:
                 self.model.book((steps, 0, 0))
                 self.booked += steps
 
@@ -48,26 +49,26 @@ class KeepMachine(UnitMachine):
     @rule()
     def halt(self) -> None:
         r = self.send("H")
-        assert r is not None and r.code == 0 and r.inta, f"H answered {r}"
+        assert r is not None and r.ok and r.inta, f"H answered {r}"
         self.halted = True
 
     @precondition(lambda self: self.halted and not self.kept)
     @rule(lift=st.integers(1, 300))
     def keep_and_detour(self, lift: int) -> None:
         r = self.send("K")
-        assert r is not None and r.code == 0 and not r.inta, f"K answered {r}"
+        assert r is not None and r.ok and not r.inta, f"K answered {r}"
         self.kept, self.halted = True, False
         for z in (-lift, lift):
             self.idle()
             r = self.send(f"L0,0,{z}")
-            assert r is not None and r.code == 0, f"L0,0,{z} after K answered {r}"
+            assert r is not None and r.ok, f"L0,0,{z} after K answered {r}"
         self.idle()
 
     @precondition(lambda self: self.kept)
     @rule(speed=st.sampled_from([500, 1000, 3000]))
     def restore(self, speed: int) -> None:
         r = self.send("R")
-        assert r is not None and r.code == 0 and r.inta, f"R answered {r} (INTA as saved)"
+        assert r is not None and r.ok and r.inta, f"R answered {r} (INTA as saved)"
         self.kept, self.halted = False, True
         self.send(f"V{speed}")
         self.send("XA")
@@ -77,8 +78,9 @@ class KeepMachine(UnitMachine):
     def go(self) -> None:
         r = self.send("G")
         # with nothing left to run, 6 ("for Go, nothing to start") is allowed too (spec 5)
-        assert r is not None and r.code in (0, 6), f"G answered {r}"
-        if r.code == 6:
+        assert r is not None and r.code in (ErrorCode.OK, ErrorCode.NOTHING_TO_GO), \
+            f"G answered {r}"
+        if r.code == ErrorCode.NOTHING_TO_GO:
             self.send("D")
         self.halted = False
 
@@ -88,7 +90,7 @@ class KeepMachine(UnitMachine):
             self.halted = True
         if self.halted:
             r = self.send("G")
-            if r is not None and r.code == 6:
+            if r is not None and r.code == ErrorCode.NOTHING_TO_GO:
                 self.send("D")
         self.idle()
         got = self.position()

@@ -8,11 +8,12 @@ from hypothesis.stateful import initialize, precondition, rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import ErrorCode
 
 # member frame -> (kind, code it fails the packet with, steps it commits)
-MEMBERS = {"C1,0,0": ("C", 0, (1, 0, 0)), "C0,2,0": ("C", 0, (0, 2, 0)),
-           "B500": ("B", 0, None), "B1": ("B", 5, None), "V100": ("V", 4, None),
-           "C1,2": ("C", 4, None)}
+MEMBERS = {"C1,0,0": ("C", ErrorCode.OK, (1, 0, 0)), "C0,2,0": ("C", ErrorCode.OK, (0, 2, 0)),
+           "B500": ("B", ErrorCode.OK, None), "B1": ("B", ErrorCode.RANGE, None),
+           "V100": ("V", ErrorCode.SYNTAX, None), "C1,2": ("C", ErrorCode.SYNTAX, None)}
 
 
 class PacketMachine(UnitMachine):
@@ -26,7 +27,7 @@ class PacketMachine(UnitMachine):
     def mode(self, summed: bool) -> None:
         if summed:
             r = self.send("%+", checksum=False)
-            holds(r is not None and r.code == 0, "6.checksum.mode-commands", f"%+ answered {r}")
+            holds(r is not None and r.ok, "6.checksum.mode-commands", f"%+ answered {r}")
             self.model.checksums = True
 
     @rule()
@@ -54,7 +55,7 @@ class PacketMachine(UnitMachine):
         holds(r is not None, "7.packet.exchange", "*E got no answer")
         holds((r.code, r.values) == (expected[0], [str(expected[1])]), "7.packet.codes",
               f"*E{n}: {r.text}, expected {expected[0]},{expected[1]}")
-        if expected[0] == 0:
+        if expected[0] == ErrorCode.OK:
             for body in members:
                 steps = MEMBERS[body][2]
                 if steps:
@@ -64,7 +65,7 @@ class PacketMachine(UnitMachine):
     @rule()
     def breaker(self) -> None:
         r = self.send("@")
-        holds(r is not None and r.code == 0, "7.packet.breakers",
+        holds(r is not None and r.ok, "7.packet.breakers",
               f"@ inside a packet answered {r}")
         self.model.packet = None
         self.pending = []

@@ -9,6 +9,7 @@ from hypothesis.stateful import initialize, rule
 from conformance.case import CaseContext, case
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from gve_fixtures.protocol import ErrorCode, St6
 
 WAITING = "10.1.queue.wait-for-go"
 
@@ -35,7 +36,8 @@ class QueueMachine(UnitMachine):
             r = self.send("C" + ("1,0,0" if i % 2 == 0 else "-1,0,0"))
             full = self.queued >= self.model.buffer
             # the count of queued vectors rests on their waiting while INTA = 1 [D]
-            holds(r is not None and r.code == (1 if full else 0), WAITING,
+            holds(r is not None
+                  and r.code == (ErrorCode.QUEUE_FULL if full else ErrorCode.OK), WAITING,
                   f"C with {self.queued} queued of {self.model.buffer}: {r}")
             if not full:
                 self.queued += 1
@@ -43,14 +45,16 @@ class QueueMachine(UnitMachine):
     @rule()
     def wait_idiom(self) -> None:
         r = self.send("L0,0,0")
-        holds(r is not None and r.code == (1 if self.queued else 0), WAITING, f"L0,0,0: {r}")
-        if r.code == 0:
+        holds(r is not None
+              and r.code == (ErrorCode.QUEUE_FULL if self.queued else ErrorCode.OK), WAITING,
+              f"L0,0,0: {r}")
+        if r.ok:
             self.queued += 1            # accepted while INTA = 1: it waits for G [D 10.1]
 
     @rule()
     def delete(self) -> None:
         r = self.send("D")
-        holds(r is not None and r.code == 0, "5.code.ok", f"D answered {r}")
+        holds(r is not None and r.ok, "5.code.ok", f"D answered {r}")
         self.queued = 0
         self.status.update({4: 0, 5: 0})    # D clears ST4..ST6 (spec 10.4)
         r = self.send("H")                  # interrupted again, so vectors stay queued
@@ -59,7 +63,7 @@ class QueueMachine(UnitMachine):
     @rule(n=st.sampled_from([3, 4, 5]), value=st.integers(0, 255))
     def status_word(self, n: int, value: int) -> None:
         r = self.send("SW%d,%02X" % (n, value))
-        holds(r is not None and r.code == 0, "10.cmd.status-words", f"SW{n} answered {r}")
+        holds(r is not None and r.ok, "10.cmd.status-words", f"SW{n} answered {r}")
         self.status[n] = value
         r = self.send(f"SR{n}")
         holds(r is not None and r.values == ["%02X" % value], "10.cmd.status-words",
@@ -68,15 +72,15 @@ class QueueMachine(UnitMachine):
     @rule(address=st.integers(0x40, 0x47), value=st.integers(0, 255))
     def eeprom_write(self, address: int, value: int) -> None:
         r = self.send("EW%02X,%02X" % (address, value))
-        holds(r is not None and r.code == 0, "10.cmd.eeprom-bytes", f"EW answered {r}")
+        holds(r is not None and r.ok, "10.cmd.eeprom-bytes", f"EW answered {r}")
         self.eeprom[address] = value
 
     def flags(self) -> None:
         r = self.send("F")
-        holds(r is not None and r.code == 0 and r.values, "10.cmd.flags", f"F answered {r}")
-        full = 0x20 if self.queued >= self.model.buffer else 0
-        run = 0x40 if self.queued else 0
-        holds(r.hex() & 0x60 == full | run, WAITING,
+        holds(r is not None and r.ok and r.values, "10.cmd.flags", f"F answered {r}")
+        full = St6.QUEUE_FULL if self.queued >= self.model.buffer else 0
+        run = St6.RUN if self.queued else 0
+        holds(r.hex() & (St6.QUEUE_FULL | St6.RUN) == full | run, WAITING,
               f"F = {r.values[0]}, {self.queued} of {self.model.buffer} queued")
 
     def teardown(self) -> None:

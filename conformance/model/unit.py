@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from conformance.protocol.catalogue import classes
+from gve_fixtures.protocol import ErrorCode
 
 UNCOUNTED = tuple(sorted(classes(indexed=False)))       # spec 8
 PACKET_MEMBERS = classes(packet="member")               # spec 7
@@ -21,7 +22,7 @@ class ModelUnit:
     checksums: bool = False
     index: int = 0
     inta: bool = False
-    packet: list[tuple[str, int]] | None = None     # (member kind, its code)
+    packet: list[tuple[str, ErrorCode]] | None = None     # (member kind, its code)
     committed: list[int] = field(default_factory=lambda: [0, 0, 0])
     #: frames that do not advance the index: @ and > by our reading [D]; a unit whose @
     #: counts itself (measured by the machines) has none
@@ -34,35 +35,35 @@ class ModelUnit:
             self.index = (self.index + 1) % 256
 
     # -- section 6 ------------------------------------------------------------------------
-    def checksum_answer(self, sum_state: str) -> int:
+    def checksum_answer(self, sum_state: str) -> ErrorCode:
         """The code for a frame whose checksum is "good", "bad", "missing" or "lower"."""
         if not self.checksums:
-            return 0 if sum_state == "missing" else 4
-        return 0 if sum_state in ("good", "lower") else 4
+            return ErrorCode.OK if sum_state == "missing" else ErrorCode.SYNTAX
+        return ErrorCode.OK if sum_state in ("good", "lower") else ErrorCode.SYNTAX
 
     # -- section 7 ------------------------------------------------------------------------
     def open_packet(self) -> None:
         self.packet = []
 
-    def member(self, kind: str, code: int) -> None:
+    def member(self, kind: str, code: ErrorCode) -> None:
         assert self.packet is not None
         self.packet.append((kind, code))
 
-    def end_packet(self, n: int, room: int) -> tuple[int, int]:
-        """(code, k) of *E<n> (spec 7), and commit when 0."""
+    def end_packet(self, n: int, room: int) -> tuple[ErrorCode, int]:
+        """(code, k) of *E<n> (spec 7), and commit when OK."""
         if self.packet is None:
-            return 4, 0
+            return ErrorCode.SYNTAX, 0
         members, self.packet = self.packet, None
         k = len(members)
         if k != n:
-            return 2, k
+            return ErrorCode.COUNT_MISMATCH, k
         for _, c in members:
             if c:
                 return c, k
         vectors = sum(1 for kind, _ in members if kind == "C")
         if vectors > room:
-            return 1, k
-        return 0, k
+            return ErrorCode.QUEUE_FULL, k
+        return ErrorCode.OK, k
 
     def book(self, steps: tuple[int, ...]) -> None:
         for i, s in enumerate(steps):

@@ -33,6 +33,8 @@ from conformance.motion.tolerance import (
     tolerance,
     widened,
 )
+from conformance.protocol.catalogue import classes
+from conformance.protocol.parse import parse
 from gve_fixtures.protocol import SECOND
 
 #: dense model points per trace
@@ -41,6 +43,10 @@ TRACE_POINTS = 60
 SETTLE = 0.03
 #: a scenario's moves take well under this
 UNTIL_SECONDS = 5.0
+_VECTORS = classes(vector=True)
+_MODAL = classes(modal=True)
+_SWITCHES = classes(switch=True)
+_EXCHANGES = classes(exchanges=True)
 
 
 @dataclass
@@ -102,7 +108,7 @@ class Probe:
         """Send a frame the scenario needs (the case cannot judge when it is refused) and
         book what it does."""
         r = self.link.send(body)
-        self.ctx.require(r is not None and r.code == 0, f"{body} answered "
+        self.ctx.require(r is not None and r.ok, f"{body} answered "
                          f"{'nothing' if r is None else r.text}, expected 0")
         self._book(body, *self._timing(body, r))
         return r
@@ -111,7 +117,7 @@ class Probe:
         """Read PF and keep the reading (None when the unit did not answer with positions;
         bytes that are not decimals fail the case through the response's accessor)."""
         r = self.link.send("PF")
-        if r is None or r.code != 0 or len(r.values) < 3:
+        if r is None or not r.ok or len(r.values) < 3:
             return None
         values = r.decs()
         self.readings.append(Reading(self._timing("PF", r)[0], values, label))
@@ -157,14 +163,11 @@ class Probe:
     # -- the frames' meaning (spec 10) --------------------------------------------------
     def _book(self, body: str, w: Window, answered: Window) -> None:
         head, rest = _split(body)
-        if head in ("L", "C"):
+        if head in _VECTORS:
             d = tuple(int(x) * self.scale for x in rest.split(","))
             self.events.append(Event(w, "push", {"d": d, "kind": head,
                                                  "p": self._captured()}))
-        elif head in ("V", "A", "B", "$", "T"):
-            self.modal[head] = int(rest)
-            self.params[head] = int(rest)
-        elif head in ("VK", "VN"):
+        elif head in _SWITCHES:
             self.modal["VK"] = head == "VK"
             self.params["VK" if head == "VK" else "VN"] = True
         elif head == "VL":
@@ -177,7 +180,10 @@ class Probe:
         elif head == "XM":
             self.events.append(Event(w, "override", {"name": "XM", "value": int(rest)}))
             self.params["XM"] = int(rest)
-        elif head in ("XA", "XU", "XD"):
+        elif head in _MODAL:                 # one value each: V, A, B, $, T
+            self.modal[head] = int(rest)
+            self.params[head] = int(rest)
+        elif head in _EXCHANGES:
             p = self._captured()             # XA: the modal V (GVE54: and A) as it is now
             self.events.append(Event(w, "override", {
                 "name": head, "modal_v": p.V, "modal_a": p.A,
@@ -345,10 +351,8 @@ def _within(tol: Tolerance) -> str:
 
 
 def _split(body: str) -> tuple[str, str]:
-    for head in ("VL", "VK", "VN", "XM", "XA", "XU", "XD"):
-        if body.startswith(head):
-            return head, body[len(head):]
-    return body[:1], body[1:]
+    read = parse(body, strict=True)
+    return (read.name, read.params) if read.name else (body[:1], body[1:])
 
 
 def _band(model: MotionModel, variants: list[tuple[MotionModel, list[int]]], w: Window,

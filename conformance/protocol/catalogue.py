@@ -18,6 +18,7 @@ CATALOGUE_FILE = Path(__file__).with_name("commands.toml")
 #: the class of a frame that writes status word ST6 (spec 10.3)
 ST6_WRITE = "SW6"
 PACKET_ROLES = ("opens", "member", "breaker", "closes")
+RESUMED = ("queue", "save")
 
 
 @dataclass(frozen=True)
@@ -63,6 +64,12 @@ class Command:
     reaction: bool = False
     position: bool = False
     optional: bool = False
+    exchanges: bool = False
+    paces: bool = False
+    own_speed: bool = False
+    empties: bool = False
+    still: bool = False
+    resumes: str | None = None
     examples: tuple[str, ...] = field(default=(), compare=False)
 
     @property
@@ -74,6 +81,11 @@ class Command:
     def ends_packet(self) -> bool:
         """Whether it ends an open packet: `*E` closes it, a breaker discards it (spec 7)."""
         return self.packet in ("breaker", "closes")
+
+    @property
+    def switch(self) -> bool:
+        """Whether it is a modal switch: modal, with no value (`VK` / `VN`)."""
+        return self.modal and not self.fields
 
 
 _FLAGS = {f.name for f in fields(Command)} - {"name", "fields", "rules", "examples",
@@ -92,6 +104,8 @@ def catalogue(path: Path = CATALOGUE_FILE) -> dict[str, Command]:
             raise ValueError(f"{path.name}: command {name!r}: unknown key(s) {sorted(unknown)}")
         if entry.get("packet") not in (None, *PACKET_ROLES):
             raise ValueError(f"{path.name}: command {name!r}: packet {entry['packet']!r}")
+        if entry.get("resumes") not in (None, *RESUMED):
+            raise ValueError(f"{path.name}: command {name!r}: resumes {entry['resumes']!r}")
         command = Command(
             name, tuple(Field(f["kind"], _range(f.get("range")), tuple(f.get("choices", ())),
                               f.get("syntax", "")) for f in entry.get("fields", ())),

@@ -20,6 +20,7 @@ from conformance.link.exclusive import LeftAlone, open_serial, settings_kept
 from conformance.link.framing import frame, parse_response
 from conformance.targets.base import Target
 from gve_fixtures.profile import Profile, available_profiles, load_profile
+from gve_fixtures.protocol import ErrorCode
 
 #: how long one question waits for its answer (no unit answers `?` slower)
 ANSWER_SECONDS = 0.3
@@ -57,9 +58,9 @@ def _ask(port: serial.SerialBase, address: int, body: str) -> str | None:
         if not raw.endswith(b"\r"):
             return None
         r = parse_response(raw, summed=summed)
-        if r.code == 0 and r.values:
+        if r.ok and r.values:
             return ",".join(r.values)
-        if r.code != 4:
+        if r.code != ErrorCode.SYNTAX:
             return None
     return None
 

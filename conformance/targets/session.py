@@ -37,7 +37,7 @@ from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotR
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import ErrorCode, St6
 
 
 class Reachable(Protocol):
@@ -244,7 +244,7 @@ class RealSession(Session):
         self._probe_checksums(link)
         for name, body in (("version", "?"), ("processor_id", "Q")):
             r = link.send(body)
-            if r is not None and r.code == 0:
+            if r is not None and r.ok:
                 self.identity[name] = ",".join(r.values)
         self.report.identity = self.identity
         self.report.line = _round_trip(link)
@@ -287,15 +287,15 @@ class RealSession(Session):
     def _probe_checksums(self, link: Link) -> None:
         """The checksum mode as found: `?` without a checksum is refused (4) in the mode."""
         r = link.send("?", checksum=False)
-        if r is not None and r.code == 4:
+        if r is not None and r.code == ErrorCode.SYNTAX:
             summed = link.send("?", checksum=True)
-            if summed is not None and summed.code == 0:
+            if summed is not None and summed.ok:
                 link.checksums = True
         self.checksums = link.checksums
 
     def _position(self, link: Link) -> dict[int, int]:
         r = link.send("PF")
-        if r is None or r.code != 0 or len(r.values) < 3:
+        if r is None or not r.ok or len(r.values) < 3:
             return {}
         try:
             return {i: r.dec(i) for i in range(min(3, len(self.profile.axes)))}
@@ -334,9 +334,9 @@ class RealSession(Session):
         if r is None and urgent and self.guard.packet_open:
             self._close_packet(link, timeout)
             r = link.send("H", timeout=timeout)
-        if r is None or r.code == 4:
+        if r is None or r.code == ErrorCode.SYNTAX:
             other = link.send("H", checksum=not link.checksums, timeout=timeout)
-            if other is not None and other.code == 0:
+            if other is not None and other.ok:
                 link.checksums = not link.checksums
                 return other
         return r
@@ -363,18 +363,27 @@ class RealSession(Session):
                  "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
+        if self._has_mpg():
+            frames.append(f"Y{p.mpg.reset_mode}")
         if p.microstep:
             frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
         return frames
 
+    def _has_mpg(self) -> bool:
+        return self.profile.mpg is not None and "Y" in self.profile.commands
+
     def _stop(self, link: Link, then: Sequence[str] = ()) -> None:
-        """`H`, checksums off, interrupts off (ST0..ST5 = 00), then `D`: the queue empty
-        and ST6 clear (an input still enabled would set INTA again at once); then the
-        frames ``then``."""
+        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00),
+        then `D`: the queue empty and ST6 clear (an input still enabled would set INTA
+        again at once); then the frames ``then``. An MPG that EEPROM 06 made effective
+        holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
+        the INTA of `H` outlive the stop, so it is off until the reset frames set its
+        reset mode again."""
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        link.send_each([*(f"SW{n},00" for n in range(6)), "D", *then])
+        mpg = ["Y-"] if self._has_mpg() else []
+        link.send_each([*mpg, *(f"SW{n},00" for n in range(6)), "D", *then])
 
     def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
@@ -420,12 +429,12 @@ class RealSession(Session):
                 self.report.problems.append(why)
             return
         r = link.send(body)
-        if r is None or r.code != 0:
+        if r is None or not r.ok:
             raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
         link.wait(cruise)                                  # asking before it ends is moot
-        if link.poll("L0,0,0", lambda r: r.code == 0, seconds) is None:
+        if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
             raise CouldNotTest("the return to where the run began did not end in time")
         self._position(link)
 
@@ -487,7 +496,7 @@ class RealSession(Session):
         self._restore_status(link)
         if self.checksums:
             r = link.send("%+", checksum=False)
-            if r is None or r.code != 0:
+            if r is None or not r.ok:
                 self.report.problems.append(f"checksum mode not turned back on: %+ answered {r}")
             else:
                 self.report.restored.append("checksum mode back on")
@@ -599,7 +608,7 @@ def _round_trip(link: Link) -> dict[str, float]:
 
 
 def _hex_ok(r: Response | None) -> bool:
-    return r is not None and r.code == 0 and len(r.values) >= 1 and \
+    return r is not None and r.ok and len(r.values) >= 1 and \
         len(r.values[0]) == 2 and all(c in "0123456789ABCDEF" for c in r.values[0])
 
 

@@ -5,6 +5,7 @@ wait for frames nobody answers."""
 
 from __future__ import annotations
 
+import termios
 from contextlib import suppress
 from typing import NoReturn, Protocol
 
@@ -15,7 +16,10 @@ from conformance.link.safety import TargetNotResponding
 #: after the port failed, how long a program may take to be seen ending
 ENDING_SECONDS = 1.0
 
-_FAILURES = (serial.SerialException, OSError)
+#: how a port's failure shows: a pseudo-terminal whose program ended is hung up, and on
+#: it every ioctl fails — pyserial's reads and writes say so as SerialException/OSError,
+#: its tcflush, tcdrain and tcsetattr as termios.error (no OSError)
+_FAILURES = (serial.SerialException, OSError, termios.error)
 
 
 class Program(Protocol):
@@ -87,11 +91,20 @@ class TargetPort:
 
     @timeout.setter
     def timeout(self, value: float | None) -> None:
-        self._port.timeout = value
+        try:
+            self._port.timeout = value             # pyserial reconfigures the port
+        except _FAILURES as err:
+            self._gone(err)
 
     def reset_input_buffer(self) -> None:
         try:
             self._port.reset_input_buffer()
+        except _FAILURES as err:
+            self._gone(err)
+
+    def flush(self) -> None:
+        try:
+            self._port.flush()
         except _FAILURES as err:
             self._gone(err)
 

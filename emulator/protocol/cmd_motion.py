@@ -39,6 +39,8 @@ def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if dev.state.reference_until > t:
         raise CommandError(ErrorCode.QUEUE_FULL, "a reference run is in progress")
     if dev.motion.queued(t) and not dev.mutant.active("line-while-busy"):
+        if dev.mutant.active("refused-line-queued"):
+            dev.push(steps, False, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "L waits until nothing is queued or running")
     dev.push(steps, False, t)
     return []
@@ -64,7 +66,12 @@ def modal(key: str, attr: str) -> Handler:
     """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
-        setattr(dev.state.modal, attr, within(dec(p), r.lo, r.hi))
+        value = dec(p)
+        if not r.lo <= value <= r.hi and (
+                (key == "V" and dev.mutant.active("velocity-refused-stored"))
+                or (key == "A" and dev.mutant.active("accel-refused-stored"))):
+            setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))
+        setattr(dev.state.modal, attr, within(value, r.lo, r.hi))
         return []
     handler.__name__ = f"cmd_{attr}"
     return handler

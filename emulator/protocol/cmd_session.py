@@ -47,6 +47,10 @@ def member(dev: Device, name: str | None, params: str) -> Member:
     if name is None:
         return Member(None, None, ErrorCode.UNKNOWN)
     if name not in ("C", "B"):
+        r = dev.profile.ranges["V"]
+        if name == "V" and dev.mutant.active("failed-packet-applies-v") \
+                and params.isdigit() and r.lo <= int(params) <= r.hi:
+            dev.state.modal.V = int(params)
         return Member(name, None, ErrorCode.SYNTAX)
     try:
         if name == "C":

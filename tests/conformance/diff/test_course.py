@@ -71,3 +71,28 @@ def test_a_packet_opens_on_the_units_own_star_s_and_closes_on_a_breaker():
     assert c.in_packet
     c.stepped("@", Step(FRAME, "@"))
     assert not c.in_packet
+
+
+def test_a_position_beyond_every_vector_taken_is_beyond_reach():
+    c = Course(parse_target("emu:GVE54").profile)              # MF: 1 sixteenth a step
+    c.took("M", "M8", ok())                                    # 2 sixteenths a step
+    c.took("L", "L20,0,0", ok())
+    c.took("L", "L0,-5,0", ok(1, code=5))                      # refused: goes nowhere
+    assert c.beyond_reach(["41", "0", "0"]) and not c.beyond_reach(["40", "0", "0"])
+    assert c.beyond_reach(["0", "-1", "0"])
+    c.took("NX", "NX100", ok())                                # a counter set: unknown
+    assert not c.beyond_reach(["1000", "0", "0"])
+
+
+def test_vl_capping_only_axes_never_moved_below_the_rate_is_capped_elsewhere():
+    c = course()                                               # V1000
+    c.took("VL", "VL100,1000,1000", ok())
+    assert not c.capped_elsewhere                              # nothing moved yet
+    c.took("L", "L0,300,0", ok())
+    assert c.capped_elsewhere
+    c.took("L", "L10,0,0", ok(1))                              # X moves: its cap acts
+    assert not c.capped_elsewhere
+    c = course()
+    c.took("VL", "VL1000,1000,1000", ok())
+    c.took("L", "L0,300,0", ok())
+    assert not c.capped_elsewhere                              # no cap below the rate

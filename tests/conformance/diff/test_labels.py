@@ -85,3 +85,17 @@ def test_a_breaker_unanswered_inside_a_packet_is_the_breakers_rule():
 def test_a_repeat_after_an_index_is_whether_the_index_is_remembered():
     assert label(">", "data", set(), {"V", "@"}, 0, 0) == "8.repeat.remembered"
     assert label(">", "data", set(), {"V"}, 0, 0) == "8.repeat.answer"
+
+
+def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
+    # a VL that capped only axes the motion never moved: another axis's value held it
+    assert label("PF", "position", {"capped-elsewhere"}, {"VL", "L"}, 0) == \
+        "10.cmd.axis-limits-own-axis"
+    assert label("PF", "position", set(), {"VL", "L"}, 0) == "10.2.motion.axis-caps"
+    # GVE54: beyond where the vectors could go is the mode's step, short of it its rates
+    assert label("PF", "position", {"beyond-reach"}, {"M", "L"}, 0) == "10.7.motor.modes"
+    assert label("PF", "position", set(), {"M", "L"}, 0) == "10.7.motor.rates-scaled"
+    # a status word read back otherwise after a refused write: the refusal stored it
+    assert label("SR", "data", set(), {"SW", "SW-refused"}, 0) == \
+        "4.response.failed-not-executed"
+    assert label("SR", "data", set(), {"SW"}, 0) == "10.3.status.all-bits"

@@ -32,7 +32,8 @@ def test_the_catalogue_behind_a_16_ms_relay_gets_no_fail() -> None:
     ran = 0
     start = time.monotonic()
     try:
-        for _ in range(REPEATS):
+        for n in range(REPEATS):
+            began = time.monotonic()
             target = parse_target(f"serial:{relay.path}?baud=115200", profile="GVE84-100",
                                   allow_destructive=True, max_travel=100_000)
             results = run([target], select(None)).results
@@ -43,6 +44,9 @@ def test_the_catalogue_behind_a_16_ms_relay_gets_no_fail() -> None:
                 if r.verdict in (FAIL, ERROR):
                     failed.setdefault(r.id, []).append(
                         next((c["what"] for c in r.checks if not c["ok"]), r.verdict))
+            # each run as it ends: a long repeat cut short still tells what ran
+            print(f"run {n + 1}: {ran} cases in {time.monotonic() - began:.0f} s, load "
+                  f"{os.getloadavg()[0]:.1f}; FAIL/ERROR so far {failed}", flush=True)
     finally:
         relay.close()
         emu.stop()

@@ -4,6 +4,7 @@ its own frames and for the raw frames the differential sides send."""
 import pytest
 
 from conformance.diff.sides import Side
+from conformance.link.link import LATE, Link
 from conformance.targets import parse_target
 
 
@@ -33,3 +34,58 @@ def test_a_side_reads_the_answer_to_a_mode_change_as_the_link_does():
     on = side.exchange(b"!0%+\r", body="%+")
     assert on.code == 0 and on.response.checksum is not None
     assert side.link.send("%-").code == 0
+
+
+class _Line:
+    """A real-time port whose answers come as scripted: each ``read_until`` returns the
+    next piece (``b""``: its timeout ran out); ``then`` arrives after the last piece."""
+
+    def __init__(self, pieces: list[bytes], then: bytes = b"") -> None:
+        self.pieces, self.then, self.waiting, self.timeout = list(pieces), then, b"", None
+        self.timeouts: list[float] = []
+        self.written = bytearray()
+
+    @property
+    def in_waiting(self) -> int:
+        return len(self.waiting)
+
+    def write(self, data: bytes) -> None:
+        self.written += data
+
+    def read_until(self, _end: bytes) -> bytes:
+        self.timeouts.append(self.timeout)
+        piece = self.pieces.pop(0) if self.pieces else b""
+        if not self.pieces:
+            self.waiting, self.then = self.waiting + self.then, b""
+        return piece
+
+    def read(self, n: int) -> bytes:
+        got, self.waiting = self.waiting[:n], self.waiting[n:]
+        return got
+
+
+def real_link(port: _Line) -> Link:
+    return Link(port, link().guard, virtual=False)
+
+
+def test_an_answer_after_its_timeout_is_its_frames_answer_noted_late():
+    port = _Line([b"", b"0,12\r"])            # nothing in time, then the whole answer
+    ln = real_link(port)
+    r = ln.send("SR6")
+    assert r is not None and r.raw == b"0,12\r"
+    assert ln.violations == [] and len(ln.late) == 1 and "SR6" in ln.late[0]
+    assert port.timeouts[1:] == [LATE]
+
+
+def test_a_late_answer_then_another_is_still_answered_twice():
+    port = _Line([b"", b"0\r"], then=b"0\r")
+    ln = real_link(port)
+    assert ln.send("V1000").raw == b"0\r"
+    assert len(ln.late) == 1 and any("answered twice" in v for v in ln.violations)
+
+
+def test_a_timeout_the_caller_chose_takes_no_late_answer():
+    port = _Line([b"", b"0\r"])
+    ln = real_link(port)
+    assert ln.send("V1000", timeout=0.1) is None and ln.late == []
+    assert port.timeouts == [0.1]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import re
+import time
 
 import pytest
 
@@ -29,7 +30,8 @@ def test_measured_family_repeated_gets_no_fail(latency_ms: int | None) -> None:
     bands: list[tuple[float, int]] = []
     try:
         path = relay.path if relay else emu.first
-        for _ in range(REPEATS):
+        for n in range(REPEATS):
+            began = time.monotonic()
             target = parse_target(f"serial:{path}?baud=115200", profile="GVE84-100",
                                   allow_destructive=True, max_travel=100_000)
             for r in run([target], select(["10.*measured*"])).results:
@@ -37,6 +39,9 @@ def test_measured_family_repeated_gets_no_fail(latency_ms: int | None) -> None:
                           if (m := BAND.search(c["what"]))]
                 if r.verdict == FAIL:
                     failed[r.id] = failed.get(r.id, 0) + 1
+            # each run as it ends: a long repeat cut short still tells what ran
+            print(f"latency {latency_ms} ms, run {n + 1}: {time.monotonic() - began:.0f} s, "
+                  f"load {os.getloadavg()[0]:.1f}; FAILs so far {failed}", flush=True)
     finally:
         if relay:
             relay.close()

@@ -38,6 +38,25 @@ def test_answers_follow_spec_2_and_8():
     assert cat.catalogue()[">"].lines == 2
 
 
+def test_what_commands_do_to_a_motion_follows_spec_10():
+    assert cat.classes(vector=True) == {"L", "C"}
+    assert cat.classes(exchanges=True) == {"XA", "XU", "XD"}
+    assert cat.classes(paces=True) == {"V", "A", "VL", "XM"}
+    assert cat.classes(own_speed=True) == {"W", "Y"}
+    assert cat.classes(empties=True) == {"D", "K"}
+    assert cat.classes(still=True) == {"D", "K", "R"}
+    assert cat.classes(resumes="queue") == {"G", "SW6"}
+    assert cat.classes(resumes="save") == {"R"}
+    assert cat.classes(switch=True) == {"VK", "VN"}
+
+
+def test_an_unknown_resumed_place_is_refused(tmp_path):
+    path = tmp_path / "commands.toml"
+    path.write_text('[command.G]\nresumes = "stack"\n', encoding="utf-8")
+    with pytest.raises(ValueError, match="resumes"):
+        cat.catalogue(path)
+
+
 def test_eeprom_writes_and_their_widths():
     assert {n: cat.eeprom_width(n) for n in ("EW", "EFW", "EUW", "ER", "nope")} == {
         "EW": 1, "EFW": 4, "EUW": 4, "ER": 0, "nope": 0}

@@ -213,3 +213,21 @@ def test_a_measured_line_lengthens_the_answer_timeout_by_twice_its_slowest_round
     assert measured - link.answer_timeout("V1000", 8) == \
         pytest.approx(2 * unit.session.report.line["max_ms"] / 1e3)
     unit.session.finish()
+
+
+def test_a_hand_wheel_an_eeprom_write_made_effective_is_stopped_and_put_back():
+    """EEPROM 06 enabling the GVE114's MPG (on after reset) holds the axes: the stop after
+    the case turns it off, so `D` clears the INTA of its `H` and 06 is written back; the
+    next known state has INTA clear and the MPG in its reset mode."""
+    unit = in_process_unit("GVE114-500", allow_destructive=True)
+    session = unit.begin()
+    link = session.open_link()
+    assert link.send("EW06,01").code == 0
+    assert link.send("SR6").hex() & 0x40                      # RUN: the MPG holds the axes
+    session.after_case()
+    link = session.open_link()
+    assert link.send("SR6").hex() == 0                        # no INTA left by the stop
+    assert link.send("ER06").hex() == 0xFF
+    assert unit.state()["mpg"] == "&"
+    session.finish()
+    assert session.report.problems == []

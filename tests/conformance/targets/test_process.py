@@ -14,9 +14,11 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
+from conformance.case import Case
 from conformance.catalogue import select
 from conformance.cli.run import main
 from conformance.runner import run
@@ -29,6 +31,8 @@ pytestmark = pytest.mark.pty
 pytest_plugins = ["pytester"]
 
 EMULATOR = [sys.executable, "-m", "emulator"]
+#: a simulator that dies at a frame of its choosing (its docstring)
+DYING = [sys.executable, str(Path(__file__).with_name("dying_relay.py"))]
 #: rig cases that use every command of the channel: in, switch, power-on, state
 RIG_CASES = ["10.cmd.output.port", "10.cmd.reference.to-switch",
              "10.3.inputs.level-after-clearing", "10.3.inputs.physical-across-restart"]
@@ -105,6 +109,81 @@ def test_a_program_that_dies_mid_run_ends_the_run_with_the_target_s_failure():
     assert any("restorations stopped" in p for p in result.problems)
     assert took < 10, f"{took:.1f} s"
     assert target.program is None and gone(process_.pid)
+
+
+@pytest.mark.parametrize(("body", "when"), [
+    *(("Z", when) for when in ("before", "mid-answer", "after")),
+    # after its last answer it may die after the case: the next test kills it there
+    *(("XQ", when) for when in ("before", "mid-answer"))])   # 5.errors.unknown's first, last
+@pytest.mark.parametrize("stepper", ["c", "python"])
+def test_a_program_that_dies_at_any_instant_of_a_case_fails_that_case(body, when, stepper):
+    """Killed when a frame of the case arrives, when part of its answer was read, when
+    all of it was: the case in progress FAILs with how the program ended, never ERRs."""
+    target = exec_target([*DYING, body, when, "--stepper", stepper])
+    pid = target.program.process.pid
+    result = run([target], select(["5.errors.ok", "5.errors.unknown", "6.*"]))
+    got = [r.verdict for r in result.results]
+    assert ERROR not in got, [(r.id, r.notes) for r in result.results if r.verdict == ERROR]
+    assert got[:2] == [PASS, FAIL] and set(got[2:]) == {COULD_NOT_TEST}, got
+    why = result.results[1].failed_checks[-1]["what"]
+    assert "program ended" in why and "killed by signal 9" in why, why
+    assert all("program ended" in r.notes[0] for r in result.results[2:])
+    assert target.program is None and gone(pid)
+
+
+@pytest.mark.parametrize(("body", "nth"), [
+    ("H", 2),           # the second case's known state (the first `H` is the first case's)
+    ("Z", 1)])          # the second case's own first frame
+@pytest.mark.parametrize("stepper", ["c", "python"])
+def test_a_program_killed_as_a_frame_is_written_fails_that_case(stepper, body, nth):
+    """Killed and reaped the instant a frame of the second case is on its pty, before
+    the link asks for the answer (which sets the port's timeout first): once a rare ERROR
+    under load (in the known state, before the case has its link), now the case's
+    FAIL."""
+    target = exec_target([*EMULATOR, "--pty", "--stepper", stepper])
+    process_ = target.program.process
+    serial_port = target._port._port             # pyserial's port under the target's
+    write = serial_port.write
+    seen = []
+
+    def write_then_killed(data: bytes) -> int | None:
+        n = write(data)
+        if data[2:].split(b",")[0].rstrip(b"\r") == body.encode():
+            seen.append(data)
+            if len(seen) == nth:
+                process_.kill()
+                process_.wait()
+        return n
+
+    serial_port.write = write_then_killed
+    result = run([target], select(["5.errors.ok", "5.errors.unknown", "6.*"]))
+    got = [r.verdict for r in result.results]
+    assert got[:2] == [PASS, FAIL] and set(got[2:]) == {COULD_NOT_TEST}, [
+        (r.id, r.verdict, r.notes) for r in result.results]
+    why = result.results[1].failed_checks[-1]["what"]
+    assert "program ended" in why and "killed by signal 9" in why, why
+
+
+def test_a_program_that_dies_as_its_case_ends_fails_that_case():
+    """Killed once the case's last answer was judged, before the case's end (where the
+    link listens for bytes still on their way): that case FAILs, the rest is not run."""
+    target = exec_target([*EMULATOR, "--pty"])
+    process_ = target.program.process
+
+    def last_answer_then_killed(ctx) -> None:
+        ctx.expect(ctx.link.send("?") is not None, "? answered")
+        process_.kill()
+        process_.wait()                         # ended, its pty hung up, before the end
+
+    dying = Case("5.dies-at-the-end", last_answer_then_killed, "5.code.ok", "M", "test",
+                 rules=("5.code.ok",))
+    result = run([target], [dying, *select(["5.errors.ok"])])
+    got = [r.verdict for r in result.results]
+    assert got == [FAIL, COULD_NOT_TEST], [(r.id, r.notes) for r in result.results]
+    checks = result.results[0].checks
+    assert checks[0]["ok"] and not checks[-1]["ok"], checks
+    assert "program ended" in checks[-1]["what"] and "killed by signal 9" in checks[-1]["what"]
+    assert "program ended" in result.results[1].notes[0]
 
 
 @pytest.mark.parametrize("stopping", [signal.SIGINT, signal.SIGTERM])
