@@ -27,6 +27,7 @@ from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -380,6 +381,7 @@ def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
 
 #: at most this many runs for the last pass over a shrunk sequence
 MINIMISE_RUNS = 300
+_RESTARTS = classes(restart=True)
 
 
 def minimise(pair: Pair, finding: Finding, budget: Budget, *,
@@ -429,7 +431,8 @@ def _lesser(steps: list[Step], i: int, outcome: ExampleRun) -> Iterator[list[Ste
         yield [*steps[:i], joined, *steps[i + 2:]]
     if s.kind == FILL and s.times > 1:
         yield [*steps[:i], replace(s, times=s.times // 2), *steps[i + 1:]]
-    yield steps[:i] + steps[i + 1:]
+    if not _restarts_wait(steps, i):
+        yield steps[:i] + steps[i + 1:]
     if s.kind == FRAME and (s.checksum != "auto" or s.stall is not None):
         yield [*steps[:i], replace(s, checksum="auto", stall=None), *steps[i + 1:]]
     last = outcome.disagreement.index if outcome.disagreement else len(outcome.records)
@@ -441,6 +444,14 @@ def _lesser(steps: list[Step], i: int, outcome: ExampleRun) -> Iterator[list[Ste
             longer = replace(prev, seconds=round(prev.seconds + took / 1e9, 5))
             yield [*steps[:i - 1], longer, *steps[i + 1:]]
         yield [*steps[:i], Step(WAIT, seconds=round(took / 1e9, 5)), *steps[i + 1:]]
+
+
+def _restarts_wait(steps: list[Step], i: int) -> bool:
+    """Step ``i`` is the wait out of a restart: without it the next frames go to a unit
+    that is deaf while it restarts, and a unit that lives on between sequences is then
+    silent for the run's guard (no host sends so; a target right to be deaf)."""
+    return (steps[i].kind == WAIT and i > 0 and steps[i - 1].kind == FRAME
+            and command_of(steps[i - 1].body) in _RESTARTS)
 
 
 class _Spent(Exception):

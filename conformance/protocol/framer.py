@@ -12,7 +12,6 @@ suite playing the unit to a host (the relay: :meth:`HostFramer.feed` with instan
 
 from __future__ import annotations
 
-import copy
 import re
 from dataclasses import dataclass, field
 from itertools import pairwise
@@ -113,11 +112,17 @@ class HostFramer:
     def frames(self, data: bytes, *, commit: bool = True, t: int = 0) -> list[HostFrame]:
         """The frames ``data`` completes (fragments are not kept); with ``commit=False``
         the state is unchanged (to judge bytes before they are written)."""
-        framer = self if commit else copy.deepcopy(self)
+        framer = self if commit else self._trial()
         kept = len(framer.out)
         done = [e for _, e in framer.feed(data, t) if isinstance(e, HostFrame)]
         del framer.out[kept:]
         return done
+
+    def _trial(self) -> HostFramer:
+        """A framer in this one's state, with nothing collected yet: what is collected
+        grows with the run, and a trial only needs the frame in progress."""
+        return HostFramer([], bytearray(self._raw), list(self._times), self._after_cr,
+                          bytearray(self._stray), self._stray_at)
 
     def feed(self, data: bytes, t: int) -> list[tuple[int, HostFrame | Fragment]]:
         """A chunk of bytes that arrived at ``t``; returns what it completed, each with

@@ -10,6 +10,8 @@ import shlex
 import sys
 from pathlib import Path
 
+import pytest
+
 from conformance.cli.diff import main as diff_main
 from conformance.cli.replay import main as replay_main
 from conformance.diff.engine import Budget, Pair, search
@@ -56,3 +58,19 @@ def test_a_mutant_is_found_shrunk_and_replayed(tmp_path: Path, capsys):
     assert replay_main([str(found[0]), "--target", spec, "--allow-destructive", "--yes"]) == 1
     assert replay_main([str(found[0]), "--target", cosim(), "--allow-destructive",
                         "--yes"]) == 0
+
+
+@pytest.mark.slow
+def test_a_mutant_found_the_run_goes_on_to_its_end(capsys):
+    # seed 0 shrinks a finding through an idiom with a restart (J, then its wait): the
+    # co-simulator lives on between sequences, so a frame sent into the restart would
+    # leave it silent for the guard and end the run
+    status = diff_main(["--target", cosim("--mutant", "velocity-ignored"), "--profile",
+                        "GVE84-100", "--allow-destructive", "--yes", "--examples", "2000",
+                        "--seed", "0", "--no-reports"])
+    said = capsys.readouterr()
+    out = said.out + said.err
+    assert status == 1, out
+    assert "FAIL        10.cmd.exchange-velocity" in out
+    assert "not responding" not in out
+    assert "\n2000 sequences, " in out, out

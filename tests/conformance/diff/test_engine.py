@@ -9,12 +9,13 @@ import pytest
 from conformance.cli.diff import DEFAULT_EXAMPLES
 from conformance.diff import engine
 from conformance.diff.engine import Budget, Pair, search
-from conformance.diff.grammar import Options, probes
+from conformance.diff.grammar import Grammar, Options, probes
 from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.sides import Side
-from conformance.diff.steps import FILL
+from conformance.diff.steps import FILL, FRAME, WAIT
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
+from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
 from gve_fixtures.transcript import parse
 
@@ -146,3 +147,18 @@ def test_without_hypothesis_internals_the_search_runs_as_it_is(monkeypatch):
         assert providers._get_local_constants is pool
     p = pair("go-without-inta")
     assert search(p, EVERYTHING, Budget(examples=40), stop_after=1, with_probes=False)
+
+
+def test_the_minimiser_never_sends_a_frame_into_a_restart():
+    # a unit living on between sequences (a co-simulator, a real one) is deaf while it
+    # restarts: four frames there and the run's guard calls it gone
+    grammar = Grammar(load_profile("GVE84-100"), Options(destructive=True, rig=True))
+    steps = grammar.idiom(["EW06,01", "J", "D", "K", "R"])
+    assert [s.kind for s in steps[1:3]] == [FRAME, WAIT]
+    candidates = [c for i in range(len(steps))
+                  for c in engine._lesser(steps, i, engine.ExampleRun())]
+    assert candidates
+    for c in candidates:
+        for before, after in itertools.pairwise(c):
+            if before.kind == FRAME and before.body == "J":
+                assert after.kind == WAIT and after.seconds >= 2.0, c
