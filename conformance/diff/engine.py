@@ -186,8 +186,8 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
-            if rec is not None and (rec.reference.code or 0) & 7:
-                earlier.add(f"{command}-refused")
+            if command == "SW" and rec is not None and (rec.reference.code or 0) & 7:
+                earlier.add("SW-refused")
         self.course.stepped(command, step)
         return False
 
