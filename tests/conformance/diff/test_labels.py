@@ -99,3 +99,7 @@ def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
     assert label("SR", "data", set(), {"SW", "SW-refused"}, 0) == \
         "4.response.failed-not-executed"
     assert label("SR", "data", set(), {"SW"}, 0) == "10.3.status.all-bits"
+    # a motion after a V or an A the reference refused: the refusal set it
+    assert label("PF", "position", set(), {"V", "V-refused", "L"}, 0) == \
+        "4.response.failed-not-executed"
+    assert label("PF", "position", set(), {"A", "L"}, 0) == "10.2.motion.trapezoid"
