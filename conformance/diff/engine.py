@@ -186,8 +186,7 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
-            refused = rec is not None and (rec.reference.code or 0) & 7
-            if command in ("SW", "V", "A", "L") and refused:
+            if rec is not None and (rec.reference.code or 0) & 7:
                 earlier.add(f"{command}-refused")
         self.course.stepped(command, step)
         return False
