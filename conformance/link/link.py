@@ -38,6 +38,7 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
+from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
@@ -400,5 +401,4 @@ class Link:
 def idle_st6(r: Response) -> bool:
     """Whether an answer to `SR6` (or `F`) shows RUN = 0."""
     text = r.values[0] if r.values else ""
-    return len(text) == 2 and all(c in "0123456789ABCDEF" for c in text) and \
-        not int(text, 16) & St6.RUN
+    return is_hex_byte(text) and not int(text, 16) & St6.RUN

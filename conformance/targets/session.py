@@ -34,6 +34,7 @@ from conformance.link.framing import HostFramer, Response, frame
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
@@ -608,8 +609,7 @@ def _round_trip(link: Link) -> dict[str, float]:
 
 
 def _hex_ok(r: Response | None) -> bool:
-    return r is not None and r.ok and len(r.values) >= 1 and \
-        len(r.values[0]) == 2 and all(c in "0123456789ABCDEF" for c in r.values[0])
+    return r is not None and r.ok and len(r.values) >= 1 and is_hex_byte(r.values[0])
 
 
 def open_session(target: Reachable, interrupts: Interrupts | None = None) -> Session:
