@@ -155,8 +155,10 @@ class Session:
         self._link = link
         return link
 
-    def open_link(self, address: int | None = None) -> Link:
-        """A link in the known state (on the emulator: a new unit, at ``address``)."""
+    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+        """A link in the known state (on the emulator: a new unit, at ``address``).
+        ``tell``: the frames the caller sends first on it, told ahead with the known
+        state's last (Link.tell) where the unit lives on."""
         self.start()
         self.guard.check_idle()
         return self._new_link(address)
@@ -231,10 +233,10 @@ class RealSession(Session):
         link.round_trip = self.report.line
         return link
 
-    def open_link(self, address: int | None = None) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
         link = super().open_link(address)
         with self.guard.own_frames():
-            self._known_state(link)
+            self._known_state(link, tell)
         link.log.clear()
         return link
 
@@ -396,9 +398,10 @@ class RealSession(Session):
             link.rig.hands_off()
         self._stop(link, [*self._reset_frames(), "K", "R", *then])
 
-    def _known_state(self, link: Link) -> None:
+    def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
         self._settle(link, ["PF"])                 # where the axes are, for the way back
         self._go_back(link, read=False)
+        link.tell(["N", *tell])
         link.send("N")
 
     def _go_back(self, link: Link, *, read: bool = True) -> None:
