@@ -290,17 +290,21 @@ class CosimLine:
         """The frames the host is about to send one after the other, each with the seconds
         its answer is to be awaited. A simulator that offers `batch` runs them all in one
         exchange; each frame's write and read then take their part of its reply, checked,
-        timed and read exactly as one exchange a frame would be."""
+        timed and read exactly as one exchange a frame would be. One that also offers
+        `batch-stops` ends the batch after a frame that got no CR: a frame awaited longer
+        than one command may ask for (H, answered once the axes have stopped) is told
+        with that much, and the frames after it run only if it was answered meanwhile."""
         if ("batch" not in self.extensions or self._tx is not None or self._rx
                 or self._ahead):
             return
         self._usable()
+        stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
         for data, timeout in frames:
             wait = round(timeout * SECOND)
-            if not data or wait > STEP_NS:
+            if not data or (wait > STEP_NS and not stops):
                 break
-            plan.append((bytes(data), wait))
+            plan.append((bytes(data), min(wait, STEP_NS)))
         if len(plan) < 2:
             return
         command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
@@ -313,6 +317,8 @@ class CosimLine:
                 cr = self._moved(label, start, end, end + wait)
                 ahead.append(Ahead(data, start, end + wait, bytes(self._rx), self.now, cr))
                 self._rx.clear()
+                if stops and not cr:
+                    break                         # the simulator ran none after it
         self.now = here
         self._ahead.extend(ahead)
 

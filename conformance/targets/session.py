@@ -382,11 +382,14 @@ class RealSession(Session):
         holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
         the INTA of `H` outlive the stop, so it is off until the reset frames set its
         reset mode again."""
+        mpg = ["Y-"] if self._has_mpg() else []
+        frames = [*mpg, *(f"SW{n},00" for n in range(6)), "D", *then]
+        if not link.checksums and not self.guard.packet_open:
+            link.tell(["H", *frames])              # H as _halt sends it, then the rest
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        mpg = ["Y-"] if self._has_mpg() else []
-        link.send_each([*mpg, *(f"SW{n},00" for n in range(6)), "D", *then])
+        link.send_each(frames)
 
     def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
