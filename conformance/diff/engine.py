@@ -270,9 +270,25 @@ class Pair:
         self.timing.align()
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
         rec = StepRecord(step)
+        sent_at = self.target.now
+        ended: list[str] = []
+
+        def reference() -> None:
+            """The frame to the reference, as the target's exchange began; done while the
+            target runs it where its port sends a write before its read."""
+            self.timing.sent(sent_at)
+            try:
+                rec.reference = self.reference.exchange(data, lines=step.lines,
+                                                        answer=step.answer, stall=step.stall,
+                                                        body=step.body)
+            except TargetNotResponding as err:
+                rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
+                ended.append(str(err))
+
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
-                                              stall=step.stall, body=step.body)
+                                              stall=step.stall, body=step.body,
+                                              meanwhile=reference)
         except SafetyStop as err:
             why = str(err)
             out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")
@@ -283,14 +299,9 @@ class Pair:
             rec.target = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
-        self.timing.sent(rec.target.sent_at)
-        try:
-            rec.reference = self.reference.exchange(data, lines=step.lines,
-                                                    answer=step.answer, stall=step.stall,
-                                                    body=step.body)
-        except TargetNotResponding as err:
-            rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
-            out.ended = out.ended or str(err)
+        if rec.reference is None:
+            reference()
+        out.ended = out.ended or (ended[0] if ended else "")
         if out.ended and not rec.target.answer and not rec.reference.answer:
             return None
         return rec

@@ -344,3 +344,32 @@ def test_frames_told_ahead_and_not_sent_as_told_leave_the_clock_on_the_simulator
         assert not line.broken and not line._ahead
     finally:
         target.close()
+
+
+def _launched(launch: bool):
+    """The answers, clock and commands of three frames written and read on a co-simulated
+    emulator, each write launched before its read or not."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        port.line.extensions = frozenset()
+        commands = []
+        send = port.line.program.send
+        port.line.program.send = lambda text: commands.append(text) or send(text)
+        port.timeout, answers = 0.25, []
+        for data in (b"!0?\r", b"!0SR0\r", b"!0PF\r"):
+            port.write(data)
+            if launch:
+                port.launch(port.timeout)
+                assert port.line._inflight is not None, "sent before the read"
+            answers.append(port.read_until(b"\r"))
+        return answers, port.line.now, commands
+    finally:
+        target.close()
+
+
+def test_a_write_launched_before_its_read_is_the_exchange_the_read_would_send():
+    launched = _launched(True)
+    assert launched == _launched(False)
+    assert [c.split()[0] for c in launched[2]] == ["tx"] * 3 and all(launched[0])
