@@ -364,7 +364,7 @@ def _launched(launch: bool):
                 port.launch(port.timeout)
                 assert port.line._inflight is not None, "sent before the read"
             answers.append(port.read_until(b"\r"))
-        return answers, port.line.now, commands
+        return answers, port.line.now, list(commands)
     finally:
         target.close()
 
