@@ -332,8 +332,8 @@ class CosimLine:
         `batch-stops` ends the batch after a frame that got no CR: a frame awaited longer
         than one command may ask for (H, answered once the axes have stopped) is told
         with that much, and the frames after it run only if it was answered meanwhile."""
-        self._flush()
-        if "batch" not in self.extensions or self._tx is not None or self._rx or self._ahead:
+        if ("batch" not in self.extensions or self._tx is not None or self._rx
+                or self._ahead or self._inflight is not None):
             return
         self._usable()
         stops = "batch-stops" in self.extensions
