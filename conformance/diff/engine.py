@@ -42,6 +42,9 @@ except ImportError:
 _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: real time: how long the fresh reference stands before a sequence
 AGE_SECONDS = 1.0
+#: a unit that lives on between sequences: what both sides are sent first (the index read
+#: between two `SR0`, the same history for `>`); told ahead with the known state's last
+PRELUDE = ("SR0", "@", "SR0")
 
 
 @dataclass
@@ -132,7 +135,7 @@ class Pair:
     def _begin(self, out: ExampleRun) -> bool:
         """Both sides in the known state; False when the guard refused it."""
         try:
-            self.target.open()
+            self.target.open(tell=PRELUDE if self.target.real else ())
         except SafetyStop as err:
             # the known state itself was refused (a minimiser's candidate left the unit
             # where the guard cannot bring it back): the candidate shows nothing
@@ -230,17 +233,18 @@ class Pair:
         reference, a fresh unit, first stands a while: the real one's last motion ended
         long ago (a vector right away would otherwise wait the dwell T on one side only),
         and the target's too: the known state may have moved its axes back just before,
-        so the sequence begins once the longest dwell T after that has passed."""
+        so the sequence begins once the longest dwell T after that has passed (waited
+        after the reads, which the known state told a co-simulator ahead with its last)."""
         self._same_eeprom()
         self.reference.age(AGE_SECONDS)
-        self.target.wait(self.profile.range("T").hi / 1000)
         indexes = []
         for side in (self.target, self.reference):
-            r = side.link.send_each(["SR0", "@", "SR0"])[1]
+            r = side.link.send_each(PRELUDE)[1]
             try:
                 indexes.append(r.dec(0) if r is not None else 0)
             except AssertionError:
                 indexes.append(0)
+        self.target.wait(self.profile.range("T").hi / 1000)
         self._index = IndexBase((indexes[0] - indexes[1]) % 256)
         self.judge = replace(self.judge, index_offset=self._index.offset)
 
@@ -266,9 +270,25 @@ class Pair:
         self.timing.align()
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
         rec = StepRecord(step)
+        sent_at = self.target.now
+        ended: list[str] = []
+
+        def reference() -> None:
+            """The frame to the reference, as the target's exchange began; done while the
+            target runs it where its port sends a write before its read."""
+            self.timing.sent(sent_at)
+            try:
+                rec.reference = self.reference.exchange(data, lines=step.lines,
+                                                        answer=step.answer, stall=step.stall,
+                                                        body=step.body)
+            except TargetNotResponding as err:
+                rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
+                ended.append(str(err))
+
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
-                                              stall=step.stall, body=step.body)
+                                              stall=step.stall, body=step.body,
+                                              meanwhile=reference)
         except SafetyStop as err:
             why = str(err)
             out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")
@@ -279,14 +299,9 @@ class Pair:
             rec.target = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
-        self.timing.sent(rec.target.sent_at)
-        try:
-            rec.reference = self.reference.exchange(data, lines=step.lines,
-                                                    answer=step.answer, stall=step.stall,
-                                                    body=step.body)
-        except TargetNotResponding as err:
-            rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
-            out.ended = out.ended or str(err)
+        if rec.reference is None:
+            reference()
+        out.ended = out.ended or (ended[0] if ended else "")
         if out.ended and not rec.target.answer and not rec.reference.answer:
             return None
         return rec

@@ -11,6 +11,7 @@ instant the target has reached since the example began.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from conformance.link.framing import HostFramer, Response, parse_response
@@ -63,16 +64,17 @@ class Side:
     def has_rig(self) -> bool:
         return self.link is not None and self.link.rig is not None and self.rig_lost is None
 
-    def open(self) -> Link:
+    def open(self, tell: Sequence[str] = ()) -> Link:
         """A link in the known state for a new example: on the emulator a fresh unit (and
         a session of its own, so one example's silences do not count in the next); on a
-        real unit the run's session's known state."""
+        real unit the run's session's known state, ``tell`` the frames sent first on it
+        (Session.open_link)."""
         if self.virtual and not self.target.info.real:
             self.session = EmuSession(self.target, self.session.interrupts if self.session
                                       else None)
         elif self.session is None:
             self.session = self.target.begin()
-        self.link = self.session.open_link()
+        self.link = self.session.open_link(tell=tell)
         self._origin = self.link.now
         return self.link
 
@@ -95,12 +97,14 @@ class Side:
             line.advance_to(line.now + (t - self.now))
 
     def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
-                 stall: tuple[int, float] | None = None, body: str | None = None
-                 ) -> RoundTrip:
+                 stall: tuple[int, float] | None = None, body: str | None = None,
+                 meanwhile: Callable[[], None] | None = None) -> RoundTrip:
         """Send a frame's bytes (through the guard: SafetyStop when refused) and take
         what comes back: its answer (``answer``), else whatever arrives while the
         answer's bytes would have taken. ``body``: the frame's command, when known (it
-        decides how long an answer may take)."""
+        decides how long an answer may take). ``meanwhile``: work of the caller's that
+        a port which sends a write before its read (a co-simulator's) does while the
+        target runs the frame, between the two (any other port: not done here)."""
         link = self.link
         if body is None:
             body = _body(data, link.checksums)
@@ -109,8 +113,12 @@ class Side:
         sent_at = self.now
         link.send_raw(data)
         if answer:
-            r = link.read_response(link.answer_timeout(body, len(data)), lines,
-                                   summed=link.summed_after(body))
+            timeout = link.answer_timeout(body, len(data))
+            launch = getattr(link.port, "launch", None)
+            if meanwhile is not None and launch is not None:
+                launch(timeout)
+                meanwhile()
+            r = link.read_response(timeout, lines, summed=link.summed_after(body))
             back = r.raw if r is not None else b""
         else:
             back = link.wait(link.byte_seconds(len(data) + 64) + 0.005)

@@ -242,12 +242,19 @@ class Link:
         """:meth:`send` each frame in turn, in the mode the link believes. A port that can
         take frames it is told ahead (a co-simulator's, docs/cosim.md: `batch`) is told
         them first: what goes on the line, and when, is the same."""
+        self.tell(bodies)
+        return [self.send(body) for body in bodies]
+
+    def tell(self, bodies: Sequence[str]) -> None:
+        """Tell a port that takes frames told ahead (a co-simulator's, docs/cosim.md:
+        `batch`) the frames about to be sent with :meth:`send` one after the other, in the
+        mode the link believes (any other port is told nothing). Each is still judged,
+        sent and read as it comes; a frame not sent as told drops the rest."""
         expect = getattr(self.port, "expect", None)
         if expect is not None and not self._faults:
             framed = [frame(body, self.address, self.checksums) for body in bodies]
             expect([(data, self.answer_timeout(body, len(data))) for body, data in
                     zip(bodies, framed, strict=True)])
-        return [self.send(body) for body in bodies]
 
     def _book(self, frames: list[HostFrame], answer: Response | None) -> None:
         """Book frames with the answer to the last one (the others got none)."""

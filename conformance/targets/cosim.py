@@ -103,6 +103,9 @@ class CosimLine:
         self._rx = bytearray()                # bytes to the host, not read yet
         self._tx: tuple[bytes, int] | None = None   # a write not sent yet, and its start
         self._ahead: deque[Ahead] = deque()   # frames the simulator has run, to be sent
+        #: a write sent with the read to come (launch), its reply not read yet:
+        #: (command, start, end of its bytes, goal)
+        self._inflight: tuple[str, int, int, int] | None = None
         self.broken = ""
 
     # -- the channel -------------------------------------------------------------------------
@@ -262,6 +265,8 @@ class CosimLine:
     def _step(self, t: int) -> bool:
         """One command toward the instant ``t`` (the write not sent yet first): True when
         it stopped at a CR to the host."""
+        if self._inflight is not None:
+            return self._land()
         self._usable()
         if self._tx is not None:
             data, start = self._tx
@@ -285,22 +290,59 @@ class CosimLine:
         goal = max(self.now, min(t, self.now + STEP_NS))
         return self._move(f"until {goal}", self.now, self.now, goal)
 
+    # -- a write sent before its read ------------------------------------------------------------
+    def launch(self, timeout: float | None) -> None:
+        """The write not sent yet goes out now as the read of up to ``timeout`` s that
+        comes next would send it; its reply is read (and checked) when that read comes,
+        or before anything else the line is asked: the suite may do other work
+        meanwhile, while the simulator runs the frame. Only when that read has to send
+        it: nothing waits to be read (bytes received already, say during an injected
+        pause, may be the answer the read takes, and the write then waits)."""
+        if self._tx is None or self._ahead or self._rx or self.broken:
+            return
+        data, start = self._tx
+        end = self.now
+        deadline = end + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
+        goal = min(max(deadline, end), end + STEP_NS)
+        command = f"tx {data.hex().upper()}" + (f" {goal}" if goal > end else "")
+        self._tx = None
+        self._send(command)
+        self._inflight = (command, start, end, goal)
+
+    def _land(self) -> bool:
+        """The reply to the command launched: True when a CR to the host ended it."""
+        assert self._inflight is not None
+        command, start, end, goal = self._inflight
+        self._inflight = None
+        self._usable()
+        try:
+            return self._moved(command, start, end, goal)
+        except BaseException:
+            if not self.broken:
+                self.broken = (f"the exchange {command!r} was cut off before its reply was "
+                               "read: the co-simulation cannot go on")
+            raise
+
     # -- frames told ahead (the `batch` extension) ---------------------------------------------
     def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
         """The frames the host is about to send one after the other, each with the seconds
         its answer is to be awaited. A simulator that offers `batch` runs them all in one
         exchange; each frame's write and read then take their part of its reply, checked,
-        timed and read exactly as one exchange a frame would be."""
+        timed and read exactly as one exchange a frame would be. One that also offers
+        `batch-stops` ends the batch after a frame that got no CR: a frame awaited longer
+        than one command may ask for (H, answered once the axes have stopped) is told
+        with that much, and the frames after it run only if it was answered meanwhile."""
         if ("batch" not in self.extensions or self._tx is not None or self._rx
-                or self._ahead):
+                or self._ahead or self._inflight is not None):
             return
         self._usable()
+        stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
         for data, timeout in frames:
             wait = round(timeout * SECOND)
-            if not data or wait > STEP_NS:
+            if not data or (wait > STEP_NS and not stops):
                 break
-            plan.append((bytes(data), wait))
+            plan.append((bytes(data), min(wait, STEP_NS)))
         if len(plan) < 2:
             return
         command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
@@ -313,6 +355,8 @@ class CosimLine:
                 cr = self._moved(label, start, end, end + wait)
                 ahead.append(Ahead(data, start, end + wait, bytes(self._rx), self.now, cr))
                 self._rx.clear()
+                if stops and not cr:
+                    break                         # the simulator ran none after it
         self.now = here
         self._ahead.extend(ahead)
 
@@ -325,7 +369,10 @@ class CosimLine:
             self._ahead.clear()
 
     def _flush(self) -> None:
-        """Send the write not sent yet (its clock to the end of its bytes)."""
+        """Send the write not sent yet (its clock to the end of its bytes), or read the
+        reply to the one launched."""
+        if self._inflight is not None:
+            self._land()
         if self._tx is not None:
             self._step(self.now)
 
@@ -382,7 +429,7 @@ class CosimLine:
         deadline = self.now + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
         out = bytearray(self._take(size, terminator))
         while len(out) < size and not (terminator and out.endswith(terminator)):
-            if self._tx is None and self.now >= deadline:
+            if self._tx is None and self._inflight is None and self.now >= deadline:
                 break
             self._step(deadline)
             out += self._take(size - len(out), terminator)
@@ -437,6 +484,10 @@ class CosimPort:
     def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
         """The frames about to be sent, each with its answer's timeout (CosimLine.expect)."""
         self.line.expect(frames)
+
+    def launch(self, timeout: float | None) -> None:
+        """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""
+        self.line.launch(timeout)
 
     def read(self, size: int = 1) -> bytes:
         return self.line.read(size, self.timeout)

@@ -55,6 +55,9 @@ PACKET_CLOSER = "*E-1"
 #: status words restored at the end, polarity before causes before enables (an enable
 #: written last finds its polarity and cause already in place)
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
+#: EEPROM bytes read back in one go (one exchange with a co-simulator that takes frames
+#: told ahead, docs/cosim.md: `batch`; a frame at a time on any other unit)
+EEPROM_READS = 64
 
 
 class SessionError(Exception):
@@ -152,8 +155,10 @@ class Session:
         self._link = link
         return link
 
-    def open_link(self, address: int | None = None) -> Link:
-        """A link in the known state (on the emulator: a new unit, at ``address``)."""
+    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+        """A link in the known state (on the emulator: a new unit, at ``address``).
+        ``tell``: the frames the caller sends first on it, told ahead with the known
+        state's last (Link.tell) where the unit lives on."""
         self.start()
         self.guard.check_idle()
         return self._new_link(address)
@@ -228,10 +233,10 @@ class RealSession(Session):
         link.round_trip = self.report.line
         return link
 
-    def open_link(self, address: int | None = None) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
         link = super().open_link(address)
         with self.guard.own_frames():
-            self._known_state(link)
+            self._known_state(link, tell)
         link.log.clear()
         return link
 
@@ -311,11 +316,8 @@ class RealSession(Session):
 
     def _backup_eeprom(self, link: Link) -> None:
         """Every byte the run can write, before its first EEPROM write: all of them."""
-        found = {}
-        for address in range(self.profile.eeprom.size):
-            r = link.send("ER%02X" % address)
-            if _hex_ok(r):
-                found[address] = r.hex()
+        read = _read_eeprom(link, list(range(self.profile.eeprom.size)))
+        found = {address: r.hex() for address, r in read.items() if _hex_ok(r)}
         self.guard.eeprom.found(found)
         missing = self.profile.eeprom.size - len(found)
         if missing:
@@ -380,11 +382,14 @@ class RealSession(Session):
         holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
         the INTA of `H` outlive the stop, so it is off until the reset frames set its
         reset mode again."""
+        mpg = ["Y-"] if self._has_mpg() else []
+        frames = [*mpg, *(f"SW{n},00" for n in range(6)), "D", *then]
+        if not link.checksums and not self.guard.packet_open:
+            link.tell(["H", *frames])              # H as _halt sends it, then the rest
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        mpg = ["Y-"] if self._has_mpg() else []
-        link.send_each([*mpg, *(f"SW{n},00" for n in range(6)), "D", *then])
+        link.send_each(frames)
 
     def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
@@ -396,9 +401,10 @@ class RealSession(Session):
             link.rig.hands_off()
         self._stop(link, [*self._reset_frames(), "K", "R", *then])
 
-    def _known_state(self, link: Link) -> None:
+    def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
         self._settle(link, ["PF"])                 # where the axes are, for the way back
         self._go_back(link, read=False)
+        link.tell(["N", *tell])
         link.send("N")
 
     def _go_back(self, link: Link, *, read: bool = True) -> None:
@@ -541,9 +547,10 @@ class RealSession(Session):
         """Read ``addresses``, write back those that differ from the originals and read
         them again; returns those written back (a failure is a problem)."""
         changed = []
+        read = _read_eeprom(link, addresses)
         for address in addresses:
             value = self.eeprom[address]
-            r = link.send("ER%02X" % address)
+            r = read[address]
             if _hex_ok(r) and r.hex() == value:
                 continue
             link.send("EW%02X,%02X" % (address, value))
@@ -606,6 +613,15 @@ def _round_trip(link: Link) -> dict[str, float]:
     return {"min_ms": trips[0], "median_ms": trips[len(trips) // 2], "max_ms": trips[-1],
             "byte_ms": link.byte_seconds(1) * 1e3,
             "bytes_ms": link.byte_seconds(sent + len(answers[0].raw)) * 1e3}
+
+
+def _read_eeprom(link: Link, addresses: list[int]) -> dict[int, Response | None]:
+    """`ER` of each address in turn, EEPROM_READS frames told ahead at a time."""
+    read: dict[int, Response | None] = {}
+    for start in range(0, len(addresses), EEPROM_READS):
+        chunk = addresses[start:start + EEPROM_READS]
+        read.update(zip(chunk, link.send_each(["ER%02X" % a for a in chunk]), strict=True))
+    return read
 
 
 def _hex_ok(r: Response | None) -> bool:

@@ -8,7 +8,8 @@ in-process `gve://` line would give it.
     until T        advance to the instant T (ns), stopping at a CR to the host
     next           the next instant anything happens (`next T`, `next none`)
     batch D HEX .. frames in turn, each as `tx HEX T` with T its bytes' end + D ns (the
-                   extension `batch`, offered on the first line: `cosim 1 batch`)
+                   extension `batch`, offered on the first line: `cosim 1 batch`), ending
+                   after the first frame that got no CR to the host (`batch-stops`)
     baud N         the line's rate
     in, switch, power-on, state, quit, help: the test rig (docs/rig.md)
 
@@ -28,7 +29,7 @@ from emulator.link.server import CONTROL_LIMIT, StdoutGone
 
 VERSION = 1
 #: the optional extensions this simulator speaks, named on its first line (docs/cosim.md)
-EXTENSIONS = ("batch",)
+EXTENSIONS = ("batch", "batch-stops")
 CR = b"\r"
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
         "| in PORT HEX | switch AXIS POS|none | power-on | state | quit  "
@@ -84,9 +85,10 @@ class Cosim:
     def _tx(self, args: list[str]) -> list[str]:
         if len(args) not in (1, 2):
             raise CosimError("tx HEX [T]")
-        return self._send(_hex(args[0]), _instant(args[1]) if len(args) == 2 else None)
+        return self._send(_hex(args[0]), _instant(args[1]) if len(args) == 2 else None)[0]
 
-    def _send(self, data: bytes, until: int | None) -> list[str]:
+    def _send(self, data: bytes, until: int | None) -> tuple[list[str], bool]:
+        """The reply to `tx`, and whether a CR reached the host meanwhile."""
         line = self.line
         end = line.now + len(data) * line.byte_ns
         if until is not None and until < end:
@@ -96,17 +98,22 @@ class Cosim:
         if until is not None and not any(CR in data for _, data in out):
             self._run_to(until)
             out += line.take_timed()
-        return [*_rx_lines(out), f"now {line.now}"]
+        return [*_rx_lines(out), f"now {line.now}"], any(CR in data for _, data in out)
 
     def _batch(self, args: list[str]) -> list[str]:
         """Each frame in turn as `tx HEX T`, T the end of its bytes + D: the replies
-        those would give one after the other, in one exchange."""
+        those would give one after the other, in one exchange, up to and with the first
+        frame during which no CR reached the host (`batch-stops`: the rest is not run)."""
         if not args or len(args) % 2:
             raise CosimError("batch D HEX [D HEX ...]")
         frames = [(_instant(args[i]), _hex(args[i + 1])) for i in range(0, len(args), 2)]
         out: list[str] = []
         for wait, data in frames:
-            out += self._send(data, self.line.now + len(data) * self.line.byte_ns + wait)
+            reply, answered = self._send(data, self.line.now + len(data) * self.line.byte_ns
+                                         + wait)
+            out += reply
+            if not answered:
+                break
         return out
 
     def _until(self, args: list[str]) -> list[str]:

@@ -273,40 +273,55 @@ def test_the_first_line_may_name_the_extensions_it_speaks():
 
 
 #: frames whose answers come at once, and H, which answers once the axis has stopped
-#: (awaited longer than the 1 s one frame of a batch may take: sent on its own)
+#: (awaited longer than the 1 s one frame of a batch may take: sent on its own, or with
+#: `batch-stops` told with 1 s)
 FRAMES = ["?", "SW0,00", "D", "V1000", "L500,0,0", "SR6", "PF", "H"]
 
 
-def _sent(batch: bool):
-    """The records, answers, clock and commands sent of FRAMES by Link.send_each on a
-    co-simulated emulator, with `batch` or without."""
+def _sent(extensions: frozenset[str] = frozenset(), frames: list[str] = FRAMES):
+    """The records, answers, clock and commands sent of ``frames`` by Link.send_each on a
+    co-simulated emulator, with those of its extensions."""
     from conformance.link.link import Link
 
     target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
     target.preflight()
     try:
         port, baud, virtual, _ = target.connect(None)
-        if not batch:
-            port.line.extensions = frozenset()
+        assert extensions <= port.line.extensions
+        port.line.extensions = extensions
         commands = []
         send = port.line.program.send
         port.line.program.send = lambda text: commands.append(text) or send(text)
         link = Link(port, target.session.guard, baud=baud, virtual=virtual)
         target.session.guard.motion_confirmed = True
-        answers = link.send_each(FRAMES)
+        answers = link.send_each(frames)
         records = [(r.direction, r.data, r.t) for r in link.log]
         return records, [a and a.raw for a in answers], port.line.now, list(commands)
     finally:
         target.close()
 
 
-def test_frames_told_ahead_go_in_one_exchange_and_read_as_one_a_frame():
-    batched, answers, now, commands = _sent(batch=True)
-    single, single_answers, single_now, single_commands = _sent(batch=False)
+@pytest.mark.parametrize(("extensions", "sent"), [({"batch"}, ["batch", "tx"]),
+                                                   ({"batch", "batch-stops"}, ["batch"])])
+def test_frames_told_ahead_go_in_one_exchange_and_read_as_one_a_frame(extensions, sent):
+    batched, answers, now, commands = _sent(frozenset(extensions))
+    single, single_answers, single_now, single_commands = _sent()
     assert (batched, answers, now) == (single, single_answers, single_now)
-    assert [c.split()[0] for c in commands] == ["batch", "tx"]
+    assert [c.split()[0] for c in commands] == sent
     assert [c.split()[0] for c in single_commands] == ["tx"] * len(FRAMES)
     assert answers[FRAMES.index("H")] is not None, "H answered once the axis stopped"
+
+
+def test_a_batch_that_stops_at_a_frame_unanswered_sends_the_rest_as_they_come():
+    """`batch-stops`: `*S` (opening a packet) gets no answer; the batch ends there (the
+    simulator ran none after it), and the frames after it go one an exchange: the same
+    bytes at the same instants."""
+    frames = ["SR6", "*S", "SR6", "PF"]
+    batched, answers, now, commands = _sent(frozenset({"batch", "batch-stops"}), frames)
+    single, single_answers, single_now, _ = _sent(frozenset(), frames)
+    assert (batched, answers, now) == (single, single_answers, single_now)
+    assert [c.split()[0] for c in commands] == ["batch", "tx", "tx"], commands
+    assert answers[0] is not None and answers[1] is None
 
 
 def test_frames_told_ahead_and_not_sent_as_told_leave_the_clock_on_the_simulator_s():
@@ -329,3 +344,32 @@ def test_frames_told_ahead_and_not_sent_as_told_leave_the_clock_on_the_simulator
         assert not line.broken and not line._ahead
     finally:
         target.close()
+
+
+def _launched(launch: bool):
+    """The answers, clock and commands of three frames written and read on a co-simulated
+    emulator, each write launched before its read or not."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        port.line.extensions = frozenset()
+        commands = []
+        send = port.line.program.send
+        port.line.program.send = lambda text: commands.append(text) or send(text)
+        port.timeout, answers = 0.25, []
+        for data in (b"!0?\r", b"!0SR0\r", b"!0PF\r"):
+            port.write(data)
+            if launch:
+                port.launch(port.timeout)
+                assert port.line._inflight is not None, "sent before the read"
+            answers.append(port.read_until(b"\r"))
+        return answers, port.line.now, list(commands)
+    finally:
+        target.close()
+
+
+def test_a_write_launched_before_its_read_is_the_exchange_the_read_would_send():
+    launched = _launched(True)
+    assert launched == _launched(False)
+    assert [c.split()[0] for c in launched[2]] == ["tx"] * 3 and all(launched[0])

@@ -27,6 +27,9 @@ BAUD = 115200
 B = byte_time(BAUD)
 
 
+#: the first line: the version and the extensions the emulator speaks
+FIRST = "cosim 1 batch batch-stops"
+
 def cosim(model: str = "GVE84-100") -> Cosim:
     spec = LineSpec(units=[(model, None)])
     return Cosim(Line(spec.build_units(), BAUD))
@@ -128,7 +131,7 @@ def test_serve_cosim_announces_the_version_and_ends_at_the_end_of_input():
     out = io.StringIO()
     spec = LineSpec(units=[("GVE84-100", None)])
     serve_cosim(Line(spec.build_units(), BAUD), io.BytesIO(b"until 7\n\nnext\n"), out)
-    assert out.getvalue() == "cosim 1 batch\nnow 7\nnext none\n"
+    assert out.getvalue() == f"{FIRST}\nnow 7\nnext none\n"
 
 
 def test_a_line_that_is_too_long_is_refused():
@@ -147,7 +150,7 @@ def test_python_m_emulator_cosim_with_several_units(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and done.stderr == ""
     lines = done.stdout.splitlines()
-    assert lines[0] == "cosim 1 batch"
+    assert lines[0] == FIRST
     answer = rx([x for x in lines if x.startswith("rx ")])
     assert answer.startswith(b"0,") and answer.endswith(b"\r")
     both, one = (json.loads(x) for x in lines if x.startswith("{"))
@@ -158,7 +161,7 @@ def test_python_m_emulator_cosim_with_several_units(tmp_path):
 def test_python_m_emulator_cosim_ends_quietly_when_its_input_ends():
     done = subprocess.run([sys.executable, "-m", "emulator", "--cosim"], input="",
                           capture_output=True, text=True, timeout=60)
-    assert (done.returncode, done.stdout, done.stderr) == (0, "cosim 1 batch\n", "")
+    assert (done.returncode, done.stdout, done.stderr) == (0, FIRST + "\n", "")
 
 
 def test_the_session_in_docs_cosim_md_is_the_emulator_s():
@@ -167,14 +170,14 @@ def test_the_session_in_docs_cosim_md_is_the_emulator_s():
     doc = (Path(__file__).resolve().parents[3] / "docs" / "cosim.md").read_text()
     block = doc.split("## A session", 1)[1].split("```")[1]
     lines = [re.split(r"\s{3,}", x.strip())[0] for x in block.splitlines() if x.strip()]
-    assert lines[0] == "cosim 1 batch"
+    assert lines[0] == FIRST
     commands = [x[2:] for x in lines if x.startswith("> ")]
     expected = [x for x in lines[1:] if not x.startswith("> ")]
     done = subprocess.run([sys.executable, "-m", "emulator", "--model", "GVE84-100",
                            "--cosim"], input="\n".join(commands) + "\n",
                           capture_output=True, text=True, timeout=60)
     got = done.stdout.splitlines()
-    assert got[0] == "cosim 1 batch" and len(got[1:]) == len(expected), got
+    assert got[0] == FIRST and len(got[1:]) == len(expected), got
     for want, have in zip(expected, got[1:], strict=True):
         if want.endswith(", ...}"):              # the keys shown, as shown
             shown = json.loads(want.replace(", ...}", "}"))
@@ -190,9 +193,8 @@ def _now(replies: list[str]) -> int:
 
 
 def test_batch_replies_as_its_frames_would_one_tx_each():
-    """Each pair as `tx HEX T`, T its bytes' end + D: an answer awaited too briefly (1 µs)
-    comes in the next frame's reply, as it would."""
-    frames = [(250_000_000, b"!0?\r"), (1_000, b"!0SR0\r"), (300_000_000, b"!0V1000\r"),
+    """Each pair as `tx HEX T`, T its bytes' end + D."""
+    frames = [(250_000_000, b"!0?\r"), (250_000_000, b"!0SR0\r"), (300_000_000, b"!0V1000\r"),
               (250_000_000, b"!0PF\r")]
     one, expected = cosim(), []
     for wait, data in frames:
@@ -200,7 +202,22 @@ def test_batch_replies_as_its_frames_would_one_tx_each():
         expected += one.handle(f"tx {data.hex()} {end + wait}")
     got = cosim().handle("batch " + " ".join(f"{w} {d.hex().upper()}" for w, d in frames))
     assert got == expected
-    assert any(x.startswith("rx ") for x in got) and _now(got) > 4 * B
+    assert sum(x.startswith("now ") for x in got) == 4 and _now(got) > 4 * B
+
+
+def test_a_batch_ends_after_a_frame_that_got_no_cr():
+    """`batch-stops`: an answer awaited too briefly (1 µs) ends the batch with that frame's
+    `now`; the frames after it are not run (their answer comes in the next reply)."""
+    frames = [(250_000_000, b"!0?\r"), (1_000, b"!0SR0\r"), (300_000_000, b"!0V1000\r")]
+    one, expected = cosim(), []
+    for wait, data in frames[:2]:
+        end = (_now(expected) if expected else 0) + len(data) * B
+        expected += one.handle(f"tx {data.hex()} {end + wait}")
+    c = cosim()
+    got = c.handle("batch " + " ".join(f"{w} {d.hex().upper()}" for w, d in frames))
+    assert got == expected and sum(x.startswith("now ") for x in got) == 2
+    later = c.handle(f"until {_now(got) + 300_000_000}")
+    assert rx([x for x in later if x.startswith("rx ")]) == b"0,00\r", "SR0's answer, no V's"
 
 
 @pytest.mark.parametrize("text", ["batch", "batch 5", "batch 5 ZZ", "batch x 2130",
