@@ -62,9 +62,13 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 # -- modal parameters and overrides ---------------------------------------------------------
 
-#: the mutants that store a modal value refused for its range, clamped to the range
-_RANGE_STORED = {"V": "velocity-refused-stored", "A": "accel-refused-stored",
-                 "B": "brake-refused-stored", "T": "dwell-refused-stored"}
+def _stores_refused(dev: Device, key: str) -> bool:
+    """Whether the unit's mutant stores ``key`` refused for its range (clamped to it)."""
+    act = dev.mutant.active
+    return ((key == "V" and act("velocity-refused-stored"))
+            or (key == "A" and act("accel-refused-stored"))
+            or (key == "B" and act("brake-refused-stored"))
+            or (key == "T" and act("dwell-refused-stored")))
 
 
 def modal(key: str, attr: str) -> Handler:
@@ -76,8 +80,7 @@ def modal(key: str, attr: str) -> Handler:
                 and dev.mutant.active("velocity-syntax-refused-stored"):
             dev.state.modal.V = int(head)
         value = dec(p)
-        if not r.lo <= value <= r.hi and key in _RANGE_STORED \
-                and dev.mutant.active(_RANGE_STORED[key]):
+        if not r.lo <= value <= r.hi and _stores_refused(dev, key):
             setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))
         setattr(dev.state.modal, attr, within(value, r.lo, r.hi))
         return []
