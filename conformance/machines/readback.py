@@ -13,6 +13,7 @@ moves, outputs, V, the spindle, a queue halted with INTA = 1."""
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -21,6 +22,7 @@ from hypothesis.stateful import precondition, rule
 
 from conformance.case import CaseContext, case
 from conformance.link.line_band import line_band
+from conformance.link.link import idle_st6
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
 from conformance.protocol.catalogue import catalogue, classes
@@ -200,7 +202,8 @@ class ReadBackMachine(UnitMachine):
     @precondition(lambda self: not self.halted)
     @rule()
     def halt_queue(self) -> None:
-        """Two C queued and halted at once: INTA = 1, RUN = 1, the rest waiting."""
+        """Two C queued and halted at once: INTA = 1, RUN = 1, the rest waiting; the
+        frames refused only then are refused at once."""
         if not (self.fits("C40,0,0") and self.fits("C80,0,0")):
             return
         for body in ("C40,0,0", "C40,0,0"):
@@ -212,6 +215,9 @@ class ReadBackMachine(UnitMachine):
         holds(r is not None and r.inta, "10.4.halt.ramp", f"H answered {r}")
         self.halted = True
         self.resumed_end = ends
+        # what only a halted queue refuses, at once: the queue they must leave as it was
+        # is read where G takes it (resume, or the example's end)
+        self.refuse([r for r in REFUSALS if r.state == HALTED and self.meets(r)])
 
     @precondition(lambda self: self.halted)
     @rule()
@@ -319,17 +325,18 @@ class ReadBackMachine(UnitMachine):
         return at
 
     def dwell_effect(self) -> list[int] | None:
-        """Where the way back of a move stands DWELL_SECONDS after the unit took it: sent
-        again and again until taken, it starts T after the move out ended (or when taken,
-        if that is later)."""
+        """Where the way back of a move stands DWELL_SECONDS after it was sent, as soon
+        as F showed the move out ended (F read back to back): it starts T after that end,
+        or when it arrived if that is later."""
         out, back = f"L{DWELL_PROBE},0,0", f"L{-DWELL_PROBE},0,0"
         if not self.at_rest(out):
             return None
         self.link.wait(DWELL_PAST)
         self.settled(out, "10.1.queue.line-alone")
-        r = self.link.poll(back, lambda r: r.code is not None
-                           and r.code != ErrorCode.QUEUE_FULL, 30, every=0.0, send=self.send)
-        holds(r is not None and r.ok, "10.1.queue.wait-idiom", f"{back} answered {r}")
+        r = self.link.poll("F", lambda r: r.ok and idle_st6(r), 30, every=0.0,
+                           send=self.send)
+        holds(r is not None, "10.3.st6.bits", f"F never showed the move {out} ended")
+        self.settled(back, "10.1.queue.line-alone")
         self.link.wait(DWELL_SECONDS)
         at = self.position()
         self.idle()
@@ -403,13 +410,16 @@ class ReadBackMachine(UnitMachine):
 
     @rule(first=st.integers(0, len(REFUSALS) - 1))
     def refused(self, first: int) -> None:
-        """Every frame refused in this state, one after the other from a drawn one on:
-        each leaves the state read back as it was (the state after one is the state
-        before the next), and what those that would have set V, A, VL, XM, B, T or the
-        micro-step mode would have set reads as before, read once after them all."""
+        """Every frame refused in this state, one after the other from a drawn one on."""
         now = HALTED if self.halted else IDLE
-        todo = [r for r in REFUSALS[first:] + REFUSALS[:first]
-                if r.state in (None, now) and self.meets(r)]
+        self.refuse([r for r in REFUSALS[first:] + REFUSALS[:first]
+                     if r.state in (None, now) and self.meets(r)])
+
+    def refuse(self, todo: list[Refusal]) -> None:
+        """Send each of ``todo``: each leaves the state read back as it was (the state
+        after one is the state before the next), and what those that would have set V,
+        A, VL, XM, B, T or the micro-step mode would have set reads as before, read once
+        after them all."""
         sent = [self.body(r) for r in todo]
         touched = {effect_of(b) for r, b in zip(todo, sent, strict=True)
                    if r.address == UNIT} - {None}
@@ -483,7 +493,14 @@ class ReadBackMachine(UnitMachine):
                        "4.response.failed-not-executed")
 
     def teardown(self) -> None:
-        if self.halted:
+        """An example that ends with the queue halted resumes it: where G takes it is the
+        last read-back of what the refusals left in it. After a failure (an exception on
+        its way out) the queue is only deleted, so that the failure is the one reported."""
+        if not self.halted:
+            return
+        if sys.exc_info()[1] is None:
+            self.resume()
+        else:
             self.send("D")
 
 
@@ -496,7 +513,7 @@ class ReadBackMachine(UnitMachine):
              "10.4.halt.ramp", "10.4.delete", "10.cmd.modal", "10.4.go.resume",
              "10.cmd.accel-range", "10.cmd.axis-limits", "1.profile.v-b-range-gve54",
              "1.profile.v-b-range", "12.spindle.speed", "6.checksum.spindle-shares",
-             "10.1.queue.wait-idiom"))
+             "10.1.queue.wait-idiom", "10.3.st6.bits"))
 def readback_machine(ctx: CaseContext) -> None:
     """After every refused frame and every failed packet the state read back at rest is
     as before (V, A, VL and XM by a move's effect, B by a junction's, T by a dwell's, the
