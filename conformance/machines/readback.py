@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import precondition, rule
 
 from conformance.case import CaseContext, case
+from conformance.link.framing import Response
 from conformance.link.line_band import line_band
 from conformance.link.link import idle_st6
 from conformance.machines.base import UnitMachine, holds, index_invariant
@@ -28,7 +29,7 @@ from conformance.machines.runner import run_machine
 from conformance.protocol.catalogue import catalogue, classes
 from conformance.protocol.parse import parse
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import SECOND, ErrorCode
 from gve_fixtures.rules import load_rules
 
 IDLE, HALTED = "idle", "halted"
@@ -120,6 +121,8 @@ EFFECTS = {
     "dwell": Effect("dwell_effect", "a move taken as the one before it ended (T; V, A, "
                     "VL, XM)", polled=True),
 }
+#: the commands answered when their motion has stopped: no round trip of the line
+DEFERRED = classes(deferred=True)
 #: the commands whose value a refused frame must not set -> the effect that shows it
 EFFECT_OF = {**{name: "pace" for name in classes(paces=True)},
              "B": "junction", "T": "dwell", "M": "microstep"}
@@ -145,10 +148,19 @@ class ReadBackMachine(UnitMachine):
     index_is_the_models = index_invariant()
 
     def __init__(self, ctx: CaseContext) -> None:
+        #: ms: the round trips of the frames answered at once since the effects were
+        #: last read before refusals (the line as the readings saw it, line_band's jitter)
+        self.trips: list[float] = []
         super().__init__(ctx)
         self.halted = False
         self.v = ctx.profile.reset.V
         self.resumed_end: list[int] = []
+
+    def send(self, body: str, **kw) -> Response | None:
+        r = super().send(body, **kw)
+        if r is not None and parse(body).name not in DEFERRED:
+            self.trips.append((r.received_at - r.sent_at) / 1e6)
+        return r
 
     # -- the state the refusals meet ------------------------------------------------------
     @rule(word=st.integers(2, 5), value=st.integers(0, 255))
@@ -288,9 +300,12 @@ class ReadBackMachine(UnitMachine):
         rest) and its move out within the envelope."""
         return not self.halted and self.fits(out)
 
-    def settled(self, body: str, rule_id: str) -> None:
+    def settled(self, body: str, rule_id: str) -> Response:
+        """Send ``body``, which the unit must take (answer 0)."""
         r = self.send(body)
         holds(r is not None and r.ok, rule_id, f"{body} answered {r}")
+        assert r is not None
+        return r
 
     def v_effect(self) -> list[int] | None:
         """Where a move from rest under the modal V stands V_PROBE_SECONDS after it was
@@ -315,9 +330,10 @@ class ReadBackMachine(UnitMachine):
         if not self.at_rest(f"L{2 * JUNCTION_LEG},0,0"):
             return None
         self.link.wait(DWELL_PAST)
-        for _ in range(2):
-            self.settled(f"C{JUNCTION_LEG},0,0", "10.1.queue.cont-buffer")
-        self.link.wait(JUNCTION_SECONDS)
+        first = self.settled(f"C{JUNCTION_LEG},0,0", "10.1.queue.cont-buffer")
+        self.settled(f"C{JUNCTION_LEG},0,0", "10.1.queue.cont-buffer")
+        # the read's instant counts from the first C, as the motion does
+        self.link.wait(max(0.0, JUNCTION_SECONDS - (self.link.now - first.sent_at) / SECOND))
         at = self.position()
         self.idle()
         self.settled(f"L{-2 * JUNCTION_LEG},0,0", "10.1.queue.line-alone")
@@ -362,14 +378,16 @@ class ReadBackMachine(UnitMachine):
 
     def slack(self, effect: Effect) -> int:
         """Counter units two readings of ``effect`` may differ by on a correct unit: none
-        in virtual time or when not timed; twice the line's band at V over a real line
-        (each reading has its own latency), and a round trip more after a poll."""
-        if not effect.timed:
+        in virtual time or when not timed; over a real line twice the line's band at V
+        (each reading has its own latency), its jitter that of the round trips since the
+        readings before, and the slowest round trip more after a poll."""
+        if not effect.timed or self.link.virtual:
             return 0
         rate = self.v * self.per_step()
-        seconds = (self.link.round_trip.get("max_ms", 0.0) / 1e3
-                   if effect.polled and not self.link.virtual else 0.0)
-        return 2 * line_band(self.link.round_trip).steps(rate) + math.ceil(rate * seconds)
+        band = line_band(self.link.round_trip, self.trips)
+        polled = max([self.link.round_trip.get("max_ms", 0.0), *self.trips]) / 1e3 \
+            if effect.polled else 0.0
+        return 2 * band.steps(rate) + math.ceil(rate * polled)
 
     def effects_unchanged(self, before: dict[str, list[int] | None], what: str,
                           rule_id: str) -> None:
@@ -423,6 +441,7 @@ class ReadBackMachine(UnitMachine):
         sent = [self.body(r) for r in todo]
         touched = {effect_of(b) for r, b in zip(todo, sent, strict=True)
                    if r.address == UNIT} - {None}
+        self.trips = []
         reference = self.effects(touched)
         before = self.state()
         for refusal, body in zip(todo, sent, strict=True):
@@ -452,6 +471,7 @@ class ReadBackMachine(UnitMachine):
         as before, read once after them all."""
         packets = FAILED_PACKETS[first:] + FAILED_PACKETS[:first]
         touched = {effect_of(m) for p in packets for m in p[0]} - {None}
+        self.trips = []
         reference = self.effects(touched)
         before = self.state()
         for members, n, want in packets:
