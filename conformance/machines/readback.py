@@ -131,10 +131,11 @@ EFFECT_OF = {**{name: "pace" for name in classes(paces=True)},
 
 
 def effect_of(body: str) -> str | None:
-    """The effect that shows what ``body`` (at the unit's address) would set, if any (VK
-    and VN set nothing of a move along X)."""
+    """The effect that shows what ``body`` (at the unit's address) would set, if any: a
+    value or a mode follows its command (VK and VN set nothing of a move along X, a
+    signed `V+1` is no value)."""
     read = parse(body, strict=True)
-    return EFFECT_OF.get(read.name or "") if read.params else None
+    return EFFECT_OF.get(read.name or "") if read.params[:1].isalnum() else None
 
 
 def range_rule(body: str, profile: Profile) -> str:
