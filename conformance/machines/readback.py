@@ -96,7 +96,7 @@ V_PROBE, V_PROBE_SECONDS = 400, 0.15
 #: B's effect: two C of this length from rest, read this long after the first was sent
 #: (n < $: each cruises at B if B is below V, and leaves the junction at B)
 JUNCTION_LEG, JUNCTION_SECONDS = 200, 0.15
-#: T's effect: a move, then the way back sent until taken: read this long after that
+#: T's effect: a move, F read until it ended, then the way back, read this long after
 DWELL_PROBE, DWELL_SECONDS = 40, 0.05
 DWELL_PAST = 0.03
 #: real time: how many times more an effect that reads off is read before it fails
@@ -107,7 +107,7 @@ REREADS = 1
 class Effect:
     """How the machine reads back what refused frames of some commands would set."""
 
-    probe: str          # the machine's method that reads it (None: not here now)
+    probe: str          # the machine's method reading it (None where it cannot now)
     setting: str        # what it reads, and the settings it depends on
     timed: bool = True  # read at an instant: within the line's band in real time
     polled: bool = False   # its instant follows a poll: one round trip more in real time
@@ -160,6 +160,7 @@ class ReadBackMachine(UnitMachine):
         self.resumed_end: list[int] = []
 
     def send(self, body: str, **kw) -> Response | None:
+        """:meth:`UnitMachine.send`, keeping the round trip of a frame answered at once."""
         r = super().send(body, **kw)
         if r is not None and parse(body).name not in DEFERRED:
             self.trips.append((r.received_at - r.sent_at) / 1e6)
