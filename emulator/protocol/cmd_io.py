@@ -127,7 +127,12 @@ def cmd_flags(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_spindle(dev: Device, ses: Session, p: str, t: int) -> Reply:
     sp = dev.profile.spindle
     assert sp is not None
-    value = within(dec(p), sp.range.lo, sp.range.hi)
+    value = dec(p)
+    if not sp.range.lo <= value <= sp.range.hi and dev.mutant.active("spindle-refused-stored"):
+        stored = min(max(value, sp.range.lo), sp.range.hi)
+        dev.state.spindle = stored
+        dev.state.outputs = dev.state.outputs & 0xFE if stored else dev.state.outputs | 0x01
+    within(value, sp.range.lo, sp.range.hi)
     dev.state.spindle = value
     if value and dev.mutant.active("spindle-sets-feed-rate"):
         dev.state.modal.V = value

@@ -62,14 +62,25 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 # -- modal parameters and overrides ---------------------------------------------------------
 
+def _stores_refused(dev: Device, key: str) -> bool:
+    """Whether the unit's mutant stores ``key`` refused for its range (clamped to it)."""
+    act = dev.mutant.active
+    return ((key == "V" and act("velocity-refused-stored"))
+            or (key == "A" and act("accel-refused-stored"))
+            or (key == "B" and act("brake-refused-stored"))
+            or (key == "T" and act("dwell-refused-stored")))
+
+
 def modal(key: str, attr: str) -> Handler:
     """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
+        head = p.split(",")[0]
+        if key == "V" and "," in p and head.isdigit() and r.lo <= int(head) <= r.hi \
+                and dev.mutant.active("velocity-syntax-refused-stored"):
+            dev.state.modal.V = int(head)
         value = dec(p)
-        if not r.lo <= value <= r.hi and (
-                (key == "V" and dev.mutant.active("velocity-refused-stored"))
-                or (key == "A" and dev.mutant.active("accel-refused-stored"))):
+        if not r.lo <= value <= r.hi and _stores_refused(dev, key):
             setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))
         setattr(dev.state.modal, attr, within(value, r.lo, r.hi))
         return []
@@ -269,6 +280,8 @@ def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
     ms = dev.profile.microstep
     assert ms is not None
     if p not in ms.currents and p not in ms.factors:
+        if p[:1] in ms.factors and dev.mutant.active("microstep-refused-stored"):
+            dev.state.microstep = p[:1]
         raise CommandError(ErrorCode.SYNTAX, f"unknown motor mode {p!r}")
     dev.refuse_while_moving(t)
     if p in ms.currents:

@@ -10,9 +10,9 @@ import pytest
 
 from conformance.cli import main
 from conformance.diff.grammar import Options, probes
-from conformance.targets.emu import emulator_readings, mutants
+from conformance.targets.emu import emulator_readings
 from gve_fixtures.profile import load_profile
-from tests.conformance.diff.test_engine import PROFILE, in_area
+from tests.conformance.diff.test_engine import ON_THE_WIRE, PROFILE, in_area
 from tests.emulator.process import Emulator
 
 
@@ -94,7 +94,7 @@ def test_over_a_pty_a_probe_shows_a_millisecond_timing_bug(capsys):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("mutant", sorted(mutants()))
+@pytest.mark.parametrize("mutant", ON_THE_WIRE)
 def test_every_mutant_is_named_over_exec_by_the_probes(mutant, tmp_path):
     """What a clone's author runs, against each of the emulator's mutants as a program of
     its own (`exec:`, a pty, real time): the probes alone name a rule of the mutant's
