@@ -267,6 +267,8 @@ class Pair:
         self.reference.write_eeprom(self._eeprom_changes)
 
     def _exchange(self, step: Step, out: ExampleRun) -> StepRecord | None:
+        # a quiet line after a timed-out frame is waited for before either side acts
+        self.target.link.settle()
         self.timing.align()
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
         rec = StepRecord(step)

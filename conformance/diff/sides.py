@@ -110,8 +110,8 @@ class Side:
             body = _body(data, link.checksums)
         if stall is not None:
             link.inject("host", "delay", at=stall[0], seconds=stall[1])
-        sent_at = self.now
         link.send_raw(data)
+        sent_at = link.wrote_at - self._origin
         if answer:
             timeout = link.answer_timeout(body, len(data))
             launch = getattr(link.port, "launch", None)

@@ -81,6 +81,9 @@ class Link:
         #: keeps before the next frame, taken as their frame's (notes, not violations)
         self.late: list[str] = []
         self._quiet = 0.0        # seconds the line has been quiet since a timeout
+        #: when the last frame's bytes began to go out (ns), after any quiet the line kept
+        #: for the frame before it: the instant its round trip counts from
+        self.wrote_at = 0
         self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
@@ -185,6 +188,7 @@ class Link:
         frames = self._framer.frames(wire, commit=False)
         self.guard.check_frames(frames, summed)
         self.settle()
+        self.wrote_at = self.now
         self._framer.frames(wire)
         if fault:
             self.note(f"fault host {fault.kind} {fault.params}")
@@ -223,7 +227,6 @@ class Link:
         address = self.address if address is None else address
         data = frame(body, address, summed)
         self.frames += 1
-        sent_at = self.now
         sent = self._transmit(data, summed is not False)
         if not answer:
             self._book(sent, None)
@@ -235,7 +238,7 @@ class Link:
         self._unbooked = sent
         r = self.read_response(timeout, lines, summed=self.summed_after(body), late=late)
         if r is not None:
-            r.sent_at = sent_at
+            r.sent_at = self.wrote_at
         return r
 
     def send_each(self, bodies: Sequence[str]) -> list[Response | None]:
@@ -355,9 +358,11 @@ class Link:
         real time, after a timeout, wait until the line is quiet first."""
         state = self._last[0]
         data = b""
+        kept_quiet = False
         if not self.virtual:
             if state == _TIMED_OUT and not self.guard.interrupts.pending:
                 data = self._listen(QUIET, stop_early=True, already=self._quiet)
+                kept_quiet = not self.guard.interrupts.pending
             elif final:
                 data = self._listen(END_QUIET, stop_early=True)
         self._quiet = 0.0
@@ -365,6 +370,8 @@ class Link:
         if waiting:
             data += self.port.read(waiting)
         if not data:
+            if kept_quiet:               # the timed-out frame's answer can come no more
+                self._last = (_UNASKED, b"", b"")
             return b""
         self._record(UNIT, data, "unsolicited")
         self._after_answer(data, "after")

@@ -4,8 +4,10 @@ its own frames and for the raw frames the differential sides send."""
 import pytest
 
 from conformance.diff.sides import Side
+from conformance.link import link as link_module
 from conformance.link.link import LATE, Link
 from conformance.targets import parse_target
+from gve_fixtures.protocol import SECOND
 
 
 def link():
@@ -89,3 +91,31 @@ def test_a_timeout_the_caller_chose_takes_no_late_answer():
     ln = real_link(port)
     assert ln.send("V1000", timeout=0.1) is None and ln.late == []
     assert port.timeouts == [0.1]
+
+
+def test_a_frame_after_a_timed_out_one_counts_its_round_trip_from_the_quiet_lines_end(
+        monkeypatch):
+    # the quiet kept before it is the link's, not the line's: a round trip counted from
+    # before it would widen every band read from the round trips by that much
+    monkeypatch.setattr(link_module, "QUIET", 0.5)
+    monkeypatch.setattr(link_module, "LATE", 0.0)
+    port = _Line([b"", b"0,12\r"])           # V1000 unanswered, SR6 answered at once
+    ln = real_link(port)
+    assert ln.send("V1000") is None
+    r = ln.send("SR6")
+    assert r is not None and r.raw == b"0,12\r"
+    assert r.received_at - r.sent_at < 0.5 * SECOND
+    assert r.sent_at == ln.wrote_at
+
+
+def test_the_quiet_after_a_timed_out_frame_is_kept_once(monkeypatch):
+    monkeypatch.setattr(link_module, "QUIET", 0.5)
+    monkeypatch.setattr(link_module, "LATE", 0.0)
+    port = _Line([b""])
+    ln = real_link(port)
+    assert ln.send("V1000") is None
+    before = ln.now
+    ln.settle()                                # waits for the quiet line
+    kept = ln.now
+    ln.settle()                                # the line is known quiet: no second wait
+    assert kept - before >= 0.5 * SECOND > ln.now - kept
