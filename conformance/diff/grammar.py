@@ -379,7 +379,7 @@ class Grammar:
                 out.append(self.fixed(self._padded(f)))
                 if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
                     out.append(self.restart_wait())
-        return out
+        return _silent_in_packets(out)
 
     def fixed(self, body: str, checksum: str = "auto") -> Step:
         """A frame written in the grammar (an event, an idiom's step), answered as its
@@ -417,6 +417,23 @@ class Grammar:
         first = body[len(text):].split(",")[0]
         place = "" if read == "PF" else first
         return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+
+
+def _silent_in_packets(steps: list[Step]) -> list[Step]:
+    """The frames of an open packet are answered by nothing until one ends it (`*E`, a
+    breaker: spec 7), as a drawn packet's members are sent: a frame that waited for an
+    answer would time out and make the line keep quiet after it."""
+    out, open_packet = [], False
+    for step in steps:
+        if step.kind == FRAME:
+            command = commands().get(command_of(step.body))
+            ends = command is not None and command.ends_packet
+            if open_packet and not ends:
+                step = replace(step, answer=False)
+            open_packet = ((command is not None and command.packet == "opens")
+                           or (open_packet and not ends))
+        out.append(step)
+    return out
 
 
 def probes(profile: Profile, options: Options) -> list[tuple[dict, list[Step]]]:

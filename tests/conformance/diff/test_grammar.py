@@ -109,3 +109,11 @@ def test_probes_name_rules_and_are_left_out_where_they_cannot_be_sent():
     safe = [p["steps"] for p, _ in probes(GVE84, Options())]
     assert ["EW10,5A", "ER10"] not in safe
     assert ["EW10,5A", "ER10"] in [p["steps"] for p, _ in probes(GVE84, Options(True))]
+
+
+def test_a_written_packets_frames_await_no_answer_until_one_ends_it():
+    g = Grammar(load_profile("GVE84-100"), Options(destructive=True))
+    steps = g.idiom(["*S", "B10", "v10", "*E2", "C200", "*S", "C10", "H", "*E1", "F"])
+    assert [(s.body, s.answer) for s in steps] == [
+        ("*S", False), ("B10", False), ("v10", False), ("*E2", True), ("C200,0,0", True),
+        ("*S", False), ("C10,0,0", False), ("H", True), ("*E1", True), ("F", True)]
