@@ -167,7 +167,7 @@ class Pair:
                 break
             rec.repeat, rec.place = i, place
             out.records.append(rec)
-            self.timing.retimed(command, rec.target)
+            self.timing.retimed(command, rec.target, rec.reference)
             if command in QUERIES:
                 self._base_index(command, self._context(step, self.course.in_packet), rec)
             kind = self._difference(command, rec)

@@ -12,7 +12,7 @@ target's session measured and the example's own).
 from __future__ import annotations
 
 from conformance.diff.sides import RoundTrip, Side
-from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
@@ -61,8 +61,9 @@ class Timing:
         """The target waited a while: the reference waits as long."""
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: RoundTrip | None) -> None:
-        """A frame went to both sides, ``target`` its exchange with the target (None: a
+    def retimed(self, command: str, target: RoundTrip | None,
+                reference: RoundTrip | None = None) -> None:
+        """A frame went to both sides, ``target`` and ``reference`` its exchanges (None: a
         rig input)."""
 
     def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
@@ -118,16 +119,30 @@ class RealTime(Timing):
         self._watch_reference()
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: RoundTrip | None) -> None:
+    def retimed(self, command: str, target: RoundTrip | None,
+                reference: RoundTrip | None = None) -> None:
         if target is not None and command not in _DEFERRED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
             self.trips.append(target.received_at - target.sent_at)
         if command in _EMPTIES and self.cut_ns:
             self.lost = True
         if command in _RETIMING and self.idle_since is None:
-            self.slack_ns += self.latency_ns
+            late = self._late(command, target, reference)
+            self.slack_ns += late
             if command in _STOPPING:
-                self.cut_ns += self.latency_ns
+                self.cut_ns += late
+
+    def _late(self, command: str, target: RoundTrip | None,
+              reference: RoundTrip | None) -> int:
+        """How much later than the reference the target may have acted on a frame: the
+        latency; for one answered when the motion has stopped (H), as late as its answer
+        came after the reference's shows, the line at that frame being no measure of the
+        line before it."""
+        if (command not in _DEFERRED or target is None or reference is None
+                or not target.answer or not reference.answer):
+            return self.latency_ns
+        takes = reference.received_at - reference.sent_at
+        return acted_within(target.sent_at, target.received_at, takes, self.latency_ns)
 
     def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
