@@ -29,6 +29,7 @@ class UsbRelay:
                  stall_ms: float = 0.0, stall_from: int = 0, stalls: int = 0,
                  hold: bytes = b"", hold_ms: float = 0.0) -> None:
         self.hold, self.hold_for = hold, hold_ms / 1e3
+        self.held = 0                   # transfers held so far
         self.latency, self.jitter, self.chunk = latency_ms / 1e3, jitter_ms / 1e3, chunk
         self.stall_every, self.stall, self.stall_from = stall_every, stall_ms / 1e3, stall_from
         self.stalls = stalls            # stalls still to come
@@ -64,6 +65,7 @@ class UsbRelay:
                 if data:
                     last = to_device[-1][0] if to_device else now
                     held = self.hold_for if self.hold and self.hold in data else 0.0
+                    self.held += held > 0
                     to_device.append((max(last, self._late(now) + held), data))
             if self.device in ready:
                 data = _read(self.device)
