@@ -67,6 +67,20 @@ def test_in_real_time_an_h_answered_late_was_taken_as_late_as_its_answer_shows()
     assert (t.slack_ns // MS, t.cut_ns // MS) == (23, 23)
 
 
+def test_in_real_time_a_rig_input_was_set_as_late_as_the_rig_s_ok_came():
+    """A rig input is set over the rig's own channel: the target's unit may have seen it
+    as late as the rig's `ok` came, however quick the line's answers were; that channel's
+    time is no round trip of the line (the band's jitter does not take it)."""
+    t = RealTime(*sides())
+    t.retimed("V", RoundTrip(b"V", b"0\r", 0, 2 * MS, None))
+    t.idle_since = None                              # the reference was moving
+    t.retimed("input", RoundTrip(b"", b"ok", 5 * MS, 17 * MS, None))
+    assert (t.latency_ns // MS, t.slack_ns // MS, t.cut_ns // MS) == (2, 12, 12)
+    assert len(t.trips) == 1
+    t.retimed("input", RoundTrip(b"", b"", 20 * MS, 21 * MS, None))   # the rig lost
+    assert (t.slack_ns // MS, t.cut_ns // MS) == (14, 14)
+
+
 def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
     """Exact in virtual time; in real time from the round trip the target's session
     measured, its min and max widened by the example's immediate answers (not an H's)."""
