@@ -247,9 +247,9 @@ class Probe:
         line's band included (as :meth:`judge` would find), recording nothing."""
         line = self.line()
         events, readings = self.events, self.readings
-        self._answered_late()
-        self._widen(line)
         try:
+            self._answered_late()
+            self._widen(line)
             (model, _), variants = self.model(), self._variants()
             virtual = self.link.virtual
             t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
@@ -277,8 +277,7 @@ class Probe:
         frame alone later than any round trip before it shows."""
         if self.link.virtual:
             return
-        events = list(self.events)
-        for i, e in enumerate(events):
+        for i, e in enumerate(self.events):
             if e.kind != "halt" or e.answer is None:
                 continue
             lo, latency = e.window.lo, e.window.hi - e.window.lo
@@ -289,8 +288,8 @@ class Probe:
                 # two (the later instant) bounds it
                 took = min(took, self._braking(i, hi))
                 hi = lo + acted_within(lo, e.answer.hi, took, latency)
-            events[i] = replace(e, window=Window(lo, max(e.window.hi, hi)))
-        self.events = events
+            late = replace(e, window=Window(lo, max(e.window.hi, hi)))
+            self.events = [*self.events[:i], late, *self.events[i + 1:]]
 
     def _braking(self, i: int, t: int) -> int:
         """How long the model's event ``i`` (an H) taken at ``t`` brakes until at rest."""
