@@ -5,8 +5,10 @@ an FTDI packet less its two status bytes) or the latency timer (1..16 ms) has ru
 the buffer's first byte; every transfer, in both directions, is late by a random jitter
 of up to ``jitter_ms`` (order kept). ``stall_ms``: every ``stall_every``-th transfer
 towards the host after the first ``stall_from`` is held that much longer, ``stalls``
-times at most (an adapter's host under load). A background
-thread; :meth:`close` ends it."""
+times at most (an adapter's host under load). ``hold``: a transfer towards the unit that
+holds these bytes (a frame) reaches it ``hold_ms`` later than it would (the host under
+load the instant it sent that frame: the unit acts on it late, and nothing the host
+measured before shows it). A background thread; :meth:`close` ends it."""
 
 from __future__ import annotations
 
@@ -24,7 +26,10 @@ CHUNK = 62
 class UsbRelay:
     def __init__(self, device: str, *, latency_ms: float = 16.0, jitter_ms: float = 2.0,
                  chunk: int = CHUNK, seed: int = 0, stall_every: int = 0,
-                 stall_ms: float = 0.0, stall_from: int = 0, stalls: int = 0) -> None:
+                 stall_ms: float = 0.0, stall_from: int = 0, stalls: int = 0,
+                 hold: bytes = b"", hold_ms: float = 0.0) -> None:
+        self.hold, self.hold_for = hold, hold_ms / 1e3
+        self.held = 0                   # transfers held so far
         self.latency, self.jitter, self.chunk = latency_ms / 1e3, jitter_ms / 1e3, chunk
         self.stall_every, self.stall, self.stall_from = stall_every, stall_ms / 1e3, stall_from
         self.stalls = stalls            # stalls still to come
@@ -59,7 +64,9 @@ class UsbRelay:
                 data = _read(self.master)
                 if data:
                     last = to_device[-1][0] if to_device else now
-                    to_device.append((max(last, self._late(now)), data))
+                    held = self.hold_for if self.hold and self.hold in data else 0.0
+                    self.held += held > 0
+                    to_device.append((max(last, self._late(now) + held), data))
             if self.device in ready:
                 data = _read(self.device)
                 if data and not buffered:

@@ -153,9 +153,12 @@ class Pair:
         """A rig input set on both sides (left out where a side has no rig)."""
         if not (self.target.has_rig and self.reference.has_rig):
             return
-        self.timing.retimed("input", None)
-        if (self.target.set_input(step.port, step.value)
-                and self.reference.set_input(step.port, step.value)):
+        sent_at = self.target.now
+        done = self.target.set_input(step.port, step.value)
+        # the target's rig acted somewhere before its `ok`, the reference's at once
+        self.timing.retimed("input", RoundTrip(b"", b"ok" * done, sent_at, self.target.now,
+                                               None))
+        if done and self.reference.set_input(step.port, step.value):
             out.records.append(StepRecord(step, place=place))
             earlier.add("input")
 
@@ -170,7 +173,7 @@ class Pair:
                 break
             rec.repeat, rec.place = i, place
             out.records.append(rec)
-            self.timing.retimed(command, rec.target)
+            self.timing.retimed(command, rec.target, rec.reference)
             if command in QUERIES:
                 self._base_index(command, self._context(step, self.course.in_packet), rec)
             kind = self._difference(command, rec)

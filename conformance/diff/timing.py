@@ -12,7 +12,7 @@ target's session measured and the example's own).
 from __future__ import annotations
 
 from conformance.diff.sides import RoundTrip, Side
-from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import St6
 
@@ -29,6 +29,9 @@ _STOPPING = classes(stops=True) | {"input"}
 #: frames whose answer does not come at once: answered when the motion has stopped, or
 #: followed by a restart (their answer's time is no measure of the line's latency)
 _DEFERRED = classes(deferred=True) | classes(restart=True)
+#: what gives no round trip of the target's line: those, and a rig input (set over the
+#: rig's own channel, answered `ok` once done)
+_UNTIMED = _DEFERRED | {"input"}
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
 _READINGS = classes(position=True) | {">"}
 _EMPTIES = classes(empties=True)
@@ -61,9 +64,11 @@ class Timing:
         """The target waited a while: the reference waits as long."""
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: RoundTrip | None) -> None:
-        """A frame went to both sides, ``target`` its exchange with the target (None: a
-        rig input)."""
+    def retimed(self, command: str, target: RoundTrip | None,
+                reference: RoundTrip | None = None) -> None:
+        """A frame went to both sides, ``target`` and ``reference`` its exchanges (a rig
+        input: ``target`` the target rig's, from the command to its `ok`; None: not
+        timed)."""
 
     def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:
@@ -118,16 +123,33 @@ class RealTime(Timing):
         self._watch_reference()
         self._follow(self.target.now)
 
-    def retimed(self, command: str, target: RoundTrip | None) -> None:
-        if target is not None and command not in _DEFERRED and target.answer:
+    def retimed(self, command: str, target: RoundTrip | None,
+                reference: RoundTrip | None = None) -> None:
+        if target is not None and command not in _UNTIMED and target.answer:
             self.latency_ns = max(self.latency_ns, target.received_at - target.sent_at)
             self.trips.append(target.received_at - target.sent_at)
         if command in _EMPTIES and self.cut_ns:
             self.lost = True
         if command in _RETIMING and self.idle_since is None:
-            self.slack_ns += self.latency_ns
+            late = self._late(command, target, reference)
+            self.slack_ns += late
             if command in _STOPPING:
-                self.cut_ns += self.latency_ns
+                self.cut_ns += late
+
+    def _late(self, command: str, target: RoundTrip | None,
+              reference: RoundTrip | None) -> int:
+        """How much later than the reference the target may have acted on a frame (or a
+        rig input): the latency, or as late as its own answer came, less what it takes
+        by the reference's answer when it answers once done (H): the line at that frame
+        (or the rig's channel) is no measure of the line before it."""
+        if target is None or not target.answer:
+            return self.latency_ns
+        takes = 0
+        if command in _DEFERRED:
+            if reference is None or not reference.answer:
+                return self.latency_ns
+            takes = reference.received_at - reference.sent_at
+        return acted_within(target.sent_at, target.received_at, takes, self.latency_ns)
 
     def allowance(self, command: str, target: RoundTrip, reference: RoundTrip
                   ) -> tuple[bool, int]:

@@ -17,6 +17,12 @@ round trips the case saw itself when it saw two or more (the line under load in 
 middle of a run is not the line at its start, and one slow `?` among the session's five
 must not blunt every case of the run), else the session's. In virtual time the line is
 exact and the band is zero (:data:`EXACT`), never printed.
+
+A frame answered only when what it does is done (H: when the motion has come to rest)
+gives no round trip, and the line that carried it may have been slower than at any frame
+before it (a host under load the instant it sent that one): how late the unit may have
+acted on it is read from its own answer too (:func:`acted_within`; a rig input from the
+rig's `ok` alike).
 """
 
 from __future__ import annotations
@@ -73,3 +79,12 @@ def line_band(line: Mapping[str, float] | None, observed_ms: Iterable[float] = (
     one_way = max(0.0, (median - line.get("bytes_ms", 0.0)) / 2)
     jitter = max(trips) - min(trips)
     return LineBand((one_way + jitter + line.get("byte_ms", 0.0)) / 1e3)
+
+
+def acted_within(sent_at: int, answered_at: int, takes_ns: int, latency_ns: int) -> int:
+    """How long after ``sent_at`` (ns) a unit may have acted on a frame: up to the slowest
+    round trip an immediate answer took (``latency_ns``), and up to when its own answer
+    had come (``answered_at``) less what the frame takes before it answers
+    (``takes_ns``: an H's braking, by the reference's answer or the model's; 0 for an
+    answer at once, a rig's `ok`), whatever the line added to this one frame alone."""
+    return max(0, latency_ns, answered_at - takes_ns - sent_at)

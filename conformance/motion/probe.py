@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
 from conformance.link.framing import Response, frame
-from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 from conformance.motion.model import MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
@@ -247,8 +247,9 @@ class Probe:
         line's band included (as :meth:`judge` would find), recording nothing."""
         line = self.line()
         events, readings = self.events, self.readings
-        self._widen(line)
         try:
+            self._answered_late()
+            self._widen(line)
             (model, _), variants = self.model(), self._variants()
             virtual = self.link.virtual
             t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
@@ -269,6 +270,32 @@ class Probe:
             return EXACT
         return line_band(self.link.round_trip, [t / 1e6 for t in self.trips])
 
+    def _answered_late(self) -> None:
+        """Real time: each H's window reaches as late as its answer shows it may have been
+        taken (conformance/link/line_band.py, :func:`acted_within`): its answer left no
+        sooner than the model's braking after it, and the line may have carried that
+        frame alone later than any round trip before it shows."""
+        if self.link.virtual:
+            return
+        for i, e in enumerate(self.events):
+            if e.kind != "halt" or e.answer is None:
+                continue
+            lo, latency = e.window.lo, e.window.hi - e.window.lo
+            took = self._braking(i, e.window.hi)
+            hi = lo + acted_within(lo, e.answer.hi, took, latency)
+            if hi > e.window.hi:
+                # taken later, it may brake from another rate: the shorter braking of the
+                # two (the later instant) bounds it
+                took = min(took, self._braking(i, hi))
+                hi = lo + acted_within(lo, e.answer.hi, took, latency)
+            late = replace(e, window=Window(lo, max(e.window.hi, hi)))
+            self.events = [*self.events[:i], late, *self.events[i + 1:]]
+
+    def _braking(self, i: int, t: int) -> int:
+        """How long the model's event ``i`` (an H) taken at ``t`` brakes until at rest."""
+        nth = sum(e.kind == "halt" for e in self.events[:i])
+        return self.model({i: t})[1][nth] - t
+
     def _widen(self, line: LineBand) -> None:
         """Every event's and reading's window widened by the line's band: the unit may
         have acted (or read its counters) that much either side of what the host saw."""
@@ -283,6 +310,7 @@ class Probe:
         """Judge every reading taken after the first event, and the instant each H
         answered, with the line's band; record the trace, with the faults marked on it."""
         line = self.line()
+        self._answered_late()
         self._widen(line)
         (model, rests), variants = self.model(), self._variants()
         virtual = self.link.virtual

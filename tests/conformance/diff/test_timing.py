@@ -1,10 +1,17 @@
 """The timing a pair is run with: exact between two sides in virtual time, the real-time
 allowance (latency, slack, cut) as soon as one side is not."""
 
+import pytest
+
 from conformance.diff.engine import Pair
+from conformance.diff.grammar import Grammar, Options
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.timing import RealTime, Timing
+from conformance.link.framing import frame
+from conformance.link.interrupts import Interrupts
 from conformance.targets import parse_target
+from tests.emulator.process import Emulator
+from tests.usb_relay import UsbRelay
 
 MS = 1_000_000
 
@@ -46,6 +53,34 @@ def test_in_real_time_a_course_change_while_moving_widens_later_readings():
     assert (t.latency_ns, t.slack_ns, t.cut_ns, t.lost, t.idle_since) == (0, 0, 0, False, 0)
 
 
+def test_in_real_time_an_h_answered_late_was_taken_as_late_as_its_answer_shows():
+    """An H answers when stopped: the target took it up to as much later than the
+    reference as its answer came later (the line at that frame, which the immediate
+    answers before it do not show); never less late than the latency."""
+    t = RealTime(*sides())
+    t.retimed("V", RoundTrip(b"V", b"0\r", 0, 2 * MS, None))
+    t.idle_since = None                              # the reference was moving
+    braked = RoundTrip(b"H", b"8\r", 0, 50 * MS, None)
+    t.retimed("H", RoundTrip(b"H", b"8\r", 0, 71 * MS, None), braked)
+    assert (t.slack_ns // MS, t.cut_ns // MS) == (21, 21)
+    t.retimed("H", RoundTrip(b"H", b"8\r", 0, 50 * MS, None), braked)
+    assert (t.slack_ns // MS, t.cut_ns // MS) == (23, 23)
+
+
+def test_in_real_time_a_rig_input_was_set_as_late_as_the_rig_s_ok_came():
+    """A rig input is set over the rig's own channel: the target's unit may have seen it
+    as late as the rig's `ok` came, however quick the line's answers were; that channel's
+    time is no round trip of the line (the band's jitter does not take it)."""
+    t = RealTime(*sides())
+    t.retimed("V", RoundTrip(b"V", b"0\r", 0, 2 * MS, None))
+    t.idle_since = None                              # the reference was moving
+    t.retimed("input", RoundTrip(b"", b"ok", 5 * MS, 17 * MS, None))
+    assert (t.latency_ns // MS, t.slack_ns // MS, t.cut_ns // MS) == (2, 12, 12)
+    assert len(t.trips) == 1
+    t.retimed("input", RoundTrip(b"", b"", 20 * MS, 21 * MS, None))   # the rig lost
+    assert (t.slack_ns // MS, t.cut_ns // MS) == (14, 14)
+
+
 def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
     """Exact in virtual time; in real time from the round trip the target's session
     measured, its min and max widened by the example's immediate answers (not an H's)."""
@@ -64,3 +99,34 @@ def test_the_line_band_is_the_target_s_measured_line_widened_by_the_example():
     t.begin()
     assert t.line().seconds == 4.5e-3
     target.close_example()
+
+
+@pytest.mark.pty
+def test_in_real_time_an_h_the_line_delivers_late_is_judged_by_its_own_answer():
+    """A correct unit behind a line that delivers one frame late, the H (20 ms: the host
+    under load as it sent it, which no round trip before it shows): the unit brakes from
+    20 steps farther, and its answer comes as much later than the reference's. The read
+    at rest after it is judged with how late that answer shows the H may have been taken,
+    not only with the latency of the frames before it: no disagreement."""
+    emu = Emulator("--model", "GVE84-100", "--pty")
+    relay = UsbRelay(emu.first, latency_ms=1, jitter_ms=0, hold=frame("H", 0, False),
+                     hold_ms=20)
+    target = parse_target(f"serial:{relay.path}", profile="GVE84-100")
+    try:
+        target.preflight()
+        session = target.begin(Interrupts())
+        pair = Pair(Side(target, session), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        steps = Grammar(target.profile, Options()).idiom(
+            ["L400", "wait 0.1", "H", "wait 0.3", "PF"])
+        out = pair.run(steps)
+        session.finish()
+    finally:
+        target.close()
+        relay.close()
+        emu.stop()
+    read = out.records[-1]
+    assert read.step.body == "PF" and read.target is not None
+    farther = read.target.response.decs()[0] - read.reference.response.decs()[0]
+    assert farther >= 10, farther                     # the hold did delay the H
+    assert out.disagreement is None, (read.target.answer, read.reference.answer)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.link.line_band import EXACT, LineBand, line_band
+from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 
 LINE = {"min_ms": 1.0, "median_ms": 3.0, "max_ms": 4.0, "byte_ms": 0.5, "bytes_ms": 1.0}
 
@@ -46,3 +46,14 @@ def test_steps_and_widened_instants() -> None:
     assert band.steps(1000) == 5 and band.steps(0) == 0
     assert band.ns == 4_500_000
     assert band.widen(10_000_000, 12_000_000) == (5_500_000, 16_500_000)
+
+
+def test_a_frame_answered_at_its_end_was_acted_on_as_late_as_its_answer_shows() -> None:
+    ms = 1_000_000
+    # sent at 10 ms, answered at 75 ms, what it does takes 50: taken up to 15 ms late,
+    # though no immediate answer took more than 2
+    assert acted_within(10 * ms, 75 * ms, 50 * ms, 2 * ms) == 15 * ms
+    # an answer as soon as the frame's work allows: the latency of the frames before
+    assert acted_within(10 * ms, 61 * ms, 50 * ms, 2 * ms) == 2 * ms
+    # an answer sooner than its work takes (a unit that stops dead) widens nothing
+    assert acted_within(10 * ms, 11 * ms, 50 * ms, 0) == 0

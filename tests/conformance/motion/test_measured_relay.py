@@ -10,6 +10,7 @@ import time
 import pytest
 
 from conformance.catalogue import select
+from conformance.link.framing import frame
 from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.verdict import FAIL
@@ -51,3 +52,25 @@ def test_measured_family_repeated_gets_no_fail(latency_ms: int | None) -> None:
           f"±{lines[len(lines) // 2]:.1f} ms, widest ±{lines[-1]:.1f} ms; steps median "
           f"±{steps[len(steps) // 2]}, widest ±{steps[-1]}")
     assert bands and not failed
+
+
+@pytest.mark.pty
+def test_an_h_the_line_delivers_late_fails_no_measured_case() -> None:
+    """The HALT cases behind a line that delivers each H 40 ms late (the host under load as
+    it sent it, which no round trip before it shows): the unit brakes from farther on, and
+    its answer comes as much later; the readings after it are judged with how late that
+    answer shows the H may have been taken. A correct unit fails no check."""
+    emu = Emulator("--model", "GVE84-100", "--pty")
+    relay = UsbRelay(emu.first, latency_ms=1, jitter_ms=0, hold=frame("H", 0, False),
+                     hold_ms=40)
+    try:
+        target = parse_target(f"serial:{relay.path}?baud=115200", profile="GVE84-100",
+                              allow_destructive=True, max_travel=100_000)
+        results = run([target], select(["10.4.measured.*"])).results
+        held = relay.held
+    finally:
+        relay.close()
+        emu.stop()
+    assert len(results) == 3 and held >= 3            # each case's H came late
+    failed = {r.id: [c["what"] for c in r.checks if not c["ok"]] for r in results}
+    assert not any(failed.values()), failed
