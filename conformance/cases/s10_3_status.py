@@ -102,8 +102,7 @@ def polarity(ctx: CaseContext) -> None:
 
 
 @case("10.3.interrupt.stops-motion",
-      rules=("10.3.inputs.interrupt", "10.3.status.meaning"),
-      tag="M", rig=True)
+      rules=("10.3.inputs.interrupt", "10.3.status.meaning"), rig=True)
 def interrupt(ctx: CaseContext) -> None:
     """An enabled active input stops the motion, sets its cause bit and INTA."""
     link = ctx.link
