@@ -336,6 +336,7 @@ class Pair:
             "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
             and step.body.upper() != name,
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
+            "enables": name == "SW" and step.body[2:4] in ("0,", "1,"),
         }
         return {k for k, on in flags.items() if on}
 

@@ -11,6 +11,7 @@ from conformance.diff import engine
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Grammar, Options, probes
 from conformance.diff.gvt import steps_of, transcript
+from conformance.diff.labels import label
 from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME, WAIT
 from conformance.targets import parse_target
@@ -177,3 +178,15 @@ def test_the_minimiser_never_sends_a_frame_into_a_restart():
         for before, after in itertools.pairwise(c):
             if before.kind == FRAME and before.body == "J":
                 assert after.kind == WAIT and after.seconds >= 2.0, c
+
+
+def test_an_sw_enabling_an_input_already_active_is_when_inputs_interrupt():
+    # a unit whose inputs interrupt as they become active: IN0 made active by its
+    # polarity, then enabled, interrupts on the reference only
+    target = parse_target("emu:GVE54?reading=edge-triggered-inputs")
+    p = Pair(Side(target), Side(parse_target("emu:GVE54")), target.profile)
+    steps = Grammar(p.profile, EVERYTHING).idiom(["SW2,01", "SW0,01"])
+    found = p.run(steps).disagreement
+    assert found is not None and found.command == "SW" and "enables" in found.context
+    assert label(found.command, found.kind, set(found.context), set(found.earlier), 0) \
+        == "10.3.inputs.level-triggered"

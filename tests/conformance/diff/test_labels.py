@@ -103,3 +103,15 @@ def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
     assert label("PF", "position", set(), {"V", "V-refused", "L"}, 0) == \
         "4.response.failed-not-executed"
     assert label("PF", "position", set(), {"A", "L"}, 0) == "10.2.motion.trapezoid"
+
+
+def test_an_input_interrupting_is_the_manuals_and_when_it_does_the_decision():
+    # where the axes are after an input: it stopped them, or not (M84 12.5.11)
+    assert label("PF", "position", set(), {"input", "SW"}, 0) == "10.3.inputs.interrupt"
+    assert verdict_of("10.3.inputs.interrupt", False)[0] == FAIL
+    # an input still active when G, D or an SW clears, or when an SW enables it: whether
+    # that interrupts again is when inputs interrupt
+    for command in ("G", "D", "SW", "SW6"):
+        assert label(command, "inta", set(), {"input"}, 0) == "10.3.inputs.level-triggered"
+    assert label("SW", "inta", {"enables"}, {"SW"}, 0) == "10.3.inputs.level-triggered"
+    assert label("SW", "inta", set(), {"SW"}, 0) == "4.response.inta-bit"
