@@ -321,11 +321,7 @@ class ReadBackMachine(UnitMachine):
         self.link.wait(DWELL_PAST)
         self.settled(out, "10.1.queue.line-alone")
         self.link.wait(V_PROBE_SECONDS)
-        at = self.position()
-        self.idle()
-        self.settled(f"L{-V_PROBE},0,0", "10.1.queue.line-alone")
-        self.idle()
-        return at
+        return self._read_and_return(f"L{-V_PROBE},0,0")
 
     def junction_effect(self) -> list[int] | None:
         """Where a path of two C from rest stands JUNCTION_SECONDS after the first was
@@ -338,9 +334,13 @@ class ReadBackMachine(UnitMachine):
         self.settled(f"C{JUNCTION_LEG},0,0", "10.1.queue.cont-buffer")
         # the read's instant counts from the first C, as the motion does
         self.link.wait(max(0.0, JUNCTION_SECONDS - (self.link.now - first.sent_at) / SECOND))
+        return self._read_and_return(f"L{-2 * JUNCTION_LEG},0,0")
+
+    def _read_and_return(self, back: str) -> list[int]:
+        """The axes' position now; once at rest, ``back`` takes them where they began."""
         at = self.position()
         self.idle()
-        self.settled(f"L{-2 * JUNCTION_LEG},0,0", "10.1.queue.line-alone")
+        self.settled(back, "10.1.queue.line-alone")
         self.idle()
         return at
 
