@@ -115,3 +115,14 @@ def test_an_input_interrupting_is_the_manuals_and_when_it_does_the_decision():
         assert label(command, "inta", set(), {"input"}, 0) == "10.3.inputs.level-triggered"
     assert label("SW", "inta", {"enables"}, {"SW"}, 0) == "10.3.inputs.level-triggered"
     assert label("SW", "inta", set(), {"SW"}, 0) == "4.response.inta-bit"
+
+
+def test_a_clear_with_an_input_its_polarity_made_active_is_when_inputs_interrupt():
+    for command in ("G", "D", "K", "R", "SW6"):
+        assert label(command, "inta", set(), {"SW"}, 0) == "10.3.inputs.level-triggered"
+
+
+def test_a_stalled_repeat_run_whole_is_the_watchdogs_time():
+    # the reference's watchdog answered 2 (one line) where `>` run whole answered others
+    assert label(">", "bytes", {"stalled"}, set(), None, None) == "3.frame.watchdog-time"
+    assert label("?", "silence", {"stalled"}, set(), 2, None) == "3.frame.watchdog"
