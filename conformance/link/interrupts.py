@@ -64,14 +64,15 @@ class Interrupts:
         if threading.current_thread() is not threading.main_thread():
             yield
             return
-        # The mask holds the signal only where this thread would take it; in a process
-        # with other threads one of them takes it and Python runs the handler here anyway,
-        # so the handlers are swapped for a recorder too, and what it recorded is handed
-        # to the real handlers when the block ends.
+        # The mask holds the signal only where this thread would take it: another thread
+        # may take it and Python runs the handler here anyway, and one that lands while a
+        # program is being started runs it as soon as fork_exec returns (seen on a loaded
+        # machine, the program started and its Popen lost). So the handlers are swapped
+        # for a recorder too, and what it recorded is handed to the real handlers when
+        # the block ends.
         caught: list[int] = []
-        alone = threading.active_count() == 1      # no other thread: the mask holds them
-        handlers = {} if alone else {
-            sig: signal.signal(sig, lambda sig, _: caught.append(sig)) for sig in STOPPING}
+        handlers = {sig: signal.signal(sig, lambda sig, _: caught.append(sig))
+                    for sig in STOPPING}
         previous = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
         try:
             yield

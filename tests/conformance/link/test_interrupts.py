@@ -55,3 +55,18 @@ def test_a_signal_to_a_default_handler_is_raised_after_the_block():
     except KeyboardInterrupt:
         reached.append("interrupted")
     assert reached == ["end of block", "interrupted"]
+
+
+def test_a_signal_the_mask_lets_through_still_waits_for_the_end_of_the_block():
+    # starting a program can let a held signal through for a moment (fork_exec): the
+    # handler that runs then must not raise where the program's Popen would be lost
+    reached = []
+    try:
+        with Interrupts.held():
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, [signal.SIGINT])
+            signal.raise_signal(signal.SIGINT)
+            reached.append("end of block")
+    except KeyboardInterrupt:
+        reached.append("interrupted")
+    assert reached == ["end of block", "interrupted"]
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
