@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 import serial
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import emulator  # noqa: F401  (registers gve://)
 from emulator.link.control import Quit
@@ -97,7 +99,9 @@ def test_next_names_what_is_due():
 
 @pytest.mark.parametrize("text", ["tx", "tx 2", "tx ZZ", "tx 21 22 23", "until", "until -5",
                                   "until 1.5", "until 0 0", "next 1", "baud 0", "baud x",
-                                  "fly", "tx 210D 1"])
+                                  "fly", "tx 210D 1", "until \u00b2", "until " + "9" * 5000,
+                                  "baud \u00b2", "baud " + "9" * 40, "tx 210D \u00b2",
+                                  "batch \u00b2 210D", "in 1 \u00b2F", "switch X \u00b2"])
 def test_malformed_commands_are_one_error_line_and_change_nothing(text):
     c = cosim()
     c.handle("until 1000")
@@ -227,3 +231,23 @@ def test_a_malformed_batch_is_one_error_line_and_changes_nothing(text):
     reply = c.handle(text)
     assert len(reply) == 1 and reply[0].startswith("error: ")
     assert c.handle("until 1000") == ["now 1000"] and c.handle("next") == ["next none"]
+
+
+words = st.sampled_from(["tx", "until", "next", "baud", "batch", "in", "switch", "state",
+                         "power-on", "help", "210D", "1", "X", "none", "@0", "@9", "-5",
+                         "\u00b2", "\u0663", "9" * 30, "", "0D" * 3, "1e5"])
+
+
+@given(st.lists(st.one_of(words, st.text(max_size=6)), max_size=5).map(" ".join))
+@settings(max_examples=300, deadline=None, derandomize=True)
+def test_any_line_is_replies_never_a_crash(text):
+    """Whatever a driver sends, the reply is lines (an error among them), and the clock
+    never goes back: numbers are ASCII digits of bounded length, or an error."""
+    c = cosim()
+    before = c.line.now
+    try:
+        replies = c.handle(text)
+    except Quit:
+        return
+    assert all(isinstance(r, str) and "\n" not in r for r in replies)
+    assert c.line.now >= before
