@@ -105,25 +105,37 @@ def main():
         words = line.split()
         if not words:
             continue
-        if words[0] == "tx":
-            data = bytes.fromhex(words[1])
-            to_unit.extend((now + (i + 1) * byte_ns, b) for i, b in enumerate(data))
-            sent = run(now + len(data) * byte_ns, False)
-            if len(words) == 3 and all(b != CR for _, b in sent):
-                sent += run(int(words[2]), True)
-            out = [f"rx {t} {b:02X}" for t, b in sent] + [f"now {now}"]
-        elif words[0] == "until":
-            out = [f"rx {t} {b:02X}" for t, b in run(int(words[1]), True)] + [f"now {now}"]
-        elif words[0] == "next":
-            out = [f"next {to_host[0][0]}" if to_host else "next none"]
-        elif words[0] == "baud":
-            byte_ns, out = round(1e10 / int(words[1])), ["ok"]
-        elif words[0] in ("quit", "exit"):
-            return
-        else:
-            out = [f"error: {words[0]} is not in this simulator"]
+        try:
+            if words[0] == "tx":
+                data = bytes.fromhex(words[1])
+                end = now + len(data) * byte_ns
+                until = instant(words[2], end) if len(words) == 3 else None
+                to_unit.extend((now + (i + 1) * byte_ns, b) for i, b in enumerate(data))
+                sent = run(end, False)
+                if until is not None and all(b != CR for _, b in sent):
+                    sent += run(until, True)
+                out = [f"rx {t} {b:02X}" for t, b in sent] + [f"now {now}"]
+            elif words[0] == "until":
+                out = [f"rx {t} {b:02X}" for t, b in run(instant(words[1], now), True)]
+                out.append(f"now {now}")
+            elif words[0] == "next":
+                out = [f"next {to_host[0][0]}" if to_host else "next none"]
+            elif words[0] == "baud":
+                byte_ns, out = round(1e10 / instant(words[1], 1)), ["ok"]
+            elif words[0] in ("quit", "exit"):
+                return
+            else:
+                out = [f"error: {words[0]} is not in this simulator"]
+        except (ValueError, IndexError) as err:      # a bad number, a missing word
+            out = [f"error: {err}"]
         print("\n".join(out), flush=True)
 
+
+def instant(word, least):
+    """A number of the protocol: ASCII digits, and not below ``least``."""
+    if not (word.isascii() and word.isdigit()) or int(word) < least:
+        raise ValueError(f"{word!r} is not a whole number from {least} on")
+    return int(word)
 
 if __name__ == "__main__":
     main()
