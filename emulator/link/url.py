@@ -53,9 +53,12 @@ class LineSpec:
 
 def positive(name: str, text: str) -> int:
     """A whole number above 0 (a baud rate, a watchdog time)."""
-    value = decimal(text, name)
+    try:
+        value = decimal(text, name)
+    except ValueError:
+        value = 0
     if value <= 0:
-        raise ValueError(f"{name} must be a whole number above 0, not {text!r}")
+        raise ValueError(f"{name} must be a whole number above 0, not {text[:40]!r}")
     return value
 
 
