@@ -125,14 +125,15 @@ def test_the_wheel_is_tagged_for_the_limited_api(dists):
 
 
 def _interpreter(version: str) -> str:
-    """The ``python3.N`` on PATH that runs (a pyenv shim of a version not selected does
-    not): .ci/run puts pyenv's versions on PATH when it finds them."""
-    found = shutil.which(f"python{version}")
-    ok = found and subprocess.run([found, "-c", ""], capture_output=True,
-                                  check=False).returncode == 0
-    assert ok, (f"python{version} is not on PATH: every supported Python is tested "
-                "(.ci/run adds pyenv's versions to PATH)")
-    return found
+    """The first ``python3.N`` on PATH that runs (a pyenv shim of a version pyenv has not
+    selected does not): .ci/run puts pyenv's versions on PATH when it finds them."""
+    for folder in os.environ.get("PATH", "").split(os.pathsep):
+        found = shutil.which(f"python{version}", path=folder)
+        if found and subprocess.run([found, "-c", ""], capture_output=True,
+                                    check=False).returncode == 0:
+            return found
+    raise AssertionError(f"no python{version} on PATH runs: every supported Python is "
+                         "tested (.ci/run adds pyenv's versions to PATH)")
 
 
 @pytest.mark.parametrize("version", PYTHONS)
