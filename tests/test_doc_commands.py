@@ -106,7 +106,8 @@ def _plugin_options_exist(words: list[str]) -> None:
     from conformance import plugin
 
     class Options:
-        names: set[str] = set()
+        def __init__(self) -> None:
+            self.names: set[str] = set()
 
         def getgroup(self, *args, **kwargs):
             return self
