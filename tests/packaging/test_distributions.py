@@ -2,8 +2,8 @@
 carries the whole tracked tree and a wheel that carries every file of the packages; each
 installs into a fresh virtual environment, with the C stepper core, and passes a smoke
 run; the wheel is tagged for CPython's limited API (abi3) and installs and runs on every
-supported Python; docs/ci.md's job runs from the wheel; ``tox`` passes on a fresh clone,
-its smoke subset on every supported Python. Slow (minutes, and pip reaches the package
+supported Python; docs/ci.md's job runs from the wheel (test_tox.py: ``tox`` on a fresh
+clone). Slow (minutes, and pip reaches the package
 index): ``.ci/run`` runs these after the default tests, ``python -m pytest -m slow
 tests/packaging``."""
 
@@ -172,21 +172,6 @@ def test_the_ci_job_installs_the_wheel_runs_and_fails_a_broken_clone(dists, tmp_
     bin_dir = tmp_path / ".gve-venv" / "bin"
     run([str(bin_dir / "python"), "-c", C_CORE], tmp_path)
     assert "PASSED" in run([str(bin_dir / SMOKE[0]), *SMOKE[1:]], tmp_path).stdout
-
-
-def test_tox_passes_on_a_fresh_clone_on_every_supported_python(tmp_path):
-    """tox's envlist (lint and a smoke subset per Python) passes; one invocation, so the
-    sdist is built once."""
-    tracked()
-    for version in PYTHONS:
-        _interpreter(version)
-    clone = tmp_path / "clone"
-    run(["git", "clone", "--quiet", str(ROOT), str(clone)], tmp_path)
-    envs = ["lint", *(f"py{v.replace('.', '')}" for v in PYTHONS)]
-    done = run([sys.executable, "-m", "tox", "-e", ",".join(envs), "--", "-q"], clone,
-               timeout=1800)
-    for env in envs:
-        assert re.search(rf"^  {env}: OK", done.stdout, re.MULTILINE), done.stdout[-3000:]
 
 
 def test_the_ci_job_installs_its_default_suite_from_a_checkout(checkout):
