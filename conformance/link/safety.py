@@ -527,9 +527,10 @@ class Guard:
     # -- answers and silences ----------------------------------------------------------------
     def answered(self, response: Response | None, at: int | None = None) -> None:
         """Count frames in a row that got no answer (or bytes that are not one); ``at``:
-        the instant (ns on the link's clock). A frame unanswered outside a restart the
-        suite caused may be a restart's (spec 2: bytes are lost while a unit restarts):
-        the next position read is weighed with it (:meth:`_read`)."""
+        the instant the frame went out (ns on the line's clock). A frame unanswered
+        outside a restart the suite caused may be a restart's (spec 2: bytes are lost
+        while a unit restarts): the next position read is weighed with it
+        (:meth:`_read`)."""
         if response is not None and response.code is not None:
             self.silences, self.garbage, self._silent_from = 0, "", None
             if self._last != "J":                # the J's own answer comes before its silence
@@ -555,9 +556,10 @@ class Guard:
             self.check_idle()
 
     def _silent_long(self, at: int | None) -> bool:
-        """Whether the frames unanswered in a row have been so for long enough to give the
+        """Whether the frames unanswered in a row went out over long enough to give the
         unit up: longer than it would take to restart (spec 2), so that one that did is
-        heard again."""
+        heard again (a frame sent while it was deaf, `H` above all, may wait long for an
+        answer that cannot come: the instants are when the frames went out)."""
         if at is None or self._silent_from is None:
             return True
         return at - self._silent_from >= SILENT_RESTARTS * self.profile.restart_ms * 1_000_000
