@@ -546,7 +546,10 @@ class Guard:
         self.silences += 1
         if self._silent_from is None:
             self._silent_from = at
-        if not self._restarting:
+        if not self._restarting and response is None:
+            # only silence is a restart's (spec 2: bytes are lost while a unit restarts);
+            # bytes that are no answer the suite could read (a `>` answered in one line
+            # where it awaited two) came from a unit that was there to send them
             self.unanswered += 1
             self._summing = False
         if response is not None:

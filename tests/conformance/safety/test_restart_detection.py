@@ -100,6 +100,22 @@ def test_after_silence_power_on_counters_where_the_frames_also_end_at_zero_are_a
     assert x(g) == Span(0, 1000) and g.lost
 
 
+def test_bytes_that_are_no_readable_answer_are_no_restart_s_silence():
+    """A unit that restarts is deaf and mute (spec 2): one that sent bytes the suite could
+    not read as the answer (a `>` answered in one line where two were awaited; diff draws
+    such frames) was there to send them."""
+    g = guard()
+    sent(g, "L1000,0,0")
+    sent(g, "L-1000,0,0", "7")
+    g.check(">")
+    g.accepted(">", None)
+    g.answered(parse_response(b"A\r", summed=False, lines=2))   # not the two of `>`
+    sent(g, "L-1000,0,0")
+    sent(g, "SR6", "0,00")
+    sent(g, "PF", "0,0,0,0")
+    assert not g.restarts and not g.lost
+
+
 def test_the_same_reads_without_a_silence_are_no_restart():
     g = guard()
     sent(g, "L1000,0,0")
