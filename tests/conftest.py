@@ -5,6 +5,8 @@ on) never sees it. Caught here, SIGINT goes back to its default in every child."
 import os
 import signal
 
+import pytest
+
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
@@ -19,3 +21,15 @@ def pytest_xdist_auto_num_workers(config) -> int | None:
     cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
              else os.cpu_count() or 1)
     return 2 * cores
+
+
+@pytest.fixture(autouse=True)
+def _diff_draws_a_known_seed(monkeypatch: pytest.MonkeyPatch) -> None:
+    """`diff` without --seed draws a fresh one (a user's run explores); the project's own
+    tests run it in process on a seed of their own choosing, the same every run, so that
+    what they find is found again. A test of the fresh seed itself patches it back."""
+    monkeypatch.setattr("conformance.cli.diff.fresh_seed", lambda: TEST_SEED)
+
+
+#: the seed an in-process diff of the tests draws when it is given none
+TEST_SEED = 0
