@@ -1,16 +1,30 @@
-"""One way to show what a check observed and expected, the same on the console, in the
-HTML report and in JUnit: the bytes a unit sent as transcripts write them (printable
-ASCII as itself, ``\\r`` and ``\\xNN`` for the rest: ``F\\r``), in double quotes, never a
-Python ``repr`` (which doubled the backslashes and showed ``b'...'``)."""
+"""One way to show what a target sent — a unit, a simulator (its lines, its standard
+error), a host program — the same on the console, in the text reports, in the HTML
+report and in JUnit: the bytes as transcripts write them (printable ASCII as itself,
+``\\r``, ``\\n`` and ``\\xNN`` for the rest: ``F\\r``), a program's text with every
+character that is not printable escaped alike, in double quotes, never a Python
+``repr`` (which doubled the backslashes and showed ``b'...'``). Nothing a target sends
+reaches a terminal raw: no escape sequence, no carriage return, no line of its own."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from conformance.link.framing import readable
+from gve_fixtures.transcript import escape
 
 #: what an empty observation is shown as
 NOTHING = "(nothing)"
+#: the most characters of a target's text one message shows (then "...")
+SHOWN_CHARS = 200
+
+_NAMED = {"\r": "\\r", "\n": "\\n", "\t": "\\t", "\\": "\\\\"}
+
+
+def readable(data: bytes) -> str:
+    """Bytes as text for people: printable ASCII as itself, the rest escaped as in
+    transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report."""
+    return "".join(chr(b) if 0x20 <= b <= 0x7E and b != 0x5C else escape(bytes([b]))
+                   for b in data)
 
 
 def as_text(value: Any) -> str:
@@ -26,3 +40,29 @@ def as_text(value: Any) -> str:
 def quoted(text: str) -> str:
     """``"F\\r"``; ``(nothing)`` for an empty text."""
     return f'"{text}"' if text else NOTHING
+
+
+def _character(ch: str) -> str:
+    if ch in _NAMED:
+        return _NAMED[ch]
+    if ch.isprintable():
+        return ch
+    code = ord(ch)
+    return f"\\x{code:02X}" if code < 0x100 else f"\\u{code:04X}" if code < 0x10000 \
+        else f"\\U{code:08X}"
+
+
+def escaped(value: str | bytes | bytearray) -> str:
+    """What a target sent, escaped for people, without quotes: bytes as a transcript
+    writes them; text with CR, LF, TAB and the backslash named and every character that
+    is not printable (controls, escape sequences, invisible formatting) as ``\\xNN``."""
+    if isinstance(value, bytes | bytearray):
+        return readable(bytes(value))
+    return "".join(_character(ch) for ch in value)
+
+
+def shown(value: str | bytes | bytearray, limit: int = SHOWN_CHARS) -> str:
+    """What a target sent, for a message: its first ``limit`` characters (or bytes)
+    escaped, in double quotes, ``...`` when there was more; ``(nothing)`` when empty."""
+    text = escaped(value[:limit])
+    return quoted(text + "..." if len(value) > limit else text)

@@ -43,6 +43,7 @@ from conformance.cli.usage import (
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
+from conformance.quoting import escaped
 from conformance.reports import write_junit, write_reports
 from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
@@ -375,7 +376,8 @@ def _session_lines(result: RunResult) -> list[str]:
         if not s["real"]:
             continue
         lines.append(f"{spec} ({s['profile']}"
-                     + (f", {s['identity'].get('version')}" if s["identity"] else "") + "):")
+                     + (f", {escaped(s['identity'].get('version', ''))}" if s["identity"] else "")
+                     + "):")
         if s["excursion"]:
             axes = ", ".join(f"{a} {lo:+g}..{hi:+g}" for a, (lo, hi)
                              in zip(s["axes"], s["excursion"], strict=True))

@@ -25,6 +25,8 @@ import tempfile
 import threading
 import time
 
+from conformance.quoting import shown
+
 #: how long the program may take to end after ``quit``, then after SIGTERM
 QUIT_SECONDS = 2.0
 TERM_SECONDS = 2.0
@@ -174,7 +176,7 @@ class Program:
         how = (f"was killed by signal {-status}" if status < 0 else
                f"exited with status {status}")
         tail = self.stderr_tail()
-        return f"{shlex.join(self.command)} {how}" + (f" (stderr: {tail})" if tail else "")
+        return f"{shlex.join(self.command)} {how}" + (f" (stderr: {shown(tail)})" if tail else "")
 
     # -- the end -----------------------------------------------------------------------------
     def stop(self) -> None:

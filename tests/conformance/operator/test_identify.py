@@ -82,6 +82,6 @@ def test_ports_lists_and_probes_a_pty_backed_port(unit, capsys, tmp_path, monkey
     (tmp_path / "ttyUSB-nothing").write_text("")      # no device: nothing written to it
     assert main(["ports", "--glob", str(tmp_path / "tty*"), "--probe"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].endswith("-> GVE54: ? 'Ip54v3 21.12.2007' at 115200 baud, address 0")
+    assert out[0].endswith('-> GVE54: ? "Ip54v3 21.12.2007" at 115200 baud, address 0')
     assert out[1].endswith("-> skipped: not a serial device")
     assert (tmp_path / "ttyUSB-nothing").read_text() == ""

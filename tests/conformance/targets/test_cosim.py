@@ -77,10 +77,10 @@ SAYS = {
     "future": "a byte in the future",
     "overshoot": "past the instant",
     "short": "where the clock had to stop",
-    "garbage": "'hello there': not rx T HEX or now T",
+    "garbage": '"hello there": not rx T HEX or now T',  # quoted as a target's text is
     "error": "it refused",
     "after-cr": "after the CR",
-    "dies": "exited with status 3 (stderr: the simulator gave up)",
+    "dies": 'exited with status 3 (stderr: "the simulator gave up")',
 }
 
 
@@ -187,7 +187,7 @@ def test_the_command_line_says_fail_and_exits_1():
                            "--cases", "5.errors.*"], capture_output=True, text=True,
                           timeout=120, stdin=subprocess.DEVNULL)
     assert done.returncode == 1, done.stdout + done.stderr
-    assert "FAIL" in done.stdout and "'hello there'" in done.stdout
+    assert "FAIL" in done.stdout and '"hello there"' in done.stdout
     assert "Traceback" not in done.stdout + done.stderr
 
 
