@@ -59,6 +59,9 @@ for line in sys.stdin:
         "overshoot": [f"now {goal + 1}"],
         "short": [f"now {goal - 1}"],
         "garbage": ["hello there"],
+        "digits": [f"now {goal}²"],
+        "huge": ["now " + "9" * 5000],
+        "escape": ["\x1b]0;title\x07\x1b[2J"],
         "error": ["error: the clock is broken"],
         "after-cr": [f"rx {goal - 2000} 0D", f"rx {goal - 1000} 30", f"now {goal}"],
     }[mode]
@@ -81,6 +84,9 @@ SAYS = {
     "error": "it refused",
     "after-cr": "after the CR",
     "dies": 'exited with status 3 (stderr: "the simulator gave up")',
+    "digits": "²\": not now T",                   # str.isdigit() takes ², int() does not
+    "huge": "99...\": not now T",                 # more digits than int() reads
+    "escape": '"\\x1B]0;title\\x07\\x1B[2J": not rx T HEX',   # escaped, not run
 }
 
 
