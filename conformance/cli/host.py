@@ -16,7 +16,7 @@ import argparse
 import fnmatch
 import sys
 
-from conformance.cli.ending import counted, end, new_run_id, progress
+from conformance.cli.ending import claimed, counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
@@ -31,6 +31,7 @@ from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
 from conformance.quoting import quoted
+from conformance.reports.files import release
 from conformance.runner import CaseResult
 from conformance.verdict import ORDER, PASS, grade
 from gve_fixtures.profile import Profile, ProfileError
@@ -160,6 +161,7 @@ def main(argv: list[str] | None = None) -> int:
         plan = plan_of(args)
         if not args.no_reports:
             writable_folder(args.report_dir)
+        folder = None if args.no_reports else claimed(args.report_dir)
     except UsageError as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
@@ -172,9 +174,11 @@ def main(argv: list[str] | None = None) -> int:
         return r.notes[0] if r.verdict != PASS and r.notes else None
 
     try:
-        result = certify(plan, new_run_id(), progress(args.quiet, worst), console=sys.stdout,
-                         operator=sys.stdin)
+        result = certify(plan, new_run_id() if folder is None else folder.name,
+                         progress(args.quiet, worst), console=sys.stdout, operator=sys.stdin)
     except (HostStartError, ValueError) as err:
+        if folder is not None:
+            release(folder)
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
     result.meta.command = ["host", *argv]

@@ -20,6 +20,7 @@ from serial import SerialException
 from conformance.catalogue import select
 from conformance.cli.colour import paint, wanted
 from conformance.cli.commands import subcommands_help
+from conformance.cli.ending import claimed, written
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
     ask_before_motion,
@@ -45,6 +46,7 @@ from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.quoting import escaped
 from conformance.reports import write_junit, write_reports
+from conformance.reports.files import release
 from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
@@ -207,6 +209,10 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
     if not args.no_reports:
         writable_folder(args.report_dir)
     with ExitStack() as run_scope:
+        if not args.no_reports:         # the run's folder, before anything is sent
+            folder = claimed(args.report_dir, args.run_id)
+            args.run_id = folder.name
+            run_scope.callback(release, folder)      # given back if nothing was written
         try:
             run_scope.enter_context(example_database(example_database_of(args)))
         except ValueError as err:
@@ -258,15 +264,21 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
         f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
     for line in _session_lines(result):
         say(line)
+    lost = False                        # a report that could not be written (a full disk)
     if not args.no_reports:
-        folder = write_reports(result, args.report_dir)
-        say(f"reports: {folder}/report.html, results.json, junit.xml")
+        folder = written(lambda: write_reports(result, args.report_dir))
+        lost = folder is None
+        if folder is not None:
+            say(f"reports: {folder}/report.html, results.json, junit.xml")
     if args.junitxml:
-        say(f"JUnit XML: {write_junit(result, args.junitxml)}")
+        junit = written(lambda: write_junit(result, args.junitxml))
+        lost = lost or junit is None
+        if junit is not None:
+            say(f"JUnit XML: {junit}")
     verdict, _ = overall(result.results, result.interrupted, result.problems)
     line = last_line(result.results, result.interrupted, result.problems)
     _say(paint(verdict, verdict, colour) + line[len(verdict):])
-    return exit_status(verdict != FAILED, result.interrupted)
+    return exit_status(verdict != FAILED and not lost, result.interrupted)
 
 
 class Stopped(Exception):
