@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive, summary
+from conformance.cli.usage import INTERRUPTED, Parser, UsageError, positive, summary
 from conformance.link.framing import readable
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
 
@@ -151,6 +151,11 @@ def main(argv: list[str] | None = None) -> int:
             trials.append(t)
             _show(t, args.verbose)
     fair = sum(t.fair for t in trials)
+    if pool.interrupted:        # a signal: every worker stopped, no score to give
+        print(f"\nfairness: interrupted by a signal after {len(trials)} of {len(jobs)} "
+              f"readings ({len(trials) - fair} unfair) in "
+              f"{time.perf_counter() - start:.1f} s: no score")
+        return INTERRUPTED
     score = 100.0 * fair / len(trials) if trials else 100.0
     print(f"\nfairness score: {fair}/{len(trials)} = {score:.1f} % in "
           f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "

@@ -21,7 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive, summary
+from conformance.cli.usage import INTERRUPTED, Parser, UsageError, positive, summary
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
@@ -151,6 +151,11 @@ def main(argv: list[str] | None = None) -> int:
     caught = sum(h.caught for h in results)
     score = 100.0 * caught / len(results) if results else 100.0
     errors = sum(len(h.errors) for h in results)
+    if pool.interrupted:        # a signal: every worker stopped, no score to give
+        print(f"\nmutation: interrupted by a signal after {len(results)} of {len(jobs)} "
+              f"mutants ({caught} caught, {errors} ERROR) in "
+              f"{time.perf_counter() - start:.1f} s: no score")
+        return INTERRUPTED
     print(f"\nmutation score: {caught}/{len(results)} = {score:.1f} % "
           f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
           f"{sum(h.runs for h in results)} case runs, {errors} ERROR")
