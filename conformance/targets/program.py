@@ -25,6 +25,7 @@ import tempfile
 import threading
 import time
 
+from conformance.link.interrupts import Interrupts
 from conformance.quoting import shown
 
 #: how long the program may take to end after ``quit``, then after SIGTERM
@@ -49,9 +50,13 @@ class Program:
         self.command = command
         self._stderr = tempfile.TemporaryFile()  # noqa: SIM115  (open while it runs)
         try:
-            self.process = subprocess.Popen(
-                command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr,
-                process_group=0, close_fds=True)
+            # a signal waits until the program is known (and stopped at exit): never a
+            # Popen lost as fork_exec returns, its program running on
+            with Interrupts.held():
+                self.process = subprocess.Popen(
+                    command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                    stderr=self._stderr, process_group=0, close_fds=True)
+                _RUNNING.add(self)
         except (OSError, ValueError) as err:
             self._stderr.close()
             reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
@@ -61,7 +66,6 @@ class Program:
         self._lines: queue.Queue[str | None] = queue.Queue()
         self._background = False
         self._eof = False
-        _RUNNING.add(self)
 
     # -- what it says ---------------------------------------------------------------------
     def _take(self, timeout: float | None) -> str | None:
