@@ -23,6 +23,7 @@ import pytest
 
 from conformance import settings as settings_profiles
 from conformance.link.interrupts import Interrupts
+from conformance.plugin_stop import before_item, hold, interrupted
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
@@ -67,6 +68,7 @@ class GveItem(pytest.Item):
 
     def runtest(self) -> None:
         interrupts = self.config.stash[_INTERRUPTS]
+        before_item(self.session, interrupts)
         try:
             # a worker starts its targets here, at its first item of each (an exec:
             # target's program: whether it has a rig decides the rig cases)
@@ -76,7 +78,7 @@ class GveItem(pytest.Item):
         with interrupts.catching():
             result = run_case(self.case, self.target, self.settings_name)
         if result.interrupted:
-            raise KeyboardInterrupt
+            interrupted(self.session)
         if result.verdict in (MISSING, COULD_NOT_TEST):
             pytest.skip(f"{result.verdict}: {'; '.join(result.notes)[:200]}")
         if result.verdict in (FAIL, ERROR):
@@ -170,6 +172,7 @@ def pytest_configure(config: pytest.Config) -> None:
         raise pytest.UsageError(str(err)) from None
     config.stash[_TARGETS] = targets
     config.stash[_INTERRUPTS] = interrupts
+    hold(config, interrupts, controller=controller)
 
 
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
