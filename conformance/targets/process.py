@@ -186,7 +186,7 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
     if not command:
         raise TargetError(f"{spec}: give the command that starts the simulator "
                           "(exec:'./clone-sim --pty')")
-    p = real_profile(spec, profile, mutant, max_travel,
+    p = real_profile(spec, profile, mutant,
                      "put --mutant NAME in the command when it is the emulator")
     info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)
     return ProcessTarget(info, p, p.address, p.default_baud, spec, command=tuple(command))
