@@ -29,12 +29,16 @@ def readable(data: bytes) -> str:
 
 def as_text(value: Any) -> str:
     """A check's value as it is kept in a result: bytes as a transcript writes them,
-    None as empty, anything else as its text."""
+    None as empty, anything else as its text with every character that is not printable
+    escaped (a unit's text kept as a str, a pattern's backslashes left as written)."""
     if value is None:
         return ""
     if isinstance(value, bytes | bytearray):
         return readable(bytes(value))
-    return str(value)
+    text = str(value)
+    if text.isprintable():
+        return text
+    return "".join(ch if ch.isprintable() else _character(ch) for ch in text)
 
 
 def quoted(text: str) -> str:
