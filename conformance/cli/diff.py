@@ -118,9 +118,11 @@ def main(argv: list[str] | None = None) -> int:
         args = parse_args(argv)
         folder = None if args.no_reports else claimed(args.report_dir)
         target, reference = targets(args)
-    except (UsageError, TargetError, LookupError, ValueError) as err:
+    except (UsageError, TargetError, LookupError, ValueError, KeyboardInterrupt) as err:
         if folder is not None:
             release(folder)
+        if isinstance(err, KeyboardInterrupt):
+            raise
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     run_id = new_run_id() if folder is None else folder.name
