@@ -28,9 +28,11 @@ pytest.importorskip("xdist", reason="pytest-xdist (the dev extra) runs the worke
 CASES = ["--gve-cases", "5.errors.*", "--gve-cases", "8.index.*", "--gve-cases", "10.4.*"]
 
 
-@pytest.mark.parametrize(("sig", "workers"), [(signal.SIGINT, "2"), (signal.SIGTERM, "2"),
-                                              (signal.SIGHUP, "2"), (signal.SIGTERM, "0")],
-                         ids=["SIGINT", "SIGTERM", "SIGHUP", "SIGTERM-without-xdist"])
+@pytest.mark.parametrize(("sig", "workers"), [
+    pytest.param(signal.SIGINT, "2", id="SIGINT", marks=pytest.mark.slow),
+    pytest.param(signal.SIGTERM, "2", id="SIGTERM"),
+    pytest.param(signal.SIGHUP, "2", id="SIGHUP", marks=pytest.mark.slow),
+    pytest.param(signal.SIGTERM, "0", id="SIGTERM-without-xdist")])
 def test_a_signal_to_the_controller_halts_every_worker_s_unit(tmp_path, sig, workers):
     """(``-n 0``: pytest alone, the same signal to the one process that runs the items.)"""
     nth = random.Random(f"xdist {sig} {workers}").randrange(20, 80)

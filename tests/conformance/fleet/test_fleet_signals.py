@@ -47,8 +47,10 @@ def assert_halted_first(frames: list[tuple[float, bytes]], signalled: float) -> 
 CASES = ["--cases", "5.errors.*", "--cases", "8.index.*", "--cases", "10.4.*"]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP],
-                         ids=["SIGINT", "SIGTERM", "SIGHUP"])
+@pytest.mark.parametrize("sig", [
+    # SIGINT by default in test_cli_fleet.py: here in the slow runs
+    pytest.param(signal.SIGINT, id="SIGINT", marks=pytest.mark.slow),
+    pytest.param(signal.SIGTERM, id="SIGTERM"), pytest.param(signal.SIGHUP, id="SIGHUP")])
 def test_a_signal_to_the_fleet_halts_every_unit_first(tmp_path, sig):
     nth = random.Random(f"fleet {sig}").randrange(20, 120)
     fleet: list[subprocess.Popen] = []
