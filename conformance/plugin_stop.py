@@ -43,7 +43,10 @@ class Controller(Interrupts):
 
     @pytest.hookimpl(optionalhook=True)
     def pytest_xdist_newgateway(self, gateway: Any) -> None:
-        self.workers.append(gateway.remote_exec(_OWN_GROUP).receive(60))
+        spec = gateway.spec
+        if getattr(spec, "popen", False) and not getattr(spec, "via", None):
+            # a worker on this machine (a remote one's pid is no process here)
+            self.workers.append(gateway.remote_exec(_OWN_GROUP).receive(60))
 
     def signal(self, *_: object) -> None:
         for pid in self.workers:
