@@ -19,7 +19,7 @@ import contextlib
 import os
 import signal
 from contextlib import ExitStack
-from typing import Any, NoReturn
+from typing import Any
 
 import pytest
 
@@ -73,14 +73,15 @@ def hold(config: pytest.Config, interrupts: Interrupts, *, controller: bool) -> 
     config.add_cleanup(stack.close)
 
 
-def interrupted(session: pytest.Session) -> NoReturn:
-    """The item a signal stopped (its unit halted): COULD-NOT-TEST, and no item after it;
-    the session ends as pytest ends an interrupted one, its units put back."""
+def interrupted(session: pytest.Session) -> None:
+    """The item a signal stopped (its unit halted, the case COULD-NOT-TEST, reported as
+    any): no item after it; the session ends as pytest ends an interrupted one, its units
+    put back."""
     session.shouldstop = STOPPED
-    pytest.skip(f"{COULD_NOT_TEST}: interrupted by a signal: H and D sent, the rest not run")
 
 
 def before_item(session: pytest.Session, interrupts: Interrupts) -> None:
     """No item starts after a signal (one counted between items)."""
     if interrupts.stopped:
         interrupted(session)
+        pytest.skip(f"{COULD_NOT_TEST}: not run: interrupted by a signal")

@@ -39,10 +39,12 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from conformance.cli.ending import written
+from conformance.cli.ending import recap, say_all, written
+from conformance.cli.progress import Progress
 from conformance.cli.usage import INTERRUPTED, exit_status
 from conformance.link.interrupts import Interrupts
 from conformance.reports.files import ReportNotWritten, write_text
+from conformance.runner import CaseResult, RunResult
 from conformance.targets import Target
 from conformance.verdict import FAILED, ORDER, PASSED
 
@@ -99,32 +101,33 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
             print(f"gve-conformance: {err}", file=sys.stderr)
             return 1
     jobs = min(args.jobs, len(members))
-    quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's last line only
+    quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's end only
     if not quiet:
         print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
-    interrupted = _run_members(members, folder, jobs, start, quiet)
+    with Progress(len(members), unit="target", quiet=quiet,
+                  verbose=bool(getattr(args, "verbose", False)), every_step=True) as shown:
+        interrupted = _run_members(members, folder, jobs, start, shown)
     seconds = time.perf_counter() - start
     for m in members:
         (folder / f"{m.label}.job.json").unlink(missing_ok=True)
-        path = folder / m.label / "results.json"
-        if path.is_file():
-            m.result = json.loads(path.read_text(encoding="utf-8"))
+        m.result = m.result or _results(folder, m)
     summary = _summary(members, run_id, seconds, interrupted)
     if not quiet:
         _print_summary(summary)
+    say_all([line for m in members for line in _recap(m)])
     lost = False                        # a report that could not be written (a full disk)
     if args.junitxml:
         junit = written(lambda: merge_junit(folder, members, args.junitxml, seconds))
         lost = junit is None
-        if junit is not None and not quiet:
+        if junit is not None:
             print(f"JUnit XML: {junit}")
     if args.no_reports:
         shutil.rmtree(folder, ignore_errors=True)
     else:
         index = written(lambda: _write_summary(folder, summary))
         lost = lost or index is None
-        if index is not None and not quiet:
+        if index is not None:
             print(f"reports: {index} (one folder per target), {SUMMARY_JSON}")
     print(f"{summary['verdict']}: {summary['reason']}")
     return exit_status(summary["verdict"] == PASSED and not lost, interrupted or any(
@@ -151,8 +154,25 @@ def _interrupt(m: Member) -> None:
             os.kill(m.process.pid, signal.SIGINT)
 
 
+def _results(folder: Path, m: Member) -> dict:
+    """The member's results.json ({} when it wrote none)."""
+    path = folder / m.label / "results.json"
+    return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+
+
+def _recap(m: Member) -> list[str]:
+    """What failed on the member's target, as a single run's recap says it."""
+    data = m.result
+    results = [CaseResult(d["id"], d["section"], data["cases"][d["id"]]["rule"], d["tag"],
+                          data["cases"][d["id"]]["source"], d["profile"], d["target"],
+                          d["verdict"], checks=d["checks"], notes=d["notes"])
+               for d in data.get("results", [])]
+    lines = recap(RunResult(data.get("run_id", m.label), results))
+    return [f"[{m.label}] {line}" for line in lines]
+
+
 def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
-                 quiet: bool = False) -> bool:
+                 shown: Progress) -> bool:
     """Run the members' processes, at most ``jobs`` at once; True when interrupted."""
     pending, running = deque(members), []
     wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
@@ -172,7 +192,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
                     # a signal now waits until the member is running and known to the
                     # handler, which passes it on: none is started and then forgotten
                     with Interrupts.held():
-                        _start(m, folder, start, wake, out_lock, quiet)
+                        _start(m, folder, start, wake, out_lock, shown)
                         running.append(m)
                 with contextlib.suppress(queue.Empty):
                     wake.get(timeout=0.5)
@@ -187,7 +207,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
 
 
 def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
-           out_lock: threading.Lock, quiet: bool = False) -> None:
+           out_lock: threading.Lock, shown: Progress) -> None:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     m.started = time.perf_counter() - start
     # its standard input is a pipe the fleet holds: its end tells the member the fleet
@@ -201,14 +221,18 @@ def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
     def relay() -> None:
         assert m.process is not None and m.process.stdout is not None
         for line in m.process.stdout:
-            if quiet:
+            if shown.quiet:
                 continue                # read all the same, so that the member never blocks
             with out_lock:
-                print(f"[{m.label}] {line}".rstrip(), flush=True)
+                shown.print(f"[{m.label}] {line}".rstrip())
         status = m.process.wait()
         with contextlib.suppress(OSError):
             m.process.stdin.close()
         m.ended = time.perf_counter() - start
+        m.result = _results(folder, m)
+        with out_lock:
+            shown.step(f"{m.spec}: {m.result.get('verdict', FAILED)} — "
+                       f"{m.result.get('reason', 'the target wrote no results')}")
         m.status = status               # last: the member counts as done from here
         wake.put(m)
 
@@ -266,6 +290,7 @@ def merge_junit(folder: Path, members: list[Member], path: str, seconds: float) 
         if not source.is_file():
             continue
         for suite in ET.parse(source).getroot().iter("testsuite"):
+            suite.set("id", str(len(root)))          # numbered from 0 across the fleet
             root.append(suite)
             tests += int(suite.get("tests", "0"))
     root.set("tests", str(tests))

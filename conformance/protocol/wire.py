@@ -16,8 +16,8 @@ import re
 from dataclasses import dataclass, field
 
 from conformance.protocol.bounded import decimal
-from conformance.quoting import readable, shown
 from gve_fixtures.protocol import INTA_BIT, ErrorCode, St6
+from gve_fixtures.transcript import escape
 
 CR = b"\r"
 BANG = b"!"
@@ -30,6 +30,20 @@ _HEX_BYTE = re.compile(HEX_BYTE)
 def is_hex_byte(text: str, either_case: bool = False) -> bool:
     """Whether ``text`` is two hex digits (upper case, or of ``either_case``)."""
     return _HEX_BYTE.fullmatch(text.upper() if either_case else text) is not None
+
+
+def readable(data: bytes) -> str:
+    """Bytes as text for people: printable ASCII as itself, the rest escaped as in
+    transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report (the one
+    way every room shows them: conformance/quoting.py)."""
+    return "".join(chr(b) if 0x20 <= b <= 0x7E and b != 0x5C else escape(bytes([b]))
+                   for b in data)
+
+
+def shown_bytes(data: bytes, limit: int = 200) -> str:
+    """A unit's bytes in a message: their first ``limit`` escaped, in double quotes,
+    ``...`` when there were more (what conformance/quoting.py's ``shown`` gives bytes)."""
+    return f'"{readable(data[:limit])}{"..." if len(data) > limit else ""}"'
 
 
 def byte_sum(data: bytes) -> int:
@@ -67,7 +81,8 @@ class Values(list):
         try:
             return super().__getitem__(index)
         except IndexError:
-            raise UnitDataError(f"the answer {shown(self.raw)} has no value {index}") from None
+            raise UnitDataError(f"the answer {shown_bytes(self.raw)} has no value "
+                                f"{index}") from None
 
 
 @dataclass
@@ -96,7 +111,7 @@ class Response:
 
     # -- safe accessors: the unit's fault when the bytes are not there ---------------------
     def _fail(self, what: str) -> UnitDataError:
-        return UnitDataError(f"the answer {shown(self.raw)} {what}")
+        return UnitDataError(f"the answer {shown_bytes(self.raw)} {what}")
 
     def hex(self, index: int = 0) -> int:
         """Value ``index`` as two upper-case hex digits (status words, ports, EEPROM bytes)."""
@@ -133,7 +148,7 @@ class Response:
 
 def _value(text: str) -> str:
     """A value of an answer (the unit's bytes read as latin-1) shown as its bytes are."""
-    return shown(text.encode("latin-1"), 80)
+    return shown_bytes(text.encode("latin-1"), 80)
 
 
 def parse_response(raw: bytes, *, summed: bool, lines: int = 1) -> Response:
