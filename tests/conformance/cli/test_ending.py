@@ -132,7 +132,8 @@ def test_reports_that_cannot_be_written_end_the_run_with_one_line(tmp_path, caps
     assert status == 1
     assert captured.err.count("\n") == 1, captured.err
     assert f"cannot write {tmp_path}/full/results.json: No space left on device" in captured.err
-    assert "restored: ST0..ST5 as found" in captured.out, "restored before the reports"
+    assert "restored: ST0..ST5 written back and read back as found" in captured.out, \
+        "restored before the reports"
     assert captured.out.splitlines()[-1].startswith("PASSED"), "the verdict still said"
     assert state["status"][:6] == ["00"] * 6
     assert not (tmp_path / "full" / "results.json").exists()
@@ -162,5 +163,5 @@ def test_a_full_tmpfs_ends_the_run_with_one_line(tmp_path):
     assert done.stderr.count("\n") == 1 and "No space left on device" in done.stderr, \
         done.stderr
     assert f"cannot write {reports}/full/" in done.stderr
-    assert "restored: ST0..ST5 as found" in done.stdout
+    assert "restored: ST0..ST5 written back and read back as found" in done.stdout
     assert state["status"][:6] == ["00"] * 6
