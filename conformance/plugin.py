@@ -41,6 +41,7 @@ from conformance import settings as settings_profiles
 from conformance.case import Case
 from conformance.explain import reason
 from conformance.link.interrupts import Interrupts
+from conformance.plugin_stop import before_item, hold, interrupted
 from conformance.quoting import quoted
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
@@ -186,6 +187,7 @@ class GveItem(pytest.Item):
 
     def runtest(self) -> None:
         interrupts = self.config.stash[_INTERRUPTS]
+        before_item(self.session, interrupts)
         try:
             # a worker starts its targets here, at its first item of each (an exec:
             # target's program: whether it has a rig decides the rig cases)
@@ -198,7 +200,7 @@ class GveItem(pytest.Item):
         self.user_properties += [("verdict", result.verdict), ("tag", self.case.tag),
                                  ("section", self.case.section)]
         if result.interrupted:
-            raise KeyboardInterrupt
+            interrupted(self.session)       # its verdict reported, no item after it
         if result.verdict in (FAIL, ERROR):
             raise CaseFailed(result)
 
@@ -301,6 +303,7 @@ def pytest_configure(config: pytest.Config) -> None:
         raise pytest.UsageError(str(err)) from None
     config.stash[_TARGETS] = targets
     config.stash[_INTERRUPTS] = interrupts
+    hold(config, interrupts, controller=controller)
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -15,12 +15,21 @@ import importlib
 import sys
 
 from conformance.cli.commands import SUBCOMMANDS
+from conformance.cli.usage import INTERRUPTED
+from conformance.link.interrupts import Interrupts
 
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
-    if args and args[0] in SUBCOMMANDS:
-        module = importlib.import_module(SUBCOMMANDS[args[0]][0])
-        return module.main(args[1:])
-    from conformance.cli import run
-    return run.main(args)
+    # SIGINT, SIGTERM and SIGHUP alike; a job that was stopped before its own handling
+    # began (or after it ended) still ends with one line, not a traceback
+    with Interrupts.alike():
+        try:
+            if args and args[0] in SUBCOMMANDS:
+                module = importlib.import_module(SUBCOMMANDS[args[0]][0])
+                return module.main(args[1:])
+            from conformance.cli import run
+            return run.main(args)
+        except KeyboardInterrupt:
+            print("gve-conformance: interrupted by a signal", file=sys.stderr, flush=True)
+            return INTERRUPTED

@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-from conformance.cli.ending import counted, end, new_run_id
+from conformance.cli.ending import claimed, counted, end, new_run_id, written
 from conformance.cli.progress import Progress
 from conformance.cli.unit import ask_before_motion, unattended
 from conformance.cli.usage import (
@@ -32,6 +31,7 @@ from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
+from conformance.reports.files import release
 from conformance.runner import RunResult
 from conformance.settings import fresh_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
@@ -158,15 +158,21 @@ class _Watched(Budget):
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    folder = None
     try:
         args = parse_args(argv)
+        folder = None if args.no_reports else claimed(args.report_dir, args.run_id)
         target, reference = targets(args)
-    except (UsageError, TargetError, LookupError, ValueError) as err:
+    except (UsageError, TargetError, LookupError, ValueError, KeyboardInterrupt) as err:
+        if folder is not None:
+            release(folder)
+        if isinstance(err, KeyboardInterrupt):
+            raise
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     seed = args.seed if args.seed is not None else fresh_seed()
-    run_id = args.run_id or new_run_id()
-    folder = None if args.no_reports else Path(args.report_dir) / run_id
+    run_id = (args.run_id or new_run_id()) if folder is None else folder.name
+    lost: list[str] = []                   # the transcripts that could not be written
     meta = meta_of(args, argv, target, reference, seed)
     interrupts = Interrupts()
     session = target.begin(interrupts)
@@ -191,9 +197,11 @@ def main(argv: list[str] | None = None) -> int:
         t = transcript(f, profile=target.profile.name, target=target.info.spec,
                        reference=reference.info.spec, seed=seed)
         path = ""
-        if folder is not None:
-            folder.mkdir(parents=True, exist_ok=True)
-            path = str(write(folder / f"diff-{n:02d}.gvt", t))
+        if folder is not None and not lost:     # one line says a full disk, not one a finding
+            where = folder / f"diff-{n:02d}.gvt"
+            path = str(written(lambda: write(where, t), PROG) or "")
+            if not path:
+                lost.append(where.name)
         r = finding_result(f, profile=target.profile.name, target=target.info.spec,
                            transcript=list(t.lines()), path=path)
         run.results.append(r)

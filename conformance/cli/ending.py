@@ -1,26 +1,47 @@
-"""What every job of `gve-conformance` prints and how it ends: a run's ID, one line per
-result as it comes, then the recap — the cases to look at listed again (ERROR, FAIL,
-NON-STRICT: each with why and the rule's sentence), where the reports are, and the
-verdict line (what was judged, what was not tested and why) — also under ``-q``; the exit
-status (0 when the verdict line says PASSED, else 1)."""
+"""What every job of `gve-conformance` prints and how it ends: a run's ID and folder
+(taken before the run: never another run's), one line per result as it comes, then the
+recap — the cases to look at listed again (ERROR, FAIL, NON-STRICT: each with why and the
+rule's sentence), where the reports are (or one line saying which file could not be
+written and why: then the exit status is not 0), and the verdict line (what was judged,
+what was not tested and why) — also under ``-q``; the exit status (0 when the verdict
+line says PASSED, else 1)."""
 
 from __future__ import annotations
 
-import time
-import uuid
+import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from conformance.cli.colour import paint
-from conformance.cli.usage import exit_status
-from conformance.reports import write_junit, write_reports
+from conformance.cli.usage import UsageError, exit_status
+from conformance.reports import ReportNotWritten, write_junit, write_reports
 from conformance.reports.failures import failures
+from conformance.reports.files import RunFolderTaken, claim, new_run_id
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import ORDER, PASSED, last_line, overall
 
+__all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
+           "written"]
 
-def new_run_id() -> str:
-    return time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+
+def claimed(report_dir: str | Path, run_id: str | None = None) -> Path:
+    """The run's report folder, taken now, before anything is sent (a fresh id when
+    ``run_id`` is None); UsageError when the id names another run's folder."""
+    try:
+        return claim(report_dir, run_id)
+    except (RunFolderTaken, ReportNotWritten) as err:
+        raise UsageError(str(err)) from None
+
+
+def written(write: Callable[[], Path], prog: str = "gve-conformance") -> Path | None:
+    """What ``write()`` wrote, or None after one line on standard error naming the file
+    that could not be written and why (a full disk): the run's unit is restored by then,
+    its verdict still printed, its exit status not 0."""
+    try:
+        return write()
+    except ReportNotWritten as err:
+        print(f"{prog}: {err}", file=sys.stderr, flush=True)
+        return None
 
 
 def progress(quiet: bool, detail: Callable[[CaseResult], str | None]
@@ -72,12 +93,18 @@ def end(result: RunResult, report_dir: str | Path | None, *,
     read for; the exit status: 0 for PASSED, 1 otherwise, 130 when a signal stopped the
     job."""
     say_all(recap(result, colour))
+    lost = False                        # a report that could not be written (a full disk)
     if report_dir is not None:
-        folder = write_reports(result, report_dir)
-        print(f"reports: {folder}/report.html, results.json, junit.xml")
+        folder = written(lambda: write_reports(result, report_dir))
+        lost = folder is None
+        if folder is not None:
+            print(f"reports: {folder}/report.html, results.json, junit.xml")
     if junitxml:
-        print(f"JUnit XML: {write_junit(result, junitxml)}")
+        junit = written(lambda: write_junit(result, junitxml))
+        lost = lost or junit is None
+        if junit is not None:
+            print(f"JUnit XML: {junit}")
     verdict, _ = overall(result.results, result.interrupted, result.problems)
     line = last_line(result.results, result.interrupted, result.problems)
     print(paint(verdict, verdict, colour) + line[len(verdict):], flush=True)
-    return exit_status(verdict == PASSED, result.interrupted)
+    return exit_status(verdict == PASSED and not lost, result.interrupted)

@@ -18,7 +18,14 @@ from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
 from conformance.cli.progress import Progress
-from conformance.cli.usage import Parser, UsageError, add_loudness, positive, summary
+from conformance.cli.usage import (
+    INTERRUPTED,
+    Parser,
+    UsageError,
+    add_loudness,
+    positive,
+    summary,
+)
 from conformance.link.framing import readable
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
 
@@ -158,6 +165,11 @@ def main(argv: list[str] | None = None) -> int:
     unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
     for line in [f"what failed ({len(trials) - fair} reading(s)):", *unfair] if unfair else []:
         print(line, flush=True)
+    if pool.interrupted:        # a signal: every worker stopped, no score to give
+        print(f"fairness: interrupted by a signal after {len(trials)} of {len(jobs)} "
+              f"readings ({len(trials) - fair} unfair) in "
+              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
+        return INTERRUPTED
     print(f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
           f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
           f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO")

@@ -9,9 +9,13 @@ exactly as a single run would, with the fleet's seed and example database and th
 profile the fleet chose for it; the fleet has asked before moving (the members have no
 terminal: hand steps are COULD-NOT-TEST there). Its output comes back line by line
 behind the target's name. The processes live in process
-groups of their own: an interrupt (Ctrl-C or SIGTERM) reaches the fleet alone, which
-sends every running target one SIGINT, so that each halts its unit as a single run does,
-starts no other, waits for them and still reports.
+groups of their own: a stopping signal (Ctrl-C, SIGTERM, SIGHUP alike) reaches the fleet
+alone, which passes each one on at once — from its handler, before anything else runs —
+as a SIGINT to every running target, so that each halts its unit as a single run does
+(`H` the next frame on its line); it starts no other, waits for them and still reports. A
+target is started with the signals held, so that none falls between its start and its
+being known. A target whose fleet is gone (killed outright) sees its standard input end
+and stops as if signalled.
 """
 
 from __future__ import annotations
@@ -35,9 +39,11 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from conformance.cli.ending import recap, say_all
+from conformance.cli.ending import recap, say_all, written
 from conformance.cli.progress import Progress
-from conformance.cli.usage import exit_status
+from conformance.cli.usage import INTERRUPTED, exit_status
+from conformance.link.interrupts import Interrupts
+from conformance.reports.files import ReportNotWritten, write_text
 from conformance.runner import CaseResult, RunResult
 from conformance.targets import Target
 from conformance.verdict import FAILED, ORDER, PASSED
@@ -89,7 +95,11 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
     for m, target in zip(members, targets, strict=True):
         job = {"args": dict(child, target=[m.spec], profile=target.profile.name,
                             run_id=m.label), "argv": argv}
-        (folder / f"{m.label}.job.json").write_text(json.dumps(job), encoding="utf-8")
+        try:
+            write_text(folder / f"{m.label}.job.json", json.dumps(job))
+        except ReportNotWritten as err:             # before any target started
+            print(f"gve-conformance: {err}", file=sys.stderr)
+            return 1
     jobs = min(args.jobs, len(members))
     quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's end only
     if not quiet:
@@ -106,17 +116,42 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
     if not quiet:
         _print_summary(summary)
     say_all([line for m in members for line in _recap(m)])
+    lost = False                        # a report that could not be written (a full disk)
     if args.junitxml:
-        print(f"JUnit XML: {merge_junit(folder, members, args.junitxml, seconds)}")
+        junit = written(lambda: merge_junit(folder, members, args.junitxml, seconds))
+        lost = junit is None
+        if junit is not None:
+            print(f"JUnit XML: {junit}")
     if args.no_reports:
         shutil.rmtree(folder, ignore_errors=True)
     else:
-        (folder / SUMMARY_JSON).write_text(json.dumps(summary, indent=1), encoding="utf-8")
-        (folder / INDEX_HTML).write_text(_index_html(summary), encoding="utf-8")
-        print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
+        index = written(lambda: _write_summary(folder, summary))
+        lost = lost or index is None
+        if index is not None:
+            print(f"reports: {index} (one folder per target), {SUMMARY_JSON}")
     print(f"{summary['verdict']}: {summary['reason']}")
-    return exit_status(summary["verdict"] == PASSED, interrupted or any(
+    return exit_status(summary["verdict"] == PASSED and not lost, interrupted or any(
         row["interrupted"] for row in summary["targets"]))
+
+
+class _Fleet(Interrupts):
+    """The fleet's signals: counted as a run counts them, each passed on at once, from
+    the handler, as SIGINT to every running target (the third ends them at once too)."""
+
+    def __init__(self, running: list[Member]) -> None:
+        super().__init__()
+        self.running = running
+
+    def signal(self, *_: object) -> None:
+        for m in self.running:
+            _interrupt(m)
+        super().signal()
+
+
+def _interrupt(m: Member) -> None:
+    if m.process is not None and m.process.poll() is None:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(m.process.pid, signal.SIGINT)
 
 
 def _results(folder: Path, m: Member) -> dict:
@@ -142,44 +177,45 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
     pending, running = deque(members), []
     wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
     out_lock = threading.Lock()
-    interrupted = False
-
-    def interrupt(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt
-
-    before = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    interrupts = _Fleet(running)
+    said = False
     try:
-        while pending or running:
-            try:
-                while pending and len(running) < jobs and not interrupted:
+        with interrupts.catching():
+            while pending or running:
+                if interrupts.stopped and not said:
+                    said = True
+                    pending.clear()
+                    print("fleet: interrupted; every running target halts its unit and "
+                          "reports", file=sys.stderr, flush=True)
+                while pending and len(running) < jobs and not interrupts.stopped:
                     m = pending.popleft()
-                    running.append(m)
-                    _start(m, folder, start, wake, out_lock, shown)
+                    # a signal now waits until the member is running and known to the
+                    # handler, which passes it on: none is started and then forgotten
+                    with Interrupts.held():
+                        _start(m, folder, start, wake, out_lock, shown)
+                        running.append(m)
                 with contextlib.suppress(queue.Empty):
                     wake.get(timeout=0.5)
-                running = [m for m in running if m.status is None]
-            except KeyboardInterrupt:
-                interrupted = True
-                pending.clear()
-                print("fleet: interrupted; every running target halts its unit and reports",
-                      file=sys.stderr, flush=True)
-                for m in running:
-                    if m.process is not None and m.process.poll() is None:
-                        os.kill(m.process.pid, signal.SIGINT)
-    finally:
-        for sig, handler in before.items():
-            signal.signal(sig, handler)
-    return interrupted
+                running[:] = [m for m in running if m.status is None]
+    except KeyboardInterrupt:           # the third signal: passed on, no more waiting
+        print("fleet: stopped at once (third signal)", file=sys.stderr, flush=True)
+        for m in running:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                if m.process is not None:
+                    m.process.wait(5)
+    return interrupts.stopped
 
 
 def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
            out_lock: threading.Lock, shown: Progress) -> None:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     m.started = time.perf_counter() - start
+    # its standard input is a pipe the fleet holds: its end tells the member the fleet
+    # is gone (fleet_member.py)
     m.process = subprocess.Popen(
         [sys.executable, "-m", "conformance.cli.fleet_member",
          str(folder / f"{m.label}.job.json")],
-        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
         text=True, errors="replace", env=env, process_group=0)
 
     def relay() -> None:
@@ -190,6 +226,8 @@ def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
             with out_lock:
                 shown.print(f"[{m.label}] {line}".rstrip())
         status = m.process.wait()
+        with contextlib.suppress(OSError):
+            m.process.stdin.close()
         m.ended = time.perf_counter() - start
         m.result = _results(folder, m)
         with out_lock:
@@ -199,6 +237,12 @@ def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
         wake.put(m)
 
     threading.Thread(target=relay, name=f"fleet-{m.label}", daemon=True).start()
+
+
+def _write_summary(folder: Path, summary: dict) -> Path:
+    """summary.json and index.html beside the targets' folders; the page's path."""
+    write_text(folder / SUMMARY_JSON, json.dumps(summary, indent=1))
+    return write_text(folder / INDEX_HTML, _index_html(summary))
 
 
 def _summary(members: list[Member], run_id: str, seconds: float, interrupted: bool) -> dict:
@@ -211,7 +255,9 @@ def _summary(members: list[Member], run_id: str, seconds: float, interrupted: bo
                      "verdict": r.get("verdict", FAILED),
                      "reason": r.get("reason", "the target's process wrote no results"),
                      "counts": r.get("counts", {}), "seconds": r.get("seconds"),
-                     "frames": r.get("frames", 0), "interrupted": r.get("interrupted", False),
+                     "frames": r.get("frames", 0),
+                     # a member stopped before its run began wrote no results
+                     "interrupted": r.get("interrupted", m.status == INTERRUPTED),
                      "started": round(m.started, 3),
                      "ended": None if m.ended is None else round(m.ended, 3)})
     failed = [row for row in rows if row["verdict"] != PASSED and not row["interrupted"]]
@@ -248,10 +294,7 @@ def merge_junit(folder: Path, members: list[Member], path: str, seconds: float) 
             root.append(suite)
             tests += int(suite.get("tests", "0"))
     root.set("tests", str(tests))
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    ET.ElementTree(root).write(out, encoding="utf-8", xml_declaration=True)
-    return out
+    return write_text(path, ET.tostring(root, encoding="unicode", xml_declaration=True))
 
 
 def _index_html(summary: dict) -> str:

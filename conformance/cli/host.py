@@ -16,7 +16,7 @@ import argparse
 import fnmatch
 import sys
 
-from conformance.cli.ending import counted, end, new_run_id, progress
+from conformance.cli.ending import claimed, counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
@@ -32,6 +32,7 @@ from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
 from conformance.operator import Console
+from conformance.reports.files import release
 from conformance.runner import CaseResult
 from conformance.verdict import PASS
 from gve_fixtures.profile import Profile, ProfileError
@@ -165,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
             writable_folder(args.report_dir)
         if plan.command is None and not Console().interactive:
             raise UsageError(NOBODY_TO_SAY)
+        folder = None if args.no_reports else claimed(args.report_dir, args.run_id)
     except UsageError as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
@@ -173,9 +175,12 @@ def main(argv: list[str] | None = None) -> int:
         return reason(r).line() if r.verdict != PASS else None
 
     try:
-        result = certify(plan, args.run_id or new_run_id(), progress(args.quiet, why),
-                         console=sys.stdout, operator=sys.stdin)
+        run_id = (args.run_id or new_run_id()) if folder is None else folder.name
+        result = certify(plan, run_id, progress(args.quiet, why), console=sys.stdout,
+                         operator=sys.stdin)
     except (HostStartError, ValueError) as err:
+        if folder is not None:
+            release(folder)
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
     result.meta.command = ["host", *argv]

@@ -25,7 +25,14 @@ from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
 from conformance.cli.progress import Progress
-from conformance.cli.usage import Parser, UsageError, add_loudness, positive, summary
+from conformance.cli.usage import (
+    INTERRUPTED,
+    Parser,
+    UsageError,
+    add_loudness,
+    positive,
+    summary,
+)
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
@@ -184,6 +191,11 @@ def main(argv: list[str] | None = None) -> int:
     for line in [f"what failed ({sum(not h.caught or bool(h.errors) for h in results)} "
                  "mutant(s)):", *failed] if failed else []:
         print(line, flush=True)
+    if pool.interrupted:        # a signal: every worker stopped, no score to give
+        print(f"mutation: interrupted by a signal after {len(results)} of {len(jobs)} "
+              f"mutants ({caught} caught, {errors} ERROR) in "
+              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
+        return INTERRUPTED
     print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
           f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
           f"{sum(h.runs for h in results)} case runs, {errors} ERROR"

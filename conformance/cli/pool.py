@@ -1,26 +1,263 @@
-"""Jobs side by side in worker processes, or in this process when there is one job."""
+"""Jobs side by side in worker processes (or in this process for one job), stopped
+alike by SIGINT, SIGTERM and SIGHUP: the jobs of `mutation` and `fairness`.
+
+A stopping signal to this process (Ctrl-C, a CI's cancel, a closed terminal) is counted
+as a run counts it (link/interrupts.py) and passed on at once to every worker; a worker
+that gets one — passed on, or sent to it alone, or to the whole process group by a
+terminal — ends at once, the job it ran with it (its units are the embedded emulator's,
+in its own memory: nothing moves, nothing is left to put back), its pipe closing says so.
+Either way the map ends: the results so far are the caller's, :attr:`Workers.interrupted`
+says why there are no more, every worker has ended, and nobody prints a traceback. A
+worker whose parent is gone (killed outright) ends as if signalled: no orphan runs on.
+
+One job runs in this process; a signal raises :class:`Stopped` where the job stands (one
+that lands where Python cannot raise, in a finalizer, is delivered again at once).
+"""
 
 from __future__ import annotations
 
+import contextlib
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import traceback
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ProcessPoolExecutor
-from contextlib import AbstractContextManager
+from multiprocessing.connection import Connection, wait
 from typing import Any
 
+from conformance.cli.usage import INTERRUPTED
+from conformance.link.interrupts import STOPPING, Interrupts
 
-class _Serial:
-    """One job: no worker processes."""
+#: how long the workers may take to end once stopped, before they are killed
+ENDING_SECONDS = 10.0
 
-    def __enter__(self) -> _Serial:
+
+class Stopped(BaseException):
+    """Raised in a job where a stopping signal lands: no ``except Exception`` (nor a
+    run's ``except KeyboardInterrupt``, which would go on with the next case) takes it."""
+
+
+class WorkerFailed(RuntimeError):
+    """A job raised an exception in its worker: its traceback, as the worker printed it."""
+
+
+def _leave(*_: object) -> None:
+    """A worker's handler: it ends at once, its pipe closing (no reply is cut: replies go
+    out with the signals held)."""
+    os._exit(INTERRUPTED)
+
+
+@contextlib.contextmanager
+def _redelivered() -> Iterator[None]:
+    """A Stopped that a finalizer or a callback swallowed ("Exception ignored in ...")
+    is raised again, where Python can raise it: the signal is not lost, nothing is
+    printed."""
+    before = sys.unraisablehook
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, Stopped):
+            signal.raise_signal(signal.SIGTERM)
+        else:
+            before(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        sys.unraisablehook = before
+
+
+class _Stopping(Interrupts):
+    """This process's signals while the jobs run: counted, and each passed on at once to
+    every worker (from the handler itself: no frame of theirs waits for a loop here)."""
+
+    def __init__(self, pids: Callable[[], list[int]]) -> None:
+        super().__init__()
+        self.pids = pids
+
+    def signal(self, *_: object) -> None:
+        for pid in self.pids():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGTERM)
+        super().signal()
+
+
+class Workers:
+    """``map`` of a function over items, ``jobs`` at a time (see the module's text)."""
+
+    def __init__(self, jobs: int) -> None:
+        self.jobs = jobs
+        self.interrupted = False
+        self.failed = ""            # the traceback of a job that raised
+        self._processes: list[multiprocessing.Process] = []
+        self._conns: list[Connection] = []            # to each worker
+
+    def __enter__(self) -> Workers:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        return None
+        self._end()
 
     def map(self, fn: Callable[[Any], Any], items: Iterable[Any]) -> Iterator[Any]:
-        return map(fn, items)
+        """The results of ``fn`` on each item, in the order of the items, until a stopping
+        signal ends the map (then :attr:`interrupted`). A job that raised raises
+        WorkerFailed here once the workers have ended."""
+        todo = list(enumerate(items))
+        if self.jobs <= 1 or len(todo) <= 1:
+            yield from self._here(fn, [item for _, item in todo])
+            return
+        yield from self._there(fn, todo)
+
+    # -- one job: in this process --------------------------------------------------------------
+    def _here(self, fn: Callable[[Any], Any], items: list[Any]) -> Iterator[Any]:
+        working = False                 # inside fn: a signal ends it where it stands
+
+        def stop(*_: object) -> None:
+            self.interrupted = True
+            if working:
+                raise Stopped
+
+        before = {sig: signal.signal(sig, stop) for sig in STOPPING}
+        try:
+            for item in items:
+                if self.interrupted:
+                    return
+                try:
+                    working = True
+                    with _redelivered():
+                        result = fn(item)
+                    working = False
+                except Stopped:
+                    working = False
+                    return
+                yield result
+        finally:
+            for sig, handler in before.items():
+                signal.signal(sig, handler)
+
+    # -- several: in worker processes ----------------------------------------------------------
+    def _there(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]]) -> Iterator[Any]:
+        stopping = _Stopping(lambda: [p.pid for p in self._processes if p.pid])
+        try:
+            with stopping.catching():
+                yield from self._run(fn, todo, stopping)
+                self.interrupted = self.interrupted or stopping.stopped
+                self._end()
+        except KeyboardInterrupt:                   # a third signal: no more waiting
+            self.interrupted = True
+            for process in self._processes:
+                process.kill()
+        self._end()
+        if self.failed:
+            raise WorkerFailed(self.failed)
+
+    def _run(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]],
+             stopping: Interrupts) -> Iterator[Any]:
+        context = multiprocessing.get_context()
+        idle: list[Connection] = []
+        busy: dict[Connection, int] = {}
+        done: dict[int, Any] = {}
+        for _ in range(min(self.jobs, len(todo))):
+            here, there = context.Pipe()
+            process = context.Process(target=_serve, args=(there,), daemon=True)
+            # started with the signals held: a worker exists before one is passed on
+            with Interrupts.held():
+                process.start()
+                self._processes.append(process)
+            there.close()
+            idle.append(here)
+            self._conns.append(here)
+        pending, following = list(todo), 0
+        while (pending or busy) and not stopping.stopped and not self.failed:
+            while idle and pending:
+                conn = idle.pop()
+                index, item = pending.pop(0)
+                try:
+                    conn.send((fn, item))
+                except OSError:                      # it ended meanwhile: as if signalled
+                    self.interrupted = True
+                    stopping.signal()
+                    break
+                busy[conn] = index
+            for conn in wait(list(busy), timeout=0.2):
+                index = busy.pop(conn)
+                try:
+                    outcome, value = conn.recv()
+                except (EOFError, OSError):
+                    outcome, value = "stopped", None     # killed: as if signalled
+                if outcome == "done":
+                    done[index] = value
+                    idle.append(conn)
+                elif outcome == "failed":
+                    self.failed = value
+                else:
+                    self.interrupted = True
+                    stopping.signal()                    # the others stop too
+            while following in done:
+                yield done.pop(following)
+                following += 1
+
+    def _end(self) -> None:
+        """Every worker ended: asked (no more jobs, or SIGTERM when stopped), then
+        killed after ENDING_SECONDS."""
+        for conn in self._conns:
+            with contextlib.suppress(OSError):
+                conn.send(None)
+                conn.close()
+        self._conns.clear()
+        for process in self._processes:
+            if self.interrupted and process.is_alive():
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(process.pid, signal.SIGTERM)
+        for process in self._processes:
+            process.join(ENDING_SECONDS)
+            if process.is_alive():
+                process.kill()
+                process.join()
+        self._processes.clear()
 
 
-def workers(jobs: int) -> AbstractContextManager:
+def _serve(conn: Connection) -> None:
+    """A worker: jobs from ``conn`` until there are no more; a stopping signal ends it at
+    once (see the module's docstring)."""
+    for sig in STOPPING:
+        signal.signal(sig, _leave)
+    _watch_parent()
+    while True:
+        try:
+            task = conn.recv()
+        except EOFError:
+            return
+        if task is None:                       # no more jobs
+            return
+        fn, item = task
+        try:
+            reply = ("done", fn(item))
+        except Exception:
+            reply = ("failed", traceback.format_exc())
+        try:
+            with Interrupts.held():            # a reply goes out whole or not at all
+                conn.send(reply)
+        except OSError:
+            return                             # the parent is gone: nobody to tell
+
+
+def _watch_parent() -> None:
+    """Stop this worker as a signal would when its parent ends (killed outright: its
+    signals never came)."""
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        wait([parent.sentinel])
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
+
+
+def workers(jobs: int) -> Workers:
     """A pool whose ``map`` runs ``jobs`` at a time (in order of the items)."""
-    return ProcessPoolExecutor(jobs) if jobs > 1 else _Serial()
+    return Workers(jobs)

@@ -18,7 +18,7 @@ from serial import SerialException
 from conformance.catalogue import select
 from conformance.cli.colour import wanted
 from conformance.cli.commands import subcommands_help
-from conformance.cli.ending import counted, end, new_run_id
+from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
     ask_before_motion,
@@ -41,6 +41,8 @@ from conformance.coverage import coverage, format_coverage
 from conformance.link.account import account_lines
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
+from conformance.quoting import escaped
+from conformance.reports.files import release
 from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
@@ -199,6 +201,10 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
     if not args.no_reports:
         writable_folder(args.report_dir)
     with ExitStack() as run_scope:
+        if not args.no_reports:         # the run's folder, before anything is sent
+            folder = claimed(args.report_dir, args.run_id)
+            args.run_id = folder.name
+            run_scope.callback(release, folder)      # given back if nothing was written
         try:
             run_scope.enter_context(example_database(example_database_of(args)))
         except ValueError as err:
@@ -360,7 +366,8 @@ def _session_lines(result: RunResult) -> list[str]:
         if not s["real"]:
             continue
         lines.append(f"{spec} ({s['profile']}"
-                     + (f", {s['identity'].get('version')}" if s["identity"] else "") + "):")
+                     + (f", {escaped(s['identity'].get('version', ''))}" if s["identity"] else "")
+                     + "):")
         if s["excursion"]:
             axes = ", ".join(f"{a} {lo:+g}..{hi:+g}" for a, (lo, hi)
                              in zip(s["axes"], s["excursion"], strict=True))

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from conformance.cli.usage import UsageError
 from conformance.metadata import RunMeta
 from conformance.operator import Console, confirm_motion
+from conformance.quoting import escaped, shown
 from conformance.targetinfo import EMULATOR, is_emulator_spec
 from conformance.targets import Target
 from conformance.targets.identify import ask, bauds, choose, of_target, variant_of
@@ -47,7 +48,7 @@ def resolve(spec: str, profile: str | None, variant: str | None, console: Consol
         raise ValueError(f"{spec}: no GVE unit answered ? at address {address} "
                          "(is it on, on this port, at this address?)")
     chosen, how = choose(identity, variant, _ask_variant(console))
-    console.say(f"{spec}: ? {identity.version!r}, Q {identity.processor_id!r} at "
+    console.say(f"{spec}: ? {shown(identity.version)}, Q {shown(identity.processor_id)} at "
                 f"{identity.baud} baud -> profile {chosen.name} ({how})")
     if "baud" not in q:                               # keep the rate it answered at
         spec += ("&" if "?" in rest else "?") + f"baud={identity.baud}"
@@ -66,7 +67,8 @@ def record_identities(targets: list[Target], meta: RunMeta) -> None:
 
 def _what_moves(target: Target, version: str, processor_id: str) -> list[str]:
     axes = ", ".join(f"{a} ±{target.info.max_travel}" for a in target.profile.axes)
-    return [f"{target.info.spec}: {version or '(no answer to ?)'}, Q {processor_id}, "
+    return [f"{target.info.spec}: {escaped(version) or '(no answer to ?)'}, "
+            f"Q {escaped(processor_id)}, "
             f"judged as {target.profile.name}",
             f"  envelope (full steps either side of where the run began): {axes}",
             "  destructive tests (J, W, EEPROM writes; EEPROM backed up and restored): "

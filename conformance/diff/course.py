@@ -10,6 +10,7 @@ import re
 
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
+from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
@@ -92,8 +93,8 @@ class Course:
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
-        elif command == "T" and body[1:].isdigit():
-            self.t_ns = int(body[1:]) * 1_000_000
+        elif command == "T" and (ms := decimal(body[1:])) is not None:
+            self.t_ns = ms * 1_000_000
 
     def _queue(self, command: str, body: str) -> None:
         if command in _EMPTIES:      # D and K alike, as the timing takes them

@@ -12,6 +12,7 @@ from pathlib import Path
 from conformance.diff.engine import Finding, StepRecord
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
 from conformance.link.framing import HostFramer, readable
+from conformance.reports.files import write_text
 from gve_fixtures.transcript import (
     ACTION,
     HOST,
@@ -100,9 +101,7 @@ def _lines(rec: StepRecord, disagreeing: bool, rule: str | None, verdict: str) -
 
 
 def write(path: str | Path, t: Transcript) -> Path:
-    path = Path(path)
-    path.write_text(t.dumps(), encoding="ascii")
-    return path
+    return write_text(path, t.dumps(), encoding="ascii")
 
 
 def steps_of(t: Transcript) -> list[Step]:

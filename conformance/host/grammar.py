@@ -14,9 +14,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
 
+from conformance.protocol.bounded import decimal, hexadecimal
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import HEX_BYTE, byte_sum
+from conformance.quoting import escaped
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import MAX_FRAME
 from gve_fixtures.rules import load_rules
@@ -150,9 +152,9 @@ def _command(f: ParsedFrame, profile: Profile) -> None:
     # (``command``) is read as spec 3 writes it, as the conforming units behind the relay read it
     f.key = classed.key
     f.check(not lower, "3.frame.upper-case",
-            lambda: f"command letters `{f.body[: len(upper or '')]}` are not upper case")
+            lambda: f"command letters `{escaped(f.body[: len(upper or '')])}` are not upper case")
     if not f.check(name is not None or lower, "1.profile.command-set",
-                   lambda: f"`{f.body[:3]}…` is no command of spec 10") or name is None:
+                   lambda: f"`{escaped(f.body[:3])}…` is no command of spec 10") or name is None:
         return
     command = table[name]
     f.command = name
@@ -208,17 +210,19 @@ def _value(spec: Field, text: str, command: Command, profile: Profile,
     syntax = spec.syntax or _SYNTAX_RULE[spec.kind]
     if spec.kind == "word":
         ok = text in spec.choices
-        return syntax, None if ok else (f"`{command.name}`: `{text}` is not one of "
+        return syntax, None if ok else (f"`{command.name}`: `{escaped(text)}` is not one of "
                                         f"{' '.join(spec.choices)}")
     if spec.kind == "float":
         if not _FLOAT.match(text):
-            return syntax, f"`{text}` is not a decimal number"
-        return syntax, None if _float32(float(text)) else f"`{text}` is no finite float32"
+            return syntax, f"`{escaped(text)}` is not a decimal number"
+        return syntax, None if _float32(float(text)) else f"`{escaped(text)}` is no finite float32"
     pattern, base = (_DEC, 10) if spec.kind == "dec" else (_HEX, 16)
     if not pattern.match(text):
         what = "decimal integer" if base == 10 else "hexadecimal number"
-        return syntax, f"`{command.name}`: `{text}` is not a {what}"
-    value = int(text, base)
+        return syntax, f"`{command.name}`: `{escaped(text)}` is not a {what}"
+    value = decimal(text, signed=True) if base == 10 else hexadecimal(text)
+    if value is None:           # more digits than any field of the protocol has
+        return syntax, f"`{command.name}`: `{text[:40]}...` has {len(text)} digits"
     lo, hi = _bounds(spec, profile, spindle and command.name == "V")
     rules = ("12.spindle.speed",) if spindle and command.name == "V" else command.rules
     rule = _applicable(rules, profile.name, profile.family)

@@ -14,7 +14,8 @@ from conformance.protocol.wire import (
     frame,
     parse_response,
     readable,
+    shown_bytes,
 )
 
 __all__ = ["BANG", "CR", "HostFrame", "HostFramer", "Response", "UnitDataError", "Values",
-           "byte_sum", "frame", "parse_response", "readable"]
+           "byte_sum", "frame", "parse_response", "readable", "shown_bytes"]

@@ -6,6 +6,12 @@ frame in flight gets its answer (or times out), and the link raises
 session's `H`, then `D`. A signal
 during the restorations that follow stops them the same way (`H`, `D` again, the rest
 skipped). A third signal raises KeyboardInterrupt at once.
+
+Outside a run (parsing the command line, opening ports, asking the operator) the three
+signals alike raise KeyboardInterrupt where they land (:meth:`Interrupts.alike`), so that
+a job ends the same way whichever of them came; a process that starts others (a program,
+a worker, a fleet's member) does so with the signals held (:meth:`Interrupts.held`), so
+that each signal finds it known and passes on to it.
 """
 
 from __future__ import annotations
@@ -58,30 +64,46 @@ class Interrupts:
     @contextlib.contextmanager
     def held() -> Iterator[None]:
         """The stopping signals held back while the block runs (main thread only): one
-        that comes meanwhile is delivered when it ends. The link asks whether it may
-        write and writes inside one such block, so a signal lands either before the
-        question (nothing is written) or after the bytes went out, never in between."""
+        that comes meanwhile is delivered when it ends, to the handler it was meant for.
+        The link asks whether it may write and writes inside one such block, so a signal
+        lands either before the question (nothing is written) or after the bytes went
+        out, never in between."""
         if threading.current_thread() is not threading.main_thread():
             yield
             return
-        # The mask holds the signal only where this thread would take it: another thread
-        # may take it and Python runs the handler here anyway, and one that lands while a
-        # program is being started runs it as soon as fork_exec returns (seen on a loaded
-        # machine, the program started and its Popen lost). So the handlers are swapped
-        # for a recorder too, and what it recorded is handed to the real handlers when
-        # the block ends.
+        # The handlers are swapped for a recorder, and what it recorded is handed to the
+        # real handlers when the block ends: Python runs a handler in the main thread
+        # whichever thread the signal reached, and one that lands while a program is
+        # being started runs as soon as fork_exec returns (seen on a loaded machine, the
+        # program started and its Popen lost). Not a signal mask: a program started
+        # inside the block would inherit it through exec and never see SIGINT, SIGTERM
+        # or SIGHUP (a fleet's member, a host program, a simulator).
         caught: list[int] = []
         handlers = {sig: signal.signal(sig, lambda sig, _: caught.append(sig))
                     for sig in STOPPING}
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
         try:
             yield
         finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
             for sig, handler in handlers.items():
                 signal.signal(sig, handler)
             for sig in caught:
                 _deliver(sig, handlers[sig])
+
+    @staticmethod
+    @contextlib.contextmanager
+    def alike() -> Iterator[None]:
+        """SIGTERM and SIGHUP do what SIGINT does by default while the block runs:
+        KeyboardInterrupt in the main thread (a run inside counts all three instead)."""
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        previous = {sig: signal.signal(sig, signal.default_int_handler)
+                    for sig in STOPPING if sig != signal.SIGINT}
+        try:
+            yield
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
 
     @contextlib.contextmanager
     def catching(self) -> Iterator[Interrupts]:

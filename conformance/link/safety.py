@@ -29,7 +29,6 @@ Public interface (docs/suite.md, "The session and its guard")::
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -47,6 +46,7 @@ from conformance.link.envelope import (
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
+from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
@@ -467,8 +467,9 @@ class Guard:
                 self.envelope.ended()
         elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
-            if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
-                self._read(name, {i: int(r.values[i]) for i in range(axes)})
+            read = [decimal(v, signed=True) for v in r.values[:axes]]
+            if len(read) == axes and None not in read:
+                self._read(name, dict(enumerate(read)))
 
     def _read(self, name: str, counters: dict[int, int]) -> None:
         """A position read: when it tells the counters no longer count from where the

@@ -10,7 +10,9 @@ from hypothesis.stateful import run_state_machine_as_test
 
 from conformance import settings as settings_profiles
 from conformance.case import CaseContext, CouldNotTest
+from conformance.link.framing import UnitDataError
 from conformance.machines.base import UnitMachine
+from conformance.verdict import ALWAYS
 from gve_fixtures.rules import load_rules
 
 
@@ -69,7 +71,11 @@ def _failed(ctx: CaseContext, machine: type, err: BaseException) -> None:
     rule = getattr(err, "rule", None)
     what = f"{machine.__name__}: {err}".splitlines()[0][:300]
     seen = {"observed": getattr(err, "observed", ""), "expected": getattr(err, "expected", "")}
-    if rule is not None and rule not in ctx.case.rules:
+    if isinstance(err, UnitDataError):
+        # bytes no rule's reading allows where a value belongs, as the runner grades them
+        ctx.expect(False, f"{machine.__name__}: the unit's answer cannot be read: "
+                   f"{str(err).splitlines()[0][:300]}", **seen, tag=ALWAYS)
+    elif rule is not None and rule not in ctx.case.rules:
         # a rule of the machinery the case does not list (the index, PF): its own tag
         ctx.expect(False, f"{what} [{rule}]", **seen, tag=load_rules()[rule].tag)
     else:

@@ -15,15 +15,14 @@ A frame whose command is ``SW`` and whose first field reads 6 writes ST6 and is 
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from functools import lru_cache
 
+from conformance.protocol.bounded import decimal, hexadecimal
 from conformance.protocol.catalogue import ST6_WRITE, catalogue, names_longest_first
 
 _ST6 = 6
-_DEC = re.compile(r"-?[0-9]+")
-_HEX = re.compile(r"[0-9A-Fa-f]+")
+_ADDRESSES = frozenset("01234567")
 
 
 @dataclass(frozen=True)
@@ -63,7 +62,7 @@ def parse(body: str, *, strict: bool = False, address: int | None = None) -> Par
 def parse_text(text: str, *, strict: bool = False) -> Parsed:
     """Read a frame's text after `!` (its address digit, then the body)."""
     digit = text[:1]
-    address = int(digit) if digit.isdigit() and digit <= "7" else None
+    address = int(digit) if digit in _ADDRESSES else None
     return parse(text[1:] if address is not None else text, strict=strict, address=address)
 
 
@@ -89,13 +88,11 @@ def split_fields(name: str, params: str) -> tuple[str, ...]:
 
 
 def read_int(text: str, *, strict: bool = False, base: int = 10) -> int | None:
-    """A field's integer; lenient: spaces and a leading `+` as a unit that does not
-    conform might take them. None: not an integer."""
-    if strict and not (_HEX if base == 16 else _DEC).fullmatch(text):
-        return None
+    """A field's integer (ASCII digits, bounded: protocol/bounded.py); lenient: spaces and
+    a leading `+` as a unit that does not conform might take them. None: not an
+    integer."""
     if not strict:
         text = text.strip().lstrip("+")
-    try:
-        return int(text, base)
-    except ValueError:
-        return None
+    if base == 16:
+        return hexadecimal(text)
+    return decimal(text, signed=True)

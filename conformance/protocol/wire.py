@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from conformance.protocol.bounded import decimal
 from gve_fixtures.protocol import INTA_BIT, ErrorCode, St6
 from gve_fixtures.transcript import escape
 
@@ -24,7 +25,6 @@ BANG = b"!"
 #: a byte as the unit writes it: two upper-case hex digits (spec 4, 6)
 HEX_BYTE = "[0-9A-F]{2}"
 _HEX_BYTE = re.compile(HEX_BYTE)
-_DECIMAL = re.compile(r"-?\d+")
 
 
 def is_hex_byte(text: str, either_case: bool = False) -> bool:
@@ -34,9 +34,16 @@ def is_hex_byte(text: str, either_case: bool = False) -> bool:
 
 def readable(data: bytes) -> str:
     """Bytes as text for people: printable ASCII as itself, the rest escaped as in
-    transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report."""
+    transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report (the one
+    way every room shows them: conformance/quoting.py)."""
     return "".join(chr(b) if 0x20 <= b <= 0x7E and b != 0x5C else escape(bytes([b]))
                    for b in data)
+
+
+def shown_bytes(data: bytes, limit: int = 200) -> str:
+    """A unit's bytes in a message: their first ``limit`` escaped, in double quotes,
+    ``...`` when there were more (what conformance/quoting.py's ``shown`` gives bytes)."""
+    return f'"{readable(data[:limit])}{"..." if len(data) > limit else ""}"'
 
 
 def byte_sum(data: bytes) -> int:
@@ -74,7 +81,8 @@ class Values(list):
         try:
             return super().__getitem__(index)
         except IndexError:
-            raise UnitDataError(f"the answer {readable(self.raw)} has no value {index}") from None
+            raise UnitDataError(f"the answer {shown_bytes(self.raw)} has no value "
+                                f"{index}") from None
 
 
 @dataclass
@@ -103,21 +111,22 @@ class Response:
 
     # -- safe accessors: the unit's fault when the bytes are not there ---------------------
     def _fail(self, what: str) -> UnitDataError:
-        return UnitDataError(f"the answer {self.text} {what}")
+        return UnitDataError(f"the answer {shown_bytes(self.raw)} {what}")
 
     def hex(self, index: int = 0) -> int:
         """Value ``index`` as two upper-case hex digits (status words, ports, EEPROM bytes)."""
         text = self.values[index]
         if not is_hex_byte(text):
-            raise self._fail(f"has {text!r} where two hex digits belong")
+            raise self._fail(f"has {_value(text)} where two hex digits belong")
         return int(text, 16)
 
     def dec(self, index: int = 0) -> int:
         """Value ``index`` as a decimal integer (positions, counts, the index)."""
         text = self.values[index]
-        if not _DECIMAL.fullmatch(text):
-            raise self._fail(f"has {text!r} where a decimal number belongs")
-        return int(text)
+        value = decimal(text, signed=True)
+        if value is None:
+            raise self._fail(f"has {_value(text)} where a decimal number belongs")
+        return value
 
     def decs(self) -> list[int]:
         """Every value as a decimal integer."""
@@ -135,6 +144,11 @@ class Response:
     def st6(self, index: int = 0) -> St6:
         """Value ``index`` read as status word ST6 (the answer to `SR6` or `F`)."""
         return St6(self.hex(index))
+
+
+def _value(text: str) -> str:
+    """A value of an answer (the unit's bytes read as latin-1) shown as its bytes are."""
+    return shown_bytes(text.encode("latin-1"), 80)
 
 
 def parse_response(raw: bytes, *, summed: bool, lines: int = 1) -> Response:

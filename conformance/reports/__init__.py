@@ -1,6 +1,8 @@
 """Run reports: JUnit XML, JSON and one self-contained HTML page, written per
 run into ``<folder>/<run id>/``. ``write_reports(run, folder) -> Path`` is the one entry
-point (the suite's run, host certification and fleets call it per target or per run)."""
+point (the suite's run, host certification and fleets call it per target or per run);
+each file is written whole or not at all, ReportNotWritten saying which could not be
+(files.py)."""
 
 from __future__ import annotations
 
@@ -8,21 +10,22 @@ import json
 from pathlib import Path
 
 from conformance.reports.banner import run_verdict
+from conformance.reports.files import ReportNotWritten, write_text
 from conformance.reports.html import render_html
 from conformance.reports.junit import render_junit, write_junit
 from conformance.reports.logs import compact, compact_checks, compact_traces
 from conformance.reports.sections import section_key, section_name
 from conformance.runner import RunResult
 
-__all__ = ["render_html", "render_junit", "to_json", "write_junit", "write_reports"]
+__all__ = ["ReportNotWritten", "render_html", "render_junit", "to_json", "write_junit",
+           "write_reports"]
 
 
 def write_reports(run: RunResult, folder: str | Path) -> Path:
     out = Path(folder) / run.run_id
-    out.mkdir(parents=True, exist_ok=True)
     write_junit(run, out / "junit.xml")
-    (out / "results.json").write_text(json.dumps(to_json(run), separators=(",", ":")), encoding="utf-8")
-    (out / "report.html").write_text(render_html(run), encoding="utf-8")
+    write_text(out / "results.json", json.dumps(to_json(run), separators=(",", ":")))
+    write_text(out / "report.html", render_html(run))
     return out
 
 

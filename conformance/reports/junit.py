@@ -27,6 +27,7 @@ from pathlib import Path
 
 from conformance.explain import reason
 from conformance.reports.banner import run_verdict
+from conformance.reports.files import write_text
 from conformance.reports.logs import compact
 from conformance.reports.sections import section_title
 from conformance.reports.text import clean
@@ -151,7 +152,4 @@ def render_junit(run: RunResult, full_logs: bool | None = None) -> str:
 
 def write_junit(run: RunResult, path: str | Path) -> Path:
     """The JUnit file at ``path`` (``--junitxml``: where a CI expects it)."""
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(render_junit(run), encoding="utf-8")
-    return out
+    return write_text(path, render_junit(run))

@@ -11,6 +11,7 @@ from conformance.targetinfo import EMULATOR
 from conformance.targets import emu, port, process
 from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
 from conformance.targets.session import Session, SessionError, SessionReport
+from gve_fixtures.profile import Profile
 
 __all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Session", "SessionError", "SessionReport",
            "Target", "TargetError", "parse_target"]
@@ -31,6 +32,18 @@ def parse_target(spec: str, *, profile: str | None = None, allow_destructive: bo
     if module is None:
         raise TargetError(f"unknown target {spec!r}: use emu:PROFILE, "
                           "serial:PATH?baud=&address=, tcp:HOST:PORT, or exec:COMMAND")
-    return module.parse(kind, rest, spec=spec, profile=profile,
-                        allow_destructive=allow_destructive, max_travel=max_travel,
-                        mutant=mutant, strict=strict)
+    target = module.parse(kind, rest, spec=spec, profile=profile,
+                          allow_destructive=allow_destructive, max_travel=max_travel,
+                          mutant=mutant, strict=strict)
+    within_vector_range(max_travel, target.profile)
+    return target
+
+
+def within_vector_range(max_travel: int, profile: Profile) -> None:
+    """The one bound of ``--max-travel``, on every target and in every subcommand (the
+    embedded emulator's too: the same command line must mean the same on every target):
+    1 to the profile's vector range (TargetError otherwise)."""
+    if not 0 < max_travel <= profile.vector_range:
+        raise TargetError(f"--max-travel {max_travel}: the envelope is 1 to "
+                          f"{profile.vector_range} full steps on the {profile.name} "
+                          "(its vector range)")

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
+from conformance.protocol.bounded import decimal
+from conformance.quoting import shown
 from gve_fixtures.protocol import SECOND
 
 VERSION = 1
@@ -63,9 +65,7 @@ def announced(first: str) -> int | None:
     """The protocol version a program's first line announces (None: not ``cosim N``,
     which the names of the extensions it offers may follow)."""
     words = first.split()
-    if len(words) >= 2 and words[0] == "cosim" and words[1].isdigit():
-        return int(words[1])
-    return None
+    return decimal(words[1]) if len(words) >= 2 and words[0] == "cosim" else None
 
 
 def offered(first: str) -> frozenset[str]:
@@ -150,7 +150,7 @@ class CosimLine:
             if not self.program.alive or self.program.wait(0.2):
                 self._ended(command)
             self._break(f"no reply to {command!r} within {REPLY_SECONDS:g} s" if not said
-                        else f"after {command!r} it sent {said[:120]!r} and then nothing "
+                        else f"after {command!r} it sent {shown(said, 120)} and then nothing "
                         f"within {REPLY_SECONDS:g} s (no `now`)")
         return text
 
@@ -161,7 +161,7 @@ class CosimLine:
         with self._exchange(command):
             reply = self._reply(command, time.monotonic() + REPLY_SECONDS, "")
         if reply.strip() != "ok":
-            self._break(f"it answered 'baud {self.baud}' with {reply[:120]!r}, not ok")
+            self._break(f"it answered 'baud {self.baud}' with {shown(reply, 120)}, not ok")
         return self.ask("state")
 
     def ask(self, command: str) -> str:
@@ -181,9 +181,10 @@ class CosimLine:
         words = reply.split()
         if len(words) == 2 and words[0] == "next" and words[1] == "none":
             return None
-        if len(words) == 2 and words[0] == "next" and words[1].isdigit():
-            return int(words[1])
-        self._break(f"it answered 'next' with {reply[:120]!r}, not next T or next none")
+        due = decimal(words[1]) if len(words) == 2 and words[0] == "next" else None
+        if due is not None:
+            return due
+        self._break(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -207,18 +208,18 @@ class CosimLine:
             if len(words) == 3 and words[0] == "rx":
                 t, data = _rx(words)
                 if t is None or not data:
-                    self._break(f"it answered {command!r} with {said[:120]!r}: not rx T HEX")
+                    self._break(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX")
                 if t <= start:
-                    self._break(f"after {command!r} it sent {said[:120]!r}: a byte stamped "
+                    self._break(f"after {command!r} it sent {shown(said, 120)}: a byte stamped "
                                 f"{t}, not after the instant {start} the command began "
                                 "(a byte in the past)")
                 if t < last:
-                    self._break(f"after {command!r} it sent {said[:120]!r}: stamped {t}, "
+                    self._break(f"after {command!r} it sent {shown(said, 120)}: stamped {t}, "
                                 f"before the byte it sent before ({last})")
                 for i, value in enumerate(data):
                     at = t + i * b
                     if stop is not None or (cr_sent and at > end):
-                        self._break(f"after {command!r} it sent {said[:120]!r}: a byte at "
+                        self._break(f"after {command!r} it sent {shown(said, 120)}: a byte at "
                                     f"{at}, after the CR at "
                                     f"{stop if stop is not None else end} where the clock "
                                     "was to stop")
@@ -233,31 +234,32 @@ class CosimLine:
                     self._break(f"it answered {command!r} with more than {REPLY_BYTES} bytes")
                 self._rx += data
             elif len(words) == 2 and words[0] == "now":
-                if not words[1].isdigit():
-                    self._break(f"it answered {command!r} with {said[:120]!r}: not now T")
-                self._arrived(command, said, int(words[1]), start, end, goal, last,
+                now = decimal(words[1])
+                if now is None:
+                    self._break(f"it answered {command!r} with {shown(said, 120)}: not now T")
+                self._arrived(command, said, now, start, end, goal, last,
                               end if cr_sent else stop if stop is not None else goal)
                 return cr_sent or stop is not None
             elif said.startswith("error"):
-                self._break(f"it refused {command!r}: {said[:200]}")
+                self._break(f"it refused {command!r}: {shown(said)}")
             else:
-                self._break(f"it answered {command!r} with {said[:120]!r}: not rx T HEX "
+                self._break(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX "
                             "or now T")
 
     def _arrived(self, command: str, said: str, now: int, start: int, end: int, goal: int,
                  last: int, expected: int) -> None:
         """``now`` must be where the command was to take the clock."""
         if now < start:
-            self._break(f"after {command!r} it sent {said!r}: time went backwards "
+            self._break(f"after {command!r} it sent {shown(said)}: time went backwards "
                         f"(it was {start})")
         if now < last:
-            self._break(f"after {command!r} it sent {said!r}: before the last byte it sent "
+            self._break(f"after {command!r} it sent {shown(said)}: before the last byte it sent "
                         f"({last}), a byte in the future")
         if now > goal:
-            self._break(f"after {command!r} it sent {said!r}: past the instant {goal} "
+            self._break(f"after {command!r} it sent {shown(said)}: past the instant {goal} "
                         "it was asked for")
         if now != expected:
-            self._break(f"after {command!r} it sent {said!r}, where the clock had to stop "
+            self._break(f"after {command!r} it sent {shown(said)}, where the clock had to stop "
                         f"at {expected}" + (" (the end of the host's bytes)" if expected ==
                                             end and end > start else ""))
         self.now = now
@@ -447,18 +449,19 @@ class CosimLine:
     def set_baud(self, baud: int) -> None:
         reply = self.ask(f"baud {baud}")
         if reply.strip() != "ok":
-            self._break(f"it answered 'baud {baud}' with {reply[:120]!r}, not ok")
+            self._break(f"it answered 'baud {baud}' with {shown(reply, 120)}, not ok")
         self.baud, self.byte_ns = baud, byte_ns(baud)
 
 
 def _rx(words: list[str]) -> tuple[int | None, bytes]:
-    if not words[1].isdigit():
+    t = decimal(words[1])
+    if t is None:
         return None, b""
     try:
         data = bytes.fromhex(words[2])
     except ValueError:
         return None, b""
-    return int(words[1]), data if len(words[2]) == 2 * len(data) else b""
+    return t, data if len(words[2]) == 2 * len(data) else b""
 
 
 class CosimPort:

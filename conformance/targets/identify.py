@@ -18,6 +18,7 @@ import serial
 
 from conformance.link.exclusive import LeftAlone, open_serial, settings_kept
 from conformance.link.framing import frame, parse_response
+from conformance.quoting import escaped, shown
 from conformance.targets.base import Target
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 from gve_fixtures.protocol import ErrorCode
@@ -108,20 +109,20 @@ def choose(identity: Identity, variant: str | None = None,
     """The profile for ``identity`` and how it was chosen; ValueError when it cannot be."""
     found = candidates(identity.version)
     if not found:
-        raise ValueError(f"the unit answered ? with {identity.version!r}, which no profile "
+        raise ValueError(f"the unit answered ? with {shown(identity.version)}, which no profile "
                          "knows: give --profile (or add a profile: fixtures/README.md)")
     if len(found) == 1:
-        return found[0], f"auto: ? answered {identity.version!r}"
+        return found[0], f"auto: ? answered {shown(identity.version)}"
     family = found[0].family
     choices = ", ".join(variant_of(p.name) for p in found)
-    why = f"auto: ? answered {identity.version!r}, the same for {choices}"
+    why = f"auto: ? answered {shown(identity.version)}, the same for {choices}"
     if variant is None and ask_variant is not None:
         variant, why = ask_variant(found), why + "; variant given by the operator"
     elif variant is not None:
         why += "; --variant"
     if variant is None:
-        raise ValueError(f"the unit is a {family} ({identity.version}), but its answer does "
-                         f"not say which variant: give --variant ({choices})")
+        raise ValueError(f"the unit is a {family} ({escaped(identity.version)}), but its "
+                         f"answer does not say which variant: give --variant ({choices})")
     for p in found:
         if variant in (p.name, variant_of(p.name)):
             return p, why
@@ -142,7 +143,7 @@ def probe(url: str, address: int = 0) -> str:
     if identity is None:
         return "no GVE unit answered"
     family = family_of(identity.version) or "unknown family"
-    return f"{family}: ? {identity.version!r} at {identity.baud} baud, address {address}"
+    return f"{family}: ? {shown(identity.version)} at {identity.baud} baud, address {address}"
 
 
 def of_target(target: Target) -> Identity | None:

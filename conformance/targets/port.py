@@ -118,7 +118,7 @@ def _number(q: dict, key: str, default: int, spec: str, lo: int, hi: int) -> int
     return value
 
 
-def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel: int,
+def real_profile(spec: str, profile: str | None, mutant: str | None,
                  mutant_hint: str = "") -> Profile:
     """The profile a unit in real time is judged as, once the options make sense for it
     (TargetError with one line otherwise)."""
@@ -128,17 +128,13 @@ def real_profile(spec: str, profile: str | None, mutant: str | None, max_travel:
     if mutant is not None:
         raise TargetError(f"--mutant plants a bug in the embedded emulator; {spec} is not one"
                           + (f" ({mutant_hint})" if mutant_hint else ""))
-    p = load_profile(profile)
-    if not 0 < max_travel <= p.vector_range:
-        raise TargetError(f"--max-travel {max_travel}: the envelope is 1 to "
-                          f"{p.vector_range} full steps on the {p.name} (its vector range)")
-    return p
+    return load_profile(profile)
 
 
 def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destructive: bool,
           max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     url, q = locate(kind, rest)
-    p = real_profile(spec, profile, mutant, max_travel)
+    p = real_profile(spec, profile, mutant)
     baud = _number(q, "baud", p.default_baud, spec, 1, 10_000_000)
     address = _number(q, "address", p.address, spec, 0, 7)
     info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)

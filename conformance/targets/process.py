@@ -11,14 +11,23 @@ time, the rig's commands part of the same protocol. The program is stopped when 
 target is closed (at the end of the run, also after Ctrl-C once the session has halted
 the unit), and a program that ends during the run makes the target not responding at
 once.
+
+A command that cannot be started is the user's mistake (one line, exit status 2); a
+program that started and then serves no port — it ends, says nothing, or its first line
+is neither a port it can open nor ``cosim N`` — is the target's fault: the run goes on,
+its session cannot begin, every case COULD-NOT-TEST saying why (its bytes escaped).
 """
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
 
+from conformance.link.interrupts import Interrupts
+from conformance.protocol.bounded import decimal
+from conformance.quoting import shown
 from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
 from conformance.targets.cosim import (
@@ -32,6 +41,7 @@ from conformance.targets.cosim import (
 from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
+from conformance.targets.session import Session, SessionError
 from conformance.targets.targetport import ENDING_SECONDS, TargetPort
 from gve_fixtures.profile import available_profiles
 
@@ -47,7 +57,8 @@ def port_url(line: str) -> str | None:
     if text.startswith("/") or "://" in text:
         return text
     host, colon, port = text.rpartition(":")
-    if colon and host and port.isdigit() and " " not in host:
+    number = decimal(port)
+    if colon and host and number is not None and 0 < number < 65536 and " " not in host:
         return f"socket://{host}:{port}"
     return None
 
@@ -60,8 +71,21 @@ class ProcessTarget(PortTarget):
         super().__post_init__()
         self.program: Program | None = None
         self.rig: ControlRig | None = None
+        self.unserved = ""          # why the program served no port: the target's fault
+
+    def preflight(self) -> None:
+        with contextlib.suppress(SessionError):     # said by the session, case by case
+            self._open()
+
+    def begin(self, interrupts: Interrupts | None = None) -> Session:
+        session = super().begin(interrupts)
+        if self.unserved:
+            session.failed = self.unserved
+        return session
 
     def _open(self):
+        if self.unserved:
+            raise SessionError(self.unserved)
         if self._port is None:
             first = self._start()
             version = announced(first)
@@ -72,14 +96,19 @@ class ProcessTarget(PortTarget):
             try:
                 self._port = TargetPort(open_port(url, self.baud, self.info.spec),
                                          self.program)
-            except TargetError:
-                self._stop()
-                raise
+            except TargetError as err:
+                self._unserved(f"the program's port cannot be used: {err}")
         return self._port
 
     def _fail(self, why: str) -> NoReturn:
         self._stop()
         raise TargetError(f"{self.info.spec}: {why}")
+
+    def _unserved(self, why: str) -> NoReturn:
+        """The program started and serves no port: the target's fault, not the user's."""
+        self._stop()
+        self.unserved = f"{self.info.spec}: {why}"
+        raise SessionError(self.unserved)
 
     def _start(self) -> str:
         """Start the program; its first line."""
@@ -91,16 +120,16 @@ class ProcessTarget(PortTarget):
         if first is None:
             program.wait(ENDING_SECONDS)
             tail = program.stderr_tail()
-            self._fail(f"the program printed no port: {program.ended()}" if not program.alive
+            self._unserved(f"the program printed no port: {program.ended()}" if not program.alive
                        else f"the program printed no port within {FIRST_LINE_SECONDS:g} s"
-                       + (f" (stderr: {tail})" if tail else ""))
+                       + (f" (stderr: {shown(tail)})" if tail else ""))
         return first
 
     def _serve_port(self, first: str) -> str:
         """The port the first line names and the rig on standard input; the port's URL."""
         url = port_url(first)
         if url is None:
-            self._fail(f"the program's first line {first[:200]!r} is not a port (a pty "
+            self._unserved(f"the program's first line {shown(first)} is not a port (a pty "
                        "path, socket://HOST:PORT or HOST:PORT) nor cosim 1")
         self.program.read_in_background()              # it never blocks on its output
         self.rig = ControlRig.detect(self.program, self.address, self._restarted)
@@ -157,7 +186,7 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
     if not command:
         raise TargetError(f"{spec}: give the command that starts the simulator "
                           "(exec:'./clone-sim --pty')")
-    p = real_profile(spec, profile, mutant, max_travel,
+    p = real_profile(spec, profile, mutant,
                      "put --mutant NAME in the command when it is the emulator")
     info = TargetInfo(kind, spec, False, False, allow_destructive, max_travel, strict)
     return ProcessTarget(info, p, p.address, p.default_baud, spec, command=tuple(command))

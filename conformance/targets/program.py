@@ -25,6 +25,9 @@ import tempfile
 import threading
 import time
 
+from conformance.link.interrupts import Interrupts
+from conformance.quoting import shown
+
 #: how long the program may take to end after ``quit``, then after SIGTERM
 QUIT_SECONDS = 2.0
 TERM_SECONDS = 2.0
@@ -47,9 +50,13 @@ class Program:
         self.command = command
         self._stderr = tempfile.TemporaryFile()  # noqa: SIM115  (open while it runs)
         try:
-            self.process = subprocess.Popen(
-                command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._stderr,
-                process_group=0, close_fds=True)
+            # a signal waits until the program is known (and stopped at exit): never a
+            # Popen lost as fork_exec returns, its program running on
+            with Interrupts.held():
+                self.process = subprocess.Popen(
+                    command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                    stderr=self._stderr, process_group=0, close_fds=True)
+                _RUNNING.add(self)
         except (OSError, ValueError) as err:
             self._stderr.close()
             reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
@@ -59,7 +66,6 @@ class Program:
         self._lines: queue.Queue[str | None] = queue.Queue()
         self._background = False
         self._eof = False
-        _RUNNING.add(self)
 
     # -- what it says ---------------------------------------------------------------------
     def _take(self, timeout: float | None) -> str | None:
@@ -174,7 +180,7 @@ class Program:
         how = (f"was killed by signal {-status}" if status < 0 else
                f"exited with status {status}")
         tail = self.stderr_tail()
-        return f"{shlex.join(self.command)} {how}" + (f" (stderr: {tail})" if tail else "")
+        return f"{shlex.join(self.command)} {how}" + (f" (stderr: {shown(tail)})" if tail else "")
 
     # -- the end -----------------------------------------------------------------------------
     def stop(self) -> None:

@@ -13,10 +13,11 @@ A rig that does not answer in time or refuses a command makes the case COULD-NOT
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 
 from conformance.link.safety import TargetNotResponding
+from conformance.protocol.bounded import decimal, hexadecimal, json_object
+from conformance.quoting import shown
 from conformance.targets.program import Program
 from conformance.verdict import CouldNotTest
 
@@ -29,14 +30,6 @@ DETECT_SECONDS = 1.0
 REPLY_SECONDS = 5.0
 #: an input port the rig's hands do not touch reads all ones (nothing grounded)
 RELEASED = 0xFF
-
-
-def _object(reply: str | None) -> dict | None:
-    try:
-        value = json.loads(reply) if reply else None
-    except ValueError:
-        return None
-    return value if isinstance(value, dict) else None
 
 
 def over_program(program: Program) -> Ask:
@@ -77,7 +70,7 @@ class ControlRig:
         program.discard()
         if not program.send("state"):
             return None
-        found = _object(program.line(DETECT_SECONDS))
+        found = json_object(program.line(DETECT_SECONDS))
         return None if found is None else cls(over_program(program), found, address,
                                                on_power_on)
 
@@ -85,20 +78,20 @@ class ControlRig:
     def found_in(cls, reply: str, ask: Ask, address: int,
                  on_power_on: Callable[[], None] = lambda: None) -> ControlRig | None:
         """The rig, when ``reply`` (to `state`) is a JSON object; else None (no rig)."""
-        found = _object(reply)
+        found = json_object(reply)
         return None if found is None else cls(ask, found, address, on_power_on)
 
     # -- the channel ---------------------------------------------------------------------------
     def _ask(self, command: str) -> str:
         reply = self.ask(command)
         if reply.startswith("error"):
-            raise CouldNotTest(f"the rig refused {command!r}: {reply}")
+            raise CouldNotTest(f"the rig refused {command!r}: {shown(reply)}")
         return reply
 
     def _do(self, command: str) -> None:
         reply = self._ask(command)
         if reply.strip().lower() != "ok":
-            raise CouldNotTest(f"the rig answered {command!r} with {reply!r}, not ok")
+            raise CouldNotTest(f"the rig answered {command!r} with {shown(reply)}, not ok")
 
     def _unit(self, state: dict) -> dict:
         """One unit's state (a simulator of several units answers one per address)."""
@@ -128,23 +121,25 @@ class ControlRig:
 
     def state(self, address: int | None = None) -> dict:
         reply = self._ask(f"state{self._at(address)}")
-        state = _object(reply)
+        state = json_object(reply)
         if state is None:
-            raise CouldNotTest(f"the rig's state is not one JSON object: {reply[:200]!r}")
+            raise CouldNotTest(f"the rig's state is not one JSON object: {shown(reply)}")
         return self._unit(state)
 
-    def _number(self, key: str, base: int) -> int:
+    def _number(self, key: str, read: Callable[[str], int | None]) -> int:
         value = self.state().get(key)
-        try:
-            return int(str(value), base)
-        except ValueError:
-            raise CouldNotTest(f"the rig's state gives no readable {key!r}: {value!r}") from None
+        # a JSON number or its text, read as the rig writes it (bool is no number)
+        number = None if isinstance(value, bool) else read(str(value))
+        if number is None:
+            raise CouldNotTest(f"the rig's state gives no readable {key!r}: "
+                               f"{shown(str(value))}")
+        return number
 
     def outputs(self, address: int | None = None) -> int:
-        return self._number("outputs", 16)
+        return self._number("outputs", hexadecimal)
 
     def spindle(self, address: int | None = None) -> int:
-        return self._number("spindle", 10)
+        return self._number("spindle", decimal)
 
     def hands_off(self) -> None:
         """The rig as found: the inputs the suite set back to their levels then, the
@@ -152,10 +147,8 @@ class ControlRig:
         inputs = self.found.get("inputs")
         for port in sorted(self._touched):
             level = inputs.get(str(port), "FF") if isinstance(inputs, dict) else "FF"
-            try:
-                value = int(str(level), 16)
-            except ValueError:
-                value = RELEASED
+            value = hexadecimal(str(level))
+            value = RELEASED if value is None or value > 0xFF else value
             if self._touched[port] != value:
                 self._do(f"in {port} {value:02X}{self._at(None)}")
         for axis in sorted(self._switches):

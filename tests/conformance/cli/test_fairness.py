@@ -4,11 +4,17 @@ emulator FAILs the same difference; the score line."""
 
 from __future__ import annotations
 
+import random
+import signal
+
+import pytest
+
 from conformance.catalogue import select
 from conformance.cli import main
 from conformance.runner import run_case
 from conformance.targets import parse_target
 from conformance.verdict import FAIL, NON_STRICT
+from tests.processes import alive, descendants, signalled
 
 
 def test_an_emulator_taking_a_reading_is_graded_by_the_tags():
@@ -50,3 +56,19 @@ def test_diff_runs_against_the_reading_and_names_the_rule_it_reads(capsys):
         assert "NON-STRICT 8.index.queries-uncounted" in line and "FAIL" not in \
             line.replace("NON-STRICT", ""), line
     assert "fairness score: 1/1 = 100.0 %" in out
+
+
+@pytest.mark.parametrize(("sig", "group"), [(signal.SIGINT, True), (signal.SIGTERM, False),
+                                            (signal.SIGHUP, False)],
+                         ids=["SIGINT-to-the-group", "SIGTERM", "SIGHUP"])
+def test_a_signal_stops_every_worker_with_one_line(sig, group):
+    """SIGINT (to the process group, as a terminal sends it), SIGTERM or SIGHUP at a
+    drawn instant while two readings are tried: the workers end, one last line, 130."""
+    delay = random.Random(f"fairness {sig}").uniform(0.0, 1.5)
+    argv = ["fairness", "--jobs", "2", "--reading", "plus-sign", "--reading", "queries-counted"]
+    status, out, started = signalled(argv, sig, group=group, delay=delay,
+                                     ready=lambda pid: len(descendants(pid)) >= 2)
+    assert status == 130, out
+    assert "Traceback" not in out, out
+    assert out.splitlines()[-1].startswith("fairness: interrupted by a signal after "), out
+    assert len(started) >= 2 and not any(alive(p) for p in started)

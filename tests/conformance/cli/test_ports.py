@@ -1,6 +1,8 @@
 """`gve-conformance ports --probe` disturbs nobody: a port another program holds
 (TIOCEXCL, a lock) gets no byte and keeps its settings, and says
-why it was skipped; a free port gets `?` only and its settings back."""
+why it was skipped; a free port gets `?` only and its settings back; a pseudo-terminal
+that was not named (found by a glob, as the docs' `--glob '/dev/pts/*'`: somebody's
+interactive terminal) gets no byte at all."""
 
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ def only_globbed(monkeypatch):
 
 
 def probe(path: str, capsys) -> str:
-    assert main(["ports", "--glob", path, "--probe"]) == 0
+    assert main(["ports", "--probe", path]) == 0         # named: a pty too is asked
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 1 and out[0].startswith(path)
     return out[0]
@@ -69,3 +71,16 @@ def test_what_is_no_serial_device_is_skipped(tmp_path, capsys):
     plain.write_text("")
     assert probe(str(plain), capsys).endswith("-> skipped: not a serial device")
     assert plain.read_text() == ""
+
+
+def test_a_pseudo_terminal_a_glob_found_gets_no_byte(pty, capsys):  # noqa: F811
+    master, slave, path = pty
+    settings = cooked(slave)
+    assert main(["ports", "--glob", path, "--probe"]) == 0
+    (line,) = capsys.readouterr().out.splitlines()
+    assert line.endswith(f"-> skipped: a pseudo-terminal (an interactive terminal, or "
+                         f"another program's line): probed only when named, "
+                         f"gve-conformance ports --probe {path}")
+    assert pending(master) == b""
+    assert termios.tcgetattr(slave) == settings
+    assert ports.is_pseudo_terminal(path) and not ports.is_pseudo_terminal("/dev/null")

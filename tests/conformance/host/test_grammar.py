@@ -117,3 +117,13 @@ def test_a_frame_is_classed_as_every_reader_classes_it_and_judged_strictly():
     assert [p.rule for p in plus.problems] == ["3.params.decimal"]
     assert parse_frame(b"!0SW0,80", GVE84, False).key == "SW"
     assert command_of(b"!0H", GVE84) == "H" and command_of(b"!0h", GVE84) is None
+
+
+@pytest.mark.parametrize("raw", [b"!0L" + b"1" * 5000 + b",0,0", b"!0SW1," + b"F" * 5000,
+                                 b"!0L\x1b]0;x\x07,0,0"])
+def test_a_host_s_hostile_field_is_a_problem_of_its_frame_shown_escaped(raw):
+    """More digits than int() reads, or an escape sequence: a problem named by its rule,
+    never a crash, never a raw control byte in what a report shows."""
+    problems = parse_frame(raw, GVE84, False).problems
+    assert problems and all(p.rule for p in problems)
+    assert not any(ch in p.what for p in problems for ch in "\x1b\x07")

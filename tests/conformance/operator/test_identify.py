@@ -80,8 +80,12 @@ def test_ports_lists_and_probes_a_pty_backed_port(unit, capsys, tmp_path, monkey
     link = tmp_path / "ttyUSB-bench"
     link.symlink_to(unit.path)                        # as udev names an adapter
     (tmp_path / "ttyUSB-nothing").write_text("")      # no device: nothing written to it
+    # the symlink named: asked, though a pty is behind it; found by the glob: not asked
+    assert main(["ports", "--glob", str(tmp_path / "tty*"), "--probe", str(link)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith('-> GVE54: ? "Ip54v3 21.12.2007" at 115200 baud, address 0')
+    assert out[1].endswith("-> skipped: not a serial device")
     assert main(["ports", "--glob", str(tmp_path / "tty*"), "--probe"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].endswith("-> GVE54: ? 'Ip54v3 21.12.2007' at 115200 baud, address 0")
-    assert out[1].endswith("-> skipped: not a serial device")
+    assert "-> skipped: a pseudo-terminal" in out[0]
     assert (tmp_path / "ttyUSB-nothing").read_text() == ""

@@ -40,6 +40,10 @@ MISTAKES = {
     "envelope of no steps": (["--target", "serial:/dev/null", "--profile", "GVE84-100",
                               "--max-travel", "0"], "--max-travel: '0': give 1 or more"),
     "envelope not a number": (["--max-travel", "far"], "not a whole number: 'far'"),
+    # one bound on every target: the embedded emulator's, and with no target at all
+    "envelope beyond the GVE54's vectors": (["--target", "emu:GVE54", "--max-travel",
+                                             "70000"], "1 to 65535 full steps on the GVE54"),
+    "envelope beyond a vector, no target": (["--max-travel", "70000"], "on the GVE54"),
     "unknown scheme": (["--target", "bogus:x"], "unknown target 'bogus:x'"),
     "unknown profile": (["--target", "emu:GVE99"], "GVE99"),
     "real target without a profile": (["--target", "tcp:127.0.0.1:9"], "--profile"),
@@ -70,6 +74,17 @@ def test_an_unwritable_report_dir_is_refused_before_anything_is_sent(tmp_path, c
     assert err.count("\n") == 1 and "cannot write reports to" in err
 
 
+@pytest.mark.parametrize("subcommand", ["diff", "replay"])
+def test_the_envelope_has_one_bound_in_every_subcommand(subcommand, capsys, tmp_path):
+    transcript = tmp_path / "t.gvt"
+    transcript.write_text("# gve-transcript 1\n> !0?\\r\n")
+    argv = [subcommand, *([str(transcript)] if subcommand == "replay" else []),
+            "--target", "emu:GVE54", "--max-travel", "70000"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "1 to 65535 full steps on the GVE54" in err, err
+
+
 def test_a_closed_pipe_ends_quietly():
     proc = subprocess.run(f"{sys.executable} -m conformance --list | head -1", shell=True,
                           capture_output=True, text=True, timeout=60)
@@ -87,6 +102,10 @@ PLUGIN_MISTAKES = {
     "profile contradicting emu": (["--gve-target", "emu:GVE54", "--gve-profile", "GVE84-100"],
                                   "contradicts"),
     "unknown mutant": (["--gve-target", "emu:GVE84-100?mutant=nosuch"], "unknown mutant"),
+    "envelope of no steps": (["--gve-target", "emu:GVE84-100", "--gve-max-travel", "0"],
+                             "--max-travel 0: the envelope is 1 to"),
+    "envelope beyond the GVE54's vectors": (["--gve-target", "emu:GVE54",
+                                             "--gve-max-travel", "70000"], "on the GVE54"),
     **{f"tcp target {what}": (["--gve-target", spec, "--gve-profile", "GVE84-100"],
                               "tcp:HOST:PORT")
        for what, spec in BAD_TCP.items()},

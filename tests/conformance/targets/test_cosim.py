@@ -59,6 +59,9 @@ for line in sys.stdin:
         "overshoot": [f"now {goal + 1}"],
         "short": [f"now {goal - 1}"],
         "garbage": ["hello there"],
+        "digits": [f"now {goal}²"],
+        "huge": ["now " + "9" * 5000],
+        "escape": ["\x1b]0;title\x07\x1b[2J"],
         "error": ["error: the clock is broken"],
         "after-cr": [f"rx {goal - 2000} 0D", f"rx {goal - 1000} 30", f"now {goal}"],
     }[mode]
@@ -77,10 +80,13 @@ SAYS = {
     "future": "a byte in the future",
     "overshoot": "past the instant",
     "short": "where the clock had to stop",
-    "garbage": "'hello there': not rx T HEX or now T",
+    "garbage": '"hello there": not rx T HEX or now T',  # quoted as a target's text is
     "error": "it refused",
     "after-cr": "after the CR",
-    "dies": "exited with status 3 (stderr: the simulator gave up)",
+    "dies": 'exited with status 3 (stderr: "the simulator gave up")',
+    "digits": "²\": not now T",                   # str.isdigit() takes ², int() does not
+    "huge": "99...\": not now T",                 # more digits than int() reads
+    "escape": '"\\x1B]0;title\\x07\\x1B[2J": not rx T HEX',   # escaped, not run
 }
 
 
@@ -187,7 +193,7 @@ def test_the_command_line_says_fail_and_exits_1():
                            "--cases", "5.errors.*"], capture_output=True, text=True,
                           timeout=120, stdin=subprocess.DEVNULL)
     assert done.returncode == 1, done.stdout + done.stderr
-    assert "FAIL" in done.stdout and "'hello there'" in done.stdout
+    assert "FAIL" in done.stdout and '"hello there"' in done.stdout
     assert "Traceback" not in done.stdout + done.stderr
 
 

@@ -227,9 +227,6 @@ def test_the_program_is_stopped_after_ctrl_c(tmp_path, stopping):
     ("exec:", "give the command"),
     ("exec:'unclosed", "cannot read the command"),
     ("exec:no-such-program-here --pty", "cannot start 'no-such-program-here'"),
-    ("exec:false", "printed no port: false exited with status 1"),
-    ("exec:sh -c 'echo bad news >&2; exit 3'", "exited with status 3 (stderr: bad news)"),
-    ("exec:echo hello", "first line 'hello' is not a port"),
 ])
 def test_a_bad_exec_spec_is_one_line_and_exit_status_2(capsys, spec, says):
     assert main(["--target", spec, "--profile", "GVE84-100", "--no-reports"]) == 2
@@ -237,11 +234,31 @@ def test_a_bad_exec_spec_is_one_line_and_exit_status_2(capsys, spec, says):
     assert err.count("\n") == 1 and says in err, err
 
 
+@pytest.mark.parametrize(("spec", "says"), [
+    ("exec:false", "printed no port: false exited with status 1"),
+    ("exec:sh -c 'echo bad news >&2; exit 3'", 'exited with status 3 (stderr: "bad news")'),
+    ("exec:echo hello", 'first line "hello" is not a port'),
+    ("exec:echo cosim ²", 'first line "cosim ²" is not a port'),
+    ("exec:echo /no/such/port", "the program's port cannot be used"),
+])
+def test_a_program_that_serves_no_port_is_the_targets_fault(capsys, spec, says):
+    """Not a mistake on the command line: the run ends FAILED, every case COULD-NOT-TEST
+    naming the target and what it printed."""
+    assert main(["--target", spec, "--profile", "GVE84-100", "--cases", "5.errors.ok",
+                 "--yes", "--no-reports"]) == 1
+    captured = capsys.readouterr()
+    assert captured.err == "" and "Traceback" not in captured.out
+    assert f"COULD-NOT-TEST  5.errors.ok [GVE84-100]  -- not run: {spec}: " in captured.out
+    assert says in captured.out
+    assert captured.out.splitlines()[-1].startswith("FAILED — no case could judge the target")
+
+
 def test_a_program_that_prints_nothing_is_given_up(monkeypatch, capsys):
     monkeypatch.setattr(process, "FIRST_LINE_SECONDS", 0.3)
     monkeypatch.setattr("conformance.targets.program.QUIT_SECONDS", 0.2)
-    assert main(["--target", "exec:sleep 30", "--profile", "GVE84-100", "--no-reports"]) == 2
-    assert "printed no port within 0.3 s" in capsys.readouterr().err
+    assert main(["--target", "exec:sleep 30", "--profile", "GVE84-100", "--cases",
+                 "5.errors.ok", "--yes", "--no-reports"]) == 1
+    assert "printed no port within 0.3 s" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(("argv", "says"), [

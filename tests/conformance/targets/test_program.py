@@ -84,7 +84,7 @@ def test_how_it_ended_names_the_command_the_status_and_stderr():
     assert p.line(10) is None                 # its output ended
     assert p.wait(10)
     assert p.ended() == "sh -c 'echo first >&2; echo last words >&2; exit 3' exited with " \
-                        "status 3 (stderr: last words)"
+                        'status 3 (stderr: "last words")'
     p.stop()
 
 

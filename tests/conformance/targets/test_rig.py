@@ -83,7 +83,7 @@ def test_a_program_whose_state_is_not_an_object_has_no_rig(started, answer):
 def test_a_refused_command_makes_the_case_could_not_test(started):
     rig = ControlRig.detect(started(EMULATOR), 0)
     assert rig is not None
-    with pytest.raises(CouldNotTest, match=r"the rig refused 'in 5 00': error: "):
+    with pytest.raises(CouldNotTest, match=r"the rig refused 'in 5 00': \"error: "):
         rig.set_input(5, 0x00)
 
 
@@ -98,16 +98,16 @@ def test_a_rig_that_stops_answering_makes_the_case_could_not_test(started, monke
 def test_a_state_without_what_a_case_reads_makes_the_case_could_not_test(started):
     rig = ControlRig.detect(started(simulator({"state": '{"outputs": "zz"}'})), 0)
     assert rig is not None
-    with pytest.raises(CouldNotTest, match="no readable 'outputs': 'zz'"):
+    with pytest.raises(CouldNotTest, match="no readable 'outputs': \"zz\""):
         rig.outputs()
-    with pytest.raises(CouldNotTest, match="no readable 'spindle': None"):
+    with pytest.raises(CouldNotTest, match="no readable 'spindle': \"None\""):
         rig.spindle()
 
 
 def test_a_reply_that_is_not_ok_makes_the_case_could_not_test(started):
     rig = ControlRig.detect(started(simulator({"state": "{}", "power-on": "done"})), 0)
     assert rig is not None
-    with pytest.raises(CouldNotTest, match="answered 'power-on' with 'done', not ok"):
+    with pytest.raises(CouldNotTest, match="answered 'power-on' with \"done\", not ok"):
         rig.power_on()
 
 

@@ -1,0 +1,120 @@
+"""The worker pool of `mutation` and `fairness`: SIGINT, SIGTERM and SIGHUP alike — to
+the main process, to one worker alone, or the main process killed outright — end the
+map with the results so far, every worker ended, nothing raised past the pool."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conformance.cli.pool import WorkerFailed, workers
+from conformance.link.interrupts import STOPPING
+
+#: seconds a job "works" when it is not the first: long enough to be stopped in
+LONG = 60.0
+
+
+def job(n: int) -> int:
+    """Returns at once for 0, else runs until stopped (or LONG seconds pass)."""
+    end = time.monotonic() + (0 if n == 0 else LONG)
+    while time.monotonic() < end:
+        pass
+    return n
+
+
+def pid_of_worker(n: int) -> int:
+    return os.getpid()
+
+
+def failing(n: int) -> int:
+    raise ValueError(f"job {n} broke")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # a zombie is no worker: it has ended, its parent has not reaped it yet
+    status = f"/proc/{pid}/stat"
+    return not (os.path.exists(status) and open(status).read().split()[2] == "Z")
+
+
+def _children() -> list[int]:
+    task = f"/proc/{os.getpid()}/task/{os.getpid()}/children"
+    return [int(p) for p in open(task).read().split()] if os.path.exists(task) else []
+
+
+@pytest.mark.parametrize("sig", STOPPING, ids=lambda s: signal.Signals(s).name)
+def test_a_signal_to_this_process_stops_every_worker_and_ends_the_map(sig):
+    got, started = [], time.monotonic()
+    with workers(2) as pool:
+        for result in pool.map(job, [0, 1, 2, 3]):
+            got.append(result)
+            if result == 0:
+                pids = _children()
+                os.kill(os.getpid(), sig)
+    assert got == [0] and pool.interrupted
+    assert time.monotonic() - started < LONG / 2
+    assert pids and not any(_alive(p) for p in pids)
+
+
+def test_a_signal_to_one_worker_alone_stops_them_all():
+    with workers(2) as pool:
+        for result in pool.map(job, [0, 1, 2, 3]):
+            if result == 0:
+                pids = _children()
+                os.kill(pids[0], signal.SIGTERM)
+    assert pool.interrupted
+    assert not any(_alive(p) for p in pids)
+
+
+def test_without_a_signal_every_result_comes_in_order_and_the_workers_end():
+    with workers(3) as pool:
+        got = list(pool.map(pid_of_worker, range(9)))
+    assert not pool.interrupted and len(got) == 9
+    assert os.getpid() not in got and not any(_alive(p) for p in set(got))
+
+
+def test_a_job_that_raises_is_the_pools_error_once_the_workers_ended():
+    with pytest.raises(WorkerFailed, match=r"job \d broke"), workers(2) as pool:
+        list(pool.map(failing, [1, 2]))
+    assert _children() == []
+
+
+def test_one_job_runs_here_and_stops_alike():
+    with workers(1) as pool:
+        for result in pool.map(job, [0, 1]):
+            if result == 0:
+                os.kill(os.getpid(), signal.SIGHUP)
+    assert pool.interrupted
+
+
+def test_workers_whose_parent_is_killed_outright_end():
+    """No orphan: the main process killed with SIGKILL (no handler runs) leaves no worker
+    running."""
+    code = ("import sys; sys.path.insert(0, %r)\n"
+            "from tests.conformance.cli.test_pool import job\n"
+            "from conformance.cli.pool import workers\n"
+            "with workers(2) as pool:\n"
+            "    for r in pool.map(job, [0, 1, 2]):\n"
+            "        import os; print(open(f'/proc/{os.getpid()}/task/{os.getpid()}/children')"
+            ".read(), flush=True)\n") % os.getcwd()
+    main = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        pids = [int(p) for p in main.stdout.readline().split()]
+        assert pids
+        main.kill()
+        main.wait(10)
+        end = time.monotonic() + 20           # a deadline for the condition, not a sleep
+        while any(_alive(p) for p in pids) and time.monotonic() < end:
+            time.sleep(0.05)
+        assert not any(_alive(p) for p in pids)
+    finally:
+        main.kill()
+        main.wait()
