@@ -124,7 +124,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
         pending = []
         for f, answer in batches:
             if f.address in guard.addresses:
-                need = max(need, *(guard.farthest(body) for body in f.bodies(None)))
+                need = max(need, *(guard.farthest(body) for body in f.bodies(summed)))
             body = f.bodies(summed)[0]
             r = None if answer is None else parse_response(answer, summed=summed)
             guard.accepted(body, r, f.address)

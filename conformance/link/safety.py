@@ -63,6 +63,8 @@ LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
 _PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
+#: frames that set the checksum mode, and so how the unit reads the frames after them
+_SUMMING = classes(summing=True)
 #: what a command sets moving again, by name: "queue" or "save"
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 #: consecutive frames without an answer after which the target is given up
@@ -214,11 +216,16 @@ class Guard:
         return True
 
     def check_frames(self, frames: list[HostFrame], summed: bool | None) -> None:
-        """:meth:`check` every reading of raw frames (with and without a trailing
-        checksum when the mode is not known)."""
+        """:meth:`check` raw frames as the unit reads them: in checksum mode (``summed``)
+        a frame's last field is its checksum, not a component (spec 6); when the mode is
+        not known (None), and after a frame that may set it, every reading (with and
+        without a trailing checksum)."""
         for f in frames:
-            for body in f.bodies(summed):
+            bodies = f.bodies(summed)
+            for body in bodies:
                 self.check(body, f.address if f.address is not None else self.address)
+            if any(Body.parse(body).name in _SUMMING for body in bodies):
+                summed = None
 
     def _check_destructive(self, body: str, command: Body) -> None:
         if not self.allow_destructive:
