@@ -235,8 +235,12 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 
 def cmd_delete(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if dev.mutant.active("delete-refused"):
+        raise CommandError(ErrorCode.BUSY, "D refused at rest")
     if not dev.mutant.active("delete-while-moving"):
         dev.refuse_while_moving(t)
+    if dev.mutant.active("delete-ignored"):
+        return []
     dev.motion.clear(t)
     s = dev.state
     s.status[4] = s.status[5] = s.status[6] = 0
