@@ -282,5 +282,14 @@ class Envelope:
         self.set_counters = False
         self._see()
 
+    def anchor(self, counters: dict[int, int]) -> None:
+        """Counters read while the axes are known not to have moved since the bookkeeping
+        last knew them (at rest, right after a set of the counters): each is anchored to
+        where the bookkeeping has its axis, so a counter that did not take the set is not
+        taken for motion."""
+        for axis, value in counters.items():
+            self.offset[axis] = self.start[axis] - point(value)
+        self.set_counters = False
+
     def _see(self) -> None:
         self.seen = [a.hull(b) for a, b in zip(self.seen, self.reach(), strict=True)]

@@ -155,6 +155,7 @@ class Guard:
         self._own = _Depth()                      # inside the session's own frames
         self._emergency = _Depth()
         self._hands_on = _Depth()                 # a technician's hand step is open
+        self._unmoved = _Depth()                  # reads with nothing moved since the last
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
@@ -169,6 +170,12 @@ class Guard:
     def emergency(self) -> _Depth:
         """`H` and `D` after Ctrl-C: the frames that go out before anything else."""
         return self._emergency
+
+    def unmoved(self) -> _Depth:
+        """Position reads the session takes at rest with nothing sent that moves since the
+        bookkeeping last knew where the axes are (right after `N`): a counter read
+        otherwise is a counter that did not take the set, never motion."""
+        return self._unmoved
 
     def hands_on(self) -> _Depth:
         """A technician's hand step is open (a prompt waits for them): no motion until it
@@ -398,7 +405,19 @@ class Guard:
         elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
-                self.envelope.observe({i: int(r.values[i]) for i in range(axes)})
+                read = {i: int(r.values[i]) for i in range(axes)}
+                (self.envelope.anchor if self._unmoved else self.envelope.observe)(read)
+
+    def doubt_rest(self) -> None:
+        """The unit showed that something may still move although an answer said
+        otherwise (a `D` answered 0 that left INTA and RUN): no position read tells where
+        the axes rest until the unit shows rest again (RUN = 0, an `L` or `N` it takes)."""
+        self.envelope.settled = False
+
+    @property
+    def keep_held(self) -> bool:
+        """Whether a `K` the unit took (or may have) holds a save no `R` or `J` gave back."""
+        return self.envelope.saved is not None
 
     # -- answers and silences ----------------------------------------------------------------
     def answered(self, response: Response | None) -> None:

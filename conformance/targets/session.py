@@ -11,7 +11,11 @@ examples:
   its checksum mode, ST0..ST5, where the axes are, and — when destructive commands are
   allowed — every EEPROM byte, before the run's first EEPROM write;
 - the known state a case starts from (:meth:`open_link`): `H`, `D`, the reset values of
-  what cannot be read, the axes back where the run began, counters zeroed;
+  what cannot be read, the axes back where the run began, counters zeroed — by the
+  manuals' rules only, and read back (ST6 at rest, the counters at 0): a step the unit
+  refuses, or that does not do what its rule says, is a FAIL of that rule
+  (:class:`StepFailure`, once a run) and the run goes on where it safely can; a unit not
+  brought to rest leaves the case COULD-NOT-TEST, naming what was left;
 - Ctrl-C (:meth:`emergency_stop`: `H`, then `D`) and the restorations
   (:meth:`finish`): EEPROM and status words put back and verified by reading back, the
   checksum mode as found, what cannot be read set to the reset state; what could not be
@@ -33,12 +37,18 @@ from conformance.known_state import known_axis_limits
 from conformance.link.framing import HostFramer, Response, frame
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import (
+    LONGEST_ANSWER_S,
+    EmulatorGuard,
+    Guard,
+    SafetyStop,
+    TargetNotResponding,
+)
 from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode, St6
+from gve_fixtures.protocol import SECOND, ErrorCode, St6
 
 
 class Reachable(Protocol):
@@ -60,8 +70,35 @@ RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
 EEPROM_READS = 64
 
 
+#: how often the known state asks whether a halted remainder `D` did not delete has run
+#: out: a remainder whose axes did not move for that long is stuck (then `H` again)
+RUN_OUT_POLL_S = 1.0
+#: ST6 bits that keep a unit from being at rest for a case: moving, braking, or
+#: interrupted with vectors waiting for `G` (spec 10.3: INTA/RUN 0/0 is idle [M])
+NOT_AT_REST = St6.RUN | St6.STOP | St6.INTA
+
+
 class SessionError(Exception):
     """The session cannot begin on this target (one line for the user)."""
+
+
+@dataclass(frozen=True)
+class StepFailure:
+    """A known-state step the unit refused, or that did not do what its rule says. The
+    machinery relies on the manuals' rules only (spec preamble), so this is a failure of
+    that rule, reported once a run under the rule's section with the evidence, not a
+    wall of COULD-NOT-TEST nor a FAIL of the case that was about to begin."""
+
+    rule: str          # the rule of fixtures/rules.toml the step relies on
+    step: str          # the step, for the result's ID: "delete", "zero", "return-move"
+    what: str
+    observed: str
+    expected: str
+
+
+class StepFailed(CouldNotTest):
+    """The known state could not be set for a case (a step failed, or the unit is not at
+    rest): the case is COULD-NOT-TEST with the reason."""
 
 
 @dataclass
@@ -111,6 +148,9 @@ class Session:
         self.failed = ""                           # why the session could not begin
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
+        #: the known-state steps that failed, each rule once (:class:`StepFailure`)
+        self.failures: list[StepFailure] = []
+        self._untaken = 0                           # failures not yet taken by the run
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return EmulatorGuard(self.profile, self.target.address, interrupts)
@@ -179,6 +219,19 @@ class Session:
         """The EEPROM bytes as the run found them (read now if they were not: reading
         changes nothing); empty where the unit has no `ER` or every link is a new unit."""
         return self.guard.eeprom.originals
+
+    def take_failures(self) -> list[StepFailure]:
+        """The known-state steps that failed since the last call (each rule once a run),
+        for the run to report as FAILs of their rules."""
+        new = self.failures[self._untaken:]
+        self._untaken = len(self.failures)
+        return new
+
+    def _step_failed(self, failure: StepFailure) -> StepFailure:
+        """Book ``failure`` (a rule already failed this run keeps its first evidence)."""
+        if all(f.rule != failure.rule for f in self.failures):
+            self.failures.append(failure)
+        return failure
 
     def after_case(self) -> None:
         """What a case changed that outlives it, put back (nothing on a fresh unit)."""
@@ -375,37 +428,146 @@ class RealSession(Session):
     def _has_mpg(self) -> bool:
         return self.profile.mpg is not None and "Y" in self.profile.commands
 
-    def _stop(self, link: Link, then: Sequence[str] = ()) -> None:
-        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00),
-        then `D`: the queue empty and ST6 clear (an input still enabled would set INTA
-        again at once); then the frames ``then``. An MPG that EEPROM 06 made effective
-        holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
-        the INTA of `H` outlive the stop, so it is off until the reset frames set its
-        reset mode again."""
+    def _stop(self, link: Link, then: Sequence[str] = ()) -> str:
+        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00), the
+        save of a `K` the last case left given back with `R` (the manual's inverse of `K`:
+        the queue back to its size), then `D`: the queue empty and ST6 clear (an input
+        still enabled would set INTA again at once), read back with `SR6`; then the frames
+        ``then``. Only the manuals' rules: no second `K`, no `R` with nothing kept. An MPG
+        that EEPROM 06 made effective holds the axes (the unit is moving): `D` and EEPROM
+        writes would be refused and the INTA of `H` outlive the stop, so it is off until
+        the reset frames set its reset mode again. Returns why the unit is not at rest
+        ("" when it is: :meth:`_at_rest`)."""
         mpg = ["Y-"] if self._has_mpg() else []
-        frames = [*mpg, *(f"SW{n},00" for n in range(6)), "D", *then]
+        give_back = ["R"] if self.guard.keep_held and not self.interrupts.stopped else []
+        frames = [*mpg, *(f"SW{n},00" for n in range(6)), *give_back, "D", "SR6"]
         if not link.checksums and not self.guard.packet_open:
-            link.tell(["H", *frames])              # H as _halt sends it, then the rest
-        self._halt(link)
+            link.tell(["H", *frames, *then])       # H as _halt sends it, then the rest
+        halt = self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        link.send_each(frames)
+        answers = link.send_each(frames)
+        why = self._at_rest(link, halt, answers[-2], answers[-1])
+        if give_back and not why and not _accepted(answers[-3]):
+            self._step_failed(StepFailure(
+                "10.5.restore.exact", "restore", "R gives back the save of the K the unit "
+                "accepted (not while moving)", f"R {_show(answers[-3])} at rest",
+                "R accepted"))
+        link.send_each(then)
+        return why
 
-    def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
-        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
-        interrupts off, queue and save empty, the reset values of what cannot be read. A
-        KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
-        the empty queue over it and R restores that, which moves nothing. Then the
-        frames ``then``."""
+    def _at_rest(self, link: Link, halt: Response | None, deleted: Response | None,
+                 st6: Response | None) -> str:
+        """Whether the stop left the unit at rest: RUN, STOP and INTA clear in ST6, as `D`
+        after `H` leaves it (spec 10.4 [M]: `D` is for the rest of the queue after an
+        interruption, and clears ST6). Where an INTA that `H` set outlives `D`, `D` did
+        not do what its rule says (a FAIL of that rule); the unit is then brought to rest by
+        other means (:meth:`_to_rest`) and ST6 is read again. Returns why the unit is not
+        at rest ("" when it is)."""
+        if _rests(st6):
+            return ""
+        if halt is not None and halt.ok and _bits(st6) & St6.INTA:
+            # what the bookkeeping took for deleted may still be queued: no position read
+            # tells where the axes rest until the unit shows rest
+            self.guard.doubt_rest()
+            self._step_failed(StepFailure(
+                "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
+                "clears ST6", f"H {_show(halt)}, D {_show(deleted)}, SR6 {_show(st6)}",
+                "D 0, then SR6 with RUN, STOP and INTA clear"))
+            if not self.interrupts.stopped:
+                st6 = self._to_rest(link)
+                if _rests(st6):
+                    return ""
+        return f"the unit is not at rest after the known state: SR6 reads {_show(st6)}" \
+            + _left(st6)
+
+    def _to_rest(self, link: Link) -> Response | None:
+        """At rest by other means than `D`, by the manuals' rules: `G`, and the remainder
+        runs out (:meth:`_run_out`; the axes end where the bookkeeping knows them); still
+        not at rest, `J` where destructive commands are allowed (the reset state, ST6 = 00:
+        spec 9 [M]) and what cannot be read set again. Then the position read at rest,
+        and ST6 again."""
+        if not self._run_out(link):
+            self._halt(link)
+        self._position(link)
+        st6 = link.send("SR6")
+        if _rests(st6) or not self.guard.allow_destructive or "J" not in self.profile.commands:
+            return st6
+        link.send("J")
+        link.wait(self.profile.restart_ms / 1000 + MARGIN)
+        link.send_each([*(["Y-"] if self._has_mpg() else []), *self._reset_frames()])
+        self._position(link)
+        return link.send("SR6")
+
+    def _run_out(self, link: Link) -> bool:
+        """`G`, then `L0,0,0` until it is taken (0, INTA clear: nothing queued or running,
+        spec 10.1 [M]) while `PF` shows the axes moving, as long as the remainder could take
+        at the slowest `V` (the reset frames put XM back); whether it was taken."""
+        link.send("G")
+        # how far the axes may still go: the queue, or where a D the unit answered 0
+        # without deleting anything left the bookkeeping's doubt
+        travel = max(s.hi - s.lo for s in self.guard.envelope.reach())
+        seconds = 2 * travel / self.profile.range("V").lo + 2 * self.guard.stop_seconds() + 2
+        deadline = link.now + min(seconds, LONGEST_ANSWER_S) * SECOND
+        before: list[str] | None = None
+        while link.now < deadline:
+            r = link.send("L0,0,0")
+            if r is not None and r.ok and not r.inta:
+                return True
+            here = link.send("PF")
+            moved = None if here is None else here.values
+            if moved == before:                    # a second and not a step: stuck
+                return False
+            before = moved
+            link.wait(RUN_OUT_POLL_S)
+        return False
+
+    def _settle(self, link: Link, then: Sequence[str] = ()) -> str:
+        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped
+        (:meth:`_stop`), the reset values of what cannot be read, then the frames
+        ``then``. Returns why the unit is not at rest ("" when it is)."""
         if link.rig is not None:
             link.rig.hands_off()
-        self._stop(link, [*self._reset_frames(), "K", "R", *then])
+        return self._stop(link, [*self._reset_frames(), *then])
 
     def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
-        self._settle(link, ["PF"])                 # where the axes are, for the way back
+        """Stopped and at rest (read back), the reset values, the axes back where the run
+        began, the counters zeroed (read back); :class:`StepFailed` when the unit could
+        not be brought there."""
+        left = self._settle(link, ["PF"])          # where the axes are, for the way back
+        if left:
+            raise StepFailed(left)
         self._go_back(link, read=False)
-        link.tell(["N", *tell])
-        link.send("N")
+        link.tell(["N", "PF", *tell])
+        self._zero(link)
+
+    def _zero(self, link: Link) -> None:
+        """`N`, read back with `PF`: every counter 0 (spec 10 [M]). Where `N` did not zero
+        them at rest, a FAIL of its rule, and `N<axis>0` where the unit has it; counters
+        still elsewhere leave the case COULD-NOT-TEST (cases judge positions from 0)."""
+        zeroed = link.send("N")
+        with self.guard.unmoved():                 # at rest: a counter read is no motion
+            here = self._position(link)
+        if here and not any(here.values()):
+            return
+        st6 = link.send("SR6")
+        if not _rests(st6):
+            raise StepFailed(f"the unit is not at rest after the known state: N answered "
+                             f"{_show(zeroed)}, SR6 reads {_show(st6)}" + _left(st6))
+        self._step_failed(StepFailure(
+            "10.cmd.zero", "zero", "N zeroes every axis counter (the unit at rest)",
+            f"N {_show(zeroed)}, PF {_counters(here)}", "N 0, PF 0 on every axis"))
+        names = self.profile.axes
+        setters = [f"N{a}0" for a in names[:3] if f"N{a}" in self.profile.commands]
+        if setters:
+            link.send_each(setters)
+            with self.guard.unmoved():
+                here = self._position(link)
+            if here and not any(here.values()):
+                return
+        raise StepFailed(f"the position counters could not be zeroed (N answered "
+                         f"{_show(zeroed)}, PF then {_counters(here)}): the cases judge "
+                         "positions from 0")
 
     def _go_back(self, link: Link, *, read: bool = True) -> None:
         """Move the axes back to where the run began (known exactly only at rest; the
@@ -437,13 +599,31 @@ class RealSession(Session):
             return
         r = link.send(body)
         if r is None or not r.ok:
-            raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
+            self._return_refused(link, body, r)
+            return
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
         link.wait(cruise)                                  # asking before it ends is moot
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
-            raise CouldNotTest("the return to where the run began did not end in time")
+            self._step_failed(StepFailure(
+                "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "
+                f"ends: L0,0,0 is then taken (within {seconds:.1f} s)",
+                f"{body} 0, L0,0,0 not taken", "L0,0,0 answered 0"))
+            raise StepFailed("the return to where the run began did not end in time")
         self._position(link)
+
+    def _return_refused(self, link: Link, body: str, r: Response | None) -> None:
+        """The return move answered otherwise than 0: at rest (ST6 read back) that is a
+        FAIL of `L` from rest (spec 10.1 [M]) and the axes stay where they are (the
+        envelope still bounds every frame); else the case cannot begin."""
+        st6 = link.send("SR6") if r is not None else None
+        if not _rests(st6):
+            raise StepFailed(f"the return to where the run began ({body}) answered "
+                             f"{_show(r)}, SR6 then {_show(st6)}" + _left(st6))
+        self._step_failed(StepFailure(
+            "10.1.queue.line-alone", "return-move", "the return move, an L with nothing "
+            "queued or running (the unit read back at rest), is accepted",
+            f"{body} {_show(r)}, SR6 {_show(st6)}", f"{body} 0"))
 
     # -- Ctrl-C and the end --------------------------------------------------------------------
     def emergency_stop(self) -> None:
@@ -622,6 +802,36 @@ def _read_eeprom(link: Link, addresses: list[int]) -> dict[int, Response | None]
         chunk = addresses[start:start + EEPROM_READS]
         read.update(zip(chunk, link.send_each(["ER%02X" % a for a in chunk]), strict=True))
     return read
+
+
+def _show(r: Response | None) -> str:
+    return "nothing" if r is None else r.text
+
+
+def _bits(st6: Response | None) -> St6:
+    """ST6 as an `SR6` answer gives it (every bit set when it gives none: not at rest)."""
+    return St6(st6.hex()) if _hex_ok(st6) else St6(0xFF)
+
+
+def _rests(st6: Response | None) -> bool:
+    """Whether an `SR6` answer shows the unit at rest (RUN, STOP and INTA clear)."""
+    return not _bits(st6) & NOT_AT_REST
+
+
+def _left(st6: Response | None) -> str:
+    """What an `SR6` answer shows left (" (RUN, INTA)"), or nothing."""
+    if not _hex_ok(st6):
+        return ""
+    names = [b.name for b in (St6.RUN, St6.STOP, St6.INTA) if st6.hex() & b]
+    return f" ({', '.join(n or '' for n in names)})" if names else ""
+
+
+def _counters(here: dict[int, int]) -> str:
+    return ",".join(str(v) for v in here.values()) if here else "unread"
+
+
+def _accepted(r: Response | None) -> bool:
+    return r is not None and r.ok
 
 
 def _hex_ok(r: Response | None) -> bool:
