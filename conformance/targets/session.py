@@ -439,7 +439,10 @@ class RealSession(Session):
         the reset frames set its reset mode again. Returns why the unit is not at rest
         ("" when it is: :meth:`_at_rest`)."""
         mpg = ["Y-"] if self._has_mpg() else []
-        give_back = ["R"] if self.guard.keep_held and not self.interrupts.stopped else []
+        held = self.guard.keep_held and not self.interrupts.stopped
+        # R moves nothing on a unit that keeps the manual (the save holds INTA with any
+        # queue), but a unit that does not may run it: R only where the envelope takes it
+        give_back = ["R"] if held and self.guard.fits("R") else []
         frames = [*mpg, *(f"SW{n},00" for n in range(6)), *give_back, "D", "SR6"]
         if not link.checksums and not self.guard.packet_open:
             link.tell(["H", *frames, *then])       # H as _halt sends it, then the rest
@@ -448,6 +451,8 @@ class RealSession(Session):
             link.send("%-", checksum=True)
         answers = link.send_each(frames)
         why = self._at_rest(link, halt, answers[-2], answers[-1])
+        if held and not give_back and not why:
+            why = self._keep_not_given_back(link)
         if give_back and not why and not _accepted(answers[-3]):
             self._step_failed(StepFailure(
                 "10.5.restore.exact", "restore", "R gives back the save of the K the unit "
@@ -466,7 +471,12 @@ class RealSession(Session):
         at rest ("" when it is)."""
         if _rests(st6):
             return ""
-        if halt is not None and halt.ok and _bits(st6) & St6.INTA:
+        if not _bits(st6) & St6.INTA and halt is not None:
+            # moving or braking with no stop of H's left: given the longest stop to end
+            st6 = link.poll("SR6", _rests, 2 * self.guard.stop_seconds() + 2) or st6
+            if _rests(st6):
+                return ""
+        if halt is not None and halt.ok and _hex_ok(st6) and _bits(st6) & St6.INTA:
             # what the bookkeeping took for deleted may still be queued: no position read
             # tells where the axes rest until the unit shows rest
             self.guard.doubt_rest()
@@ -481,6 +491,28 @@ class RealSession(Session):
         return f"the unit is not at rest after the known state: SR6 reads {_show(st6)}" \
             + _left(st6)
 
+    def _keep_not_given_back(self, link: Link) -> str:
+        """A `K` the last case left whose save `R` would give back beyond the envelope:
+        `J` where destructive commands are allowed (the save gone with the reset); else
+        why the unit is not in the known state (its queue takes one `L` only)."""
+        if self._may_reset():
+            return "" if _rests(self._reset(link)) else "the unit is not at rest after J"
+        return ("a KEEP the last case left is still held (its R would give back a queue "
+                "the envelope cannot take), and J, which would clear it, needs "
+                "--allow-destructive")
+
+    def _may_reset(self) -> bool:
+        return self.guard.allow_destructive and "J" in self.profile.commands
+
+    def _reset(self, link: Link) -> Response | None:
+        """`J` (the reset state: ST6 = 00, spec 9 [M]), the hand wheel off and what cannot
+        be read set again; the position read at rest, ST6 read back."""
+        link.send("J")
+        link.wait(self.profile.restart_ms / 1000 + MARGIN)
+        link.send_each([*(["Y-"] if self._has_mpg() else []), *self._reset_frames()])
+        self._position(link)
+        return link.send("SR6")
+
     def _to_rest(self, link: Link) -> Response | None:
         """At rest by other means than `D`, by the manuals' rules: `G`, and the remainder
         runs out (:meth:`_run_out`; the axes end where the bookkeeping knows them); still
@@ -491,13 +523,7 @@ class RealSession(Session):
             self._halt(link)
         self._position(link)
         st6 = link.send("SR6")
-        if _rests(st6) or not self.guard.allow_destructive or "J" not in self.profile.commands:
-            return st6
-        link.send("J")
-        link.wait(self.profile.restart_ms / 1000 + MARGIN)
-        link.send_each([*(["Y-"] if self._has_mpg() else []), *self._reset_frames()])
-        self._position(link)
-        return link.send("SR6")
+        return st6 if _rests(st6) or not self._may_reset() else self._reset(link)
 
     def _run_out(self, link: Link) -> bool:
         """`G`, then `L0,0,0` until it is taken (0, INTA clear: nothing queued or running,
@@ -548,8 +574,8 @@ class RealSession(Session):
         zeroed = link.send("N")
         with self.guard.unmoved():                 # at rest: a counter read is no motion
             here = self._position(link)
-        if here and not any(here.values()):
-            return
+        if _accepted(zeroed) and here and not any(here.values()):
+            return                                 # taken: nothing runs (7 if RUN = 1)
         st6 = link.send("SR6")
         if not _rests(st6):
             raise StepFailed(f"the unit is not at rest after the known state: N answered "
@@ -664,7 +690,9 @@ class RealSession(Session):
                 self._halt(link, timeout=MARGIN, urgent=True)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._settle(link)
+        left = self._settle(link)
+        if left:
+            self.report.problems.append(f"the unit is not left at rest: {left}")
         self.report.reset.append("set to the reset state (they cannot be read): "
                                  + ", ".join(self._reset_frames()))
         if self.profile.microstep:

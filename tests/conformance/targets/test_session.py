@@ -147,3 +147,24 @@ def test_the_d_mutants_through_a_session_fail_d_not_a_wall_of_could_not_test(mut
     lost = [(r.id, r.notes[0]) for r in result.results if r.verdict == COULD_NOT_TEST]
     assert all("setup D answered" in note for _, note in lost), lost
     assert verdicts.count(PASS) > 20
+
+
+@pytest.mark.parametrize("destructive", [False, True])
+def test_a_k_whose_save_the_envelope_cannot_take_back_is_cleared_by_j_or_said(destructive):
+    # single-l leaves a K holding ~740 steps of a 990-step queue; R would count it whole
+    # from where the axes then stand, beyond an envelope of 1000
+    u = used_unit("GVE84-100", max_travel=1000, allow_destructive=destructive)
+    u.port = Rewritten(u.port, {})
+    result = run([u], select(["10.5.keep.single-l", "11.golden.g4f-status-read"]))
+    verdicts = {r.id: r.verdict for r in result.results}
+    assert verdicts["10.5.keep.single-l"] == PASS
+    assert b"!0R\r" not in frames_sent(u)
+    if destructive:
+        assert verdicts["11.golden.g4f-status-read"] == PASS and b"!0J\r" in frames_sent(u)
+        assert result.problems == []
+    else:
+        (r,) = [r for r in result.results if r.id == "11.golden.g4f-status-read"]
+        assert r.verdict == COULD_NOT_TEST and "a KEEP the last case left is still held" in \
+            r.notes[0]
+        # and the end of the run says the unit is left so
+        assert any("KEEP" in p for p in result.problems), result.problems
