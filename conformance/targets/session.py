@@ -227,11 +227,13 @@ class Session:
         self._untaken = len(self.failures)
         return new
 
-    def _step_failed(self, failure: StepFailure) -> StepFailure:
-        """Book ``failure`` (a rule already failed this run keeps its first evidence)."""
-        if all(f.rule != failure.rule for f in self.failures):
+    def _step_failed(self, link: Link, failure: StepFailure) -> None:
+        """Book ``failure`` (a rule already failed this run keeps its first evidence), its
+        evidence read on ``link``: not where an answer on it did not belong to its frame
+        (answered twice, or late), since then no answer read there is surely its frame's
+        (that FAILs the case whatever the tag)."""
+        if not link.violations and all(f.rule != failure.rule for f in self.failures):
             self.failures.append(failure)
-        return failure
 
     def after_case(self) -> None:
         """What a case changed that outlives it, put back (nothing on a fresh unit)."""
@@ -454,7 +456,7 @@ class RealSession(Session):
         if held and not give_back and not why:
             why = self._keep_not_given_back(link)
         if give_back and not why and not _accepted(answers[-3]):
-            self._step_failed(StepFailure(
+            self._step_failed(link, StepFailure(
                 "10.5.restore.exact", "restore", "R gives back the save of the K the unit "
                 "accepted (not while moving)", f"R {_show(answers[-3])} at rest",
                 "R accepted"))
@@ -480,7 +482,7 @@ class RealSession(Session):
             # what the bookkeeping took for deleted may still be queued: no position read
             # tells where the axes rest until the unit shows rest
             self.guard.doubt_rest()
-            self._step_failed(StepFailure(
+            self._step_failed(link, StepFailure(
                 "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
                 "clears ST6", f"H {_show(halt)}, D {_show(deleted)}, SR6 {_show(st6)}",
                 "D 0, then SR6 with RUN, STOP and INTA clear"))
@@ -580,7 +582,7 @@ class RealSession(Session):
         if not _rests(st6):
             raise StepFailed(f"the unit is not at rest after the known state: N answered "
                              f"{_show(zeroed)}, SR6 reads {_show(st6)}" + _left(st6))
-        self._step_failed(StepFailure(
+        self._step_failed(link, StepFailure(
             "10.cmd.zero", "zero", "N zeroes every axis counter (the unit at rest)",
             f"N {_show(zeroed)}, PF {_counters(here)}", "N 0, PF 0 on every axis"))
         names = self.profile.axes
@@ -631,7 +633,7 @@ class RealSession(Session):
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
         link.wait(cruise)                                  # asking before it ends is moot
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
-            self._step_failed(StepFailure(
+            self._step_failed(link, StepFailure(
                 "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "
                 f"ends: L0,0,0 is then taken (within {seconds:.1f} s)",
                 f"{body} 0, L0,0,0 not taken", "L0,0,0 answered 0"))
@@ -646,7 +648,7 @@ class RealSession(Session):
         if not _rests(st6):
             raise StepFailed(f"the return to where the run began ({body}) answered "
                              f"{_show(r)}, SR6 then {_show(st6)}" + _left(st6))
-        self._step_failed(StepFailure(
+        self._step_failed(link, StepFailure(
             "10.1.queue.line-alone", "return-move", "the return move, an L with nothing "
             "queued or running (the unit read back at rest), is accepted",
             f"{body} {_show(r)}, SR6 {_show(st6)}", f"{body} 0"))
