@@ -452,6 +452,9 @@ class RealSession(Session):
         if link.checksums:
             link.send("%-", checksum=True)
         answers = link.send_each(frames)
+        if halt is not None and halt.code is not None and not halt.ok:
+            self._step_failed(link, StepFailure("10.cmd.halt-answer", "halt", "H is "
+                                                "answered 8", f"H {_show(halt)}", "8"))
         why = self._at_rest(link, halt, answers[-2], answers[-1])
         if held and not give_back and not why:
             why = self._keep_not_given_back(link)

@@ -168,3 +168,11 @@ def test_a_k_whose_save_the_envelope_cannot_take_back_is_cleared_by_j_or_said(de
             r.notes[0]
         # and the end of the run says the unit is left so
         assert any("KEEP" in p for p in result.problems), result.problems
+
+
+def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
+    u = unit(frames={b"!0H\r": b"!0Z\r"})            # answered 3 (unknown)
+    result = run([u], select(["5.errors.ok", "10.3.flags.f-command"]))
+    verdicts = {r.id: r.verdict for r in result.results}
+    assert verdicts.pop("10.known-state.halt") == FAIL
+    assert set(verdicts.values()) == {PASS}
