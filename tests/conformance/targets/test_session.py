@@ -18,33 +18,23 @@ from conformance.runner import run
 from conformance.targets import parse_target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 from tests.conformance.cases.used import UsedUnit, used_unit
+from tests.conformance.safety.units import Recorder
 
 #: cases that send no D of their own and leave a halted queue or a KEEP behind
 CASES = ["5.errors.ok", "10.3.flags.f-command", "10.5.keep.single-l", "10.5.keep.saves-st6",
          "11.golden.g4a-line-idle", "10.5.machine.keep-restore"]
 
 
-class Rewritten:
+class Rewritten(Recorder):
     """The unit's port with some frames changed on their way to it (a unit that does
-    otherwise than its answer says)."""
+    otherwise than its answer says); ``frames`` records what reached the unit."""
 
     def __init__(self, port, frames: dict[bytes, bytes]) -> None:
-        self._port = port
-        self._frames = frames
-        self.sent: list[bytes] = []
+        super().__init__(port)
+        self._rewrite = frames
 
     def write(self, data: bytes) -> int:
-        self.sent.append(data)
-        return self._port.write(self._frames.get(data, data))
-
-    def __getattr__(self, name):
-        return getattr(self._port, name)
-
-    def __setattr__(self, name, value):
-        if name == "timeout":
-            self._port.timeout = value
-        else:
-            super().__setattr__(name, value)
+        return super().write(self._rewrite.get(data, data))
 
 
 def unit(profile: str = "GVE84-100", frames: dict[bytes, bytes] | None = None, *,
@@ -55,7 +45,7 @@ def unit(profile: str = "GVE84-100", frames: dict[bytes, bytes] | None = None, *
 
 
 def frames_sent(u: UsedUnit) -> list[bytes]:
-    return [f for f in u.port.sent if f.startswith(b"!")]
+    return u.port.frames
 
 
 def test_the_known_state_takes_no_second_k_and_gives_back_a_k_left_with_its_r():
