@@ -34,6 +34,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
+from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response, frame, readable
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
@@ -125,6 +126,9 @@ class SessionReport:
     #: the line's round trip measured at the start (`?` exchanges): ms min, median, max,
     #: and the byte time at the baud rate
     line: dict[str, float] = field(default_factory=dict)
+    #: where the session's time went: seconds per head of conformance/link/account.py
+    #: and the wall time
+    time: dict[str, float] = field(default_factory=dict)
     wire_log: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
@@ -154,6 +158,7 @@ class Session:
         #: the known-state steps that failed, each rule once (:class:`StepFailure`)
         self.failures: list[StepFailure] = []
         self._untaken = 0                           # failures not yet taken by the run
+        self.account = TimeAccount()                # where the session's time goes
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return EmulatorGuard(self.profile, self.target.address, interrupts)
@@ -195,6 +200,7 @@ class Session:
         port, baud, virtual, rig = self.target.connect(address)
         link = Link(port, self.guard, address=self.target.address if address is None else address,
                     baud=baud, virtual=virtual, rig=rig)
+        link.keep_account(self.account)
         self._link = link
         return link
 
@@ -213,6 +219,7 @@ class Session:
         if self.started:
             return
         self.started = True
+        self.account.begin()
         self._as_found()
 
     def _as_found(self) -> None:
@@ -252,6 +259,8 @@ class Session:
         self.finished = True
         self._put_back()
         self.report.interrupted = self.report.interrupted or self.interrupts.stopped
+        self.account.end()
+        self.report.time = self.account.totals()
         return self.report
 
     def _put_back(self) -> None:
@@ -526,7 +535,7 @@ class RealSession(Session):
         counters: only a read before tells where the axes stand), ST6 read back."""
         self._position(link)
         link.send("J")
-        link.wait(self.profile.restart_ms / 1000 + MARGIN)
+        link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
         link.send_each([*(["Y-"] if self._has_mpg() else []), *self._reset_frames()])
         self._position(link)
         return link.send("SR6")
@@ -563,7 +572,7 @@ class RealSession(Session):
             if moved == before:                    # a second and not a step: stuck
                 return False
             before = moved
-            link.wait(RUN_OUT_POLL_S)
+            link.wait(RUN_OUT_POLL_S, Spent.MOTION)
         return False
 
     def _settle(self, link: Link, then: Sequence[str] = ()
@@ -684,7 +693,7 @@ class RealSession(Session):
         step = WATCH * self.profile.restart_ms / 1000
         end = link.now + round(seconds * SECOND)
         while link.now < end:
-            link.wait(min(step, (end - link.now) / SECOND))
+            link.wait(min(step, (end - link.now) / SECOND), Spent.MOTION)
             if link.now < end:
                 link.send("SR6")
 
