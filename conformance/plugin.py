@@ -365,14 +365,19 @@ def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Co
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """The end of the pytest run (also after Ctrl-C): every session puts its unit back;
     what could not be put back is printed and fails the run."""
-    problems = []
+    problems, broken = [], []
     for target in session.config.stash.get(_TARGETS, []):
         report = target.session.finish()
         target.close()
         problems += [f"{target.info.spec}: {p}" for p in report.problems]
+        # a known-state step the unit broke: a FAIL of its rule, whichever item met it
+        broken += [f"{target.info.spec}: {f.rule}: the known state: {f.what}: {f.observed}"
+                   for f in target.session.failures]
     for problem in problems:
         print(f"\ngve-conformance: PROBLEM on {problem}")
-    if problems and session.exitstatus == pytest.ExitCode.OK:
+    for failure in broken:
+        print(f"\ngve-conformance: FAIL on {failure}")
+    if (problems or broken) and session.exitstatus == pytest.ExitCode.OK:
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 

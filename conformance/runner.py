@@ -3,6 +3,7 @@ session per target per run, Ctrl-C, a target that stops answering."""
 
 from __future__ import annotations
 
+import re
 import time
 import traceback
 from collections.abc import Callable
@@ -19,6 +20,7 @@ from conformance.metadata import RunMeta
 from conformance.operator import Console
 from conformance.targets import Session, SessionError, Target
 from conformance.verdict import ALWAYS, COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
+from gve_fixtures.rules import load_rules
 
 
 @dataclass
@@ -174,6 +176,26 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
     return result
 
 
+def step_results(session: Session, target: Target) -> list[CaseResult]:
+    """The known-state steps that failed since the last call (targets/session.py
+    :class:`StepFailure`), each a result of its own: a FAIL of the step's rule (graded by
+    its tag), filed under the rule's section as ``<section>.known-state.<step>``."""
+    out = []
+    for f in session.take_failures():
+        rule = load_rules()[f.rule]
+        section = re.match(r"\d+(?:\.\d+)*", f.rule).group(0)   # as a case's ID files it
+        r = CaseResult(f"{section}.known-state.{f.step}", section, rule.text,
+                       rule.tag, rule.source, target.profile.name, target.info.spec,
+                       grade(rule.tag, target.info.strict))
+        r.checks = [{"ok": False, "what": f.what, "observed": f.observed,
+                     "expected": f.expected, "tag": rule.tag, "rule": f.rule}]
+        r.notes = ["a step of the known state the suite sets before each case relies on "
+                   "this rule of the manual and the unit broke it; the run went on where "
+                   "it safely could"]
+        out.append(r)
+    return out
+
+
 def _without_rig(case: Case, console: Console | None) -> str | None:
     """Why the rig case cannot run on a target without a rig (None: the technician's
     hands stand in for it)."""
@@ -272,6 +294,8 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
                 continue
             r = run_case(case, target, settings, seed, console)
             add(r)
+            for step in step_results(session, target):
+                add(step)
             stopped = r.stopped
     finally:
         try:
@@ -279,6 +303,8 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
         except KeyboardInterrupt:
             report = session.report
             report.problems.append("restorations abandoned (Ctrl-C pressed three times)")
+        for step in step_results(session, target):
+            add(step)
         run.sessions[target.info.spec] = report.to_dict()
         run.problems += report.problems
         target.close()

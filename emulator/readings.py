@@ -72,6 +72,11 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                          "@ is remembered for > like any received command: > after @ "
                          "answers !0@ and the index it gave (the manual's > repeats the "
                          "last received command and its answer)"),
+    "second-keep-refused": (("10.5.keep.one-level-info",),
+                            "GVE84/GVE114: a K while an earlier K's save is held (no R "
+                            "since) is refused with 4 and changes nothing: their manuals "
+                            "allow KEEP without its RESTORE only once (the GVE54's, whose "
+                            "manual says the save is lost, is not read so)"),
     "next-vectors-B": (("10.2.motion.junction-own-b",),
                        "a junction of two C is passed at the B the next C captured, not the "
                        "one of the C that ends there"),

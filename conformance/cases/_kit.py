@@ -6,6 +6,7 @@ from conformance.case import CaseContext, case
 from conformance.link.account import Spent
 from conformance.link.framing import Response
 from conformance.motion.probe import Probe
+from conformance.preconditions import feature
 from conformance.quoting import answer_text
 from gve_fixtures.protocol import ErrorCode
 
@@ -48,6 +49,26 @@ def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | No
     ctx.require(r is not None and r.raw.split(b",")[0].rstrip(b"\r") == expect.encode(),
                 f"setup {body} answered {show(r)}, expected {expect}")
     return r
+
+
+def configured(ctx: CaseContext, name: str) -> None:
+    """Setup: the feature ``name`` configured as its manual requires before a case relies
+    on it (conformance/preconditions.toml): every parameter it names read, and one the
+    manual does not allow written and read back (EEPROM: needs --allow-destructive; the
+    session puts the bytes back after the case). COULD-NOT-TEST where a write is needed
+    and not allowed, or does not take."""
+    f = feature(name)
+    for p in f.params_for(ctx.profile):
+        r = ctx.link.send(p.read())
+        if r is not None and r.ok and p.holds(r.values):
+            continue
+        ctx.require(ctx.target.allow_destructive,
+                    f"{f.name} needs {p.shown} ({f.source}); it reads {show(r)}, and "
+                    "writing it needs --allow-destructive")
+        setup(ctx, p.write())
+        r = ctx.link.send(p.read())
+        ctx.require(r is not None and r.ok and p.holds(r.values),
+                    f"{f.name} needs {p.shown}: {p.write()} was taken, yet it reads {show(r)}")
 
 
 def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> None:

@@ -8,6 +8,7 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    configured,
     fresh_reset,
     index,
     index_moved,
@@ -64,7 +65,7 @@ def reset_motion(ctx: CaseContext) -> None:
       rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg"))
 def mpg_moving(ctx: CaseContext) -> None:
     link = ctx.link
-    setup(ctx, "EW06,01")                    # MPG enabled (spec 9, M114 12.2)
+    configured(ctx, "mpg")                   # enabled, every parameter in range (M114 12)
     answers(ctx, link.send("J"), "0", "J → 0", tag="D")
     link.wait(2.5, Spent.MANUAL)
     r = link.send("SR6")
@@ -82,6 +83,7 @@ def mpg_moving(ctx: CaseContext) -> None:
 # a unit whose EEPROM 06 is known to be as shipped (FF): the emulator's
 @case("9.reset.mpg-inert.as-shipped", requires=("Y",), rig=True, rules=("9.reset.mpg-inert",))
 def mpg_inert(ctx: CaseContext) -> None:
+    configured(ctx, "mpg-off")
     answers(ctx, ctx.link.send("SR6"), "0,00", "MPG mode after reset, EEPROM 06 = FF: inert")
     answers(ctx, ctx.link.send("L" + vector(ctx, 10)), "0", "and vectors are accepted")
 

@@ -38,10 +38,14 @@ def gve54_full(ctx: CaseContext) -> None:
 def one_level(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     setup(ctx, "K")      # saves the halted queue, INTA = 1
-    setup(ctx, "K")      # saves the now empty queue over it
-    tag = "M" if ctx.profile.keep != "single-L" else "D-info"
-    answers(ctx, ctx.link.send("R"), "0", "R brings back the second (empty) save", tag=tag)
-    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 as the second K saved it", tag=tag)
+    # the point itself: the GVE84/GVE114 manuals allow a K without its R only once, so
+    # a unit there may refuse the second one (the GVE54's says the first save is lost)
+    rule = "10.5.keep.one-level" if ctx.profile.keep != "single-L" else \
+        "10.5.keep.one-level-info"
+    answers(ctx, ctx.link.send("K"), "0", "a second K saves the now empty queue over it",
+            rule=rule)
+    answers(ctx, ctx.link.send("R"), "0", "R brings back the second (empty) save", rule=rule)
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 as the second K saved it", rule=rule)
 
 
 @case("10.5.keep.partial-vector",

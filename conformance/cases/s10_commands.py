@@ -17,6 +17,7 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    configured,
     measured_case,
     position,
     setup,
@@ -140,6 +141,7 @@ def flags_after_keep(ctx: CaseContext) -> None:
 @case("10.cmd.measured.axis-limits-own-axis", timing=True, requires=("VL",),
       rules=("10.cmd.axis-limits-own-axis", "10.cmd.axis-limits", "10.2.motion.axis-caps"))
 def axis_limits(ctx: CaseContext) -> None:
+    configured(ctx, "a-axis-alone")          # the GVE114's A moves alone, not with X, Y, Z
     axes = len(ctx.profile.axes)
     moves = [*AXIS_MOVES, *((A_MOVE,) if axes == 4 else ())]
     steps: list = ["A10000", "V3000", "VL" + ",".join(map(str, LIMITS[:axes]))]
@@ -165,12 +167,16 @@ def override_leaves_v(ctx: CaseContext) -> None:
 
 @case("10.cmd.mpg.modes", requires=("Y",), rules=("10.cmd.mpg",))
 def mpg_modes(ctx: CaseContext) -> None:
+    """Y answers the command back with the hand wheel usable: enabled, every parameter the
+    manual names for it in range (M114 12: otherwise "the MPG cannot be used")."""
+    configured(ctx, "mpg")
     for c in ("+", "&", "-"):
         answers(ctx, ctx.link.send(f"Y{c}"), f"0,Y{c}", f"Y{c} answers the command back")
 
 
 @case("10.cmd.output.port", rig=True, rules=("10.cmd.output",))
 def output(ctx: CaseContext) -> None:
+    configured(ctx, "outputs-by-host")
     link = ctx.link
     answers(ctx, link.send("O0,FB"), "0", "O0,FB: coolant on")
     seen = link.rig.outputs()                # read once: a technician may be the one asked
@@ -186,6 +192,7 @@ def output(ctx: CaseContext) -> None:
 @case("10.cmd.ports.bit-by-bit", rig=True,
       rules=("10.cmd.port-bits", "10.cmd.inputs", "10.cmd.output"))
 def ports(ctx: CaseContext) -> None:
+    configured(ctx, "outputs-by-host")
     link, rule = ctx.link, "10.cmd.port-bits"
     answers(ctx, link.send("SW0,00"), "0", "interrupts off", rule="10.cmd.inputs")
     answers(ctx, link.send("SW1,00"), "0", "interrupts off", rule="10.cmd.inputs")

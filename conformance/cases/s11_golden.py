@@ -10,6 +10,7 @@ import re
 from pathlib import Path
 
 from conformance.case import CaseContext, case
+from conformance.cases._kit import configured
 from conformance.link.account import Spent
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
@@ -125,7 +126,7 @@ def envelope_needed(t: Transcript, profile: Profile) -> int | None:
         pending = []
         for f, answer in batches:
             if f.address in guard.addresses:
-                need = max(need, *(guard.farthest(body) for body in f.bodies(None)))
+                need = max(need, *(guard.farthest(body) for body in f.bodies(summed)))
             body = f.bodies(summed)[0]
             r = None if answer is None else parse_response(answer, summed=summed)
             guard.accepted(body, r, f.address)
@@ -143,6 +144,7 @@ def measured_case(path: Path) -> None:
     families = t.meta.get("profiles", "").split()
     needs_rig = any(r.direction == ACTION and r.action[0] in RIG_ACTIONS for r in t.records)
     address = int(t.meta.get("address", "-1"))
+    needs = t.meta.get("needs", "").split()
     # the golden exchange's own rule (spec "11 G4" -> 11.golden.g4), then those its
     # records check (header "rules:")
     golden = re.search(r"\b11 G(\d+)", t.meta.get("spec", ""))
@@ -160,6 +162,8 @@ def measured_case(path: Path) -> None:
     def replay(ctx: CaseContext) -> None:
         if address >= 0 and address != ctx.link.address:
             ctx.fresh_link(address)
+        for name in needs:                   # what the exchange relies on, configured
+            configured(ctx, name)
         try:
             play(ctx, t, rule)
         except BeyondEnvelope as stop:

@@ -32,10 +32,10 @@ from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.reports.files import release
-from conformance.runner import RunResult
+from conformance.runner import RunResult, step_results
 from conformance.settings import fresh_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
-from conformance.verdict import COULD_NOT_TEST, FAIL
+from conformance.verdict import COULD_NOT_TEST, FAIL, CouldNotTest
 
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given
@@ -229,6 +229,13 @@ def main(argv: list[str] | None = None) -> int:
                      "tag": "always", "rule": ""}]
         run.results.append(r)
         print(f"{r.verdict}: {err}", file=sys.stderr)
+    except CouldNotTest as err:            # an example could not start from the known state
+        r = agreement_result(profile=target.profile.name, target=target.info.spec,
+                             examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
+        r.verdict, r.stopped, r.checks = COULD_NOT_TEST, str(err), []
+        r.notes = [f"the search stopped after {budget.used} sequences: {err}"]
+        run.results.append(r)
+        print(f"{r.verdict}: {err}", file=sys.stderr)
     except KeyboardInterrupt:
         run.interrupted = True
         session.emergency_stop()
@@ -237,6 +244,11 @@ def main(argv: list[str] | None = None) -> int:
         report = session.finish() if session.real else None
         target.close()
     meta.finished = now_iso()
+    for r in step_results(session, target):   # a known-state step the target broke
+        run.results.append(r)
+        check = r.checks[0]
+        say(f"{r.verdict:11} {check['rule']}: the known state: {check['what']}: "
+            f"{check['observed']}")
     if report is not None:
         run.sessions[target.info.spec] = report.to_dict()
         run.problems += report.problems

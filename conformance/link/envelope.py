@@ -356,6 +356,18 @@ class Envelope:
         self.trail = list(self.start)
         self._see()
 
+    def anchor(self, counters: dict[int, int]) -> None:
+        """Counters read while the axes are known not to have moved since the bookkeeping
+        last knew them (at rest, right after a set of the counters): each is anchored to
+        where the bookkeeping has its axis, so a counter that did not take the set is not
+        taken for motion (only while nothing can move: else it tells nothing)."""
+        if not self.settled or any(q != EMPTY for q in self.queue):
+            return
+        for axis, value in counters.items():
+            self.offset[axis] = self.start[axis] - point(value)
+        self.set_counters = False
+        self.trail = list(self.start)
+
     def _see(self) -> None:
         reach = self.reach()
         self.seen = [a.hull(b) for a, b in zip(self.seen, reach, strict=True)]

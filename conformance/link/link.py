@@ -284,9 +284,10 @@ class Link:
 
     def send_raw(self, data: bytes) -> None:
         """Bytes exactly as given (host faults apply). Every frame they complete is
-        judged and booked like any other; its answer is whatever :meth:`read_response`
-        reads next."""
-        self._unbooked = self._transmit(data, None)
+        judged as the unit reads it in the mode the link believes (the guard: every
+        reading after a frame that may change the mode) and booked like any other; its
+        answer is whatever :meth:`read_response` reads next."""
+        self._unbooked = self._transmit(data, self.checksums)
 
     def send(self, body: str, *, lines: int = 1, answer: bool = True,
              checksum: bool | str = "auto", address: int | None = None,

@@ -98,6 +98,8 @@ LONGEST_ANSWER_S = 600.0
 #: frames a unit answers at once inside an open packet, discarding it (spec 7)
 _PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
+#: frames that set the checksum mode, and so how the unit reads the frames after them
+_SUMMING = classes(summing=True)
 #: what a command sets moving again, by name: "queue" or "save"
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 #: consecutive frames without an answer after which the target is given up
@@ -204,6 +206,7 @@ class Guard:
         self._own = _Depth()                      # inside the session's own frames
         self._emergency = _Depth()
         self._hands_on = _Depth()                 # a technician's hand step is open
+        self._unmoved = _Depth()                  # reads with nothing moved since the last
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
@@ -218,6 +221,12 @@ class Guard:
     def emergency(self) -> _Depth:
         """`H` and `D` after Ctrl-C: the frames that go out before anything else."""
         return self._emergency
+
+    def unmoved(self) -> _Depth:
+        """Position reads the session takes at rest with nothing sent that moves since the
+        bookkeeping last knew where the axes are (right after `N`): a counter read
+        otherwise is a counter that did not take the set, never motion."""
+        return self._unmoved
 
     def hands_on(self) -> _Depth:
         """A technician's hand step is open (a prompt waits for them): no motion until it
@@ -273,11 +282,16 @@ class Guard:
         return True
 
     def check_frames(self, frames: list[HostFrame], summed: bool | None) -> None:
-        """:meth:`check` every reading of raw frames (with and without a trailing
-        checksum when the mode is not known)."""
+        """:meth:`check` raw frames as the unit reads them: in checksum mode (``summed``)
+        a frame's last field is its checksum, not a component (spec 6); when the mode is
+        not known (None), and after a frame that may set it, every reading (with and
+        without a trailing checksum)."""
         for f in frames:
-            for body in f.bodies(summed):
+            bodies = f.bodies(summed)
+            for body in bodies:
                 self.check(body, f.address if f.address is not None else self.address)
+            if any(Body.parse(body).name in _SUMMING for body in bodies):
+                summed = None
 
     def _check_destructive(self, body: str, command: Body) -> None:
         if not self.allow_destructive:
@@ -476,6 +490,10 @@ class Guard:
         frames say, the axes are located on their trail, the event is kept for the
         report and the case ends; motion stops unless they cannot have moved since."""
         e = self.envelope
+        if self._unmoved:                  # nothing moved since: a counter, not the axes
+            e.anchor(counters)
+            self.unanswered = 0
+            return
         expected = e.expected(sorted(counters))
         read = e.observe(counters, silence=self.unanswered > 0)
         if read in (Read.AGREES, Read.UNHELD):
@@ -524,6 +542,17 @@ class Guard:
         if self.packet_open and self.packet:
             _commit(self.envelope, self.packet, Outcome.UNCLEAR)
         self.packet, self.packet_open = [], False
+
+    def doubt_rest(self) -> None:
+        """The unit showed that something may still move although an answer said
+        otherwise (a `D` answered 0 that left INTA and RUN): no position read tells where
+        the axes rest until the unit shows rest again (RUN = 0, an `L` or `N` it takes)."""
+        self.envelope.settled = False
+
+    @property
+    def keep_held(self) -> bool:
+        """Whether a `K` the unit took (or may have) holds a save no `R` or `J` gave back."""
+        return self.envelope.saved is not None
 
     # -- answers and silences ----------------------------------------------------------------
     def answered(self, response: Response | None, at: int | None = None) -> None:

@@ -26,9 +26,19 @@ class Factory:
         self.machine = machine
         self.ctx = ctx
         self.__name__ = machine.__name__
+        #: why an example could not start from the known state: the case is then
+        #: COULD-NOT-TEST, never a failed invariant of that example or a later one
+        self.unsettled = ""
 
     def __call__(self) -> UnitMachine:
-        return self.machine(self.ctx)
+        if self.unsettled:                  # every later example and replay alike
+            raise CouldNotTest(self.unsettled)
+        try:
+            return self.machine(self.ctx)
+        except CouldNotTest as err:
+            self.unsettled = f"{self.__name__}: an example could not start from the " \
+                             f"known state: {err}"
+            raise CouldNotTest(self.unsettled) from None
 
 
 def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
@@ -37,9 +47,15 @@ def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
     run_settings, run_seed = settings_profiles.machine_run(ctx.settings, ctx.profile.name,
                                                            ctx.seed)
     # every run sets the seed: None lets Hypothesis draw one
-    factory = seed(run_seed)(Factory(machine, ctx))
+    made = Factory(machine, ctx)
+    factory = seed(run_seed)(made)
     try:
-        run_state_machine_as_test(factory, settings=run_settings)
+        try:
+            run_state_machine_as_test(factory, settings=run_settings)
+        except Exception:
+            if made.unsettled:                # however Hypothesis reports it
+                raise CouldNotTest(made.unsettled) from None
+            raise
     except FlakyFailure as err:
         # failed once and not when replayed (a real line's timing): the failure seen is
         # the finding, graded by its rule, with the replay noted

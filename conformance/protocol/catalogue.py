@@ -69,6 +69,7 @@ class Command:
     own_speed: bool = False
     empties: bool = False
     still: bool = False
+    summing: bool = False
     resumes: str | None = None
     examples: tuple[str, ...] = field(default=(), compare=False)
 

@@ -11,7 +11,11 @@ examples:
   its checksum mode, ST0..ST5, where the axes are, and — when destructive commands are
   allowed — every EEPROM byte, before the run's first EEPROM write;
 - the known state a case starts from (:meth:`open_link`): `H`, `D`, the reset values of
-  what cannot be read, the axes back where the run began, counters zeroed;
+  what cannot be read, the axes back where the run began, counters zeroed — by the
+  manuals' rules only, and read back (ST6 at rest, the counters at 0): a step the unit
+  refuses, or that does not do what its rule says, is a FAIL of that rule
+  (:class:`StepFailure`, once a run) and the run goes on where it safely can; a unit not
+  brought to rest leaves the case COULD-NOT-TEST, naming what was left;
 - Ctrl-C (:meth:`emergency_stop`: `H`, then `D`) and the restorations
   (:meth:`finish`): EEPROM and status words put back and verified by reading back, the
   checksum mode as found, what cannot be read set to the reset state; what could not be
@@ -34,7 +38,13 @@ from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response, frame, readable
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import (
+    LONGEST_ANSWER_S,
+    EmulatorGuard,
+    Guard,
+    SafetyStop,
+    TargetNotResponding,
+)
 from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
@@ -64,8 +74,35 @@ WATCH = 0.25
 EEPROM_READS = 64
 
 
+#: how often the known state asks whether a halted remainder `D` did not delete has run
+#: out: a remainder whose axes did not move for that long is stuck (then `H` again)
+RUN_OUT_POLL_S = 1.0
+#: ST6 bits that keep a unit from being at rest for a case: moving, braking, or
+#: interrupted with vectors waiting for `G` (spec 10.3: INTA/RUN 0/0 is idle [M])
+NOT_AT_REST = St6.RUN | St6.STOP | St6.INTA
+
+
 class SessionError(Exception):
     """The session cannot begin on this target (one line for the user)."""
+
+
+@dataclass(frozen=True)
+class StepFailure:
+    """A known-state step the unit refused, or that did not do what its rule says. The
+    machinery relies on the manuals' rules only (spec preamble), so this is a failure of
+    that rule, reported once a run under the rule's section with the evidence, not a
+    wall of COULD-NOT-TEST nor a FAIL of the case that was about to begin."""
+
+    rule: str          # the rule of fixtures/rules.toml the step relies on
+    step: str          # the step, for the result's ID: "delete", "zero", "return-move"
+    what: str
+    observed: str
+    expected: str
+
+
+class StepFailed(CouldNotTest):
+    """The known state could not be set for a case (a step failed, or the unit is not at
+    rest): the case is COULD-NOT-TEST with the reason."""
 
 
 @dataclass
@@ -118,6 +155,9 @@ class Session:
         self.failed = ""                           # why the session could not begin
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
+        #: the known-state steps that failed, each rule once (:class:`StepFailure`)
+        self.failures: list[StepFailure] = []
+        self._untaken = 0                           # failures not yet taken by the run
         self.account = TimeAccount()                # where the session's time goes
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
@@ -190,6 +230,21 @@ class Session:
         changes nothing); empty where the unit has no `ER` or every link is a new unit."""
         return self.guard.eeprom.originals
 
+    def take_failures(self) -> list[StepFailure]:
+        """The known-state steps that failed since the last call (each rule once a run),
+        for the run to report as FAILs of their rules."""
+        new = self.failures[self._untaken:]
+        self._untaken = len(self.failures)
+        return new
+
+    def _step_failed(self, link: Link, failure: StepFailure) -> None:
+        """Book ``failure`` (a rule already failed this run keeps its first evidence), its
+        evidence read on ``link``: not where an answer on it did not belong to its frame
+        (answered twice, or late), since then no answer read there is surely its frame's
+        (that FAILs the case whatever the tag)."""
+        if not link.violations and all(f.rule != failure.rule for f in self.failures):
+            self.failures.append(failure)
+
     def after_case(self) -> None:
         """What a case changed that outlives it, put back (nothing on a fresh unit)."""
 
@@ -250,7 +305,13 @@ class RealSession(Session):
     def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
         link = super().open_link(address)
         with self.guard.own_frames():
-            self._known_state(link, tell)
+            try:
+                self._known_state(link, tell)
+            except StepFailed:
+                # answers that did not belong to their frames (answered twice) misled
+                # what the known state read: the case gets the link and FAILs on them
+                if not link.violations:
+                    raise
         link.log.clear()
         return link
 
@@ -390,38 +451,180 @@ class RealSession(Session):
     def _has_mpg(self) -> bool:
         return self.profile.mpg is not None and "Y" in self.profile.commands
 
-    def _stop(self, link: Link, then: Sequence[str] = ()) -> list[Response | None]:
-        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00),
-        then `D`: the queue empty and ST6 clear (an input still enabled would set INTA
-        again at once); then the frames ``then``. An MPG that EEPROM 06 made effective
-        holds the axes (the unit is moving): `D` and EEPROM writes would be refused and
-        the INTA of `H` outlive the stop, so it is off until the reset frames set its
-        reset mode again."""
+    def _stop(self, link: Link, then: Sequence[str] = ()) -> tuple[str, list[Response | None]]:
+        """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00), the
+        save of a `K` the last case left given back with `R` (the manual's inverse of `K`:
+        the queue back to its size), then `D`: the queue empty and ST6 clear (an input
+        still enabled would set INTA again at once), read back with `SR6`; then the frames
+        ``then``. Only the manuals' rules: no second `K`, no `R` with nothing kept. An MPG
+        that EEPROM 06 made effective holds the axes (the unit is moving): `D` and EEPROM
+        writes would be refused and the INTA of `H` outlive the stop, so it is off until
+        the reset frames set its reset mode again. Returns why the unit is not at rest
+        ("" when it is: :meth:`_at_rest`) and the answers to ``then``."""
         mpg = ["Y-"] if self._has_mpg() else []
-        frames = [*mpg, *(f"SW{n},00" for n in range(6)), "D", *then]
+        held = self.guard.keep_held and not self.interrupts.stopped
+        # R moves nothing on a unit that keeps the manual (the save holds INTA with any
+        # queue), but a unit that does not may run it: R only where the envelope takes it
+        give_back = ["R"] if held and self.guard.fits("R") else []
+        frames = [*mpg, *(f"SW{n},00" for n in range(6)), *give_back, "D", "SR6"]
         if not link.checksums and not self.guard.packet_open:
-            link.tell(["H", *frames])              # H as _halt sends it, then the rest
-        self._halt(link)
+            link.tell(["H", *frames, *then])       # H as _halt sends it, then the rest
+        halt = self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        return link.send_each(frames)
+        answers = link.send_each(frames)
+        if halt is not None and halt.code is not None and not halt.ok:
+            self._step_failed(link, StepFailure("10.cmd.halt-answer", "halt", "H is "
+                                                "answered 8", f"H {_shown(halt)}", "8"))
+        why = self._at_rest(link, halt, answers[-2], answers[-1])
+        if held and not give_back and not why:
+            why = self._keep_not_given_back(link)
+        if give_back and not why and not _taken(answers[-3]):
+            self._step_failed(link, StepFailure(
+                "10.5.restore.exact", "restore", "R gives back the save of the K the unit "
+                "accepted (not while moving)", f"R {_shown(answers[-3])} at rest",
+                "R accepted"))
+        return why, link.send_each(then)
 
-    def _settle(self, link: Link, then: Sequence[str] = ()) -> dict[str, Response | None]:
-        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
-        interrupts off, queue and save empty, the reset values of what cannot be read. A
-        KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
-        the empty queue over it and R restores that, which moves nothing. Then the
-        frames ``then``; returns the answers to those after the stop, by frame."""
+    def _at_rest(self, link: Link, halt: Response | None, deleted: Response | None,
+                 st6: Response | None) -> str:
+        """Whether the stop left the unit at rest: RUN, STOP and INTA clear in ST6, as `D`
+        after `H` leaves it (spec 10.4 [M]: `D` is for the rest of the queue after an
+        interruption, and clears ST6). Where an INTA that `H` set outlives `D`, `D` did
+        not do what its rule says (a FAIL of that rule); the unit is then brought to rest by
+        other means (:meth:`_to_rest`) and ST6 is read again. Returns why the unit is not
+        at rest ("" when it is)."""
+        if _rests(st6):
+            return ""
+        if not _bits(st6) & St6.INTA and halt is not None:
+            # moving or braking with no stop of H's left: given the longest stop to end
+            st6 = link.poll("SR6", _rests, 2 * self.guard.stop_seconds() + 2) or st6
+            if _rests(st6):
+                return ""
+        if halt is not None and halt.ok and _hex_ok(st6) and _bits(st6) & St6.INTA:
+            # what the bookkeeping took for deleted may still be queued: no position read
+            # tells where the axes rest until the unit shows rest
+            self.guard.doubt_rest()
+            self._step_failed(link, StepFailure(
+                "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
+                "clears ST6", f"H {_shown(halt)}, D {_shown(deleted)}, SR6 {_shown(st6)}",
+                "D 0, then SR6 with RUN, STOP and INTA clear"))
+            if not self.interrupts.stopped:
+                st6 = self._to_rest(link)
+                if _rests(st6):
+                    return ""
+        return f"the unit is not at rest after the known state: SR6 reads {_shown(st6)}" \
+            + _left(st6)
+
+    def _keep_not_given_back(self, link: Link) -> str:
+        """A `K` the last case left whose save `R` would give back beyond the envelope:
+        `J` where destructive commands are allowed (the save gone with the reset); else
+        why the unit is not in the known state (its queue takes one `L` only)."""
+        if self._may_reset():
+            return "" if _rests(self._reset(link)) else "the unit is not at rest after J"
+        return ("a KEEP the last case left is still held (its R would give back a queue "
+                "the envelope cannot take), and J, which would clear it, needs "
+                "--allow-destructive")
+
+    def _may_reset(self) -> bool:
+        return self.guard.allow_destructive and "J" in self.profile.commands
+
+    def _reset(self, link: Link) -> Response | None:
+        """`J` (the reset state: ST6 = 00, spec 9 [M]), the hand wheel off and what cannot
+        be read set again; the position read at rest before and after (J zeroes the
+        counters: only a read before tells where the axes stand), ST6 read back."""
+        self._position(link)
+        link.send("J")
+        link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
+        link.send_each([*(["Y-"] if self._has_mpg() else []), *self._reset_frames()])
+        self._position(link)
+        return link.send("SR6")
+
+    def _to_rest(self, link: Link) -> Response | None:
+        """At rest by other means than `D`, by the manuals' rules: `G`, and the remainder
+        runs out (:meth:`_run_out`; the axes end where the bookkeeping knows them); still
+        not at rest, `J` where destructive commands are allowed (the reset state, ST6 = 00:
+        spec 9 [M]) and what cannot be read set again. Then the position read at rest,
+        and ST6 again."""
+        if not self._run_out(link):
+            self._halt(link)
+        self._position(link)
+        st6 = link.send("SR6")
+        return st6 if _rests(st6) or not self._may_reset() else self._reset(link)
+
+    def _run_out(self, link: Link) -> bool:
+        """`G`, then `L0,0,0` until it is taken (0, INTA clear: nothing queued or running,
+        spec 10.1 [M]) while `PF` shows the axes moving, as long as the remainder could take
+        at the slowest `V` (the reset frames put XM back); whether it was taken."""
+        link.send("G")
+        # how far the axes may still go: the queue, or where a D the unit answered 0
+        # without deleting anything left the bookkeeping's doubt
+        travel = max(s.hi - s.lo for s in self.guard.envelope.reach())
+        seconds = 2 * travel / self.profile.range("V").lo + 2 * self.guard.stop_seconds() + 2
+        deadline = link.now + min(seconds, LONGEST_ANSWER_S) * SECOND
+        before: list[str] | None = None
+        while link.now < deadline:
+            r = link.send("L0,0,0")
+            if r is not None and r.ok and not r.inta:
+                return True
+            here = link.send("PF")
+            moved = None if here is None else here.values
+            if moved == before:                    # a second and not a step: stuck
+                return False
+            before = moved
+            link.wait(RUN_OUT_POLL_S, Spent.MOTION)
+        return False
+
+    def _settle(self, link: Link, then: Sequence[str] = ()
+                ) -> tuple[str, dict[str, Response | None]]:
+        """The rig's hands off (a simulator's rig: inputs and switches as found), stopped
+        (:meth:`_stop`), the reset values of what cannot be read, then the frames
+        ``then``. Returns why the unit is not at rest ("" when it is) and the answers to
+        the frames after the stop, by frame."""
         if link.rig is not None:
             link.rig.hands_off()
-        after = [*self._reset_frames(), "K", "R", *then]
-        return dict(zip(after, self._stop(link, after)[-len(after):], strict=True))
+        after = [*self._reset_frames(), *then]
+        why, answers = self._stop(link, after)
+        return why, dict(zip(after, answers, strict=True))
 
     def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
-        self._settle(link, ["PF"])                 # where the axes are, for the way back
+        """Stopped and at rest (read back), the reset values, the axes back where the run
+        began, the counters zeroed (read back); :class:`StepFailed` when the unit could
+        not be brought there."""
+        left, _ = self._settle(link, ["PF"])       # where the axes are, for the way back
+        if left:
+            raise StepFailed(left)
         self._go_back(link, read=False)
-        link.tell(["N", *tell])
-        link.send("N")
+        link.tell(["N", "PF", *tell])
+        self._zero(link)
+
+    def _zero(self, link: Link) -> None:
+        """`N`, read back with `PF`: every counter 0 (spec 10 [M]). Where `N` did not zero
+        them at rest, a FAIL of its rule, and `N<axis>0` where the unit has it; counters
+        still elsewhere leave the case COULD-NOT-TEST (cases judge positions from 0)."""
+        zeroed = link.send("N")
+        with self.guard.unmoved():                 # at rest: a counter read is no motion
+            here = self._position(link)
+        if _taken(zeroed) and here and not any(here.values()):
+            return                                 # taken: nothing runs (7 if RUN = 1)
+        st6 = link.send("SR6")
+        if not _rests(st6):
+            raise StepFailed(f"the unit is not at rest after the known state: N answered "
+                             f"{_shown(zeroed)}, SR6 reads {_shown(st6)}" + _left(st6))
+        self._step_failed(link, StepFailure(
+            "10.cmd.zero", "zero", "N zeroes every axis counter (the unit at rest)",
+            f"N {_shown(zeroed)}, PF {_counters(here)}", "N 0, PF 0 on every axis"))
+        names = self.profile.axes
+        setters = [f"N{a}0" for a in names[:3] if f"N{a}" in self.profile.commands]
+        if setters:
+            link.send_each(setters)
+            with self.guard.unmoved():
+                here = self._position(link)
+            if here and not any(here.values()):
+                return
+        raise StepFailed(f"the position counters could not be zeroed (N answered "
+                         f"{_shown(zeroed)}, PF then {_counters(here)}): the cases judge "
+                         "positions from 0")
 
     def _go_back(self, link: Link, *, read: bool = True) -> tuple[str, dict[int, int]]:
         """Move the axes back to where the run began (known exactly only at rest; the
@@ -457,14 +660,31 @@ class RealSession(Session):
             return "", read_now
         r = link.send(body)
         if r is None or not r.ok:
-            raise CouldNotTest(f"the return to where the run began ({body}) answered "
-                               f"{_shown(r)}")
+            self._return_refused(link, body, r)
+            return "", self._position(link)
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
         self._watch(link, cruise)
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
-            raise CouldNotTest("the return to where the run began did not end in time")
+            self._step_failed(link, StepFailure(
+                "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "
+                f"ends: L0,0,0 is then taken (within {seconds:.1f} s)",
+                f"{body} 0, L0,0,0 not taken", "L0,0,0 answered 0"))
+            raise StepFailed("the return to where the run began did not end in time")
         return body, self._position(link)
+
+    def _return_refused(self, link: Link, body: str, r: Response | None) -> None:
+        """The return move answered otherwise than 0: at rest (ST6 read back) that is a
+        FAIL of `L` from rest (spec 10.1 [M]) and the axes stay where they are (the
+        envelope still bounds every frame); else the case cannot begin."""
+        st6 = link.send("SR6") if r is not None else None
+        if not _rests(st6):
+            raise StepFailed(f"the return to where the run began ({body}) answered "
+                             f"{_shown(r)}, SR6 then {_shown(st6)}" + _left(st6))
+        self._step_failed(link, StepFailure(
+            "10.1.queue.line-alone", "return-move", "the return move, an L with nothing "
+            "queued or running (the unit read back at rest), is accepted",
+            f"{body} {_shown(r)}, SR6 {_shown(st6)}", f"{body} 0"))
 
     def _watch(self, link: Link, seconds: float) -> None:
         """Let ``seconds`` of the way back pass with a frame at least every WATCH of the
@@ -547,7 +767,10 @@ class RealSession(Session):
                 self._halt(link, timeout=MARGIN, urgent=True)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._say_reset(self._settle(link))
+        left, answers = self._settle(link)
+        if left:
+            self.report.problems.append(f"the unit is not left at rest: {left}")
+        self._say_reset(answers)
         self._restore_axes(link)
         self._restore_counters(link)
         self._restore_eeprom(link)
@@ -793,6 +1016,24 @@ def _taken(r: Response | None) -> bool:
 def _counters(read: dict[int, int]) -> str:
     """Counters as PF shows them: ``394,0,0`` (``?`` for an axis not read)."""
     return ",".join(str(v) for v in read.values()) if read else "nothing readable"
+
+
+def _bits(st6: Response | None) -> St6:
+    """ST6 as an `SR6` answer gives it (every bit set when it gives none: not at rest)."""
+    return St6(st6.hex()) if _hex_ok(st6) else St6(0xFF)
+
+
+def _rests(st6: Response | None) -> bool:
+    """Whether an `SR6` answer shows the unit at rest (RUN, STOP and INTA clear)."""
+    return not _bits(st6) & NOT_AT_REST
+
+
+def _left(st6: Response | None) -> str:
+    """What an `SR6` answer shows left (" (RUN, INTA)"), or nothing."""
+    if not _hex_ok(st6):
+        return ""
+    names = [b.name for b in (St6.RUN, St6.STOP, St6.INTA) if st6.hex() & b]
+    return f" ({', '.join(n or '' for n in names)})" if names else ""
 
 
 def _hex_ok(r: Response | None) -> bool:

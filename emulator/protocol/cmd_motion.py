@@ -235,8 +235,12 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 
 def cmd_delete(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if dev.mutant.active("delete-refused"):
+        raise CommandError(ErrorCode.BUSY, "D refused at rest")
     if not dev.mutant.active("delete-while-moving"):
         dev.refuse_while_moving(t)
+    if dev.mutant.active("delete-ignored"):
+        return []
     dev.motion.clear(t)
     s = dev.state
     s.status[4] = s.status[5] = s.status[6] = 0
@@ -247,6 +251,9 @@ def cmd_delete(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_keep(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_while_moving(t)
     s = dev.state
+    if s.saved is not None and dev.profile.keep == "single-L" \
+            and dev.readings.active("second-keep-refused"):
+        raise CommandError(ErrorCode.SYNTAX, "K while an earlier K's save is held")
     st6 = 0 if dev.mutant.active("keep-forgets-st6") else s.status[6]
     s.saved = Saved(dev.motion.keep(t), s.status[4], s.status[5], st6)
     s.status[4] = s.status[5] = s.status[6] = 0

@@ -55,6 +55,8 @@ PROBES: dict[str, tuple[str, str]] = {
     "halt-answers-early": ("m10-halt-ramp", "GVE84-100"),
     "go-loses-step": ("g6-keep-restore", "GVE84-100"),
     "delete-while-moving": ("e05-mpg-is-moving", "GVE114-500"),
+    "delete-refused": ("e12-delete-after-halt", "GVE84-100"),
+    "delete-ignored": ("e12-delete-after-halt", "GVE54"),
     "keep-forgets-st6": ("g6-keep-restore", "GVE114-500"),
     "restore-drops-partial": ("g6-keep-restore", "GVE84-100"),
     "status-word-masked": ("g4f-status-read", "GVE84-100"),

@@ -28,6 +28,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
     "queries-counted": ([b"!0@\r", b"!0@\r"], b"0,0\r0,0\r", b"0,1\r0,2\r"),
     "restore-nothing-kept-refused": ([b"!0R\r"], b"0\r", b"4\r"),
+    # the second K finds the first one's save held
+    "second-keep-refused": ([b"!0K\r", b"!0K\r"], b"0\r0\r", b"0\r4\r"),
     # a long vector still running a second later
     "eeprom-write-while-moving": ([b"!0L100000,0,0\r", b"!0EW10,AB\r", b"!0ER10\r"],
                                   b"0\r7\r0,FF\r", b"0\r0\r0,AB\r"),

@@ -132,3 +132,17 @@ def test_over_exec_an_emulator_taking_every_reading_gets_no_fail(capsys):
                                                                       "INFO"))]
     assert status == 0 and findings, out
     assert not [f for f in findings if f.startswith("FAIL") or "(no known rule)" in f], out
+
+
+@pytest.mark.parametrize("mutant", ["delete-refused", "delete-ignored"])
+def test_a_target_whose_d_misbehaves_gets_a_fail_naming_d_and_diff_runs_on(mutant, capsys):
+    """The known state between sequences does not need the D under test: its failure is
+    a FAIL of D's rule (10.4), the search goes on to its budget, no traceback."""
+    target = (f"exec:{sys.executable} -m emulator --cosim --model GVE84-100 "
+              f"--mutant {mutant}")
+    status = main(["diff", "--target", target, "--profile", "GVE84-100", "--yes",
+                   "--examples", "100", "--no-reports"])
+    out, err = capsys.readouterr()
+    assert status == 1 and "Traceback" not in out + err
+    assert "FAIL        10.4.delete: the known state: D after H" in out
+    assert "100 sequences" in out

@@ -7,8 +7,12 @@ suite's classname and the verdict visible."""
 from __future__ import annotations
 
 import re
+import shlex
+import sys
 import xml.etree.ElementTree as ET
 from types import SimpleNamespace
+
+import pytest
 
 from conformance.catalogue import select
 from conformance.plugin import pytest_report_teststatus
@@ -113,3 +117,12 @@ def test_junit_gives_the_suite_s_classname_and_the_verdict(pytester):
     assert props["verdict"] == NON_STRICT
     (skipped,) = case.findall("skipped")
     assert skipped.get("message").startswith(f"{NON_STRICT} 3.frame.syntax-errors")
+
+
+def test_a_known_state_step_the_unit_breaks_fails_the_pytest_run(pytester):
+    target = "exec:" + shlex.join([sys.executable, "-m", "emulator", "--cosim", "--model",
+                                   "GVE84-100", "--mutant", "delete-ignored"])
+    result = pytester.runpytest("--gve-target", target, "--gve-profile", "GVE84-100",
+                                "--gve-cases", "5.errors.ok", "-q")
+    assert result.ret == pytest.ExitCode.TESTS_FAILED
+    result.stdout.fnmatch_lines(["*FAIL on exec:*10.4.delete: the known state: D after H*"])

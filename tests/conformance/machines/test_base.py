@@ -10,7 +10,7 @@ import pytest
 from hypothesis.stateful import rule
 
 from conformance import settings as settings_profiles
-from conformance.case import CaseContext
+from conformance.case import CaseContext, CouldNotTest
 from conformance.catalogue import select
 from conformance.machines.base import UnitMachine, index_invariant
 from conformance.machines.checksum import ChecksumMachine
@@ -115,3 +115,26 @@ def test_the_machines_that_check_positions_book_the_index_too(machine):
     ctx = context()
     run_machine(ctx, checked)
     assert not failed(ctx) and any(c.ok for c in ctx.checks)
+
+
+def test_an_example_that_cannot_start_from_the_known_state_is_could_not_test():
+    # the third example's known state finds the unit not at rest: the case cannot test,
+    # and no invariant of that example (or a later one, or a replay) is failed
+    (case,) = select([CASE])
+    target = parse_target("emu:GVE84-100")
+    opened = []
+
+    def open_link(address=None):
+        opened.append(address)
+        if len(opened) >= 3:
+            raise CouldNotTest("the unit is not at rest after the known state: SR6 reads "
+                               "0,40 (RUN)")
+        return target.session.open_link(address)
+
+    ctx = CaseContext(case, target.profile, target.info, settings_profiles.get("ci"),
+                      open_link)
+    with pytest.raises(CouldNotTest, match="Booked: an example could not start from the "
+                                           "known state: the unit is not at rest"):
+        run_machine(ctx, Booked)
+    assert not failed(ctx)
+    assert len(opened) == 3                 # not tried again once it could not start

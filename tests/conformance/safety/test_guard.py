@@ -64,6 +64,21 @@ def test_raw_bytes_are_framed_as_a_unit_frames_them():
         g.check_frames(HostFramer().frames(b"!0L400,0,600\r"), summed=None)
 
 
+def test_in_checksum_mode_a_members_last_field_is_its_checksum_on_every_profile():
+    # the GVE114 reads !0C682,151,0,7F in checksum mode as C682,151,0 with checksum 7F
+    # (spec 6): the 7F is not an A component the guard cannot bound
+    g = guard("GVE114-500", destructive=True, travel=1000)
+    (f,) = HostFramer().frames(b"!0C682,151,0,7F\r")
+    g.check_frames([f], summed=True)
+    with pytest.raises(SafetyStop, match="axis A"):
+        g.check_frames([f], summed=False)           # with the mode off it is A = 7F
+    # a frame that may set the mode makes every reading count for the frames after it
+    with pytest.raises(SafetyStop, match="axis A"):
+        g.check_frames(HostFramer().frames(b"!0%-,CF\r!0C682,151,0,7F\r"), summed=True)
+    with pytest.raises(SafetyStop, match="axis A"):
+        g.check_frames(HostFramer().frames(b"!0J\r!0C682,151,0,7F\r"), summed=True)
+
+
 def test_after_ctrl_c_only_the_sessions_own_frames_go_and_never_motion():
     interrupts = Interrupts()
     g = guard(interrupts=interrupts)

@@ -14,8 +14,8 @@ from conformance.runner import run
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL
 from tests.conformance.safety.units import in_process_unit
 
-#: frames that can start motion (R after the session's K of an empty queue restores
-#: nothing: the physical check after Ctrl-C would see it if it did)
+#: frames that can start motion (R only gives back a K a case left: the physical check
+#: after Ctrl-C would see it if it moved anything)
 MOTION = (b"L", b"C", b"G", b"W", b"*E", b"SW6")
 
 

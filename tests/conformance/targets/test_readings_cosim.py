@@ -26,6 +26,9 @@ from gve_fixtures.rules import load_rules
 MACHINERY = {
     "packet-closed-only-by-end": {"7.packet.breakers"},
     "slow-watchdog": {"3.frame.watchdog-time"},
+    # the clean-up between cases and examples takes no second K: a K a case left is given
+    # back with its R
+    "second-keep-refused": {"10.5.keep.one-level-info"},
 }
 
 
@@ -86,5 +89,9 @@ def test_diff_runs_its_budget_through_a_session_taking_a_reading(reading):
         pair.target.session.finish()
         pair.target.target.close()
     graded = [(f.disagreement.rule, f.disagreement.verdict) for f in found]
-    assert graded and all(verdict in (NON_STRICT, INFO) and rule in READINGS[reading].rules
-                          for rule, verdict in graded), graded
+    # its own point only where the grammar draws it within the budget (two K in a row
+    # it does not): the clean-up between examples is what runs through it every time
+    assert graded or reading == "second-keep-refused"
+    assert all(verdict in (NON_STRICT, INFO) and rule in READINGS[reading].rules
+               for rule, verdict in graded), graded
+    assert pair.target.session.failures == []
