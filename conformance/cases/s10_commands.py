@@ -260,14 +260,15 @@ def absent(ctx: CaseContext) -> None:
     """A command the profile lacks answers 3."""
     lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
-        ctx.expect(True, "the profile has every optional command")
+        ctx.expect(True, "the profile has every optional command", rule="1.profile.command-set")
     for name in lacking:
         r = ctx.link.send(REFUSAL_FRAMES[name])
         # an axis or port the unit lacks may be a parameter out of range instead (spec 5)
         if LACKING_LETTER.match(name) and r is not None and r.code == ErrorCode.RANGE:
-            ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks")
+            ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks",
+                       rule="5.code.unknown")
             continue
-        code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3")
+        code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3", rule="1.profile.command-set")
 
 
 @case("10.commands.counter-range-ends", requires=("NX",),
@@ -335,7 +336,9 @@ def formats(ctx: CaseContext) -> None:
       requires=("NX",))
 def set_axis(ctx: CaseContext) -> None:
     """!0NX100 sets the X counter; !0N zeroes every axis."""
-    answers(ctx, ctx.link.send("NX100"), "0", "NX100")
-    ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx))
-    answers(ctx, ctx.link.send("N"), "0", "N")
-    ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx))
+    answers(ctx, ctx.link.send("NX100"), "0", "NX100", rule="10.cmd.set-axis")
+    ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx),
+               rule="10.cmd.set-axis")
+    answers(ctx, ctx.link.send("N"), "0", "N", rule="10.cmd.zero")
+    ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx),
+               rule="10.cmd.zero")

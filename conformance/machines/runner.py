@@ -10,8 +10,9 @@ from hypothesis.stateful import run_state_machine_as_test
 
 from conformance import settings as settings_profiles
 from conformance.case import CaseContext, CouldNotTest
+from conformance.link.framing import UnitDataError
 from conformance.machines.base import UnitMachine
-from gve_fixtures.rules import load_rules
+from conformance.verdict import ALWAYS, UNREADABLE
 
 
 class Factory:
@@ -63,13 +64,17 @@ def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
 
 
 def _failed(ctx: CaseContext, machine: type, err: BaseException) -> None:
-    """The failed invariant as a check graded by the rule it names."""
+    """The failed invariant as a check graded by the rule it names (bytes of the unit that
+    cannot be read: the response grammar's, whatever the tag)."""
     rule = getattr(err, "rule", None)
     what = f"{machine.__name__}: {err}".splitlines()[0][:300]
-    if rule is not None and rule not in ctx.case.rules:
+    if isinstance(err, UnitDataError):
+        ctx.expect(False, what, observed=str(err)[-500:], expected="an answer",
+                   tag=ALWAYS, rule=UNREADABLE, machinery=True)
+    elif rule is not None and rule not in ctx.case.rules:
         # a rule of the machinery the case does not list (the index, PF): its own tag
         ctx.expect(False, f"{what} [{rule}]", observed=str(err)[-500:],
-                   expected="every invariant holds", tag=load_rules()[rule].tag)
+                   expected="every invariant holds", rule=rule, machinery=True)
     else:
         ctx.expect(False, what, observed=str(err)[-500:], expected="every invariant holds",
                    rule=rule)
