@@ -59,22 +59,47 @@ def reset_motion(ctx: CaseContext) -> None:
     Probe(ctx, "reset B", "9.reset.brake").script(["C-300,400,0", "C-200,0,0", 0.7])
 
 
+#: the MPG's parameters (M114 12.4-12.6) and the range of each: with one out of range
+#: "není možné MPG použít" (the MPG cannot be used)
+MPG_PARAMETERS = ([("EFR%02X" % (0x10 + 4 * i), 0.0, 1e4) for i in range(8)]
+                  + [("EFR%02X" % (0x30 + 4 * i), 1.0, 1e4) for i in range(4)]
+                  + [("EFR40", 1.0, 1e4), ("EFR44", 1e-9, float("inf"))])
+
+
+def mpg_rule(ctx: CaseContext) -> str:
+    """The rule whether the MPG holds RUN is judged by: the manual's where every MPG
+    parameter is in range; where one is not (an EEPROM as shipped), whether the MPG mode
+    still takes effect is a reading (9.reset.mpg-parameters)."""
+    for body, lo, hi in MPG_PARAMETERS:
+        r = ctx.link.send(body)
+        try:
+            if r is None or not r.ok or not lo <= float(r.values[0]) <= hi:
+                return "9.reset.mpg-parameters"
+        except (IndexError, ValueError):
+            return "9.reset.mpg-parameters"
+    return "9.reset.mpg"
+
+
 @case("9.reset.mpg-enabled", requires=("Y",), destructive=True,
-      rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg"))
+      rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg", "10.cmd.restart",
+             "9.reset.mpg-parameters"))
 def mpg_moving(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "EW06,01")                    # MPG enabled (spec 9, M114 12.2)
-    answers(ctx, link.send("J"), "0", "J → 0", tag="D")
+    rule = mpg_rule(ctx)
+    answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5)
     r = link.send("SR6")
     ctx.expect(r is not None and r.values == ["40"], "after J the MPG holds RUN = 1",
-               observed=show(r), expected="0,40", rule="9.reset.mpg")
+               observed=show(r), expected="0,40", rule=rule)
     code(ctx, link.send("L" + vector(ctx, 10)), ErrorCode.BUSY,
-         "vectors are refused: 7", rule="9.reset.mpg")
+         "vectors are refused: 7", rule=rule)
     for body in ("D", "K", "R", "EW40,00", "EFW44,1", "EUW48,1"):
         code(ctx, link.send(body), ErrorCode.BUSY, f"{body} while the MPG holds RUN → 7",
              rule="5.moving.definition")
     answers(ctx, link.send("Y-"), "0,Y-", "Y- turns the MPG off", rule="10.cmd.mpg")
+    # an MPG that did not take effect let the vector run: it has ended by the idiom's 0
+    link.poll("L0,0,0", lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
     answers(ctx, link.send("SR6"), "0,00", "and RUN clears", rule="10.cmd.mpg")
 
 
@@ -92,7 +117,8 @@ def reset_state(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     before = index(ctx)
     for n in range(7):
-        answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00")
+        answers(ctx, ctx.link.send(f"SR{n}"), "0,00", f"ST{n} = 00", rule="9.reset.state")
     here = position(ctx)
-    ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0])
+    ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0],
+               rule="9.reset.state")
     index_moved(ctx, before, 8, "the index counted the SR and PF frames", rule="8.index.counts")

@@ -38,10 +38,13 @@ def gve54_full(ctx: CaseContext) -> None:
 def one_level(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     setup(ctx, "K")      # saves the halted queue, INTA = 1
-    setup(ctx, "K")      # saves the now empty queue over it
-    tag = "M" if ctx.profile.keep != "single-L" else "D-info"
-    answers(ctx, ctx.link.send("R"), "0", "R brings back the second (empty) save", tag=tag)
-    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 as the second K saved it", tag=tag)
+    # the GVE54's manual: a second K overwrites the save; the others' "only once" leaves
+    # what a second K does to a reading
+    rule = "10.5.keep.one-level" + ("-info" if ctx.profile.keep == "single-L" else "")
+    answers(ctx, ctx.link.send("K"), "0", "a second K saves the now empty queue over it",
+            rule=rule)
+    answers(ctx, ctx.link.send("R"), "0", "R brings back the second (empty) save", rule=rule)
+    answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 as the second K saved it", rule=rule)
 
 
 @case("10.5.keep.partial-vector",
@@ -58,7 +61,7 @@ def partial(ctx: CaseContext) -> None:
     ctx.link.send("G")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
-               observed=position(ctx), expected=[990, 0, 0])
+               observed=position(ctx), expected=[990, 0, 0], rule="10.5.restore.exact")
 
 
 @case("10.5.keep.refused-while-moving",
@@ -67,8 +70,8 @@ def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
-    code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving")
-    code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving")
+    code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving", rule="5.code.busy-moving")
+    code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving", rule="5.code.busy-moving")
     ctx.link.send("H")
 
 

@@ -56,7 +56,8 @@ REFUSALS: tuple[Refusal, ...] = (
     Refusal("B5", E.RANGE),                          # below every profile's B
     Refusal("B700,5", E.SYNTAX, "5.code.syntax"),
     Refusal("G", E.NOTHING_TO_GO, "5.code.nothing-to-go", IDLE),
-    Refusal("L1,2", E.SYNTAX, "5.code.syntax"),
+    # a malformed component (two components may be taken with the rest 0: a reading)
+    Refusal("L1,2x,0", E.SYNTAX, "5.code.syntax"),
     Refusal("L5,0,0", E.QUEUE_FULL, "5.code.queue-full", HALTED),
     Refusal("M4,5", E.SYNTAX, "5.code.syntax"),      # a stored 4 would move 4 sixteenths
     Refusal("N", E.BUSY, "5.code.busy-run", HALTED),
