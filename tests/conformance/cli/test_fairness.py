@@ -4,10 +4,13 @@ emulator FAILs the same difference; the score line."""
 
 from __future__ import annotations
 
+import pytest
+
 from conformance.catalogue import select
 from conformance.cli import main
 from conformance.runner import run_case
 from conformance.targets import parse_target
+from conformance.targets.emu import emulator_readings
 from conformance.verdict import FAIL, NON_STRICT
 
 
@@ -82,3 +85,12 @@ def test_fairness_runs_diff_and_names_the_rule_of_every_difference(capsys):
     out = capsys.readouterr().out
     assert status == 0, out
     assert "NON-STRICT 10.5.restore.pops" in out and "FAIL" not in out.replace("NON-STRICT", "")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("reading", sorted(emulator_readings()))
+def test_every_reading_alone_is_fair_and_every_check_names_its_rule(reading):
+    from conformance.cli.fairness import FIRST, trial, trial_profiles
+    profiles = trial_profiles(emulator_readings()[reading][0], list(FIRST))
+    t = trial(reading, [reading], profiles, None)
+    assert t.fair, t.unfair
