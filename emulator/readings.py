@@ -104,7 +104,8 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "mpg-needs-parameters": (("9.reset.mpg-parameters",),
                              "the GVE114's MPG takes effect only when every MPG parameter "
                              "(limits, steps per mm, acceleration, speed: M114 12.4-12.6) "
-                             "is in range; with one out of range (an erased FF) RUN stays 0"),
+                             "is in range; with one out of range (an erased FF) RUN stays 0 "
+                             "and Y+, Y& are refused with 5"),
     "vector-fewer-components": (("10.cmd.vector-components",),
                                 "a vector takes one component or more, the missing ones "
                                 "0 (the manuals' own `!0L1000,100`)"),

@@ -169,3 +169,24 @@ def measured_case(id: str, rules: tuple[str, ...], requires: tuple[str, ...],
     def measured(ctx: CaseContext) -> None:
         steps = (fill_scenario(s, ctx) for s in scenario)
         Probe(ctx, id, rules[0]).script([s for s in steps if s])
+
+
+#: the MPG's parameters (M114 12.4-12.6) and the range of each: with one out of range
+#: "není možné MPG použít" (the MPG cannot be used)
+MPG_PARAMETERS = ([("EFR%02X" % (0x10 + 4 * i), 0.0, 1e4) for i in range(8)]
+                  + [("EFR%02X" % (0x30 + 4 * i), 1.0, 1e4) for i in range(4)]
+                  + [("EFR40", 1.0, 1e4), ("EFR44", 1e-9, float("inf"))])
+
+
+def mpg_usable(ctx: CaseContext) -> bool:
+    """Whether every MPG parameter the unit holds is in range (read with EFR): only then
+    do the manual's rules of the MPG apply whole; with one out of range (an EEPROM as
+    shipped) what the MPG mode does is a reading (9.reset.mpg-parameters)."""
+    for body, lo, hi in MPG_PARAMETERS:
+        r = ctx.link.send(body)
+        try:
+            if r is None or not r.ok or not lo <= float(r.values[0]) <= hi:
+                return False
+        except (IndexError, ValueError):
+            return False
+    return True

@@ -11,6 +11,7 @@ from conformance.cases._kit import (
     fresh_reset,
     index,
     index_moved,
+    mpg_usable,
     position,
     setup,
     show,
@@ -59,34 +60,13 @@ def reset_motion(ctx: CaseContext) -> None:
     Probe(ctx, "reset B", "9.reset.brake").script(["C-300,400,0", "C-200,0,0", 0.7])
 
 
-#: the MPG's parameters (M114 12.4-12.6) and the range of each: with one out of range
-#: "není možné MPG použít" (the MPG cannot be used)
-MPG_PARAMETERS = ([("EFR%02X" % (0x10 + 4 * i), 0.0, 1e4) for i in range(8)]
-                  + [("EFR%02X" % (0x30 + 4 * i), 1.0, 1e4) for i in range(4)]
-                  + [("EFR40", 1.0, 1e4), ("EFR44", 1e-9, float("inf"))])
-
-
-def mpg_rule(ctx: CaseContext) -> str:
-    """The rule whether the MPG holds RUN is judged by: the manual's where every MPG
-    parameter is in range; where one is not (an EEPROM as shipped), whether the MPG mode
-    still takes effect is a reading (9.reset.mpg-parameters)."""
-    for body, lo, hi in MPG_PARAMETERS:
-        r = ctx.link.send(body)
-        try:
-            if r is None or not r.ok or not lo <= float(r.values[0]) <= hi:
-                return "9.reset.mpg-parameters"
-        except (IndexError, ValueError):
-            return "9.reset.mpg-parameters"
-    return "9.reset.mpg"
-
-
 @case("9.reset.mpg-enabled", requires=("Y",), destructive=True,
       rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg", "10.cmd.restart",
              "9.reset.mpg-parameters"))
 def mpg_moving(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "EW06,01")                    # MPG enabled (spec 9, M114 12.2)
-    rule = mpg_rule(ctx)
+    rule = "9.reset.mpg" if mpg_usable(ctx) else "9.reset.mpg-parameters"
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5)
     r = link.send("SR6")

@@ -18,6 +18,7 @@ from conformance.cases._kit import (
     answers,
     code,
     measured_case,
+    mpg_usable,
     position,
     setup,
     show,
@@ -163,10 +164,14 @@ def override_leaves_v(ctx: CaseContext) -> None:
          [0, 0, 0]])
 
 
-@case("10.cmd.mpg.modes", requires=("Y",), rules=("10.cmd.mpg",))
+@case("10.cmd.mpg.modes", requires=("Y",), rules=("10.cmd.mpg", "9.reset.mpg-parameters"))
 def mpg_modes(ctx: CaseContext) -> None:
+    """Y+, Y&, Y- answer the command back; with an MPG parameter out of range (the
+    manual: the MPG cannot be used) whether Y+ and Y& may turn it on is a reading."""
+    on = "10.cmd.mpg" if mpg_usable(ctx) else "9.reset.mpg-parameters"
     for c in ("+", "&", "-"):
-        answers(ctx, ctx.link.send(f"Y{c}"), f"0,Y{c}", f"Y{c} answers the command back")
+        answers(ctx, ctx.link.send(f"Y{c}"), f"0,Y{c}", f"Y{c} answers the command back",
+                rule=on if c != "-" else "10.cmd.mpg")
 
 
 @case("10.cmd.output.port", rig=True, rules=("10.cmd.output",))

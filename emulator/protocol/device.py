@@ -86,9 +86,9 @@ class Device:
         return (mpg is not None and self.state.mpg in ("+", "&")
                 and self.eeprom.read(mpg.enable_address)[0] in mpg.enabling_values
                 and (not self.readings.active("mpg-needs-parameters")
-                     or self._mpg_parameters_in_range()))
+                     or self.mpg_parameters_in_range()))
 
-    def _mpg_parameters_in_range(self) -> bool:
+    def mpg_parameters_in_range(self) -> bool:
         """The reading mpg-needs-parameters: M114 12.4-12.6, "Pokud je hodnota některého
         parametru mimo rozsah, není možné MPG použít" (with any of them out of range the
         MPG cannot be used): the limits 0..10000, steps per mm 1..10000, the acceleration

@@ -80,8 +80,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
 #: readings of what only the GVE114 has, on a GVE114-500: EEPROM 06 enables the MPG; its
 #: parameters are erased (FF), so under the reading it does not hold RUN after J
 POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
-    "mpg-needs-parameters": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r"],
-                             b"0\r0\r0,40\r", b"0\r0\r0,00\r"),
+    "mpg-needs-parameters": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r", b"!0Y+\r"],
+                             b"0\r0\r0,40\r0,Y+\r", b"0\r0\r0,00\r5\r"),
 }
 
 
