@@ -1,5 +1,10 @@
 """Build hooks that pyproject.toml cannot express: the package list (with `fixtures/`
-installed as `gve_fixtures`) and the optional C stepper core built through cffi.
+installed as `gve_fixtures`), the optional C stepper core built through cffi and the
+wheel's tag.
+
+The C core is built against CPython's limited API (cffi's default, `.abi3.so`), so one
+wheel serves every CPython from the oldest that ``requires-python`` admits: the wheel is
+tagged ``cp311-abi3-<platform>`` rather than for the interpreter that built it.
 
 If the C core cannot be compiled (no compiler, no headers), installation goes on and
 the emulator uses its pure-Python twin, saying so once on stderr.
@@ -40,8 +45,12 @@ class OptionalBuildExt(build_ext):
               "the emulator will use the Python twin", file=sys.stderr)
 
 
+#: the oldest CPython the wheel's limited-API extension serves (``requires-python``)
+LIMITED_API = "cp311"
+
 setup(
     packages=packages,
     cffi_modules=["emulator/motion/build_stepper.py:ffibuilder"],
     cmdclass={"build_ext": OptionalBuildExt},
+    options={"bdist_wheel": {"py_limited_api": LIMITED_API}},
 )

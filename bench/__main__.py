@@ -1,6 +1,13 @@
 """Run every benchmark: `python -m bench`."""
 
-from bench import bench_cosim, bench_diff, bench_emulator, bench_host, bench_stepper
+from bench import (
+    bench_cosim,
+    bench_diff,
+    bench_emulator,
+    bench_host,
+    bench_line,
+    bench_stepper,
+)
 
 if __name__ == "__main__":
     bench_emulator.main()
@@ -12,3 +19,5 @@ if __name__ == "__main__":
     bench_diff.main([])
     print()
     bench_cosim.main([])
+    print()
+    bench_line.main([])

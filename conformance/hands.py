@@ -24,6 +24,7 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
+from conformance.link.account import Spent
 from conformance.link.framing import Response, UnitDataError
 from conformance.link.link import Link
 from conformance.link.safety import SILENCE_LIMIT
@@ -86,7 +87,7 @@ class HandRig:
         link = self._link()
         if link.poll("SR6", _at_rest, words["rest_seconds"]) is None:
             raise CouldNotTest(words["not_at_rest"].format(instruction=step.instruction))
-        with link.guard.hands_on():
+        with link.guard.hands_on(), link.spending(Spent.HANDS):
             return ask(step)
 
     def _done(self, step: HandStep, verify: Callable[[], str | None]) -> None:
@@ -180,7 +181,7 @@ class HandRig:
         def verify() -> str | None:
             after = None
             for _ in range(min(words["asks"], SILENCE_LIMIT - 1)):
-                link.wait(words["ready_seconds"])
+                link.wait(words["ready_seconds"], Spent.MANUAL)
                 after = self._index()
                 if after is not None:
                     break

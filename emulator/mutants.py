@@ -16,7 +16,9 @@ core (:data:`CORE_DEVIATIONS`), planted alike in both cores.
 
 from __future__ import annotations
 
+import contextlib
 import tomllib
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
@@ -58,6 +60,27 @@ class UnknownMutant(ValueError):
     pass
 
 
+#: while :func:`asked` records: the mutants the clean units' behaviour depended on
+_asked: set[str] | None = None
+
+
+@contextlib.contextmanager
+def asked() -> Iterator[set[str]]:
+    """Record, while the block runs, every mutant a clean unit's behaviour depended on:
+    each name its units asked :meth:`Mutant.active`, and every core deviation once a
+    unit built its stepper core. A mutant not among them cannot have changed what the
+    units did in the block: up to the first question about it, a unit carrying it acts
+    as the clean one does (the mutation sweep runs a case against it only then)."""
+    global _asked
+    outer, _asked = _asked, set()
+    try:
+        yield _asked
+    finally:
+        if outer is not None:
+            outer |= _asked
+        _asked = outer
+
+
 @dataclass(frozen=True)
 class Mutant:
     """The mutant a unit carries (or none). ``active(name)`` is the only question the
@@ -73,6 +96,8 @@ class Mutant:
 
     def active(self, name: str) -> bool:
         if self.name is None:          # the clean unit asks on every frame: answer fast
+            if _asked is not None:
+                _asked.add(name)
             return False
         if name not in MUTANTS:
             raise UnknownMutant(f"the emulator asks for an unknown mutant {name!r}")
@@ -81,6 +106,8 @@ class Mutant:
     @property
     def deviations(self) -> Deviation:
         """The stepper core's deviations this mutant plants."""
+        if self.name is None and _asked is not None:
+            _asked.update(CORE_DEVIATIONS)
         return CORE_DEVIATIONS.get(self.name or "", Deviation.NONE)
 
 

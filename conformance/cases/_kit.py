@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
+from conformance.link.account import Spent
 from conformance.link.framing import Response
 from conformance.motion.probe import Probe
 from conformance.quoting import answer_text
@@ -57,7 +58,7 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> N
     setup(ctx, "V500")
     for _ in range(vectors):
         setup(ctx, "C" + vector(ctx, steps))
-    ctx.link.wait(0.5)
+    ctx.link.wait(0.5, Spent.MOTION)
     r = ctx.link.send("H")
     ctx.require(r is not None and r.ok and r.inta, f"H answered {show(r)}")
 
@@ -65,7 +66,7 @@ def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> N
 def halted_line(ctx: CaseContext, steps: int, seconds: float) -> None:
     """Setup: an L of ``steps`` along X halted after ``seconds`` (INTA = 1, RUN = 1)."""
     setup(ctx, "L" + vector(ctx, steps))
-    ctx.link.wait(seconds)
+    ctx.link.wait(seconds, Spent.MOTION)
     r = ctx.link.send("H")
     ctx.require(r is not None and r.inta, f"H answered {show(r)}")
 
@@ -78,7 +79,7 @@ def fresh_reset(ctx: CaseContext) -> None:
     ctx.require(ctx.target.allow_destructive, "needs a reset (J): run with --allow-destructive")
     r = ctx.link.send("J")
     ctx.require(r is not None and r.ok, f"J answered {show(r)}")
-    ctx.link.wait(2.5)
+    ctx.link.wait(2.5, Spent.MANUAL)             # ready about 2 s after J (spec 2)
 
 
 def queries_counted(ctx: CaseContext, address: int | None = None) -> bool:

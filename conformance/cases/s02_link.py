@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, index, index_moved, setup
+from conformance.link.account import Spent
 from conformance.link.framing import frame
 from conformance.link.link import MARGIN
 from conformance.motion.tolerance import byte_ns
@@ -57,7 +58,7 @@ def restart(ctx: CaseContext) -> None:
     r = link.send("SW3,5A", checksum=False, timeout=1.0)
     ctx.expect(r is None, "a frame while the unit restarts gets no answer",
                observed=r, expected="nothing", rule="2.link.restart-deaf")
-    link.wait(2.5)
+    link.wait(2.5, Spent.MANUAL)
     r = link.send("@", checksum=False)
     ctx.expect(r is not None and r.raw == b"0,0\r", "it was lost: the index is 0",
                observed=r, expected="0,0", rule="2.link.restart-deaf")

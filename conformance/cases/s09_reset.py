@@ -17,6 +17,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
+from conformance.link.account import Spent
 from conformance.motion.probe import Probe
 from gve_fixtures.protocol import ErrorCode
 
@@ -32,7 +33,7 @@ def after_j(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 16))
     link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
-    link.wait(2.5)
+    link.wait(2.5, Spent.MANUAL)
     answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
     answers(ctx, link.send("@"), "0,1", "the index restarted at 0", rule="8.index.answer")
     ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", rule="9.reset.state")
@@ -68,7 +69,7 @@ def mpg_moving(ctx: CaseContext) -> None:
     setup(ctx, "EW06,01")                    # MPG enabled (spec 9, M114 12.2)
     rule = "9.reset.mpg" if mpg_usable(ctx) else "9.reset.mpg-parameters"
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
-    link.wait(2.5)
+    link.wait(2.5, Spent.MANUAL)
     r = link.send("SR6")
     ctx.expect(r is not None and r.values == ["40"], "after J the MPG holds RUN = 1",
                observed=show(r), expected="0,40", rule=rule)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, halted_line, position, setup, show, vector
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
 IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 10.3)
@@ -78,10 +79,10 @@ def physical(ctx: CaseContext) -> None:
     link = ctx.link
     link.rig.set_input(1, IN0_ACTIVE)
     answers(ctx, link.send("J"), "0", "J → 0", tag="D")
-    link.wait(2.5)
+    link.wait(2.5, Spent.MANUAL)
     answers(ctx, link.send("I1"), "0,FE", "after J the grounded input still reads 0")
     link.rig.power_on()
-    link.wait(2.5)
+    link.wait(2.5, Spent.MANUAL)
     answers(ctx, link.send("I1"), "0,FE", "after power-on the grounded input still reads 0")
 
 

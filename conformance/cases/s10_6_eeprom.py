@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, setup, show, vector
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
 #: bytes no profile gives a default to (spec 10.6)
@@ -18,7 +19,7 @@ def _restart(ctx: CaseContext, how: str = "J") -> None:
         ctx.require(r is not None and r.ok, "J answered")
     else:
         ctx.link.rig.power_on()
-    ctx.link.wait(2.5)
+    ctx.link.wait(2.5, Spent.MANUAL)
 
 
 #: the two patterns: each address's byte differs from every other address's, and the

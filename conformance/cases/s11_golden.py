@@ -10,6 +10,7 @@ import re
 from pathlib import Path
 
 from conformance.case import CaseContext, case
+from conformance.link.account import Spent
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from conformance.protocol.catalogue import classes
@@ -89,7 +90,7 @@ def _action(ctx: CaseContext, words: list[str], what: str, tag: str,
         ctx.expect(got == args[1], what, observed=got, expected=args[1], tag=tag, rule=rule)
     elif verb == "power-on":
         link.rig.power_on()
-        link.wait(2.5)
+        link.wait(2.5, Spent.MANUAL)
     else:
         raise ValueError(f"unknown transcript action {verb!r}")
 

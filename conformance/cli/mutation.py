@@ -4,7 +4,10 @@ catalogue until a case FAILs it; the command prints, per mutant, the case that c
 and the time it took, then the score, and exits 1 below 100 % or when a case reported
 ERROR on the way (a defect of the suite: a broken unit must make a case FAIL, never
 crash it). ``--sweep`` runs the whole catalogue against every mutant on one profile per
-family besides, for the ERRORs only a case that does not catch the mutant meets.
+family besides, for the ERRORs only a case that does not catch the mutant meets. The
+sweep runs a case against a mutant only where the case's clean run reached the mutant's
+code: elsewhere it runs exactly as on the clean unit, which is run once per case and
+profile and reused for every mutant.
 
 A mutant is stopped at its first FAIL by a case that PASSes the clean emulator on the
 same profile (a case failing both proves nothing; it is reported). The cases of the
@@ -37,6 +40,7 @@ class Hunt:
     description: str
     caught_by: str | None = None     # "case [profile]"
     runs: int = 0                    # case runs it took
+    unreached: int = 0               # case runs the sweep left out: the mutant's code unreached
     seconds: float = 0.0
     errors: list[str] = field(default_factory=list)   # suite defects met on the way
     clean_fails: list[str] = field(default_factory=list)   # cases failing the clean unit
@@ -91,6 +95,9 @@ def hunt(mutant: str, profiles: list[str] | None = None,
         target, clean = targets[p]
         if c.missing_for(target.profile) or (result.caught and p not in first):
             continue
+        if sweep and mutant not in clean_run(c, clean)[1]:
+            result.unreached += 1
+            continue
         r = run_case(c, target, "mutation")
         result.runs += 1
         where = f"{c.id} [{p}]"
@@ -98,7 +105,7 @@ def hunt(mutant: str, profiles: list[str] | None = None,
             result.errors.append(where)
         if r.verdict != FAIL or result.caught:
             continue
-        if run_case(c, clean, "mutation").verdict in (FAIL, ERROR):
+        if clean_run(c, clean)[0] in (FAIL, ERROR):
             result.clean_fails.append(where)
             continue
         result.caught_by = where
@@ -107,6 +114,23 @@ def hunt(mutant: str, profiles: list[str] | None = None,
             return result
     result.seconds = time.perf_counter() - start
     return result
+
+
+#: per case and clean target, in this process: its verdict and the mutants it reached
+_CLEAN: dict[tuple[str, str], tuple[str, frozenset[str]]] = {}
+
+
+def clean_run(case, clean) -> tuple[str, frozenset[str]]:
+    """The verdict of ``case`` on the clean emulator ``clean`` and the mutants whose code
+    it reached (run once per process: the runs are exact)."""
+    from conformance.runner import run_case
+    from conformance.targets.emu import mutants_reached
+    key = (case.id, clean.info.spec)
+    if key not in _CLEAN:
+        with mutants_reached() as reached:
+            verdict = run_case(case, clean, "mutation").verdict
+        _CLEAN[key] = (verdict, frozenset(reached))
+    return _CLEAN[key]
 
 
 def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool]) -> Hunt:
@@ -162,7 +186,9 @@ def main(argv: list[str] | None = None) -> int:
         print(line, flush=True)
     print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
           f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-          f"{sum(h.runs for h in results)} case runs, {errors} ERROR")
+          f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
+          + (f"; {sum(h.unreached for h in results)} not run, the mutant's code unreached"
+             if args.sweep else ""))
     return 0 if caught == len(results) and not errors else 1
 
 

@@ -38,6 +38,7 @@ from conformance.cli.usage import (
     writable_folder,
 )
 from conformance.coverage import coverage, format_coverage
+from conformance.link.account import account_lines
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.runner import RunResult, run, settings_for
@@ -352,7 +353,8 @@ def _settings_line(targets: list[Target], chosen: str | None) -> str:
 
 
 def _session_lines(result: RunResult) -> list[str]:
-    """Per real target: the largest excursion, what was restored, what could not be."""
+    """Per real target: the largest excursion, what was restored, what could not be,
+    where the time went."""
     lines = []
     for spec, s in result.sessions.items():
         if not s["real"]:
@@ -365,6 +367,7 @@ def _session_lines(result: RunResult) -> list[str]:
             lines.append(f"  largest excursion (full steps, envelope ±{s['max_travel']}): {axes}")
         lines += [f"  restored: {r}" for r in s["restored"]]
         lines += [f"  reset: {r}" for r in s["reset"]]
+        lines += [f"  {line}" for line in account_lines(s.get("time") or {})]
     lines += [f"PROBLEM: {p}" for p in result.problems]
     return lines
 

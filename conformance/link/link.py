@@ -29,14 +29,22 @@ the unfinished bytes reach the unit's own watchdog time, or its last frame timed
 and at the end of a case, the link waits out the longest watchdog a reader may choose
 (the profile's ``watchdog_longest_ms``) since the last byte, so that no such answer is
 taken for a later frame's.
+
+Every wait of the link is booked in its time account (conformance/link/account.py):
+an exchange's bytes at the baud rate as line time and the rest as the unit's (its
+answer, or the motion a command answers at the end of), a wait under what its caller
+says it waits for (the suite's own unless told), a timeout and a quiet line as the
+suite's own waits.
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import NamedTuple
 
+from conformance.link.account import Spent, TimeAccount
 from conformance.link.faults import FrameFault
 from conformance.link.framing import (
     CR,
@@ -63,7 +71,8 @@ QUIET = 2.5
 #: real time: how long after its timeout an answer is still taken as its frame's, noted
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
-#: real time: at the end of a case, how long to listen for bytes still on their way
+#: real time: at the end of a case, the longest it listens for bytes still on their way
+#: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
 END_QUIET = 0.05
 
 #: answers summed after the command whatever the mode before (spec 6, 10 J)
@@ -130,6 +139,13 @@ class Link:
         self._packet = False      # a packet the suite opened and has not seen closed
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
+        #: where the link's time went (its session's account, shared by its links)
+        self.account = TimeAccount()
+        #: the exchange whose bytes are going out: the clock when its first byte was
+        #: written, its bytes, the time paused in it (booked apart); what follows its
+        #: answer, or its absence, is booked with it
+        self._exchange: list[int] | None = None
+        self._answered_as = Spent.ANSWERS
         self._origin = self._clock()
 
     # -- time ------------------------------------------------------------------------------
@@ -141,6 +157,40 @@ class Link:
     @property
     def now(self) -> int:
         return self._clock() - self._origin
+
+    def keep_account(self, account: TimeAccount) -> None:
+        """Book this link's time in ``account`` (its session's); in virtual time the
+        account's wall time follows this link's clock from now on."""
+        self.account = account
+        if self.virtual:
+            account.follow(lambda: self.now / SECOND)
+
+    @contextlib.contextmanager
+    def spending(self, spent: Spent) -> Iterator[None]:
+        """Book the time the block takes under ``spent`` (e.g. a technician's step)."""
+        began = self._clock()
+        try:
+            yield
+        finally:
+            self.account.book(spent, (self._clock() - began) / SECOND)
+
+    def _book_exchange(self, received: int, rest: Spent, began: int) -> None:
+        """Book the exchange under way (else what was read since ``began``): its bytes
+        and the ``received`` ones at the baud rate as line time, the rest under ``rest``."""
+        if self._exchange is not None:
+            began, sent, paused = self._exchange
+        else:
+            sent = paused = 0
+        self._exchange = None
+        seconds = (self._clock() - began - paused) / SECOND
+        line = min(seconds, self.byte_seconds(sent + received))
+        self.account.book(Spent.LINE, line)
+        self.account.book(rest, seconds - line)
+
+    def _close_exchange(self) -> None:
+        """Frames sent that nothing will read an answer to: their bytes are booked now."""
+        if self._exchange is not None:
+            self._book_exchange(0, Spent.WAITS, 0)
 
     def byte_seconds(self, n: int) -> float:
         return n * 10 / self.baud
@@ -158,19 +208,29 @@ class Link:
         that long again); nothing in virtual time or when the line was not measured."""
         return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
 
+    def end_quiet(self) -> float:
+        """Real time: how long the end of a case listens for bytes still on their way (a
+        second answer follows the first at once): the line's round trip as measured
+        (:meth:`line_seconds`), at most :data:`END_QUIET`."""
+        measured = self.line_seconds()
+        return min(END_QUIET, measured) if measured else END_QUIET
+
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
         the command (spec 6, 10 J)."""
         return _MODE_AFTER.get(body, self.checksums)
 
-    def wait(self, seconds: float) -> bytes:
-        """Let ``seconds`` pass; returns whatever arrived meanwhile."""
+    def wait(self, seconds: float, spent: Spent = Spent.WAITS) -> bytes:
+        """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
+        suite's own wait unless it says otherwise); returns whatever arrived meanwhile."""
         self.guard.check_idle()
-        if self.line is not None:
-            self.line.advance(seconds)
-            data = self.port.read(self.port.in_waiting)
-        else:
-            data = self._listen(seconds, stop_early=False)
+        self._close_exchange()
+        with self.spending(spent):
+            if self.line is not None:
+                self.line.advance(seconds)
+                data = self.port.read(self.port.in_waiting)
+            else:
+                data = self._listen(seconds, stop_early=False)
         if data:
             self._record(UNIT, data)
             self._after_answer(data, "during a wait", judged=True)
@@ -194,12 +254,16 @@ class Link:
                 end = time.monotonic() + seconds
         return bytes(data)
 
-    def _pause(self, seconds: float) -> None:
+    def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
-        if self.line is not None:
-            self.line.advance(seconds)
-        else:
-            time.sleep(seconds)      # real serial/TCP time: the fault is a pause on the wire
+        began = self._clock()
+        with self.spending(spent):
+            if self.line is not None:
+                self.line.advance(seconds)
+            else:
+                time.sleep(seconds)  # real serial/TCP time: the fault is a pause on the wire
+        if self._exchange is not None:
+            self._exchange[2] += self._clock() - began
 
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
@@ -234,9 +298,11 @@ class Link:
         if fault:
             self.note(f"fault host {fault.kind} {fault.params}")
         self._dropped = not wire
+        # a frame held back mid-way waits out the unit's watchdog (spec 3)
+        paused = Spent.MANUAL if fault and fault.kind == "delay" else Spent.WAITS
         for piece, pause in pieces:
             if pause:
-                self._pause(pause)
+                self._pause(pause, paused)
             if piece:
                 self._write(piece)
         self._sent_until, self._waited_out = self.now, False
@@ -253,6 +319,9 @@ class Link:
         with self.guard.interrupts.held():
             self.guard.check_idle()
             self._record(HOST, data)
+            if self._exchange is None:
+                self._exchange = [self._clock(), 0, 0]
+            self._exchange[1] += len(data)
             self.port.write(data)
 
     def send_raw(self, data: bytes) -> None:
@@ -274,10 +343,14 @@ class Link:
             self._book(sent, None)
             return None
         late = 0.0
-        if timeout is None:
+        if self._dropped:
+            timeout = 0.0            # an injected fault dropped it: no answer can come
+        elif timeout is None:
             timeout = self.answer_timeout(body, len(data))
             late = 0.0 if self.virtual else LATE
         self._unbooked = sent
+        # H and W answer when their motion ends: the wait for them is the motion's
+        self._answered_as = Spent.MOTION if self.guard.answer_seconds(body) else Spent.ANSWERS
         r = self.read_response(timeout, lines, summed=self.summed_after(body), late=late)
         if r is not None:
             r.sent_at = self.wrote_at
@@ -356,6 +429,8 @@ class Link:
         self.port.timeout = timeout
         self._quiet = 0.0
         asked = time.monotonic()
+        began = self._clock()
+        answered_as, self._answered_as = self._answered_as, Spent.ANSWERS
         for i in range(lines):
             chunk = self.port.read_until(CR)
             if i == 0 and late and not chunk.endswith(CR) \
@@ -373,6 +448,9 @@ class Link:
                 break
             self.port.timeout = MARGIN + self.line_seconds()
         data = bytes(raw)
+        # an answer that did not come (or not whole) was waited for to the suite's deadline
+        self._book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
+                            began)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None
         if data:
@@ -404,12 +482,14 @@ class Link:
         more lines than expected (`>` after `@`, if `@` is remembered)."""
         raw = bytearray()
         self.port.timeout = seconds
+        began = self._clock()
         while True:
             chunk = self.port.read_until(CR)
             raw += chunk
             if not chunk.endswith(CR):
                 break
             self.port.timeout = self.byte_seconds(64)
+        self._book_exchange(len(raw), Spent.WAITS, began)
         if raw:
             self._record(UNIT, bytes(raw), "the rest of the answer")
         return bytes(raw)
@@ -422,12 +502,15 @@ class Link:
         state = self._last[0]
         data = self._outwait(final)
         kept_quiet = False
+        self._close_exchange()
         if not self.virtual:
             if state == _TIMED_OUT and not self.guard.interrupts.pending:
-                data = self._listen(QUIET, stop_early=True, already=self._quiet)
+                with self.spending(Spent.WAITS):
+                    data = self._listen(QUIET, stop_early=True, already=self._quiet)
                 kept_quiet = not self.guard.interrupts.pending
             elif final:
-                data = self._listen(END_QUIET, stop_early=True)
+                with self.spending(Spent.WAITS):
+                    data = self._listen(self.end_quiet(), stop_early=True)
         self._quiet = 0.0
         waiting = self.port.in_waiting
         if waiting:
@@ -460,10 +543,11 @@ class Link:
         left = (profile.watchdog_longest_ms * 1_000_000 - idle) / SECOND + MARGIN
         if left <= 0:
             return b""
-        if self.line is not None:
-            self.line.advance(left)
-            return b""
-        return self._listen(left, stop_early=False)
+        with self.spending(Spent.MANUAL):          # the watchdog's time, as a unit may take it
+            if self.line is not None:
+                self.line.advance(left)
+                return b""
+            return self._listen(left, stop_early=False)
 
     def _after_answer(self, data: bytes, when: str, *, judged: bool = False) -> None:
         """Bytes no frame asked for: a watchdog's answer to what the suite left
@@ -495,10 +579,12 @@ class Link:
                                      f"{readable(data)}", WATCHDOG_RULES[kind], always=False))
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
-             every: float = 0.05, *, send: Callable[[str], Response | None] | None = None
-             ) -> Response | None:
+             every: float = 0.05, *, send: Callable[[str], Response | None] | None = None,
+             spent: Spent = Spent.MOTION) -> Response | None:
         """Send ``body`` until ``until(response)`` holds; the last response, or None.
-        ``send``: what sends each frame (a caller that books them), else :meth:`send`."""
+        ``send``: what sends each frame (a caller that books them), else :meth:`send`;
+        the waits between them are booked under ``spent`` (the unit's motion, which
+        polls wait the end of, unless the caller says otherwise)."""
         send = self.send if send is None else send
         deadline = self.now + max_seconds * SECOND
         while True:
@@ -507,7 +593,7 @@ class Link:
                 return r
             if self.now > deadline:
                 return None
-            self.wait(every)
+            self.wait(every, spent)
 
     def wait_idle(self, max_seconds: float = 60.0) -> bool:
         """Poll SR6 until RUN = 0 (spec 10.3)."""

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 
 from conformance.case import CaseContext, CouldNotTest
 from conformance.known_state import known_axis_limits
+from conformance.link.account import Spent
 from conformance.link.framing import Response, frame
 from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 from conformance.motion.model import MotionModel
@@ -132,7 +133,7 @@ class Probe:
         """Read PF every ``every`` s for ``seconds``."""
         end = self.link.now + round(seconds * SECOND)
         while self.link.now < end:
-            self.link.wait(every)
+            self.link.wait(every, Spent.MOTION)
             self.read(label)
 
     def until(self, target: list[int], max_seconds: float, every: float) -> None:
@@ -142,7 +143,7 @@ class Probe:
             got = self.read()
             if got is not None and got[:len(target)] == target:
                 return
-            self.link.wait(every)
+            self.link.wait(every, Spent.MOTION)
         raise CouldNotTest(f"the axes did not reach {target} within {max_seconds} s")
 
     def script(self, steps: list, every: float = 0.05) -> bool:

@@ -4,6 +4,8 @@ link. The only place the suite imports the emulator, and only to open its ``gve:
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from urllib.parse import parse_qs, urlsplit
 
 import serial
@@ -26,6 +28,16 @@ def mutants() -> dict[str, tuple[str, str]]:
     # an entry is (sections, description[, area]); the area defaults to the first section
     return {name: (spec[2] if len(spec) > 2 else spec[0].split(",")[0].strip(), spec[1])
             for name, spec in MUTANTS.items()}
+
+
+@contextlib.contextmanager
+def mutants_reached() -> Iterator[set[str]]:
+    """The mutants whose code the clean embedded units of the block reached (the
+    emulator's record of them): a case whose clean run reached none of a mutant's code
+    runs against that mutant exactly as against the clean unit."""
+    from emulator.mutants import asked
+    with asked() as names:
+        yield names
 
 
 def version_text(prog: str) -> str:

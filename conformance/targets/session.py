@@ -30,6 +30,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
+from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response, frame, readable
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
@@ -88,6 +89,9 @@ class SessionReport:
     #: the line's round trip measured at the start (`?` exchanges): ms min, median, max,
     #: and the byte time at the baud rate
     line: dict[str, float] = field(default_factory=dict)
+    #: where the session's time went: seconds per head of conformance/link/account.py
+    #: and the wall time
+    time: dict[str, float] = field(default_factory=dict)
     wire_log: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
@@ -114,6 +118,7 @@ class Session:
         self.failed = ""                           # why the session could not begin
         self.finished = False
         self._link: Link | None = None             # the latest link (its checksum belief)
+        self.account = TimeAccount()                # where the session's time goes
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return EmulatorGuard(self.profile, self.target.address, interrupts)
@@ -155,6 +160,7 @@ class Session:
         port, baud, virtual, rig = self.target.connect(address)
         link = Link(port, self.guard, address=self.target.address if address is None else address,
                     baud=baud, virtual=virtual, rig=rig)
+        link.keep_account(self.account)
         self._link = link
         return link
 
@@ -173,6 +179,7 @@ class Session:
         if self.started:
             return
         self.started = True
+        self.account.begin()
         self._as_found()
 
     def _as_found(self) -> None:
@@ -197,6 +204,8 @@ class Session:
         self.finished = True
         self._put_back()
         self.report.interrupted = self.report.interrupted or self.interrupts.stopped
+        self.account.end()
+        self.report.time = self.account.totals()
         return self.report
 
     def _put_back(self) -> None:
@@ -464,7 +473,7 @@ class RealSession(Session):
         step = WATCH * self.profile.restart_ms / 1000
         end = link.now + round(seconds * SECOND)
         while link.now < end:
-            link.wait(min(step, (end - link.now) / SECOND))
+            link.wait(min(step, (end - link.now) / SECOND), Spent.MOTION)
             if link.now < end:
                 link.send("SR6")
 

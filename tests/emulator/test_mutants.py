@@ -1,7 +1,9 @@
 """Every mutant of emulator/mutants.py really deviates: on a transcript of the rule it
 breaks (tests/emulator/transcripts or a golden one), which the clean emulator passes
 (test_revised_spec.py, test_golden.py), the mutant answers differently. And every name
-the emulator asks ``active()`` about is a registered mutant."""
+the emulator asks ``active()`` about is a registered mutant. The clean emulator playing a
+mutant's probe reaches the mutant's code (``asked``): the mutation sweep leaves a case out
+for a mutant only where its clean run did not."""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from emulator.mutants import CORE_DEVIATIONS, MUTANTS, Mutant, UnknownMutant
+from emulator.mutants import CORE_DEVIATIONS, MUTANTS, Mutant, UnknownMutant, asked
 from gve_fixtures import TRANSCRIPTS_DIR
 from gve_fixtures.transcript import load
 from tests.emulator.replay import TRANSCRIPTS, open_line, play
@@ -109,6 +111,28 @@ def test_the_mutant_answers_its_probe_differently(mutant: str, tmp_path: Path) -
     problems = play(port, transcript)
     assert problems, f"{mutant} ({MUTANTS[mutant].description}) passes {name} on {profile}"
     print(f"{mutant}: {problems[0]}")
+
+
+@pytest.mark.parametrize("mutant", sorted(MUTANTS))
+def test_the_clean_unit_playing_the_probe_reaches_the_mutant(mutant: str, tmp_path: Path) -> None:
+    name, profile = PROBES[mutant]
+    transcript = load(_transcript(name))
+    address = int(transcript.meta.get("address", "0"))
+    with asked() as reached:
+        port = open_line(profile, address, eeprom=str(tmp_path / "eeprom.bin"))
+        assert play(port, transcript) == []
+    assert mutant in reached
+
+
+def test_nothing_is_recorded_outside_the_block_and_blocks_nest() -> None:
+    Mutant().active("sw6-inert")
+    with asked() as outer:
+        with asked() as inner:
+            Mutant().active("sw6-inert")
+        Mutant().active("narrow-counters")
+        Mutant("sw6-inert").active("narrow-counters")      # a mutant unit: not the clean one
+    assert inner == {"sw6-inert"}
+    assert outer == {"sw6-inert", "narrow-counters"}
 
 
 def test_names_the_emulator_asks_about_are_registered() -> None:
