@@ -143,6 +143,8 @@ class CaseContext:
         """A new link in the known state (on the emulator: a new unit, at ``address``
         when given)."""
         link = self._open_link(address)
+        if self._link is not None:
+            self._link.superseded = True
         self.links.append(link)
         self._link = link
         return link

@@ -139,6 +139,9 @@ class Link:
         self._packet = False      # a packet the suite opened and has not seen closed
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
+        #: a later link of the case took over: what this one left went to a unit that
+        #: has heard other frames since (or, on the emulator, is gone)
+        self.superseded = False
         #: where the link's time went (its session's account, shared by its links)
         self.account = TimeAccount()
         #: the exchange whose bytes are going out: the clock when its first byte was
@@ -500,17 +503,17 @@ class Link:
         (a violation), after a timeout a late one (a violation), else unsolicited. In
         real time, after a timeout, wait until the line is quiet first."""
         state = self._last[0]
+        self._close_exchange()
         data = self._outwait(final)
         kept_quiet = False
-        self._close_exchange()
         if not self.virtual:
             if state == _TIMED_OUT and not self.guard.interrupts.pending:
                 with self.spending(Spent.WAITS):
-                    data = self._listen(QUIET, stop_early=True, already=self._quiet)
+                    data += self._listen(QUIET, stop_early=True, already=self._quiet)
                 kept_quiet = not self.guard.interrupts.pending
             elif final:
                 with self.spending(Spent.WAITS):
-                    data = self._listen(self.end_quiet(), stop_early=True)
+                    data += self._listen(self.end_quiet(), stop_early=True)
         self._quiet = 0.0
         waiting = self.port.in_waiting
         if waiting:
@@ -532,7 +535,7 @@ class Link:
         next frame goes on with, and a frame the next `!` is meant to cut, are not
         waited for. Returns what arrived meanwhile (real time)."""
         kind = self.left_open()
-        if not kind or self._waited_out:
+        if not kind or self._waited_out or (final and self.superseded):
             return b""
         profile = self.guard.profile
         idle = self.now - self._sent_until
