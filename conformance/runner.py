@@ -19,7 +19,18 @@ from conformance.link.safety import TargetNotResponding
 from conformance.metadata import RunMeta
 from conformance.operator import Console
 from conformance.targets import Session, SessionError, Target
-from conformance.verdict import ALWAYS, COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS, grade, worst
+from conformance.verdict import (
+    ALWAYS,
+    COULD_NOT_TEST,
+    ERROR,
+    FAIL,
+    MISSING,
+    PASS,
+    SILENT,
+    UNREADABLE,
+    grade,
+    worst,
+)
 from gve_fixtures.rules import load_rules
 
 
@@ -123,7 +134,8 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
         verdicts.append(COULD_NOT_TEST)
         ctx.note(f"safety stop: {err}")
     except UnitDataError as err:
-        ctx.expect(False, f"the unit's answer cannot be read: {err}", tag=ALWAYS)
+        ctx.expect(False, f"the unit's answer cannot be read: {err}", tag=ALWAYS,
+                   rule=UNREADABLE, machinery=True)
     except KeyboardInterrupt:
         ended = False
         result.interrupted = True
@@ -135,7 +147,7 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
     except TargetNotResponding as err:
         ended = False
         result.stopped = str(err)
-        ctx.expect(False, str(err), tag=ALWAYS)
+        ctx.expect(False, str(err), tag=ALWAYS, rule=SILENT, machinery=True)
     except SessionError as err:
         ended = False
         result.stopped = str(err)
@@ -152,9 +164,10 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
                 except TargetNotResponding as err:    # ended with the case: its failure
                     ended = False
                     result.stopped = str(err)
-                    ctx.expect(False, str(err), tag=ALWAYS)
+                    ctx.expect(False, str(err), tag=ALWAYS, rule=SILENT, machinery=True)
             for violation in link.violations:
-                ctx.expect(False, violation, tag=ALWAYS)
+                ctx.expect(False, violation.text, tag=ALWAYS if violation.always else None,
+                           rule=violation.rule, machinery=True)
             for late in link.late:
                 ctx.note(f"late answer (the spec sets no deadline): {late}")
         if ended and hand_rig is not None and ctx.links:
@@ -278,7 +291,7 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
             if cases and isinstance(err, TargetNotResponding):
                 first = _result(cases[0], target, FAIL)
                 first.checks = [{"ok": False, "what": stopped, "observed": "", "expected": "",
-                                 "tag": ALWAYS, "rule": cases[0].rule}]
+                                 "tag": ALWAYS, "rule": SILENT}]
                 first.stopped = stopped
                 add(first)
                 cases = cases[1:]

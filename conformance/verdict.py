@@ -30,6 +30,9 @@ ORDER = (ERROR, FAIL, NON_STRICT, INFO, COULD_NOT_TEST, MISSING, PASS)
 ALWAYS = "always"
 #: the tags a check may carry: the spec's, and ALWAYS
 CHECK_TAGS = (*protocol.TAGS, ALWAYS)
+#: the rules the failures no tag softens break (spec preamble): bytes of the unit that
+#: cannot be read as an answer, and a target that stopped answering
+UNREADABLE, SILENT = "4.response.grammar", "2.link.answer-promptly"
 
 
 def grade(tag: str, strict: bool) -> str:

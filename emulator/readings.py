@@ -80,6 +80,47 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "next-vectors-B": (("10.2.motion.junction-own-b",),
                        "a junction of two C is passed at the B the next C captured, not the "
                        "one of the C that ends there"),
+    "restore-nothing-kept-range": (("10.5.restore.pops",),
+                                   "R with nothing saved by K (or a second R) is refused "
+                                   "with 5 and changes nothing"),
+    "keep-c-queue-full": (("10.5.keep.c-refused",),
+                          "after K a C is refused with 1, as a vector the one place the "
+                          "kept queue holds (for an L) has no room for"),
+    "packet-failed-count-valid": (("7.packet.codes",),
+                                  "a failed packet answers the first failing member's code "
+                                  "before a count mismatch, with the count of its valid "
+                                  "members (`*S`, `C`, `V100`, `C`, `*E3` → `4,2`)"),
+    "packet-failed-count-zero": (("7.packet.codes", "7.packet.other-member"),
+                                 "a failed packet answers `code,0` (no member taken), the "
+                                 "first failing member's code before a count mismatch, and "
+                                 "a command a packet cannot hold is unknown there (3): "
+                                 "`*S`, `V10`, `C-300,0,0,0`, `*E1` → `3,0`"),
+    "half-second-watchdog": (("3.frame.watchdog-time",),
+                             "the watchdog drops an unfinished frame after 500 ms without "
+                             "a byte"),
+    "packet-watchdog": (("7.packet.open-until-end",),
+                        "an open packet that receives nothing for 500 ms is dropped and "
+                        "answered `2,k` (k members received), as a packet that did not "
+                        "arrive whole in time"),
+    "mpg-needs-parameters": (("9.reset.mpg-parameters",),
+                             "the GVE114's MPG takes effect only when every MPG parameter "
+                             "(limits, steps per mm, acceleration, speed: M114 12.4-12.6) "
+                             "is in range; with one out of range (an erased FF) RUN stays 0 "
+                             "and Y+, Y& are refused with 5"),
+    "vector-fewer-components": (("10.cmd.vector-components",),
+                                "a vector takes one component or more, the missing ones "
+                                "0 (the manuals' own `!0L1000,100`)"),
+    "commands-any-case": (("3.frame.upper-case",),
+                          "command letters are taken in either case (`!0v1000` is V)"),
+    "eeprom-erased-zero": (("10.6.eeprom.erased",),
+                           "the EEPROM as shipped reads 00 where it was never written "
+                           "(the GVE114's tables: 00 means unused), its named defaults "
+                           "apart"),
+    "steps-a-period-late": (("10.2.motion.step-placement",),
+                            "steps placed on a continuous trapezoid and counted rounded "
+                            "down: a counter shows a step one step period after the suite's "
+                            "arithmetic places it (up to one step behind on each axis while "
+                            "moving), and H answers one step period after the last step"),
 }.items()}
 
 #: readings whose behaviour lives in the stepper core

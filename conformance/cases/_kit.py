@@ -51,17 +51,21 @@ def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | No
     return r
 
 
-def configured(ctx: CaseContext, name: str) -> None:
+def configured(ctx: CaseContext, name: str, *, required: bool = True) -> bool:
     """Setup: the feature ``name`` configured as its manual requires before a case relies
     on it (conformance/preconditions.toml): every parameter it names read, and one the
     manual does not allow written and read back (EEPROM: needs --allow-destructive; the
     session puts the bytes back after the case). COULD-NOT-TEST where a write is needed
-    and not allowed, or does not take."""
+    and not allowed, or does not take; not ``required``, a write that is not allowed
+    leaves the unit as it is and the answer is False (the case grades what it then sees
+    as a reading)."""
     f = feature(name)
     for p in f.params_for(ctx.profile):
         r = ctx.link.send(p.read())
         if r is not None and r.ok and p.holds(r.values):
             continue
+        if not required and not ctx.target.allow_destructive:
+            return False
         ctx.require(ctx.target.allow_destructive,
                     f"{f.name} needs {p.shown} ({f.source}); it reads {show(r)}, and "
                     "writing it needs --allow-destructive")
@@ -69,6 +73,7 @@ def configured(ctx: CaseContext, name: str) -> None:
         r = ctx.link.send(p.read())
         ctx.require(r is not None and r.ok and p.holds(r.values),
                     f"{f.name} needs {p.shown}: {p.write()} was taken, yet it reads {show(r)}")
+    return True
 
 
 def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> None:

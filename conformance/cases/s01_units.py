@@ -6,7 +6,7 @@ What distinguishes the GVE54, the GVE84 and the GVE114 and their variants. A pro
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, setup, show
+from conformance.cases._kit import answers, code, position, setup, show
 from gve_fixtures.protocol import ErrorCode
 
 # parameter -> (frame template, the rule its range belongs to on GVE54 / on GVE84, GVE114)
@@ -21,14 +21,29 @@ RANGES = {
 }
 
 
-@case("1.profile.axes.count", rules=("1.profile.axes",))
+@case("1.profile.axes.count", rules=("1.profile.axes", "10.cmd.vector-components"))
 def axes(ctx: CaseContext) -> None:
+    """A fourth component is the GVE114's A axis and no axis elsewhere; two components
+    (as the manuals' own `!0L1000,100`) are taken as X, Y and zeros, or refused."""
+    link = ctx.link
     four = len(ctx.profile.axes) == 4
+    start = position(ctx)
+    ctx.require(start is not None, "PF did not answer with positions")
     setup(ctx, "H", expect="8")              # vectors wait in the queue while INTA = 1
-    code(ctx, ctx.link.send("C0,0,0,1"), ErrorCode.OK if four else ErrorCode.SYNTAX,
-         f"a fourth component: {'the A axis' if four else 'no such axis'}", inta=True)
-    code(ctx, ctx.link.send("C1,0"), ErrorCode.SYNTAX, "two components are too few", inta=True)
-    setup(ctx, "D")
+    code(ctx, link.send("C0,0,0,1"), ErrorCode.OK if four else ErrorCode.SYNTAX,
+         f"a fourth component: {'the A axis' if four else 'no such axis'}", inta=True,
+         rule="1.profile.axes")
+    fewer = "10.cmd.vector-components"
+    r = link.send("C1,0")
+    ctx.expect(r is not None and r.inta and r.code in (ErrorCode.OK, ErrorCode.SYNTAX),
+               "two components: taken with the rest 0, or refused as a wrong count",
+               observed=show(r), expected="8 or C", rule=fewer)
+    taken = r is not None and r.code == ErrorCode.OK
+    setup(ctx, "G")
+    link.poll("L0,0,0", lambda r: r.ok, 30)
+    want = [start[0] + taken, start[1], start[2]]
+    ctx.expect(position(ctx) == want, f"and X moved {int(taken)} step, Y and Z none",
+               observed=position(ctx), expected=want, rule=fewer)
 
 
 @case("1.profile.interrupt-inputs.wired", rig=True,

@@ -40,7 +40,7 @@ def other_address(ctx: CaseContext) -> None:
     link.send("V2000", address=other, answer=False)
     got = link.wait(0.3)
     ctx.expect(got == b"", "no answer to another address", observed=got, expected=b"",
-               tag="always")
+               tag="always", rule="2.link.addressed-only")
     index_moved(ctx, before, 0, "the ignored frame did not count in the index",
                 rule="8.index.uncounted")
 

@@ -126,7 +126,8 @@ def watchdog(ctx: CaseContext) -> None:
         r, rest = _stalled(ctx, WATCHDOG_CEILING_S)
     code(ctx, r, ErrorCode.WATCHDOG, "the unfinished frame is answered 2", rule="5.code.watchdog")
     ctx.expect(b"0\r" not in rest, "the rest of the frame is not executed",
-               observed=rest, expected="no further answer except an error", tag="always")
+               observed=rest, expected="no further answer except an error",
+               rule="3.frame.watchdog")
     index_moved(ctx, before, 0, "a frame dropped by the watchdog does not count",
                 rule="8.index.uncounted")
 

@@ -47,7 +47,8 @@ def busy(ctx: CaseContext) -> None:
       rules=("5.code.nothing-to-go", "10.4.go.without-inta"))
 def go_idle(ctx: CaseContext) -> None:
     """G while INTA = 0 answers 6 and does nothing."""
-    code(ctx, ctx.link.send("G"), ErrorCode.NOTHING_TO_GO, "G on an idle unit → 6")
+    code(ctx, ctx.link.send("G"), ErrorCode.NOTHING_TO_GO, "G on an idle unit → 6",
+         rule="5.code.nothing-to-go")
 
 
 @case("5.errors.n-while-run",
@@ -64,7 +65,8 @@ def n_run(ctx: CaseContext) -> None:
       tag="M-ex")
 def ok(ctx: CaseContext) -> None:
     """An accepted command answers 0."""
-    answers(ctx, ctx.link.send("L" + vector(ctx, 100)), "0", "L100,0,0 on an idle unit")
+    answers(ctx, ctx.link.send("L" + vector(ctx, 100)), "0", "L100,0,0 on an idle unit",
+            rule="5.code.ok")
 
 
 @case("5.errors.out-of-range",
@@ -81,9 +83,9 @@ def out_of_range(ctx: CaseContext) -> None:
 def queue_full(ctx: CaseContext) -> None:
     """C with no room in the CONT buffer answers 1; the buffer holds the profile's size."""
     n = ctx.profile.buffer
-    if fill_queue(ctx):
+    if fill_queue(ctx, rule="1.profile.buffer"):
         code(ctx, ctx.link.send("C" + vector(ctx, 1)), ErrorCode.QUEUE_FULL,
-             f"vector {n + 1} answers 1")
+             f"vector {n + 1} answers 1", rule="5.code.queue-full")
     ctx.link.send("D")
 
 
@@ -94,13 +96,15 @@ def refused_not_executed(ctx: CaseContext) -> None:
     ctx.link.send("V1000,5")
     ctx.link.send("SW0,1FF")
     r = ctx.link.send("SR0")
-    answers(ctx, r, "0,00", "SW0,1FF (out of range) did not write ST0", tag="M")
+    answers(ctx, r, "0,00", "SW0,1FF (out of range) did not write ST0",
+            rule="4.response.failed-not-executed")
     setup(ctx, "L" + vector(ctx, 10))
-    code(ctx, ctx.link.send("L" + vector(ctx, 20)), ErrorCode.QUEUE_FULL, "L while busy → 1")
+    code(ctx, ctx.link.send("L" + vector(ctx, 20)), ErrorCode.QUEUE_FULL, "L while busy → 1",
+         rule="10.1.queue.line-alone")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     r = ctx.link.send("PF")
     ctx.expect(r is not None and r.values[:1] == ["10"], "only the accepted L moved",
-               observed=r, expected="0,10,0,0", tag="always")
+               observed=r, expected="0,10,0,0", rule="4.response.failed-not-executed")
 
 
 @case("5.errors.unknown",

@@ -19,7 +19,8 @@ def _gve114(p) -> bool:
       absent=("%",))
 def absent(ctx: CaseContext) -> None:
     """A unit without checksums answers % with 3."""
-    code(ctx, ctx.link.send("%+"), ErrorCode.UNKNOWN, "%+ → 3")
+    code(ctx, ctx.link.send("%+"), ErrorCode.UNKNOWN, "%+ → 3",
+         rule="1.profile.gve54-no-checksums")
 
 
 @case("6.checksum.address-7-shares", requires=("%",), applies=_gve114,

@@ -14,6 +14,7 @@ from conformance.cases._kit import (
     position,
     queries_counted,
     setup,
+    show,
     vector,
 )
 from conformance.link.framing import byte_sum
@@ -38,8 +39,11 @@ FAILING = (
 
 
 @case("7.packet.bad-checksum-member.corrupted-end", requires=("*S",),
-      rules=("7.packet.bad-checksum-member", "8.index.uncounted"))
+      rules=("7.packet.bad-checksum-member", "8.index.uncounted", "7.packet.open-until-end"))
 def corrupted_end(ctx: CaseContext) -> None:
+    """The corrupted *E leaves the packet open past the longest watchdog a unit may take
+    (the link waits it out after the frame timed out): a packet a watchdog closed by then
+    is its rule's reading, answered 2,k on its own."""
     link = ctx.link
     setup(ctx, "%+", checksum=False)
     before = index(ctx)
@@ -76,7 +80,10 @@ def commits(ctx: CaseContext) -> None:
 def count(ctx: CaseContext) -> None:
     """k ≠ n: nothing is committed and *E answers 2,k."""
     r = _packet(ctx, ["C" + vector(ctx, 10), "C" + vector(ctx, 10)], 3)
-    answers(ctx, r, "2,2", "2 members, *E3 → 2,2", rule="5.code.watchdog")
+    # the code is the manual's (2 for a count that differs); the count k our reading
+    code(ctx, r, ErrorCode.COUNT_MISMATCH, "2 members, *E3 → 2", rule="5.code.watchdog")
+    ctx.expect(r is not None and r.values[:1] == ["2"], "and the 2 members received",
+               observed=show(r), expected="2,2", rule="7.packet.codes")
     ctx.link.wait(1.0)
     # members committed as they arrive are another reading of the manual's packet [D]
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", rule="7.packet.all-or-nothing")
@@ -141,7 +148,7 @@ def breakers(ctx: CaseContext) -> None:
 def invalid(ctx: CaseContext) -> None:
     """A member other than C or B fails the packet with 4; nothing is committed."""
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
-    answers(ctx, r, "4,3", "V inside a packet → 4,3")
+    answers(ctx, r, "4,3", "V inside a packet → 4,3", rule="7.packet.codes")
     ctx.link.wait(1.0)
     ctx.expect(position(ctx) == [0, 0, 0], "no member was committed", observed=position(ctx),
                expected=[0, 0, 0], rule="7.packet.all-or-nothing")

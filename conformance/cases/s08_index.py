@@ -59,7 +59,7 @@ def lost_response(ctx: CaseContext) -> None:
             rule="8.repeat.remembered" if shows_index else "8.repeat.answer")
     link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
-               expected=[9, 0, 0], tag="always")
+               expected=[9, 0, 0], rule="8.index.counts")
 
 
 @case("8.repeat.last-frame-and-answer",
@@ -70,7 +70,8 @@ def repeat(ctx: CaseContext) -> None:
     link.send("T99")
     r = link.send(">", lines=2)
     expected = f"!{link.address}T99\r5"
-    answers(ctx, r, expected, "> repeats the refused frame and its answer")
+    answers(ctx, r, expected, "> repeats the refused frame and its answer",
+            rule="8.repeat.answer")
 
 
 @case("8.repeat.no-history",

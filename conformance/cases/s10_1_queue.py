@@ -41,10 +41,11 @@ for _id, (_rules, _requires, _families, _scenario) in SCENARIOS.items():
 def l_busy(ctx: CaseContext) -> None:
     """L is accepted only when nothing is queued or running; otherwise 1."""
     setup(ctx, "C" + vector(ctx, 500))
-    code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.QUEUE_FULL, "L while a C runs → 1")
+    code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.QUEUE_FULL, "L while a C runs → 1",
+         rule="10.1.queue.line-alone")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     ctx.expect(position(ctx) == [500, 0, 0], "the refused L did not move",
-               observed=position(ctx), expected=[500, 0, 0], tag="always")
+               observed=position(ctx), expected=[500, 0, 0], rule="10.1.queue.line-alone")
 
 
 @case("10.1.line.wait-idiom",
@@ -62,10 +63,10 @@ def idiom(ctx: CaseContext) -> None:
       rules=("10.1.queue.cont-buffer", "10.cmd.flags", "1.profile.buffer"))
 def queue_full_flag(ctx: CaseContext) -> None:
     """The CONT buffer's size includes the executing vector; F shows bit 5 when full."""
-    if fill_queue(ctx):
+    if fill_queue(ctx, rule="1.profile.buffer"):
         r = ctx.link.send("F")
         ctx.expect(r is not None and r.values[:1] == ["F0"], "F = INTA + RUN + INTCOM + full",
-                   observed=show(r), expected="8,F0")
+                   observed=show(r), expected="8,F0", rule="10.cmd.flags")
     ctx.link.send("D")
 
 
@@ -75,7 +76,7 @@ def refused_vector(ctx: CaseContext) -> None:
     link = ctx.link
     start = position(ctx)
     ctx.require(start is not None, "PF did not answer with positions")
-    if not fill_queue(ctx):                  # H, then the buffer's size of ±1 along X
+    if not fill_queue(ctx, rule="10.1.queue.cont-buffer"):   # H, then ±1 along X
         return
     before = link.send("F")
     code(ctx, link.send("C" + vector(ctx, *REFUSED_C)), ErrorCode.QUEUE_FULL,

@@ -171,9 +171,9 @@ def run_bit(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 500))
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
-               observed=show(r), expected="0,40")
+               observed=show(r), expected="0,40", rule="10.3.st6.bits")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
-    answers(ctx, ctx.link.send("SR6"), "0,00", "idle again")
+    answers(ctx, ctx.link.send("SR6"), "0,00", "idle again", rule="10.3.st6.inta-run")
 
 
 @case("10.3.sw6.writing-st6", rules=("10.3.sw6.acts", "10.3.sw6.live-bits"))

@@ -56,7 +56,7 @@ def delete_moving(ctx: CaseContext) -> None:
     """D while moving answers 7."""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
-    code(ctx, ctx.link.send("D"), ErrorCode.BUSY, "D while moving → 7")
+    code(ctx, ctx.link.send("D"), ErrorCode.BUSY, "D while moving → 7", rule="10.4.delete")
     ctx.link.send("H")
 
 
@@ -90,10 +90,10 @@ def halt(ctx: CaseContext) -> None:
     first = position(ctx)
     ctx.link.wait(0.5)
     ctx.expect(position(ctx) == first, "no motion after H's answer",
-               observed=position(ctx), expected=first)
+               observed=position(ctx), expected=first, rule="10.4.halt.ramp")
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 = INTA+RUN+INTCOM, STOP clear",
-               observed=show(r), expected="8,D0")
+               observed=show(r), expected="8,D0", rule="10.3.st6.inta-run")
 
 
 @case("10.4.halt.in-final-deceleration", rules=("10.4.halt.ramp", "10.3.st6.inta-run"),

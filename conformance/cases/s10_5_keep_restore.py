@@ -62,7 +62,7 @@ def partial(ctx: CaseContext) -> None:
     ctx.link.send("G")
     ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
-               observed=position(ctx), expected=[990, 0, 0])
+               observed=position(ctx), expected=[990, 0, 0], rule="10.5.restore.exact")
 
 
 @case("10.5.keep.refused-while-moving",
@@ -71,8 +71,8 @@ def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
     ctx.link.wait(0.2)
-    code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving")
-    code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving")
+    code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving", rule="5.code.busy-moving")
+    code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving", rule="5.code.busy-moving")
     ctx.link.send("H")
 
 

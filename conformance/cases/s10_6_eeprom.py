@@ -30,11 +30,12 @@ PATTERNS = (0x5A, 0xA5)
 # a unit known never to have been written: the emulator's (a real unit's may have been)
 @case("10.6.eeprom.as-shipped", rig=True, rules=("10.6.eeprom.defaults", "10.6.eeprom.erased"))
 def as_shipped(ctx: CaseContext) -> None:
-    defaults = {0x05: 0xFF, 0x0D: 0xFF, **({0x01: 0x00} if ctx.profile.family == "GVE84" else {})}
+    # the bytes a manual names (the profile's defaults; the GVE54's manual names none)
+    defaults = ctx.profile.eeprom.defaults
     for address, value in defaults.items():
         answers(ctx, ctx.link.send("ER%02X" % address), "0,%02X" % value,
                 f"EEPROM {address:02X} as shipped", rule="10.6.eeprom.defaults")
-    for address in UNWRITTEN:
+    for address in (a for a in UNWRITTEN if a not in defaults):
         answers(ctx, ctx.link.send("ER%02X" % address), "0,FF",
                 f"EEPROM {address:02X} never written: erased", rule="10.6.eeprom.erased")
     code(ctx, ctx.link.send("ER100"), ErrorCode.RANGE, "256 bytes: 100 is out of range",
@@ -127,9 +128,11 @@ def eeprom(ctx: CaseContext) -> None:
 def words(ctx: CaseContext) -> None:
     """EFW/EFR store float32 and EUW/EUR uint32 little-endian."""
     link = ctx.link
-    answers(ctx, link.send("EFW30,0.25"), "0", "EFW30,0.25")
-    answers(ctx, link.send("EFR30"), "0,0.25", "EFR30 → 0.25")
-    answers(ctx, link.send("ER33"), "0,3E", "the float's top byte at 33 (little-endian)")
-    answers(ctx, link.send("EUW40,305419896"), "0", "EUW40")
-    answers(ctx, link.send("ER40"), "0,78", "the uint's low byte first")
-    code(ctx, link.send("EFRFD"), ErrorCode.RANGE, "a word past FF → 5")
+    words = "10.cmd.eeprom-words"
+    answers(ctx, link.send("EFW30,0.25"), "0", "EFW30,0.25", rule=words)
+    answers(ctx, link.send("EFR30"), "0,0.25", "EFR30 → 0.25", rule=words)
+    answers(ctx, link.send("ER33"), "0,3E", "the float's top byte at 33 (little-endian)",
+            rule=words)
+    answers(ctx, link.send("EUW40,305419896"), "0", "EUW40", rule=words)
+    answers(ctx, link.send("ER40"), "0,78", "the uint's low byte first", rule=words)
+    code(ctx, link.send("EFRFD"), ErrorCode.RANGE, "a word past FF → 5", rule=words)

@@ -165,13 +165,16 @@ def override_leaves_v(ctx: CaseContext) -> None:
          [0, 0, 0]])
 
 
-@case("10.cmd.mpg.modes", requires=("Y",), rules=("10.cmd.mpg",))
+@case("10.cmd.mpg.modes", requires=("Y",), rules=("10.cmd.mpg", "9.reset.mpg-parameters"))
 def mpg_modes(ctx: CaseContext) -> None:
     """Y answers the command back with the hand wheel usable: enabled, every parameter the
-    manual names for it in range (M114 12: otherwise "the MPG cannot be used")."""
-    configured(ctx, "mpg")
+    manual names for it in range (M114 12: otherwise "the MPG cannot be used"). Where one
+    is out of range and writing it is not allowed, whether Y+ and Y& may turn the MPG on is
+    a reading."""
+    on = "10.cmd.mpg" if configured(ctx, "mpg", required=False) else "9.reset.mpg-parameters"
     for c in ("+", "&", "-"):
-        answers(ctx, ctx.link.send(f"Y{c}"), f"0,Y{c}", f"Y{c} answers the command back")
+        answers(ctx, ctx.link.send(f"Y{c}"), f"0,Y{c}", f"Y{c} answers the command back",
+                rule=on if c != "-" else "10.cmd.mpg")
 
 
 @case("10.cmd.output.port", rig=True, rules=("10.cmd.output",))
@@ -267,14 +270,15 @@ def absent(ctx: CaseContext) -> None:
     """A command the profile lacks answers 3."""
     lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
     if not lacking:
-        ctx.expect(True, "the profile has every optional command")
+        ctx.expect(True, "the profile has every optional command", rule="1.profile.command-set")
     for name in lacking:
         r = ctx.link.send(REFUSAL_FRAMES[name])
         # an axis or port the unit lacks may be a parameter out of range instead (spec 5)
         if LACKING_LETTER.match(name) and r is not None and r.code == ErrorCode.RANGE:
-            ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks")
+            ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks",
+                       rule="5.code.unknown")
             continue
-        code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3")
+        code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3", rule="1.profile.command-set")
 
 
 @case("10.commands.counter-range-ends", requires=("NX",),
@@ -342,7 +346,9 @@ def formats(ctx: CaseContext) -> None:
       requires=("NX",))
 def set_axis(ctx: CaseContext) -> None:
     """!0NX100 sets the X counter; !0N zeroes every axis."""
-    answers(ctx, ctx.link.send("NX100"), "0", "NX100")
-    ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx))
-    answers(ctx, ctx.link.send("N"), "0", "N")
-    ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx))
+    answers(ctx, ctx.link.send("NX100"), "0", "NX100", rule="10.cmd.set-axis")
+    ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx),
+               rule="10.cmd.set-axis")
+    answers(ctx, ctx.link.send("N"), "0", "N", rule="10.cmd.zero")
+    ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx),
+               rule="10.cmd.zero")

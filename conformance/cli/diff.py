@@ -35,7 +35,7 @@ from conformance.reports.files import release
 from conformance.runner import RunResult, step_results
 from conformance.settings import fresh_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
-from conformance.verdict import COULD_NOT_TEST, FAIL, CouldNotTest
+from conformance.verdict import COULD_NOT_TEST, FAIL, SILENT, CouldNotTest
 
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given
@@ -226,7 +226,7 @@ def main(argv: list[str] | None = None) -> int:
         r.verdict, r.stopped = (FAIL if isinstance(err, TargetNotResponding)
                                 else COULD_NOT_TEST), str(err)
         r.checks = [{"ok": False, "what": str(err), "observed": "", "expected": "",
-                     "tag": "always", "rule": ""}]
+                     "tag": "always", "rule": SILENT}]
         run.results.append(r)
         print(f"{r.verdict}: {err}", file=sys.stderr)
     except CouldNotTest as err:            # an example could not start from the known state

@@ -6,9 +6,12 @@ every profile, graded as any unit is (by the tags). A reading is fair when no ca
 or ERRs, diff finds no FAIL and runs to its end, and every difference either makes names
 its rule; the score is fair readings / readings, and CI fails below 100 %.
 
-diff runs on one profile per family (all at once too: the catalogue covers every
-profile), its budget its probes and DIFF_DRAWN drawn sequences from seed DIFF_SEED: the
-same sequences on every run, a few seconds a profile."""
+A reading alone is tried on one profile per family among those the rules it reads apply
+to (a packet's reading on the GVE84 and GVE114, which have packets): elsewhere it changes
+nothing (:func:`trial_profiles`). diff runs on those profiles (all at once too: the
+catalogue covers every profile), its budget its probes and DIFF_DRAWN drawn sequences from
+seed DIFF_SEED (:func:`diff_budget`): the same sequences on every run, a few seconds a
+profile."""
 
 from __future__ import annotations
 
@@ -69,19 +72,34 @@ def trial(reading: str, readings: list[str], profiles: list[str],
             r = run_case(c, target, "mutation")
             where = f"{c.id} [{p}]"
             failed = [ch for ch in r.checks if not ch["ok"]]
+            unnamed = [ch for ch in r.checks if not ch.get("rule")]
+            if unnamed:
+                result.unfair.append(f"{r.verdict} {where}: a check names no rule: "
+                                     f"{unnamed[0]['what']}")
             if r.verdict in (FAIL, ERROR):
                 result.unfair.append(f"{r.verdict} {where}: {reason(r).line()[:300]}")
             elif r.verdict in (NON_STRICT, INFO):
-                unnamed = [ch for ch in failed if not ch.get("rule")]
-                if unnamed:
-                    result.unfair.append(f"{r.verdict} {where}: names no rule: "
-                                         f"{unnamed[0]['what']}")
                 rules = sorted({ch["rule"] for ch in failed if ch.get("rule")})
                 result.differences.append(f"{r.verdict} {where} ({', '.join(rules)})")
         if p in FIRST:
             diff_trial(p, readings, result)
     result.seconds = time.perf_counter() - start
     return result
+
+
+def trial_profiles(rules: tuple[str, ...], profiles: list[str]) -> list[str]:
+    """The ``profiles`` a reading of ``rules`` is tried on alone: those some rule of it
+    applies to (the others meet none of what it reads)."""
+    from gve_fixtures.profile import load_profile
+    from gve_fixtures.rules import load_rules
+    known = load_rules()
+    return [p for p in profiles
+            if any(known[r].applies_to(p, load_profile(p).family) for r in rules)]
+
+
+def diff_budget(drawn_probes: int) -> int:
+    """Sequences diff runs on a profile: its probes and DIFF_DRAWN drawn ones."""
+    return drawn_probes + DIFF_DRAWN
 
 
 def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
@@ -96,7 +114,7 @@ def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
                           allow_destructive=True)
     reference = parse_target(f"emu:{profile}")
     options = Options(destructive=True, rig=target.info.has_rig and reference.info.has_rig)
-    budget = Budget(examples=len(probes(target.profile, options)) + DIFF_DRAWN)
+    budget = Budget(examples=diff_budget(len(probes(target.profile, options))))
     pair = Pair(Side(target), Side(reference), target.profile)
     where = f"diff [{profile}]"
     try:
@@ -148,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     names = args.reading or sorted(known)
     first = [p for p in FIRST if p in available_profiles()]
-    jobs = [(n, [n], first, args.cases or None) for n in names]
+    jobs = [(n, [n], trial_profiles(known[n][0], first), args.cases or None) for n in names]
     if not args.reading:
         # all at once runs on every profile, the longest trial: first, so that the
         # workers do not wait for it at the end

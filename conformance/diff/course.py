@@ -11,7 +11,7 @@ import re
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
 from conformance.protocol.bounded import decimal
-from conformance.protocol.catalogue import classes
+from conformance.protocol.catalogue import classes, eeprom_read_width, eeprom_width
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -28,6 +28,7 @@ _OWN_SPEED = classes(own_speed=True)
 #: frames besides vectors that move the axes or set their counters (J restarts them;
 #: a packet's vectors are answered by its `*E`)
 _MOVERS = _OWN_SPEED | classes(restart=True) | classes(packet="closes")
+_RESTARTS = classes(restart=True)
 
 
 class Course:
@@ -51,6 +52,12 @@ class Course:
       but of *where* the vectors go (their unit, the mode's step).
     - The VL it took and the axes its vectors moved: VL capping only axes the vectors
       never moved, below the rate they ran at, changed nothing on the reference.
+    - Whether a `K` save is held (a `K` taken and no `R` or restart since): what `R` and
+      a second `K` meet is the manual's only with one held.
+    - The EEPROM addresses it wrote: a byte read that no write in the example reached
+      reads what the unit was shipped with (a manual names some of them).
+    - Whether the GVE114's hand wheel holds the axes (its mode on, EEPROM 06 enabling it):
+      whether it does with its parameters never set is a reading (9.reset.mpg-parameters).
     """
 
     def __init__(self, profile: Profile) -> None:
@@ -64,9 +71,20 @@ class Course:
         self.in_packet = False
         self.factors = dict(profile.microstep.factors) if profile.microstep else {}
         self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
+        #: the smallest acceleration it took (commanded steps/s²): the longest last step
+        #: of a ramp to rest
+        self.accel = profile.reset.A * 1000
         self.reach: list[int] | None = [0] * len(profile.axes)
         self.caps: list[int] | None = None
         self.moved: set[int] = set()
+        self.kept = False
+        self.written: set[int] = set()
+        self.named = set(profile.eeprom.defaults)
+        self.mpg = profile.mpg
+        self.mpg_mode = profile.mpg.reset_mode if profile.mpg else ""
+        self.mpg_byte = (profile.eeprom.defaults.get(profile.mpg.enable_address,
+                                                     profile.eeprom.erased)
+                         if profile.mpg else 0)
 
     # -- what it was given -----------------------------------------------------------------
     def took(self, command: str, body: str, reference: RoundTrip, *, first: bool = True
@@ -80,6 +98,25 @@ class Course:
         self._queue(command, body)
         self._ceiling(command, body)
         self._where(command, body)
+        self._saved(command, body)
+
+    def _saved(self, command: str, body: str) -> None:
+        params = body[len(command):]
+        if command == "K":
+            self.kept = True
+        elif command == "R":
+            self.kept = False
+        elif command in _RESTARTS:         # the reset state: no save, the MPG's mode
+            self.kept = False
+            self.mpg_mode = self.mpg.reset_mode if self.mpg else ""
+        elif command == "Y":
+            self.mpg_mode = params
+        elif eeprom_width(command):
+            written = _addresses(params, eeprom_width(command))
+            self.written |= written
+            if self.mpg is not None and self.mpg.enable_address in written:
+                value = _first_number(params.partition(",")[2], 16)
+                self.mpg_byte = value if value is not None else self.mpg_byte
 
     def stepped(self, command: str, step: Step) -> None:
         """A step's frames all went: a packet opens or closes."""
@@ -108,6 +145,8 @@ class Course:
             self.speed = max(self.speed, value)
         elif command == "XM" and value is not None:
             self.override = max(self.override, value / 100)
+        elif command == "A" and value is not None and value > 0:
+            self.accel = min(self.accel, value * 1000)
         elif command == "XU":          # each XU scales the held vectors again
             self.up *= 17 / 16
         elif command in _OWN_SPEED:
@@ -159,6 +198,31 @@ class Course:
     def junction(self) -> bool:
         return self.queued == "C+C"
 
+    def unwritten(self, command: str, body: str) -> str:
+        """What an EEPROM read of ``body`` meets where no write of the example reached:
+        "named" (a byte a manual names, the profile's defaults), "unwritten", or "" (not
+        such a read)."""
+        width = eeprom_read_width(command)
+        read = _addresses(body[len(command):], width) if width else set()
+        if not read or read & self.written:
+            return ""
+        return "named" if read & self.named else "unwritten"
+
+    @property
+    def mpg_on(self) -> bool:
+        """Whether the hand wheel holds the axes: its mode on and EEPROM 06 enabling it."""
+        return (self.mpg is not None and self.mpg_mode in ("+", "&")
+                and self.mpg_byte in self.mpg.enabling_values)
+
+
+def _addresses(params: str, width: int) -> set[int]:
+    """The ``width`` EEPROM bytes a read or write from the address in ``params`` spans."""
+    try:
+        first = int(params.split(",")[0], 16)
+    except ValueError:
+        return set()
+    return set(range(first, first + width))
+
 
 def _numbers(params: str) -> list[int] | None:
     try:
@@ -167,8 +231,8 @@ def _numbers(params: str) -> list[int] | None:
         return None
 
 
-def _first_number(params: str) -> int | None:
+def _first_number(params: str, base: int = 10) -> int | None:
     try:
-        return int(params.split(",")[0])
+        return int(params.split(",")[0], base)
     except ValueError:
         return None

@@ -27,6 +27,7 @@ from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
@@ -103,7 +104,10 @@ class Pair:
         # the fastest an axis's counter can change: the variant's top rate, in counter
         # units (GVE54: a coarse micro-step mode moves several sixteenths a step)
         self._factor = max(profile.microstep.factors.values()) if profile.microstep else 1
-        self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor)
+        # somebody else's unit places its steps its own way, even in virtual time
+        placement = 0 if target.target.info.strict else PLACEMENT_STEPS
+        self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor,
+                           placement=placement)
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
@@ -210,17 +214,25 @@ class Pair:
             context.add("beyond-reach")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
+        context.add("kept" if self.course.kept else "nothing-kept")
+        shipped = self.course.unwritten(command, step.body)
+        if shipped:
+            context.add(shipped)
+        if self.course.mpg_on:
+            context.add("mpg-on")
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")
-        why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target))
+        family = self.profile.family
+        why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target),
+                      family)
         if why is not None:
             out.ended = f"both answers allowed: {why}"
             return None
         d = Disagreement(len(out.records) - 1, command, kind, rec.target, rec.reference,
                          frozenset(context), frozenset(earlier))
         d.rule = label(command, kind, context, earlier, _code(rec.reference),
-                       _code(rec.target))
+                       _code(rec.target), family)
         d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
         return d
 
@@ -315,7 +327,8 @@ class Pair:
     def _difference(self, command: str, rec: StepRecord) -> str | None:
         moving, late = self.timing.allowance(command, rec.target, rec.reference)
         judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late,
-                        line=self.timing.line())
+                        line=self.timing.line(),
+                        period_ns=step_period(self.course.accel) if self.judge.placement else 0)
         kind = difference(command, rec.target, rec.reference, judge, moving=moving)
         if kind is None:
             rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)

@@ -17,7 +17,7 @@ from conformance.verdict import INFO, grade
 from gve_fixtures.rules import load_rules
 
 LABELS_FILE = Path(__file__).with_name("labels.toml")
-_FIELDS = ("command", "kind", "context", "earlier", "reference", "target")
+_FIELDS = ("command", "kind", "context", "earlier", "reference", "target", "family")
 
 
 
@@ -78,11 +78,13 @@ def _conditions(path: Path, where: str, entry: dict, name: str) -> dict:
 
 
 def label(command: str, kind: str, context: set[str], earlier: set[str],
-          reference: int | None, target: int | None = None) -> str | None:
+          reference: int | None, target: int | None = None,
+          family: str | None = None) -> str | None:
     """The rule a disagreement touches (None: no known rule); ``reference`` and
-    ``target`` are the two sides' error codes (None: no answer)."""
+    ``target`` are the two sides' error codes (None: no answer), ``family`` the
+    profile's (GVE54, GVE84, GVE114)."""
     facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
-             "reference": reference, "target": target}
+             "reference": reference, "target": target, "family": family}
     for entry in load_labels():
         if entry.matches(facts):
             return entry.rule
@@ -90,10 +92,11 @@ def label(command: str, kind: str, context: set[str], earlier: set[str],
 
 
 def allowed(command: str, kind: str, context: set[str], earlier: set[str],
-            reference: int | None, target: int | None) -> str | None:
+            reference: int | None, target: int | None,
+            family: str | None = None) -> str | None:
     """Why the spec allows both answers (None: it does not); the fields as :func:`label`."""
     facts = {"command": command, "kind": kind, "context": context, "earlier": earlier,
-             "reference": reference, "target": target}
+             "reference": reference, "target": target, "family": family}
     for entry in load_allowed():
         if entry.matches(facts):
             return entry.rule

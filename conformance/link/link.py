@@ -18,7 +18,17 @@ still its frame's, noted as late (:attr:`Link.late`), not a failure: the spec se
 deadline, and a slow line (a USB adapter's latency timer under load) makes a correct
 unit late; later than that it is a hang's, and FAILs whatever the tag.
 Bytes after a complete answer are recorded in :attr:`Link.violations` ("answered
-twice"), which fail the case that sent the frame.
+twice"), which fail the case that sent the frame, each naming the rule it breaks.
+
+What the suite leaves unfinished on purpose — a lone `!`, a frame without its CR, an open
+packet — a watchdog may end with an answer of its own (code 2) at a time the manuals do
+not give. Such an answer is the watchdog's, never a second answer to the frame before:
+it is judged by the watchdog's rule (our reading answers a lone `!` with nothing, a
+frame with 2, and closes no packet by time). Before the next frame (once the suite let
+the unfinished bytes reach the unit's own watchdog time, or its last frame timed out)
+and at the end of a case, the link waits out the longest watchdog a reader may choose
+(the profile's ``watchdog_longest_ms``) since the last byte, so that no such answer is
+taken for a later frame's.
 
 Every wait of the link is booked in its time account (conformance/link/account.py):
 an exchange's bytes at the baud rate as line time and the rest as the unit's (its
@@ -32,6 +42,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator, Sequence
+from typing import NamedTuple
 
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.faults import FrameFault
@@ -46,8 +57,10 @@ from conformance.link.framing import (
 )
 from conformance.link.safety import Guard
 from conformance.link.virtual import Rig, line_of
+from conformance.protocol.catalogue import classes
+from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import SECOND, St6
+from gve_fixtures.protocol import SECOND, ErrorCode, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
 #: processing margin on top of the bytes' own transmission time
@@ -68,6 +81,31 @@ _MODE_AFTER = {"%+": True, "%-": False, "J": False}
 # what the last frame left on the line
 _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
 
+# what the suite's bytes left unfinished for a watchdog to end
+LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an open packet"
+#: the rule an answer of each one's watchdog is judged by (our reading: a lone `!` is
+#: dropped without an answer, a frame answered 2, a packet never closed by time)
+WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
+                  OPEN_PACKET: "7.packet.open-until-end"}
+_PACKET_BREAKERS = classes(packet="breaker")
+
+#: the rule a second answer breaks (the unit answers every complete frame once), and one
+#: after its frame's timeout (it answers as soon as possible)
+TWICE, LATE_RULE = "2.link.simplex", "2.link.answer-promptly"
+
+
+class Stray(NamedTuple):
+    """Bytes that did not belong to the frame just sent: what they were, the rule they
+    break, and whether they FAIL whatever that rule's tag (a second answer no watchdog
+    explains; a watchdog's answer is graded by its rule's tag)."""
+
+    text: str
+    rule: str
+    always: bool = True
+
+    def __str__(self) -> str:
+        return f"{self.text} [{self.rule}]"
+
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
@@ -85,7 +123,7 @@ class Link:
         self.round_trip: dict[str, float] = {}
         self.log: list[Record] = []
         self.frames = 0
-        self.violations: list[str] = []
+        self.violations: list[Stray] = []
         #: real time: answers that came after their timeout, within the quiet the line
         #: keeps before the next frame, taken as their frame's (notes, not violations)
         self.late: list[str] = []
@@ -98,6 +136,12 @@ class Link:
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
         self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
         self._dropped = False
+        self._packet = False      # a packet the suite opened and has not seen closed
+        self._sent_until = 0      # when the last byte the suite wrote went out (ns)
+        self._waited_out = True   # what is left unfinished had its watchdog waited out
+        #: a later link of the case took over: what this one left went to a unit that
+        #: has heard other frames since (or, on the emulator, is gone)
+        self.superseded = False
         #: where the link's time went (its session's account, shared by its links)
         self.account = TimeAccount()
         #: the exchange whose bytes are going out: the clock when its first byte was
@@ -192,7 +236,7 @@ class Link:
                 data = self._listen(seconds, stop_early=False)
         if data:
             self._record(UNIT, data)
-            self._after_answer(data, "during a wait")
+            self._after_answer(data, "during a wait", judged=True)
         self._last = (_UNASKED, b"", b"")
         # raw frames not read for an answer: booked as unanswered now, not only when a
         # later frame goes out on this link (there may be none: a `*S` that ends an
@@ -264,6 +308,7 @@ class Link:
                 self._pause(pause, paused)
             if piece:
                 self._write(piece)
+        self._sent_until, self._waited_out = self.now, False
         if frames:
             self._last = (_UNASKED, frames[-1].wire, b"")
         return frames
@@ -341,7 +386,28 @@ class Link:
             address = self.address if f.address is None else f.address
             if r is not None and r.ok and address in self.guard.addresses:
                 self._learn(body)
+            self._follow_packet(body, r)
             self.guard.accepted(body, r, address)
+
+    def _follow_packet(self, body: str, r: Response | None) -> None:
+        """Whether a packet the suite opened may still be open: `*S` goes unanswered when
+        a unit takes it (spec 7); an answered `*E`, or a breaker answered, closes it."""
+        name = parse(body).name
+        if name == "*S":
+            self._packet = r is None
+        elif r is not None and r.code is not None and (
+                name == "*E" or name in _PACKET_BREAKERS):
+            self._packet = False
+
+    def left_open(self) -> str:
+        """What the suite's bytes so far leave for a watchdog to end (LONE_BANG,
+        OPEN_FRAME, OPEN_PACKET), "" when nothing."""
+        partial = self._framer.partial
+        if partial == b"!":
+            return LONE_BANG
+        if partial:
+            return OPEN_FRAME
+        return OPEN_PACKET if self._packet else ""
 
     def _book_unbooked(self, answer: Response | None) -> None:
         frames, self._unbooked = self._unbooked, []
@@ -438,17 +504,17 @@ class Link:
         (a violation), after a timeout a late one (a violation), else unsolicited. In
         real time, after a timeout, wait until the line is quiet first."""
         state = self._last[0]
-        data = b""
-        kept_quiet = False
         self._close_exchange()
+        data = self._outwait(final)
+        kept_quiet = False
         if not self.virtual:
             if state == _TIMED_OUT and not self.guard.interrupts.pending:
                 with self.spending(Spent.WAITS):
-                    data = self._listen(QUIET, stop_early=True, already=self._quiet)
+                    data += self._listen(QUIET, stop_early=True, already=self._quiet)
                 kept_quiet = not self.guard.interrupts.pending
             elif final:
                 with self.spending(Spent.WAITS):
-                    data = self._listen(self.end_quiet(), stop_early=True)
+                    data += self._listen(self.end_quiet(), stop_early=True)
         self._quiet = 0.0
         waiting = self.port.in_waiting
         if waiting:
@@ -462,15 +528,59 @@ class Link:
         self._last = (_UNASKED, b"", b"")
         return data
 
-    def _after_answer(self, data: bytes, when: str) -> None:
+    def _outwait(self, final: bool) -> bytes:
+        """Wait out the longest watchdog a reader may choose since the last byte sent,
+        when the suite left something unfinished on purpose and then let it go: at the
+        end of a case, after a frame that timed out, or (a lone `!`, a frame without its
+        CR) once the unit's own watchdog time has passed without a byte. A packet the
+        next frame goes on with, and a frame the next `!` is meant to cut, are not
+        waited for. Returns what arrived meanwhile (real time)."""
+        kind = self.left_open()
+        if not kind or self._waited_out or (final and self.superseded):
+            return b""
+        profile = self.guard.profile
+        idle = self.now - self._sent_until
+        let_go = idle >= profile.watchdog_ms * 1_000_000 and kind != OPEN_PACKET
+        if not (final or let_go or self._last[0] == _TIMED_OUT):
+            return b""
+        self._waited_out = True
+        left = (profile.watchdog_longest_ms * 1_000_000 - idle) / SECOND + MARGIN
+        if left <= 0:
+            return b""
+        with self.spending(Spent.MANUAL):          # the watchdog's time, as a unit may take it
+            if self.line is not None:
+                self.line.advance(left)
+                return b""
+            return self._listen(left, stop_early=False)
+
+    def _after_answer(self, data: bytes, when: str, *, judged: bool = False) -> None:
+        """Bytes no frame asked for: a watchdog's answer to what the suite left
+        unfinished (judged by the watchdog's rule; not when the case reads them itself,
+        ``judged``), else a second answer or a late one (a violation)."""
+        kind = self.left_open()
+        if kind and _watchdog_answer(data, kind, self.checksums):
+            self._ended_by_watchdog(kind, data, judged)
+            return
         state, sent, answer = self._last
         frame_text = readable(sent) or "the last frame"
         if state == _ANSWERED:
-            self.violations.append(f"answered twice: {frame_text} got {readable(answer)}, "
-                                   f"then {readable(data)} {when}")
+            self.violations.append(Stray(f"answered twice: {frame_text} got "
+                                         f"{readable(answer)}, then {readable(data)} {when}",
+                                         TWICE))
         elif state == _TIMED_OUT:
-            self.violations.append(f"answered after its timeout: {frame_text} got "
-                                   f"{readable(data)} late")
+            self.violations.append(Stray(f"answered after its timeout: {frame_text} got "
+                                         f"{readable(data)} late", LATE_RULE))
+
+    def _ended_by_watchdog(self, kind: str, data: bytes, judged: bool) -> None:
+        """A watchdog answered what was left unfinished: our reading answers a frame so
+        too (its time is the watchdog-time rule's, which the watchdog case judges); a
+        lone `!` answered, or a packet closed by time, is a reading of its rule."""
+        if kind == OPEN_PACKET:
+            self._packet = False
+        if kind == OPEN_FRAME or judged:
+            return
+        self.violations.append(Stray(f"{kind} was ended by a watchdog answering "
+                                     f"{readable(data)}", WATCHDOG_RULES[kind], always=False))
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05, *, send: Callable[[str], Response | None] | None = None,
@@ -496,6 +606,21 @@ class Link:
 
     def transcript_lines(self) -> list[str]:
         return [rec.line() for rec in self.log]
+
+
+def _watchdog_answer(data: bytes, kind: str, summed: bool) -> bool:
+    """Whether ``data`` is nothing but answers a watchdog gives (code 2, with INTA as it
+    stands; after a packet its count of members too, spec 7's `2,k`)."""
+    lines = [line for line in data.split(CR) if line]
+    if not lines or not data.endswith(CR):
+        return False
+    for line in lines:
+        r = parse_response(line + CR, summed=summed)
+        if r is None or r.code is None or r.code & 7 != ErrorCode.WATCHDOG:
+            return False
+        if len(r.values) > (1 if kind == OPEN_PACKET else 0):
+            return False
+    return True
 
 
 def idle_st6(r: Response) -> bool:

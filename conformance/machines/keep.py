@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case import CaseContext, case
-from conformance.machines.base import UnitMachine
+from conformance.machines.base import UnitMachine, holds
 from conformance.machines.runner import run_machine
 from gve_fixtures.protocol import ErrorCode
 
@@ -25,7 +25,7 @@ class KeepMachine(UnitMachine):
     @initialize()
     def speed(self) -> None:
         r = self.send("V2000")
-        assert r is not None and r.ok
+        holds(r is not None and r.ok, "10.cmd.modal", f"V2000 answered {r}")
 
     @precondition(lambda self: not self.kept)
     @rule(steps=st.integers(200, 1500), count=st.integers(1, 3))
@@ -36,7 +36,7 @@ class KeepMachine(UnitMachine):
             if not self.fits(f"C{self.booked + 2 * steps},0,0"):
                 return
             r = self.send(f"C{steps},0,0")
-            assert r is not None, "C got no answer"
+            holds(r is not None, "10.1.queue.cont-buffer", "C got no answer")
             if r.ok:
                 self.model.book((steps, 0, 0))
                 self.booked += steps
@@ -49,26 +49,28 @@ class KeepMachine(UnitMachine):
     @rule()
     def halt(self) -> None:
         r = self.send("H")
-        assert r is not None and r.ok and r.inta, f"H answered {r}"
+        holds(r is not None and r.ok and r.inta, "10.4.halt.ramp", f"H answered {r}")
         self.halted = True
 
     @precondition(lambda self: self.halted and not self.kept)
     @rule(lift=st.integers(1, 300))
     def keep_and_detour(self, lift: int) -> None:
         r = self.send("K")
-        assert r is not None and r.ok and not r.inta, f"K answered {r}"
+        holds(r is not None and r.ok and not r.inta, "10.5.keep.saves", f"K answered {r}")
         self.kept, self.halted = True, False
         for z in (-lift, lift):
             self.idle()
             r = self.send(f"L0,0,{z}")
-            assert r is not None and r.ok, f"L0,0,{z} after K answered {r}"
+            holds(r is not None and r.ok, "10.5.keep.single-l",
+                  f"L0,0,{z} after K answered {r}")
         self.idle()
 
     @precondition(lambda self: self.kept)
     @rule(speed=st.sampled_from([500, 1000, 3000]))
     def restore(self, speed: int) -> None:
         r = self.send("R")
-        assert r is not None and r.ok and r.inta, f"R answered {r} (INTA as saved)"
+        holds(r is not None and r.ok and r.inta, "10.5.restore.exact",
+              f"R answered {r} (INTA as saved)")
         self.kept, self.halted = False, True
         self.send(f"V{speed}")
         self.send("XA")
@@ -78,8 +80,8 @@ class KeepMachine(UnitMachine):
     def go(self) -> None:
         r = self.send("G")
         # with nothing left to run, 6 ("for Go, nothing to start") is allowed too (spec 5)
-        assert r is not None and r.code in (ErrorCode.OK, ErrorCode.NOTHING_TO_GO), \
-            f"G answered {r}"
+        holds(r is not None and r.code in (ErrorCode.OK, ErrorCode.NOTHING_TO_GO),
+              "10.4.go.resume", f"G answered {r}")
         if r.code == ErrorCode.NOTHING_TO_GO:
             self.send("D")
         self.halted = False
@@ -94,7 +96,8 @@ class KeepMachine(UnitMachine):
                 self.send("D")
         self.idle()
         got = self.position()
-        assert got == self.model.committed, f"position {got}, expected {self.model.committed}"
+        holds(got == self.model.committed, "10.5.restore.exact",
+              f"position {got}, expected {self.model.committed}")
 
 
 @case("10.5.machine.keep-restore",

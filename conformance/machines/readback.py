@@ -56,7 +56,9 @@ REFUSALS: tuple[Refusal, ...] = (
     Refusal("B5", E.RANGE),                          # below every profile's B
     Refusal("B700,5", E.SYNTAX, "5.code.syntax"),
     Refusal("G", E.NOTHING_TO_GO, "5.code.nothing-to-go", IDLE),
-    Refusal("L1,2", E.SYNTAX, "5.code.syntax"),
+    # more components than any unit has axes (fewer may be taken with the rest 0: a
+    # reading); every number readable, so a guard can bound it
+    Refusal("L1,2,3,4,5", E.SYNTAX, "5.code.syntax"),
     Refusal("L5,0,0", E.QUEUE_FULL, "5.code.queue-full", HALTED),
     Refusal("M4,5", E.SYNTAX, "5.code.syntax"),      # a stored 4 would move 4 sixteenths
     Refusal("N", E.BUSY, "5.code.busy-run", HALTED),

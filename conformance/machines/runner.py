@@ -12,8 +12,7 @@ from conformance import settings as settings_profiles
 from conformance.case import CaseContext, CouldNotTest
 from conformance.link.framing import UnitDataError
 from conformance.machines.base import UnitMachine
-from conformance.verdict import ALWAYS
-from gve_fixtures.rules import load_rules
+from conformance.verdict import ALWAYS, UNREADABLE
 
 
 class Factory:
@@ -83,17 +82,21 @@ def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
 def _failed(ctx: CaseContext, machine: type, err: BaseException) -> None:
     """The failed invariant as a check graded by the rule it names: what it says, and
     what the unit did and the rule wants where the machine said (never the whole error:
-    the example's steps are in the wire log and its transcript)."""
+    the example's steps are in the wire log and its transcript); bytes of the unit that
+    cannot be read are the response grammar's, whatever the tag."""
     rule = getattr(err, "rule", None)
     what = f"{machine.__name__}: {err}".splitlines()[0][:300]
     seen = {"observed": getattr(err, "observed", ""), "expected": getattr(err, "expected", "")}
     if isinstance(err, UnitDataError):
         # bytes no rule's reading allows where a value belongs, as the runner grades them
         ctx.expect(False, f"{machine.__name__}: the unit's answer cannot be read: "
-                   f"{str(err).splitlines()[0][:300]}", **seen, tag=ALWAYS)
+                   f"{str(err).splitlines()[0][:300]}",
+                   observed=seen["observed"] or str(err)[-500:],
+                   expected=seen["expected"] or "an answer",
+                   tag=ALWAYS, rule=UNREADABLE, machinery=True)
     elif rule is not None and rule not in ctx.case.rules:
         # a rule of the machinery the case does not list (the index, PF): its own tag
-        ctx.expect(False, f"{what} [{rule}]", **seen, tag=load_rules()[rule].tag)
+        ctx.expect(False, f"{what} [{rule}]", **seen, rule=rule, machinery=True)
     else:
         ctx.expect(False, what, **seen, rule=rule)
     if len(str(err).strip().splitlines()) > 1:

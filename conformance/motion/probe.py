@@ -2,7 +2,8 @@
 unit processed them, the motion they cause is booked in the suite's model, positions are
 read with ``PF``, and at the end every reading is judged against the model at its
 instant, within the tolerance of :mod:`conformance.motion.tolerance` (printed with each
-check in real time; in virtual time it is exact and not printed), and the whole is
+check where it has a width; exact, and not printed, against the reference emulator or a
+target run with --strict in virtual time), and the whole is
 recorded as a trace for the reports, with what failed marked on it.
 
 The probe interprets the frames it sends as the unit must (spec 10): modal parameters
@@ -31,6 +32,7 @@ from conformance.motion.tolerance import (
     answer_window,
     late_window,
     processing_window,
+    step_period,
     tolerance,
     widened,
 )
@@ -69,6 +71,9 @@ class Probe:
     def __init__(self, ctx: CaseContext, name: str, rule: str) -> None:
         self.ctx, self.name, self.rule = ctx, name, rule
         self.link = ctx.link
+        #: exactness is ours only against the reference, or a target run --strict, in
+        #: virtual time: elsewhere step placement and rounding are the target's own
+        self.exact = self.link.virtual and ctx.target.strict
         p = ctx.profile
         r = p.reset
         self.scale = 1 if p.microstep is None else p.microstep.factors[p.microstep.reset_mode]
@@ -234,13 +239,13 @@ class Probe:
         return out
 
     def _banded(self, model: MotionModel, variants: list, line: LineBand, t0: int,
-                spread: int, virtual: bool) -> Iterator[tuple[Reading, Tolerance, list]]:
+                spread: int, exact: bool) -> Iterator[tuple[Reading, Tolerance, list]]:
         """Each reading taken after the first event, with its tolerance and its band."""
         for reading in self.readings:
             w = reading.window
             if w.hi - line.ns < t0:
                 continue
-            tol = tolerance(Window(0, w.hi - w.lo + spread), virtual=virtual, line=line)
+            tol = tolerance(Window(0, w.hi - w.lo + spread), exact=exact, line=line)
             yield reading, tol, _band(model, variants, w, tol.steps)
 
     def fits(self) -> bool:
@@ -252,11 +257,11 @@ class Probe:
             self._answered_late()
             self._widen(line)
             (model, _), variants = self.model(), self._variants()
-            virtual = self.link.virtual
             t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo
                   ) + line.ns
             spread = sum(e.window.hi - e.window.lo for e in self.events)
-            for reading, _, band in self._banded(model, variants, line, t0, spread, virtual):
+            for reading, _, band in self._banded(model, variants, line, t0, spread,
+                                                 self.exact):
                 got = reading.positions[:len(band)]
                 if not all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True)):
                     return False
@@ -314,20 +319,22 @@ class Probe:
         self._answered_late()
         self._widen(line)
         (model, rests), variants = self.model(), self._variants()
-        virtual = self.link.virtual
+        exact = self.exact
         # instants are printed from the first event as the host saw it, the band left out
         t0 = (self.events[0].window.lo if self.events else self.readings[0].window.lo) + line.ns
         spread = sum(e.window.hi - e.window.lo for e in self.events)
         ok_all = True
         faults: list[dict] = []
-        widest = tolerance(Window(0, spread), virtual=virtual, line=line)
+        widest = tolerance(Window(0, spread), exact=exact, line=line)
         halts = [e for e in self.events if e.kind == "halt"]
+        # another placement of the steps may come to rest up to a step period either side
+        period = 0 if exact else step_period(self._slowest_ramp())
         for n, (e, rest) in enumerate(zip(halts, rests, strict=True)):
             # what each event's window can change, added up (as for positions)
-            lo = rest + sum(min(0, v[1][n] - rest) for v in variants)
-            hi = rest + sum(max(0, v[1][n] - rest) for v in variants)
+            lo = rest + sum(min(0, v[1][n] - rest) for v in variants) - period
+            hi = rest + sum(max(0, v[1][n] - rest) for v in variants) + period
             a = e.answer
-            tol = tolerance(Window(0, a.hi - a.lo + hi - lo), virtual=virtual, line=line)
+            tol = tolerance(Window(0, a.hi - a.lo + hi - lo), exact=exact, line=line)
             ok = self.ctx.expect(
                 lo <= a.hi and a.lo <= hi,
                 f"{self.name}: H answered when the motion came to rest{_within(tol)}",
@@ -339,7 +346,7 @@ class Probe:
                                "observed": (a.lo + line.ns - t0) / SECOND,
                                "expected": [(lo - t0) / SECOND, (hi - t0) / SECOND],
                                "expected_what": "at rest"})
-        for reading, tol, band in self._banded(model, variants, line, t0, spread, virtual):
+        for reading, tol, band in self._banded(model, variants, line, t0, spread, exact):
             w = reading.window
             tol = replace(tol, band=max(math.ceil((b1 - b0) / 2) for b0, b1 in band))
             widest = max(widest, tol, key=lambda x: x.seconds)
@@ -360,6 +367,10 @@ class Probe:
         self._trace(model, t0, widest, faults)
         return ok_all
 
+    def _slowest_ramp(self) -> int:
+        """The smallest acceleration a vector of the scenario captured (steps/s²)."""
+        return min((e.args["p"].A for e in self.events if e.kind == "push"), default=0)
+
     def _trace(self, model: MotionModel, t0: int, tol, faults: list[dict]) -> None:
         end = max(r.window.hi for r in self.readings)
         end = max(end, model.rest)
@@ -375,7 +386,7 @@ class Probe:
 
 
 def _within(tol: Tolerance) -> str:
-    """The band a check used, for its text; none in virtual time, where it is exact."""
+    """The band a check used, for its text; none where the check is exact."""
     return "" if tol.exact else f" ({tol})"
 
 

@@ -26,7 +26,11 @@ and the case's own), zero in virtual time.
 
 A position judged against the model is accepted within the model's positions over the
 whole window (the model is evaluated at both ends and at every vector boundary inside),
-widened by ``steps`` (one step of placement on real targets, none in virtual time):
+widened by ``steps``: none where exactness is ours (the reference emulator, or a target
+run with --strict, in virtual time), else one step of placement on each axis — the
+model's step placement and rounding are the project's reading (docs/motion-model.md), not
+the manuals', so a simulator of somebody else's is judged as a real unit is even in
+virtual time; and so is the instant an ``H`` answers (:func:`step_period`):
 :class:`Tolerance` carries the figures, which every motion check prints (the line's band
 and the steps either side it allowed, e.g. ``±1.8 ms line, ±7 steps``).
 
@@ -41,6 +45,7 @@ import math
 from dataclasses import dataclass
 
 from conformance.link.line_band import EXACT, LineBand
+from conformance.motion.arith import acc_time
 from gve_fixtures.protocol import SECOND
 
 #: bits per byte on an 8N1 line (spec 2): start, 8 data, stop
@@ -93,7 +98,7 @@ class Tolerance:
             allowed = f"±{self.band} step{'' if self.band == 1 else 's'}"
         else:
             allowed = f"±{self.seconds * 1e3 / 2:.1f} ms"
-        return f"{LineBand(self.line)}, {allowed}"
+        return f"{LineBand(self.line)}, {allowed}" if self.line else allowed
 
 
 def processing_window(sent_at: int, received_at: int, frame_bytes: int, answer_bytes: int,
@@ -137,11 +142,19 @@ def late_window(sent_at: int, frame_bytes: int, baud: int, round_trip: int, *,
     return Window(lo, max(lo, sent_at + round_trip))
 
 
-def tolerance(window: Window, *, virtual: bool, line: LineBand = EXACT,
+def tolerance(window: Window, *, exact: bool, line: LineBand = EXACT,
               band: int | None = None) -> Tolerance:
-    """The tolerance a position read in ``window`` is judged with (``line``: the line's
-    band the window was widened by; ``band``: the steps either side it allowed)."""
-    return Tolerance(window.seconds, 0 if virtual else PLACEMENT_STEPS, line.seconds, band)
+    """The tolerance a position read in ``window`` is judged with (``exact``: the model's
+    placement is the target's own, no step either side; ``line``: the line's band the
+    window was widened by; ``band``: the steps either side it allowed)."""
+    return Tolerance(window.seconds, 0 if exact else PLACEMENT_STEPS, line.seconds, band)
+
+
+def step_period(accel: int) -> int:
+    """The longest step of a ramp at ``accel`` (steps/s²) that ends at rest, its last:
+    how far apart another placement of the same steps may put the instant the motion
+    comes to rest (an ``H``'s answer), in ns."""
+    return acc_time(0, accel, 1) if accel > 0 else 0
 
 
 def widened(window: Window, line: LineBand) -> Window:

@@ -51,6 +51,7 @@ class Command:
     motion: bool = False
     destructive: bool = False
     eeprom: int = 0
+    reads: int = 0
     packet: str | None = None
     checksums: bool = False
     vector: bool = False
@@ -156,3 +157,9 @@ def eeprom_width(name: str) -> int:
     """Bytes of EEPROM a write of ``name`` changes (0: not an EEPROM write)."""
     command = catalogue().get(name)
     return command.eeprom if command is not None else 0
+
+
+def eeprom_read_width(name: str) -> int:
+    """Bytes of EEPROM a read of ``name`` answers (0: not an EEPROM read)."""
+    command = catalogue().get(name)
+    return command.reads if command is not None else 0

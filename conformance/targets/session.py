@@ -364,7 +364,7 @@ class RealSession(Session):
     def _keep_log(self, link: Link) -> None:
         """The session's own frames and what went wrong there, for the report."""
         self.report.wire_log += link.transcript_lines()
-        self.report.violations += link.violations
+        self.report.violations += [str(v) for v in link.violations]
 
     def _probe_checksums(self, link: Link) -> None:
         """The checksum mode as found: `?` without a checksum is refused (4) in the mode."""

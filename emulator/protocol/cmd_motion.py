@@ -24,9 +24,12 @@ Handler = Callable[[Device, Session, str, int], Reply]
 # -- vectors ---------------------------------------------------------------------------
 
 def parse_steps(dev: Device, p: str) -> tuple[int, ...]:
-    """The relative steps of L or C: one value per axis (the GVE114's A may be left out)."""
+    """The relative steps of L or C: one value per axis (the GVE114's A may be left out;
+    the reading vector-fewer-components takes one value or more, the rest as 0)."""
     axes = len(dev.profile.axes)
-    values = [dec(x) for x in fields(p, (3, 4) if axes == 4 else (axes,))]
+    counts = tuple(range(1, axes + 1)) if dev.readings.active("vector-fewer-components") \
+        else (3, 4) if axes == 4 else (axes,)
+    values = [dec(x) for x in fields(p, counts)]
     lim = dev.profile.vector_range
     for v in values:
         within(v, -lim, lim)
@@ -49,7 +52,10 @@ def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
     steps = parse_steps(dev, p)
     if dev.state.kept_single:
-        raise CommandError(ErrorCode.SYNTAX, "after K the queue takes one L only")
+        # the manual's "jen typu L (C ne)": refused as syntax [D], or as no room (a reading)
+        code = ErrorCode.QUEUE_FULL if dev.readings.active("keep-c-queue-full") \
+            else ErrorCode.SYNTAX
+        raise CommandError(code, "after K the queue takes one L only")
     dev.refuse_vectors_to_mpg()
     room = dev.profile.buffer - (1 if dev.mutant.active("queue-one-short") else 0)
     if dev.motion.queued(t) >= room:
@@ -213,7 +219,7 @@ def cmd_halt(dev: Device, ses: Session, p: str, t: int) -> Reply:
     rest = dev.motion.halt(t)
     dev.state.status[6] |= INTA | INTCOM
     if rest > t and not dev.mutant.active("halt-answers-early"):
-        return Deferred(rest, lambda at: (ErrorCode.OK, []))
+        return Deferred(dev.seen_at_rest(rest), lambda at: (ErrorCode.OK, []))
     return []
 
 
@@ -267,6 +273,8 @@ def cmd_restore(dev: Device, ses: Session, p: str, t: int) -> Reply:
     s = dev.state
     if s.saved is None and dev.readings.active("restore-nothing-kept-refused"):
         raise CommandError(ErrorCode.SYNTAX, "nothing kept to restore")
+    if s.saved is None and dev.readings.active("restore-nothing-kept-range"):
+        raise CommandError(ErrorCode.RANGE, "nothing kept to restore")
     saved = s.saved or Saved(EMPTY_SAVE, 0, 0, 0)
     if not dev.mutant.active("restore-keeps-save"):
         s.saved = None                         # a stack of one level: R pops it
@@ -301,5 +309,8 @@ def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_mpg(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if p not in ("+", "&", "-"):
         raise CommandError(ErrorCode.SYNTAX, "Y takes +, & or -")
+    if p != "-" and dev.readings.active("mpg-needs-parameters") \
+            and not dev.mpg_parameters_in_range():
+        raise CommandError(ErrorCode.RANGE, "an MPG parameter is out of range")
     dev.state.mpg = p
     return ["Y" + p]

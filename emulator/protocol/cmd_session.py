@@ -52,7 +52,9 @@ def member(dev: Device, name: str | None, params: str) -> Member:
         if name == "V" and dev.mutant.active("failed-packet-applies-v") \
                 and value is not None and r.lo <= value <= r.hi:
             dev.state.modal.V = value
-        return Member(name, None, ErrorCode.SYNTAX)
+        # the reading packet-failed-count-zero: a command a packet cannot hold is unknown there
+        unknown = dev.readings.active("packet-failed-count-zero")
+        return Member(name, None, ErrorCode.UNKNOWN if unknown else ErrorCode.SYNTAX)
     try:
         if name == "C":
             return Member(name, parse_steps(dev, params), ErrorCode.OK)
@@ -90,12 +92,15 @@ def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
         n = dec(p)
     except CommandError as err:
         return Answer(err.code, [str(k)])
-    code = ErrorCode.OK
-    if k != n and not dev.mutant.active("packet-count-ignored"):
-        code = ErrorCode.COUNT_MISMATCH
-    if not code:
-        code = next((m.code for m in members if m.code), ErrorCode.OK)
-    if dev.readings.active("packet-committed-on-arrival"):
+    mismatch = k != n and not dev.mutant.active("packet-count-ignored")
+    failing = next((m.code for m in members if m.code), ErrorCode.OK)
+    reads = dev.readings.active
+    counted = _failed_count(dev, members)
+    if counted is not None:                   # a failing member's code before the count
+        code = failing or (ErrorCode.COUNT_MISMATCH if mismatch else ErrorCode.OK)
+    else:
+        code = ErrorCode.COUNT_MISMATCH if mismatch else failing
+    if reads("packet-committed-on-arrival"):
         return Answer(code, [str(k)])            # each member took effect as it arrived
     vectors = sum(1 for m in members if m.name == "C" and not m.code)
     if not code and vectors:
@@ -119,4 +124,14 @@ def cmd_packet_end(dev: Device, ses: Session, p: str, t: int) -> Reply:
             elif room > 0:
                 dev.push(m.value, True, t)  # type: ignore[arg-type]
                 room -= 1
-    return Answer(code, [str(k)])
+    return Answer(code, [str(k if not code or counted is None else counted)])
+
+
+def _failed_count(dev: Device, members: list[Member]) -> int | None:
+    """The count a failed packet's `*E` answers under the readings that count otherwise
+    than every member received (spec 7 [D]): the valid members, or none; None: k."""
+    if dev.readings.active("packet-failed-count-zero"):
+        return 0
+    if dev.readings.active("packet-failed-count-valid"):
+        return sum(1 for m in members if not m.code)
+    return None

@@ -9,6 +9,9 @@ command handlers act on the device through the methods below.
 
 from __future__ import annotations
 
+import math
+import struct
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +27,8 @@ from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
 MS = 1_000_000
+#: the reading steps-a-period-late: how far back a step period is looked for
+LATE_WINDOW = 100 * MS
 #: input ports read FF with nothing connected (spec 10.3)
 UNCONNECTED = {0: 0xFF, 1: 0xFF, 2: 0xFF}
 
@@ -35,7 +40,10 @@ class Device:
         self.profile = profile
         self.mutant = mutant
         self.readings = readings
-        self.eeprom = Eeprom(profile.eeprom.image(), eeprom_path)
+        shipped = profile.eeprom
+        if readings.active("eeprom-erased-zero"):
+            shipped = replace(shipped, erased=0x00)
+        self.eeprom = Eeprom(shipped.image(), eeprom_path)
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
                              deviations=mutant.deviations | readings.deviations)
@@ -76,7 +84,24 @@ class Device:
         """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""
         mpg = self.profile.mpg
         return (mpg is not None and self.state.mpg in ("+", "&")
-                and self.eeprom.read(mpg.enable_address)[0] in mpg.enabling_values)
+                and self.eeprom.read(mpg.enable_address)[0] in mpg.enabling_values
+                and (not self.readings.active("mpg-needs-parameters")
+                     or self.mpg_parameters_in_range()))
+
+    def mpg_parameters_in_range(self) -> bool:
+        """The reading mpg-needs-parameters: M114 12.4-12.6, "Pokud je hodnota některého
+        parametru mimo rozsah, není možné MPG použít" (with any of them out of range the
+        MPG cannot be used): the limits 0..10000, steps per mm 1..10000, the acceleration
+        1..10000 and a positive maximum speed, float32 little-endian each (an erased FF
+        FF FF FF is no number)."""
+        ranges = [(0x10 + 4 * i, 0.0, 1e4) for i in range(8)] \
+            + [(0x30 + 4 * i, 1.0, 1e4) for i in range(4)] \
+            + [(0x40, 1.0, 1e4), (0x44, 1e-9, math.inf)]
+        for address, lo, hi in ranges:
+            value = struct.unpack("<f", self.eeprom.read(address, 4))[0]
+            if not lo <= value <= hi:          # NaN compares false
+                return False
+        return True
 
     def st6(self, t: int) -> int:
         flags = self.motion.flags(t)
@@ -118,7 +143,38 @@ class Device:
             return tuple(int(x / f) for x in here)
         if self.mutant.active("narrow-counters"):
             return tuple((x + (1 << 23)) % (1 << 24) - (1 << 23) for x in here)
+        if self.readings.active("steps-a-period-late"):
+            return self._a_period_late(here, t)
         return here
+
+    def _a_period_late(self, here: tuple[int, ...], t: int) -> tuple[int, ...]:
+        """The reading steps-a-period-late: a counter shows a step one step period after
+        the instant our arithmetic places it (a unit that places its steps on a
+        continuous trapezoid and rounds the counters down): while the axes move the
+        last pulse is not counted yet, so each axis reads at most one step behind; a
+        vector that has ended shows its end (the unit is idle only once it is there)."""
+        if not self.motion.flags(t).moving:
+            return here
+        times, masks = self.motion.pulses(max(0, t - LATE_WINDOW), t + 1)
+        if not len(times):
+            return here
+        last = int(times[-1])
+        period = last - int(times[-2]) if len(times) > 1 else LATE_WINDOW
+        if t - last >= period:
+            return here
+        mask = int(masks[-1])
+        return tuple(x - (((mask >> i) & 1) * (-1 if (mask >> (4 + i)) & 1 else 1))
+                     for i, x in enumerate(here))
+
+    def seen_at_rest(self, rest: int) -> int:
+        """When the unit sees its motion at rest: at ``rest``; under the reading
+        steps-a-period-late one step period (the last) after it."""
+        if not self.readings.active("steps-a-period-late"):
+            return rest
+        times, _ = self.motion.pulses(max(0, rest - LATE_WINDOW), rest + 1)
+        if len(times) < 2:
+            return rest
+        return rest + int(times[-1]) - int(times[-2])
 
     # -- vectors ------------------------------------------------------------------------
     def push(self, steps: tuple[int, ...], continuous: bool, t: int) -> None:

@@ -46,6 +46,8 @@ _LOWER_HEX = re.compile(r"[a-f]")
 _LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 #: the reading slow-watchdog: a second, the time a reader may take for "in time"
 SLOW_WATCHDOG_MS = 1000
+#: the readings half-second-watchdog (a frame) and packet-watchdog (an open packet)
+HALF_SECOND_MS = 500
 #: the reading longer-frames: the longest frame a unit with a byte-wide length counter holds
 LONG_FRAME = 255
 
@@ -73,6 +75,8 @@ class Unit:
             self.tables[profile.spindle.address] = spindle_table(profile)
         self.addresses = frozenset(self.tables)
         wd = profile.watchdog_ms if watchdog_ms is None else watchdog_ms
+        if watchdog_ms is None and self.readings.active("half-second-watchdog"):
+            wd = HALF_SECOND_MS
         if watchdog_ms is None and self.readings.active("slow-watchdog"):
             wd = SLOW_WATCHDOG_MS
         self.framer = Framer(None if self.mutant.active("watchdog-never") else wd * MS,
@@ -80,6 +84,8 @@ class Unit:
         self.emit: Callable[[bytes, int], None] = _discard
         self.now = origin
         self._pending: list[tuple[bytes, Deferred, bool]] = []   # (frame, answer, remembered)
+        #: the reading packet-watchdog: an open packet's last byte (None: not timed)
+        self._packet_quiet: int | None = None
 
     # -- the rig ----------------------------------------------------------------------------
     def power_on(self, t: int) -> None:
@@ -89,6 +95,7 @@ class Unit:
         self.session.reset(self.profile.reset.checksums)
         self.framer.reset()
         self._pending = []
+        self._packet_quiet = None
 
     def set_input(self, port: int, value: int, t: int) -> None:
         self.advance(t)
@@ -109,22 +116,34 @@ class Unit:
         deaf = self.device.deaf_until
         if deaf > now and (best is None or deaf < best):
             best = deaf
-        if self.framer.buf is not None or self._pending:
-            for c in (self.framer.deadline(), *(d.instant for _, d, _ in self._pending)):
+        if self.framer.buf is not None or self._pending or self._packet_quiet is not None:
+            for c in (self.framer.deadline(), self._packet_deadline(),
+                      *(d.instant for _, d, _ in self._pending)):
                 if c is not None and c > now and (best is None or c < best):
                     best = c
         return best
 
+    def _packet_deadline(self) -> int | None:
+        """The reading packet-watchdog: when an open packet that received nothing since
+        its last byte is dropped (a frame under way has its own watchdog)."""
+        if self._packet_quiet is None or self.framer.buf is not None \
+                or self.session.packet is None:
+            return None
+        return self._packet_quiet + HALF_SECOND_MS * MS
+
     def advance(self, t: int) -> None:
-        if self._pending or self.framer.buf is not None:
+        if self._pending or self.framer.buf is not None or self._packet_quiet is not None:
             while True:
                 expiry = self.framer.deadline()
+                packet = self._packet_deadline()
                 answer = min((d.instant for _, d, _ in self._pending), default=None)
-                due = min((x for x in (expiry, answer) if x is not None and x <= t),
+                due = min((x for x in (expiry, packet, answer) if x is not None and x <= t),
                           default=None)
                 if due is None:
                     break
-                if due == expiry:
+                if due == packet:
+                    self._packet_expired(due)
+                elif due == expiry:
                     dropped = self.framer.expire(due)
                     if dropped is not None:
                         self._watchdog(dropped[0], due)
@@ -142,6 +161,13 @@ class Unit:
             else:
                 still.append((raw, d, remembered))
         self._pending = still
+
+    def _packet_expired(self, t: int) -> None:
+        """The reading packet-watchdog: the open packet did not arrive whole in time:
+        dropped, answered as a count mismatch is, `2,k` (k members received)."""
+        members, self.session.packet = self.session.packet or [], None
+        self._packet_quiet = None
+        self._answer(b"", ErrorCode.WATCHDOG, [str(len(members))], t, remember=False)
 
     def _watchdog(self, head: bytes, t: int) -> None:
         if len(head) < 2 and self.readings.active("lone-bang-answered"):
@@ -166,6 +192,9 @@ class Unit:
             if frame is not None:
                 self.advance(end)
                 self._frame(frame, end)
+            self._packet_quiet = t + (i - 1) * byte_ns \
+                if self.session.packet is not None \
+                and self.readings.active("packet-watchdog") else None
 
     def _address(self, raw: bytes) -> int | None:
         a = raw[1] - 48 if len(raw) > 1 else -1
@@ -210,7 +239,7 @@ class Unit:
                                  remember=COMMANDS.get(name or "", _NONE).remembered)
                 return
         text = body.decode("latin-1")
-        if self.mutant.active("lower-case-command"):
+        if self.mutant.active("lower-case-command") or self.readings.active("commands-any-case"):
             text = text.upper()
         name, params = split(text)
         known = COMMANDS.get(name or "", _NONE)

@@ -9,6 +9,7 @@ import json
 import pytest
 
 from conformance.case import REGISTRY, Case, case
+from conformance.link.link import LONE_BANG, TWICE, WATCHDOG_RULES, Stray
 from conformance.runner import run_case
 from conformance.targets import parse_target
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT, PASS
@@ -139,3 +140,48 @@ def test_a_case_s_tag_is_its_first_rule_s():
         assert REGISTRY["99.toy.derived"].tag == "D"
     finally:
         REGISTRY.pop("99.toy.derived", None)
+
+
+def test_a_check_of_a_case_with_several_rules_alike_must_name_its_rule(target):
+    # both [M]: the case's tag would grade it right, but the report could not say which
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "which rule?"),
+                      rules=("5.code.ok", "8.index.counts")), target)
+    assert r.verdict == ERROR and "must name its rule" in r.notes[0]
+
+
+def test_an_always_check_names_its_rule_too(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x", tag="always")), target)
+    assert r.verdict == ERROR and "must name its rule" in r.notes[0]
+
+
+def test_a_machinery_check_names_a_rule_its_case_does_not_list(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "answered twice", tag="always",
+                                             rule="2.link.simplex", machinery=True)), target)
+    assert r.verdict == FAIL and r.checks[0]["rule"] == "2.link.simplex"
+
+
+def test_a_machinery_check_names_a_known_rule(target):
+    r = run_case(_toy(lambda ctx: ctx.expect(False, "x", rule="9.nothing", machinery=True)),
+                 target)
+    assert r.verdict == ERROR
+
+
+def test_a_second_answer_fails_the_case_naming_the_link_s_rule(target):
+    def answered_twice(ctx):
+        ctx.link.send("?")
+        ctx.link.violations.append(Stray("answered twice: !0?\\r got 0,..., then 0", TWICE))
+        ctx.expect(True, "the answer", rule="5.code.ok")
+    r = run_case(_toy(answered_twice), target)
+    failed = [c for c in r.checks if not c["ok"]]
+    assert r.verdict == FAIL
+    assert [(c["rule"], c["tag"]) for c in failed] == [("2.link.simplex", "always")]
+
+
+def test_a_watchdog_s_answer_is_graded_by_the_watchdog_s_rule(target):
+    def ended(ctx):
+        ctx.link.violations.append(Stray("a lone '!' was ended by a watchdog answering 2",
+                                         WATCHDOG_RULES[LONE_BANG], always=False))
+        ctx.expect(True, "the answer", rule="5.code.ok")
+    r = run_case(_toy(ended), target)
+    assert r.verdict == NON_STRICT
+    assert [c["rule"] for c in r.checks if not c["ok"]] == ["3.frame.watchdog-lone-bang"]

@@ -56,13 +56,41 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "next-vectors-B": ([b"!0A1\r", b"!0B10\r", b"!0C3000,0,0\r", b"!0B1000\r",
                         b"!0C3000,0,0\r", b"!0A1\r", b"!0PF\r"],
                        b"0\r" * 6 + b"0,3000,0,0\r", b"0\r" * 6 + b"0,3499,0,0\r"),
+    # K after H (nothing running: 8 at once), then a second K
+    "restore-nothing-kept-range": ([b"!0R\r"], b"0\r", b"5\r"),
+    "keep-c-queue-full": ([b"!0K\r", b"!0C1,0,0\r"], b"0\r4\r", b"0\r1\r"),
+    # V is no member: the packet fails with 4, counting every member or the valid ones
+    "packet-failed-count-valid": ([b"!0*S\r", b"!0C1,0,0\r", b"!0V100\r", b"!0C1,0,0\r",
+                                   b"!0*E3\r"], b"4,3\r", b"4,2\r"),
+    # the count differs (2, *E1) and V is no member: 2 and k, or V's own 3 and none
+    "packet-failed-count-zero": ([b"!0*S\r", b"!0V10\r", b"!0C-300,0,0\r", b"!0*E1\r"],
+                                 b"2,2\r", b"3,0\r"),
+    # 0.3 s without a byte inside a frame: dropped (2), or the frame runs whole
+    "half-second-watchdog": ([b"!0V10", 0.3, b"00\r"], b"2\r", b"0\r"),
+    # 0.7 s without a byte inside a packet: *E1 commits it, or the packet was dropped
+    "packet-watchdog": ([b"!0*S\r", 0.1, b"!0C1,0,0\r", 0.7, b"!0*E1\r"],
+                        b"0,1\r", b"2,1\r4,0\r"),
+    "vector-fewer-components": ([b"!0L5,3\r", b"!0PF\r"], b"4\r0,0,0,0\r",
+                                b"0\r0,5,3,0\r"),
+    "commands-any-case": ([b"!0v1000\r"], b"3\r", b"0\r"),
+    "eeprom-erased-zero": ([b"!0ER40\r"], b"0,FF\r", b"0,00\r"),
+    # 50 ms into L100 at the reset's A20 the X counter shows one step less
+    "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
+                            b"0\r0,23,0,0\r"),
+}
+#: readings of what only the GVE114 has, on a GVE114-500: EEPROM 06 enables the MPG; its
+#: parameters are erased (FF), so under the reading it does not hold RUN after J
+POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
+    "mpg-needs-parameters": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r", b"!0Y+\r"],
+                             b"0\r0\r0,40\r0,Y+\r", b"0\r0\r0,00\r5\r"),
 }
 
 
-def answers(readings: tuple[str, ...], frames: list[Step]) -> bytes:
-    """What a GVE84-100 taking ``readings`` answers ``frames``, a second apart unless
-    a number says otherwise."""
-    unit = Unit("GVE84-100", readings=readings)
+def answers(readings: tuple[str, ...], frames: list[Step], profile: str = "GVE84-100"
+            ) -> bytes:
+    """What a unit of ``profile`` taking ``readings`` answers ``frames``, a second apart
+    unless a number says otherwise."""
+    unit = Unit(profile, readings=readings)
     out: list[bytes] = []
     unit.emit = lambda data, t: out.append(data)
     t = 10**9
@@ -80,7 +108,7 @@ def answers(readings: tuple[str, ...], frames: list[Step]) -> bytes:
 
 
 def test_every_reading_has_its_point_here():
-    assert set(POINTS) == set(READINGS)
+    assert set(POINTS) | set(POINTS_114) == set(READINGS)
 
 
 @pytest.mark.parametrize("name", sorted(POINTS))
@@ -88,6 +116,13 @@ def test_a_reading_answers_its_point_otherwise(name):
     frames, clean, read = POINTS[name]
     assert answers((), frames) == clean
     assert answers((name,), frames) == read
+
+
+@pytest.mark.parametrize("name", sorted(POINTS_114))
+def test_a_reading_of_the_gve114_answers_its_point_otherwise(name):
+    frames, clean, read = POINTS_114[name]
+    assert answers((), frames, "GVE114-500") == clean
+    assert answers((name,), frames, "GVE114-500") == read
 
 
 def test_readings_combine():

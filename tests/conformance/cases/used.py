@@ -68,9 +68,11 @@ class UsedUnit(PortTarget):
 
 
 def used_unit(profile: str, *, allow_destructive: bool = False,
-              max_travel: int = DEFAULT_MAX_TRAVEL, readings: tuple[str, ...] = ()) -> UsedUnit:
+              max_travel: int = DEFAULT_MAX_TRAVEL, readings: tuple[str, ...] = (),
+              mutant: str | None = None) -> UsedUnit:
     p = load_profile(profile)
-    url = f"gve://?model={profile}" + (f"&reading={','.join(readings)}" if readings else "")
+    url = f"gve://?model={profile}" + (f"&reading={','.join(readings)}" if readings else "") \
+        + (f"&mutant={mutant}" if mutant else "")
     info = TargetInfo("serial", f"serial:{url} (used)", False, False, allow_destructive,
                       max_travel)
     unit = UsedUnit(info, p, p.address, p.default_baud, url)

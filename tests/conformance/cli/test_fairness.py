@@ -13,6 +13,7 @@ from conformance.catalogue import select
 from conformance.cli import main
 from conformance.runner import run_case
 from conformance.targets import parse_target
+from conformance.targets.emu import emulator_readings
 from conformance.verdict import FAIL, NON_STRICT
 from tests.processes import alive, descendants, signalled
 
@@ -72,3 +73,44 @@ def test_a_signal_stops_every_worker_with_one_line(sig, group):
     assert "Traceback" not in out, out
     assert out.splitlines()[-1].startswith("fairness: interrupted by a signal after "), out
     assert len(started) >= 2 and not any(alive(p) for p in started)
+
+
+def test_a_reading_alone_is_tried_where_the_rules_it_reads_apply():
+    from conformance.cli.fairness import FIRST, trial_profiles
+    assert trial_profiles(("7.packet.codes",), list(FIRST)) == ["GVE84-100", "GVE114-500"]
+    assert trial_profiles(("9.reset.mpg-parameters",), list(FIRST)) == ["GVE114-500"]
+    assert trial_profiles(("3.frame.upper-case",), list(FIRST)) == list(FIRST)
+
+
+def test_a_check_that_names_no_rule_makes_a_reading_unfair(monkeypatch):
+    from conformance.cli import fairness
+    from conformance.runner import CaseResult
+
+    def unnamed(case, target, settings=None):
+        return CaseResult(case.id, case.section, case.rule, case.tag, case.source,
+                          target.profile.name, target.info.spec, "PASS",
+                          checks=[{"ok": True, "what": "x", "observed": "", "expected": "",
+                                   "tag": "M", "rule": ""}])
+    monkeypatch.setattr("conformance.runner.run_case", unnamed)
+    monkeypatch.setattr(fairness, "diff_trial", lambda *a: None)
+    t = fairness.trial("plus-sign", ["plus-sign"], ["GVE84-100"], ["1.profile.version"])
+    assert not t.fair and "names no rule" in t.unfair[0]
+
+
+def test_fairness_runs_diff_and_names_the_rule_of_every_difference(capsys):
+    # the reference's R with nothing kept answered 5: the empty save's rule, as the
+    # catalogue grades it, not the exact restore's [M]
+    status = main(["fairness", "--reading", "restore-nothing-kept-range",
+                   "--cases", "10.5.restore.*"])
+    out = capsys.readouterr().out
+    assert status == 0, out
+    assert "NON-STRICT 10.5.restore.pops" in out and "FAIL" not in out.replace("NON-STRICT", "")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("reading", sorted(emulator_readings()))
+def test_every_reading_alone_is_fair_and_every_check_names_its_rule(reading):
+    from conformance.cli.fairness import FIRST, trial, trial_profiles
+    profiles = trial_profiles(emulator_readings()[reading][0], list(FIRST))
+    t = trial(reading, [reading], profiles, None)
+    assert t.fair, t.unfair

@@ -1,5 +1,7 @@
 """Labels name rules that exist and pick the most specific one."""
 
+import pytest
+
 from conformance.diff.labels import allowed, command_of, label, load_labels, verdict_of
 from conformance.verdict import FAIL, INFO, NON_STRICT
 from gve_fixtures.rules import load_rules
@@ -39,8 +41,8 @@ def test_a_difference_within_the_dwell_is_the_dwell():
 def test_a_modal_setting_the_sequence_needs_wins_over_the_command_and_packet():
     # an L refused on one side only: the queue rule, unless a rate set earlier decides
     # when the vector before it ends
-    assert label("L", "code", set(), {"L"}, 3, 0) == "10.1.queue.line-alone"
-    assert label("L", "code", set(), {"L", "VL"}, 3, 0) == "10.2.motion.axis-caps"
+    assert label("L", "code", set(), {"L"}, 1, 0) == "10.1.queue.line-alone"
+    assert label("L", "code", set(), {"L", "VL"}, 1, 0) == "10.2.motion.axis-caps"
     assert label("P", "position", set(), {"L", "XU", "*S", "*E"}, 0) == \
         "10.cmd.exchange-velocity"
 
@@ -126,3 +128,163 @@ def test_a_stalled_repeat_run_whole_is_the_watchdogs_time():
     # the reference's watchdog answered 2 (one line) where `>` run whole answered others
     assert label(">", "bytes", {"stalled"}, set(), None, None) == "3.frame.watchdog-time"
     assert label("?", "silence", {"stalled"}, set(), 2, None) == "3.frame.watchdog"
+
+
+#: one behaviour, one grade: for every rule the catalogue grades a behaviour by and diff
+#: labels a disagreement with, that behaviour as diff sees it — (the case that grades
+#: it, then the facts: command, kind, context, earlier, reference's and target's codes,
+#: family) — and diff must name the same rule
+PAIRS: dict[str, tuple[str, tuple]] = {
+    # the firmware string answered otherwise
+    "1.profile.version": ("1.profile.version", ("?", "data", set(), set(), 0, 0)),
+    # C into a full queue taken, or C refused with room
+    "10.1.queue.cont-buffer": ("5.errors.queue-full", ("C", "code", set(), {"C"}, 1, 0)),
+    # L while a vector runs taken
+    "10.1.queue.line-alone": ("5.errors.refused-not-executed",
+                              ("L", "code", set(), {"L"}, 1, 0)),
+    # where a vector under VL is
+    "10.2.motion.axis-caps": ("10.2.measured.axis-caps",
+                              ("PF", "position", set(), {"VL", "L"}, 0, 0)),
+    "10.2.motion.dominant-rate": ("10.2.measured.cruise-at-v",
+                                  ("PF", "position", set(), {"V", "L"}, 0, 0)),
+    "10.2.motion.dwell": ("10.2.measured.dwell",
+                          ("PF", "position", {"in-dwell"}, {"L"}, 0, 0)),
+    "10.2.motion.junction": ("10.2.measured.junction",
+                             ("PF", "position", set(), {"C", "junction"}, 0, 0)),
+    "10.2.motion.path-rate": ("10.2.measured.path-rate",
+                              ("PF", "position", set(), {"VK", "L"}, 0, 0)),
+    "10.2.motion.positions-now": ("10.2.measured.cruise-at-v",
+                                  ("PF", "position", set(), {"L"}, 0, 0)),
+    "10.2.motion.short-vector": ("10.2.measured.short-vector",
+                                 ("PF", "position", set(), {"$", "L"}, 0, 0)),
+    "10.2.motion.trapezoid": ("10.2.measured.trapezoid",
+                              ("PF", "position", set(), {"A", "L"}, 0, 0)),
+    # a grounded enabled input: the motion goes on
+    "10.3.inputs.interrupt": ("10.3.interrupt.stops-motion",
+                              ("PF", "position", set(), {"SW", "L", "input"}, 0, 0)),
+    # D with the input still held: INTA again, or not
+    "10.3.inputs.level-triggered": ("10.3.inputs.level-after-clearing",
+                                    ("D", "code", set(), {"SW", "input"}, 0, 0)),
+    "10.3.inputs.physical": ("10.3.inputs.physical-across-restart",
+                             ("I1", "data", set(), {"J", "input"}, 0, 0)),
+    "10.3.status.all-bits": ("10.3.status.all-bits-stored",
+                             ("SR", "data", set(), {"SW"}, 0, 0)),
+    "10.3.sw6.acts": ("10.3.sw6.writing-st6", ("PF", "position", set(), {"L", "SW6"}, 0, 0)),
+    "10.4.delete": ("10.4.delete.refused-while-moving", ("D", "code", set(), {"C"}, 7, 0)),
+    "10.4.go.resume": ("10.4.go.resumes-exactly",
+                       ("PF", "position", set(), {"L", "H", "G"}, 0, 0)),
+    "10.4.go.without-inta": ("5.errors.go-without-inta", ("G", "code", set(), set(), 6, 0)),
+    "10.4.halt.ramp": ("10.4.halt.answers-when-stopped",
+                       ("H", "timing", set(), {"L"}, 0, 0)),
+    "10.5.keep.c-refused": ("10.5.keep.single-l", ("C", "code", set(), {"K"}, 4, 0)),
+    # a second K with a save held: refused
+    "10.5.keep.one-level": ("10.5.keep.one-level",
+                            ("K", "code", {"kept"}, {"H", "K"}, 0, 4, "GVE54")),
+    "10.5.keep.one-level-info": ("10.5.keep.one-level",
+                                 ("K", "code", {"kept"}, {"H", "K"}, 0, 4, "GVE84")),
+    "10.5.keep.saves": ("10.5.keep.saves-st6",
+                        ("SR", "data", {"kept"}, {"L", "H", "K"}, 0, 0)),
+    "10.5.restore.exact": ("10.5.keep.partial-vector",
+                           ("R", "code", {"kept"}, {"L", "H", "K"}, 0, 4)),
+    # R with nothing kept refused, whatever the code
+    "10.5.restore.pops": ("10.5.restore.empty", ("R", "code", {"nothing-kept"}, set(), 0, 5)),
+    "10.6.eeprom.defaults": ("10.6.eeprom.as-shipped",
+                             ("ER", "data", {"named"}, set(), 0, 0)),
+    "10.6.eeprom.erased": ("10.6.eeprom.as-shipped",
+                           ("ER", "data", {"unwritten"}, set(), 0, 0)),
+    "10.6.eeprom.kept": ("10.6.eeprom.kept-across-restarts",
+                         ("ER", "data", set(), {"EW", "J"}, 0, 0)),
+    "10.7.motor.modes": ("10.7.microstep.positions-in-sixteenths",
+                         ("PF", "position", {"beyond-reach"}, {"M", "L"}, 0, 0)),
+    "10.7.motor.rates-scaled": ("10.7.measured.microstep-rates",
+                                ("PF", "position", set(), {"M", "L"}, 0, 0)),
+    "10.cmd.axis-limits-own-axis": ("10.cmd.measured.axis-limits-own-axis",
+                                    ("PF", "position", {"capped-elsewhere"}, {"VL", "L"},
+                                     0, 0)),
+    "10.cmd.exchange-velocity": ("10.cmd.measured.exchange-xa",
+                                 ("PF", "position", set(), {"C", "V", "XA"}, 0, 0)),
+    "10.cmd.flags-after-keep": ("10.cmd.flags-after-keep.one-vector",
+                                ("F", "data", {"kept"}, {"K", "L"}, 0, 0)),
+    "10.cmd.inputs": ("10.3.status.inputs-read-ff", ("I1", "data", set(), set(), 0, 0)),
+    "10.cmd.override": ("10.cmd.measured.override",
+                        ("PF", "position", set(), {"L", "XM"}, 0, 0)),
+    "10.cmd.port-bits": ("10.cmd.ports.bit-by-bit", ("I1", "data", set(), {"input"}, 0, 0)),
+    "10.cmd.set-axis": ("10.commands.zero-axis", ("PF", "position", set(), {"NX"}, 0, 0)),
+    "12.spindle.feed-independent": ("12.spindle.measured.feed-unchanged",
+                                    ("PF", "position", set(), {"spindle", "L"}, 0, 0)),
+    "3.frame.other-address-whole": ("2.link.other-address-ignored",
+                                    ("V", "silence", {"other-address"}, set(), None, 0)),
+    "3.frame.upper-case": ("3.frame.lower-case-unknown", ("V", "code", {"lower"}, set(), 3, 0)),
+    # a frame stalled past the watchdog: answered 2, or run whole by a slower watchdog
+    "3.frame.watchdog": ("3.frame.watchdog", ("V", "silence", {"stalled"}, set(), 2, None)),
+    "3.frame.watchdog-time": ("3.frame.watchdog", ("V", "code", {"stalled"}, set(), 2, 0)),
+    "3.params.decimal": ("3.frame.syntax-errors", ("V", "code", {"plus"}, set(), 4, 0)),
+    "3.params.hex-digits": ("3.params.hex-fields",
+                            ("SW", "code", {"lower-param"}, set(), 0, 4)),
+    "3.params.long-decimal": ("3.params.long-decimals",
+                              ("T", "code", {"long-decimal"}, set(), 0, 4)),
+    "3.params.none-expected": ("3.params.none-expected.given",
+                               ("@", "code", {"extra-param"}, set(), 4, 0)),
+    # a refused SW0,1FF stored
+    "4.response.failed-not-executed": ("5.errors.refused-not-executed",
+                                       ("SR", "data", set(), {"SW-refused"}, 0, 0)),
+    "4.response.inta-bit": ("4.response.inta-bit", ("V", "inta", set(), {"H"}, 0, 0)),
+    "5.code.busy-eeprom": ("10.6.eeprom.refused-while-moving",
+                           ("EW", "code", set(), {"L"}, 7, 0)),
+    "5.code.ok": ("5.errors.ok", ("L", "code", set(), set(), 0, 4)),
+    "5.code.range": ("5.errors.out-of-range", ("SW", "code", set(), set(), 5, 4)),
+    # the MPG holding RUN: D refused while it does
+    "5.moving.definition": ("9.reset.mpg-enabled", ("D", "code", set(), {"EW", "J"}, 7, 0)),
+    "6.checksum.bad-refused": ("6.checksum.bad-sum-rejected",
+                               ("A", "code", {"bad-checksum"}, {"%"}, 4, 0)),
+    "6.checksum.mode-commands": ("6.machine.checksum-framing",
+                                 ("%", "code", set(), set(), 0, 4)),
+    "6.checksum.response-sum": ("6.checksum.responses-summed",
+                                ("SR", "checksum", set(), {"%"}, 0, 0)),
+    # a failed packet's C ran
+    "7.packet.all-or-nothing": ("7.packet.failed-leaves-nothing",
+                                ("PF", "position", set(), {"*S", "C", "*E"}, 0, 0)),
+    "7.packet.bad-checksum-member": ("7.packet.bad-checksum-member.corrupted-end",
+                                     ("*E", "silence", {"bad-checksum", "in-packet"},
+                                      {"*S", "C"}, None, 4)),
+    "7.packet.breakers": ("7.packet.halt-inside",
+                          ("@", "silence", {"in-packet"}, {"*S", "C"}, 0, None)),
+    # a failed packet's code or count: *S, V10, C-300,0,0,0, *E1 → 3,0 (reference 2,2)
+    "7.packet.codes": ("7.packet.invalid-member",
+                       ("*E", "code", {"in-packet"}, {"*S", "V", "C"}, 2, 3)),
+    "7.packet.exchange": ("7.packet.commits-all",
+                          ("*E", "data", {"in-packet"}, {"*S", "B", "C"}, 0, 0)),
+    # a packet a watchdog closed by time: *E answered 2,k on its own
+    "7.packet.open-until-end": ("7.packet.bad-checksum-member.corrupted-end",
+                                ("*E", "code", {"in-packet"}, {"*S", "C"}, 0, 2)),
+    "8.index.counts": ("8.index.counts-every-frame", ("@", "data", set(), {"V"}, 0, 0)),
+    "8.index.queries-uncounted": ("8.index.queries-not-counted",
+                                  ("@", "data", {"queries-counted"}, {"@"}, 0, 0)),
+    "8.repeat.answer": ("8.repeat.last-frame-and-answer", (">", "data", set(), {"T"}, 0, 0)),
+    "8.repeat.no-reexecute": ("8.repeat.not-reexecuted",
+                              ("PF", "position", set(), {"L", ">"}, 0, 0)),
+    "8.repeat.remembered": ("8.repeat.queries-forgotten",
+                            (">", "data", set(), {"V", "@"}, 0, 0)),
+    # vectors refused while the MPG holds RUN, its parameters never set
+    "9.reset.mpg-parameters": ("9.reset.mpg-enabled",
+                               ("L", "code", {"mpg-on"}, {"EW", "J"}, 7, 0, "GVE114")),
+}
+
+
+def _shared_rules() -> set[str]:
+    from conformance.catalogue import select
+    graded = {r for c in select() for r in c.rules}
+    return {entry.rule for entry in load_labels()} & graded
+
+
+def test_every_rule_both_use_has_its_behaviour_here():
+    assert set(PAIRS) == _shared_rules()
+
+
+@pytest.mark.parametrize("rule", sorted(PAIRS))
+def test_diff_names_the_rule_the_catalogue_grades_the_behaviour_by(rule):
+    from conformance.case import REGISTRY
+    case_id, facts = PAIRS[rule]
+    assert rule in REGISTRY[case_id].rules
+    command, kind, context, earlier, reference, target, *family = facts
+    assert label(command, kind, context, earlier, reference, target, *family) == rule

@@ -22,9 +22,9 @@ def _interrupt(ctx) -> None:
 
 
 def test_ctrl_c_keeps_what_ran_and_shows_the_interrupted_case(tmp_path):
-    cases = [Case("1.test.before", _ok, "r", "M", "test"),
-             Case("1.test.ctrl-c", _interrupt, "r", "M", "test"),
-             Case("1.test.after", _ok, "r", "M", "test")]
+    cases = [Case("1.test.before", _ok, "r", "M", "test", rules=("5.code.ok",)),
+             Case("1.test.ctrl-c", _interrupt, "r", "M", "test", rules=("5.code.ok",)),
+             Case("1.test.after", _ok, "r", "M", "test", rules=("5.code.ok",))]
     result = run([parse_target("emu:GVE84-100")], cases, run_id="ctrl-c")
     assert result.interrupted
     assert [(r.id, r.verdict, r.interrupted) for r in result.results] == [

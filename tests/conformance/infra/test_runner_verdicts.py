@@ -11,9 +11,14 @@ from conformance.runner import run_case
 from conformance.targets import parse_target
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, PASS
 
+#: a rule of each tag: every check names its rule, and is graded by its tag
+RULE_OF = {"M": "5.code.ok", "M-ex": "5.code.range", "D": "3.frame.upper-case",
+           "D-info": "10.3.st6.free"}
+
 
 def _toy(body, tag="M", **kw) -> Case:
-    return Case("99.toy.case", body, rule="toy rule", tag=tag, source="test", **kw)
+    return Case("99.toy.case", body, rule="toy rule", tag=tag, source="test",
+                rules=(RULE_OF[tag],), **kw)
 
 
 def _status_word(ctx):

@@ -83,7 +83,7 @@ def test_a_late_answer_then_another_is_still_answered_twice():
     port = _Line([b"", b"0\r"], then=b"0\r")
     ln = real_link(port)
     assert ln.send("V1000").raw == b"0\r"
-    assert len(ln.late) == 1 and any("answered twice" in v for v in ln.violations)
+    assert len(ln.late) == 1 and any("answered twice" in v.text for v in ln.violations)
 
 
 def test_a_timeout_the_caller_chose_takes_no_late_answer():

@@ -26,14 +26,14 @@ def test_virtual_window_is_the_instant_the_frame_completed() -> None:
     w = processing_window(r.sent_at, r.received_at, len(b"!0PF\r"), len(r.raw), link.baud,
                           virtual=True, paced=True)
     assert w.lo == w.hi == r.received_at - len(r.raw) * byte_ns(link.baud)
-    assert tolerance(w, virtual=True).exact
+    assert tolerance(w, exact=True).exact
 
 
 def test_paced_window_leaves_out_the_bytes_on_the_wire() -> None:
     b = byte_ns(9600)
     w = processing_window(0, 20 * b + 500, 5, 10, 9600, virtual=False, paced=True)
     assert (w.lo, w.hi) == (5 * b, 10 * b + 500)
-    t = tolerance(w, virtual=False)
+    t = tolerance(w, exact=False)
     assert t.steps == PLACEMENT_STEPS and t.seconds == (5 * b + 500) / 1e9
 
 

@@ -121,17 +121,20 @@ def test_the_emulator_as_a_co_simulator_runs_in_virtual_time_with_its_rig():
     assert session["real"] and session["restored"], "the session's restorations ran"
 
 
-def test_the_motion_is_judged_exactly():
-    """Every reading as on the embedded emulator: the same instants, the same positions,
-    the same (zero) tolerance."""
-    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+@pytest.mark.parametrize("strict", [False, True])
+def test_the_motion_is_judged_at_the_emulator_s_instants(strict: bool):
+    """Every reading as on the embedded emulator: the same instants, the same positions;
+    the step placement somebody else's unit may choose is allowed a step (none with
+    --strict, for a clone that claims the project's arithmetic)."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100", strict=strict)
     target.preflight()
     (r,) = run([target], select(["10.2.measured.cruise-at-v"])).results
     (emu,) = run([parse_target("emu:GVE84-100")], select(["10.2.measured.cruise-at-v"])).results
     readings = [(c["what"], c["observed"], c["expected"]) for c in r.checks
                 if " PF at " in c["what"]]
     assert r.verdict == PASS and len(readings) > 3
-    assert readings == [(c["what"], c["observed"], c["expected"]) for c in emu.checks
+    band = "" if strict else " (±1 step)"
+    assert readings == [(c["what"] + band, c["observed"], c["expected"]) for c in emu.checks
                         if " PF at " in c["what"]]
 
 
@@ -326,7 +329,9 @@ def test_a_batch_that_stops_at_a_frame_unanswered_sends_the_rest_as_they_come():
     batched, answers, now, commands = _sent(frozenset({"batch", "batch-stops"}), frames)
     single, single_answers, single_now, _ = _sent(frozenset(), frames)
     assert (batched, answers, now) == (single, single_answers, single_now)
-    assert [c.split()[0] for c in commands] == ["batch", "tx", "tx"], commands
+    # the frame after the unanswered *S waits out a packet's watchdog first (until)
+    assert [c.split()[0] for c in commands if not c.startswith("until")] == \
+        ["batch", "tx", "tx"], commands
     assert answers[0] is not None and answers[1] is None
 
 

@@ -1,0 +1,80 @@
+"""An answer a watchdog can explain is the watchdog's (conformance/link/link.py): after a
+lone `!`, a frame without its CR or an open packet, a unit with a watchdog of its own
+time (half a second, a second) answers 2 when the suite lets them go; that answer is
+judged by the watchdog's rule, never taken for a second answer to the frame before. A
+second answer to a complete frame, with nothing left for a watchdog, still FAILs."""
+
+from __future__ import annotations
+
+import pytest
+
+from conformance.case import REGISTRY
+from conformance.catalogue import select
+from conformance.link.link import OPEN_FRAME, TWICE, WATCHDOG_RULES
+from conformance.runner import run_case
+from conformance.targets import parse_target
+from conformance.verdict import ERROR, FAIL, NON_STRICT
+from tests.conformance.link.test_link import _Line, real_link
+
+WATCHDOGS = ["lone-bang-answered,half-second-watchdog,packet-watchdog",
+             "lone-bang-answered,slow-watchdog,packet-watchdog"]
+
+
+def _link(readings: str):
+    return parse_target(f"emu:GVE84-100?reading={readings}").session.open_link()
+
+
+@pytest.mark.parametrize("readings", WATCHDOGS)
+def test_a_unit_s_own_watchdog_time_fails_no_case_of_frames_and_packets(readings: str):
+    target = parse_target(f"emu:GVE84-100?reading={readings}")
+    bad = {}
+    for c in select(["3.frame.*", "3.params.*", "7.packet.*", "7.machine.*"]):
+        r = run_case(c, target, "mutation")
+        if r.verdict in (FAIL, ERROR):
+            bad[c.id] = [ch["what"] for ch in r.checks if not ch["ok"]]
+    assert bad == {}
+
+
+@pytest.mark.parametrize(("case_id", "rule"), [
+    ("3.frame.lone-bang-silent", "3.frame.watchdog-lone-bang"),
+    ("7.packet.bad-checksum-member.corrupted-end", "7.packet.open-until-end")])
+def test_the_watchdog_s_answer_is_graded_by_its_rule(case_id: str, rule: str):
+    target = parse_target(f"emu:GVE84-100?reading={WATCHDOGS[1]}")
+    r = run_case(REGISTRY[case_id], target, "mutation")
+    failed = [c for c in r.checks if not c["ok"]]
+    assert r.verdict == NON_STRICT and rule in {c["rule"] for c in failed}
+    assert all(c["tag"] != "always" for c in failed)
+
+
+def test_a_lone_bang_answered_after_the_case_s_wait_is_the_watchdog_s():
+    ln = _link("lone-bang-answered,slow-watchdog")
+    assert ln.send("V1000").raw == b"0\r"
+    ln.send_raw(b"!")
+    assert ln.wait(0.5) == b""                    # a second's watchdog: not yet
+    ln.settle(final=True)                         # the longest watchdog waited out
+    assert [(v.rule, v.always) for v in ln.violations] == [
+        ("3.frame.watchdog-lone-bang", False)]
+
+
+def test_a_frame_left_without_its_cr_answered_2_is_what_our_reading_does_too():
+    ln = _link("half-second-watchdog")
+    ln.send_raw(b"!0V1000")
+    assert ln.left_open() == OPEN_FRAME and WATCHDOG_RULES[OPEN_FRAME] == "3.frame.watchdog"
+    ln.settle(final=True)
+    assert ln.violations == [] and ln.log[-1].data == b"2\r"
+
+
+def test_a_packet_the_next_frame_goes_on_with_is_not_waited_for():
+    ln = _link("packet-watchdog")
+    ln.send("*S", answer=False)
+    ln.send("C10,0,0", answer=False)
+    assert ln.send("*E1").raw == b"0,1\r" and ln.violations == []
+
+
+def test_a_second_answer_to_a_complete_frame_still_fails():
+    port = _Line([b"0\r"], then=b"2\r")           # V1000 answered, then a 2 no one asked
+    ln = real_link(port)
+    assert ln.send("V1000").raw == b"0\r"
+    ln.settle()
+    assert [(v.rule, v.always) for v in ln.violations] == [(TWICE, True)]
+    assert "answered twice" in ln.violations[0].text
