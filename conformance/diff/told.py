@@ -56,8 +56,8 @@ def tellable(step: Step) -> bool:
     """A frame that may be told ahead: one line of answer or none, whole, not stalled
     (one that is due no answer only last: a unit that answers it all the same stops its
     part of the exchange at the answer, not where the listening ends)."""
-    return (step.kind in (FRAME, FILL) and step.lines == 1 and step.stall is None
-            and not step.raw)
+    return ((step.kind == FRAME or (step.kind == FILL and step.times > 0))
+            and step.lines == 1 and step.stall is None and not step.raw)
 
 
 class Teller:
@@ -116,7 +116,7 @@ class Teller:
     def _more(self, place: int, repeat: int) -> bool:
         """Whether a second frame may follow the one at ``place``: worth telling."""
         step = self.steps[place]
-        if not tellable(step):
+        if not (tellable(step) and step.answer):
             return False
         if step.kind == FILL and repeat + 1 < step.times:
             return True

@@ -39,9 +39,9 @@ class Ahead:
         if not self.open:
             return False
         frames = HostFramer().frames(data)
-        readings = [(body, self.guard.address if f.address is None else f.address)
-                    for f in frames for body in f.bodies(None)]
-        motion = any(Body.parse(body).name in MOTION for body, _ in readings)
+        readings = [(body, self.guard.address if f.address is None else f.address,
+                     Body.parse(body).name) for f in frames for body in f.bodies(None)]
+        motion = any(name in MOTION for _, _, name in readings)
         if not frames or b"".join(f.wire for f in frames) != data or (self._blind and motion):
             self.open = False
             return False
@@ -50,9 +50,9 @@ class Ahead:
         except (SafetyStop, Interrupted, TargetNotResponding):
             self.open = False
             return False
-        for body, address in readings:
+        for body, address, name in readings:
             self.guard.book_any(body, address)
-            self._blind = self._blind or Body.parse(body).name in _POSITION
+            self._blind = self._blind or name in _POSITION
         self.frames.append((data, timeout, None))
         return True
 
