@@ -5,17 +5,18 @@ answer the frames told before it could get.
 A frame told is on the target's line at once: the simulator runs it before the suite
 has read a single answer. So a frame is told only when the guard's judgement of it
 cannot depend on those answers: on the copy, every frame let through is booked as
-though it got any answer (Guard.book_any), and after a position read no motion is told
-(a read that contradicts the bookkeeping moves it, anywhere). The first frame the copy
-refuses ends the frames told; it goes out, judged with the answers before it, when its
-turn comes. Each told frame is still judged and booked by the run's guard as it is sent.
+though it got any answer (Guard.book_any), and nothing is told after a position read (a
+read that contradicts the bookkeeping moves it anywhere, or shows the unit restarted,
+which ends the case). The first frame the copy refuses ends the frames told; it goes
+out, judged with the answers before it, when its turn comes. Each told frame is still
+judged and booked by the run's guard as it is sent.
 """
 
 from __future__ import annotations
 
 from conformance.link.interrupts import Interrupted
 from conformance.link.link import Link
-from conformance.link.safety import MOTION, Body, SafetyStop, TargetNotResponding
+from conformance.link.safety import Body, SafetyStop, TargetNotResponding
 from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
 
@@ -30,7 +31,6 @@ class Ahead:
         self.open = link.takes_ahead
         self.guard = link.guard.ahead() if self.open else link.guard
         self.frames: list[tuple[bytes, float, int | None]] = []
-        self._blind = False                 # a position read admitted: no motion after it
 
     def admit(self, data: bytes, timeout: float) -> bool:
         """Whether the raw frame ``data`` (whole frames only), whose answer is awaited
@@ -39,10 +39,7 @@ class Ahead:
         if not self.open:
             return False
         frames = HostFramer().frames(data)
-        readings = [(body, self.guard.address if f.address is None else f.address,
-                     Body.parse(body).name) for f in frames for body in f.bodies(None)]
-        motion = any(name in MOTION for _, _, name in readings)
-        if not frames or b"".join(f.wire for f in frames) != data or (self._blind and motion):
+        if not frames or b"".join(f.wire for f in frames) != data:
             self.open = False
             return False
         try:
@@ -50,9 +47,11 @@ class Ahead:
         except (SafetyStop, Interrupted, TargetNotResponding):
             self.open = False
             return False
-        for body, address, name in readings:
-            self.guard.book_any(body, address)
-            self._blind = self._blind or name in _POSITION
+        for f in frames:
+            for body in f.bodies(None):
+                self.guard.book_any(body, f.address)
+                if Body.parse(body).name in _POSITION:
+                    self.open = False         # told last: its answer decides what may follow
         self.frames.append((data, timeout, None))
         return True
 
