@@ -1,11 +1,13 @@
 """The stepper cores: pushes, queries and pulse trains per second, per core, and the
 cost of advancing through 2048 vectors of 2**31 steps (closed form); the C core's rate
-as a multiple of its Python twin's; and the C core's pulse train against a bare C loop
-that computes the same train with the same arithmetic (the reference, built with the
-core: emulator/motion/_reference.c), as a fraction of that loop's rate.
+as a multiple of its Python twin's; and the C core's pulse train against a plain exact
+kernel that computes the same train (one vector's steps in order: Bresenham over the
+axes, an integer recurrence for the instants; built with the core:
+emulator/motion/_kernel.c), as a fraction of the kernel's rate, the two trains checked
+identical first.
 
 Everything is measured in this one run: each figure is the best of a few timed runs,
-and the subjects of one figure (the two cores; the C core and the bare loop) are timed
+and the subjects of one figure (the two cores; the C core and the kernel) are timed
 in turns, so that a machine that slows down or speeds up meanwhile moves both alike.
 
     python -m bench.bench_stepper [--repeats N]
@@ -26,9 +28,9 @@ from emulator.motion.interface import Motion, Vector
 AXES, MAX_RATE = 4, 500_000
 #: the vector of the one-vector trains: an L from rest to rest, with its cruise rate the
 #: V (below every axis limit) and no dwell, so that its plan is the reference's own; the
-#: C core and the bare loop run a train ten times as long (each timed run some 30 ms)
+#: C core and the kernel run a train ten times as long (each timed run some 30 ms)
 TRAIN_STEPS = (100_000, -33_333, 14_285, 0)
-REFERENCE_STEPS = tuple(10 * d for d in TRAIN_STEPS)
+KERNEL_STEPS = tuple(10 * d for d in TRAIN_STEPS)
 TRAIN_V, TRAIN_A = 400_000, 10_000_000
 #: queries at this many instants spread over 64 vectors, as a unit's status answers ask
 #: (queued and next_event are left out: a counter read costs one call in either core)
@@ -117,22 +119,22 @@ def one_vector(stepper: str, steps: tuple[int, ...] = TRAIN_STEPS) -> tuple[Moti
     return m, m.drain_instant() + 1
 
 
-def reference(repeats: int) -> tuple[float, float, bool]:
-    """Pulses per second of the bare C loop and of the C core for the reference train
+def against_kernel(repeats: int) -> tuple[float, float, bool]:
+    """Pulses per second of the plain kernel and of the C core for the kernel's train
     (twice as many runs as a figure, in turns), and whether the two trains are the same
     (instants and masks)."""
-    from emulator.motion.reference import reference_pulses
+    from emulator.motion.kernel import kernel_pulses
 
-    def bare(_: object = None) -> tuple[np.ndarray, np.ndarray]:
-        return reference_pulses(REFERENCE_STEPS, 0, TRAIN_V, TRAIN_A)
+    def plain(_: object = None) -> tuple[np.ndarray, np.ndarray]:
+        return kernel_pulses(KERNEL_STEPS, 0, TRAIN_V, TRAIN_A)
 
-    core, until = one_vector("c", REFERENCE_STEPS)
+    core, until = one_vector("c", KERNEL_STEPS)
     train = core.pulses(0, until)
-    same = all(np.array_equal(a, b) for a, b in zip(bare(), train, strict=True))
-    rates = in_turns(2 * repeats, {"bare": Timed(lambda: None, bare, len(train[0])),
+    same = all(np.array_equal(a, b) for a, b in zip(plain(), train, strict=True))
+    rates = in_turns(2 * repeats, {"kernel": Timed(lambda: None, plain, len(train[0])),
                                    "core": Timed(lambda: core, lambda m: m.pulses(0, until),
                                                  len(train[0]))})
-    return rates["bare"], rates["core"], same
+    return rates["kernel"], rates["core"], same
 
 
 def positive(text: str) -> int:
@@ -160,10 +162,10 @@ def main(argv: list[str] | None = None) -> None:
     if len(cores) == 1:
         print("(the C core is not built: only the Python twin was measured)")
         return
-    bare, core, same = reference(args.repeats)
-    line = f"{'pulses/s (10x that vector), bare C loop':40}c: {bare:>14,.3f}  "
+    kernel, core, same = against_kernel(args.repeats)
+    line = f"{'pulses/s (10x that vector), plain kernel':41}c: {kernel:>14,.3f}  "
     if same:
-        line += f"the C core ({core:,.0f}/s, in turns with it) is {core / bare:.0%} of it"
+        line += f"the C core ({core:,.0f}/s, in turns with it) is {core / kernel:.0%} of it"
     else:
         line += "the C core's train differs from it: no ratio"
     print(line)

@@ -26,6 +26,7 @@ from conformance.diff.labels import allowed, command_of, label, verdict_of
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
+from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
@@ -113,6 +114,10 @@ class Pair:
         self._index = IndexBase()
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
+        #: a co-simulator is told each sequence's frames ahead where the guard can judge
+        #: them (told.py); False: one exchange a frame
+        self.ahead = True
+        self._teller: Teller | None = None     # the example's frames told ahead
 
     @property
     def exact(self) -> bool:
@@ -121,19 +126,36 @@ class Pair:
 
     # -- one example ----------------------------------------------------------------------
     def run(self, steps: list[Step]) -> ExampleRun:
+        """The example on both sides; against a co-simulator its frames told ahead
+        (told.py), and redone frame by frame where the target drifted from them."""
+        out = self._run(steps, ahead=self.ahead and self.exact and self.target.real)
+        if self._teller is not None and self._teller.drifted:
+            out = self._run(steps, ahead=False)
+        return out
+
+    def _run(self, steps: list[Step], *, ahead: bool) -> ExampleRun:
         out = ExampleRun()
+        self._teller = None
         if not self._begin(out):
             return out
+        self._teller = Teller(self.target, steps, self._refer) if ahead else None
         earlier: set[str] = set()          # what the sequence did before (labels read it)
-        for place, step in enumerate(steps):
-            if step.kind == WAIT:
-                self.target.wait(step.seconds)
-                self.timing.waited()
-                out.records.append(StepRecord(step, place=place))
-            elif step.kind == INPUT:
-                self._input(step, place, out, earlier)
-            elif self._frames(step, place, out, earlier):
-                break
+        try:
+            for place, step in enumerate(steps):
+                if step.kind == WAIT:
+                    self.target.wait(step.seconds)
+                    self.timing.waited()
+                    out.records.append(StepRecord(step, place=place))
+                elif step.kind == INPUT:
+                    self._input(step, place, out, earlier)
+                elif self._frames(step, place, out, earlier):
+                    break
+            if self._teller is not None:
+                self._teller.finish()
+        except BaseException:
+            if self._teller is not None:
+                self._teller.forget()
+            raise
         return self._end(out)
 
     def _begin(self, out: ExampleRun) -> bool:
@@ -147,8 +169,8 @@ class Pair:
                 self._prelude()
         except SafetyStop as err:
             # the known state itself was refused (a minimiser's candidate left the unit
-            # where the guard cannot bring it back, a unit that restarted by itself): the
-            # candidate shows nothing
+            # where the guard cannot bring it back), or the reads that begin the sequence
+            # showed the unit restarted: the candidate shows nothing
             out.refused.append(f"the known state: {err}")
             return False
         self.course = Course(self.profile)
@@ -173,7 +195,7 @@ class Pair:
         command = command_of(step.body)
         times = step.times if step.kind == FILL else 1
         for i in range(times):
-            rec = self._exchange(step, out)
+            rec = self._exchange(step, out, place, i)
             if rec is None:
                 break
             rec.repeat, rec.place = i, place
@@ -282,11 +304,26 @@ class Pair:
                                     if image.defaults.get(a, image.erased) != v}
         self.reference.write_eeprom(self._eeprom_changes)
 
-    def _exchange(self, step: Step, out: ExampleRun) -> StepRecord | None:
+    def _refer(self, step: Step, data: bytes) -> tuple[RoundTrip, str]:
+        """The frame to the reference: its exchange, and why the sequence ends there
+        ("": it goes on)."""
+        try:
+            return self.reference.exchange(data, lines=step.lines, answer=step.answer,
+                                           stall=step.stall, body=step.body), ""
+        except TargetNotResponding as err:
+            return RoundTrip(data, b"", 0, 0, None, step.lines), str(err)
+
+    def _exchange(self, step: Step, out: ExampleRun, place: int = 0,
+                  repeat: int = 0) -> StepRecord | None:
         # a quiet line after a timed-out frame is waited for before either side acts
         self.target.link.settle()
-        self.timing.align()
+        teller = self._teller
+        if teller is None or not teller.queue:
+            self.timing.align()
+            if teller is not None:
+                teller.tell(place, repeat)
         data = step.frame_bytes(self.target.target.address, self.target.link.checksums)
+        told = teller.take(data) if teller is not None else None
         rec = StepRecord(step)
         sent_at = self.target.now
         ended: list[str] = []
@@ -295,21 +332,23 @@ class Pair:
             """The frame to the reference, as the target's exchange began; done while the
             target runs it where its port sends a write before its read."""
             self.timing.sent(sent_at)
-            try:
-                rec.reference = self.reference.exchange(data, lines=step.lines,
-                                                        answer=step.answer, stall=step.stall,
-                                                        body=step.body)
-            except TargetNotResponding as err:
-                rec.reference = RoundTrip(data, b"", 0, 0, None, step.lines)
-                ended.append(str(err))
+            rec.reference, why = self._refer(step, data)
+            if why:
+                ended.append(why)
 
+        if told is not None:               # answered by the reference ahead already
+            rec.reference = told.reference
+            if told.ended:
+                ended.append(told.ended)
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
                                               stall=step.stall, body=step.body,
-                                              meanwhile=reference)
+                                              meanwhile=reference if told is None else None)
         except SafetyStop as err:
             why = str(err)
             out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")
+            if told is not None:
+                teller.drifted = True
             return None
         except TargetNotResponding as err:
             if self.target.real:       # a fresh unit's silence ends only its example
@@ -317,6 +356,11 @@ class Pair:
             rec.target = RoundTrip(data, b"", 0, 0, None, step.lines)
             out.ended = str(err)
         out.frames += 1
+        if teller is not None and told is not None:
+            teller.check(told, rec.target)
+        if teller is not None and teller.drifted:
+            out.ended = "the target's answers drifted from the frames told ahead"
+            return None                    # the example is redone frame by frame
         if rec.reference is None:
             reference()
         out.ended = out.ended or (ended[0] if ended else "")

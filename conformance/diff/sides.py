@@ -112,8 +112,8 @@ class Side:
             link.inject("host", "delay", at=stall[0], seconds=stall[1])
         link.send_raw(data)
         sent_at = link.wrote_at - self._origin
+        timeout = self.awaited(data, body, answer)
         if answer:
-            timeout = link.answer_timeout(body, len(data))
             launch = getattr(link.port, "launch", None)
             if meanwhile is not None and launch is not None:
                 launch(timeout)
@@ -121,9 +121,17 @@ class Side:
             r = link.read_response(timeout, lines, summed=link.summed_after(body))
             back = r.raw if r is not None else b""
         else:
-            back = link.wait(link.byte_seconds(len(data) + 64) + 0.005)
+            back = link.wait(timeout)
             r = parse_response(back, summed=link.checksums) if back else None
         return RoundTrip(data, back, sent_at, self.now, r, lines)
+
+    def awaited(self, data: bytes, body: str, answer: bool = True) -> float:
+        """Seconds a frame's answer is awaited (``answer``); for a frame that is due none,
+        how long the line is listened to after it (an answer's bytes would be over)."""
+        link = self.link
+        if answer:
+            return link.answer_timeout(body, len(data))
+        return link.byte_seconds(len(data) + 64) + 0.005
 
     def wait(self, seconds: float) -> bytes:
         return self.link.wait(seconds)

@@ -378,6 +378,14 @@ class Link:
             expect([(data, self.answer_timeout(body, len(data))) for body, data in
                     zip(bodies, framed, strict=True)])
 
+    @property
+    def takes_ahead(self) -> bool:
+        """Whether raw frames may be told ahead on this link now (conformance/link/
+        ahead.py): its port takes them (a co-simulator's), no fault is planned and no
+        frame is half sent."""
+        return (getattr(self.port, "expect", None) is not None and not self._faults
+                and not self._framer.in_frame)
+
     def _book(self, frames: list[HostFrame], answer: Response | None) -> None:
         """Book frames with the answer to the last one (the others got none)."""
         for i, f in enumerate(frames):

@@ -28,6 +28,7 @@ Public interface (docs/suite.md, "The session and its guard")::
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -374,6 +375,36 @@ class Guard:
             self._restarting = True          # its silence is the suite's own doing
         self._learn(command, response, outcome)
 
+    # -- frames told ahead ------------------------------------------------------------------
+    def ahead(self) -> Guard:
+        """A copy of this guard on which frames told ahead of their sending (a
+        co-simulator's `batch`) are judged one after the other, each booked with
+        :meth:`book_any` once judged: a frame the copy lets through, this guard lets
+        through when it comes to be sent, whatever the unit answered the ones before it.
+        The copy asks nobody (motion not confirmed yet is refused on it) and changes
+        nothing here."""
+        trial = copy.copy(self)
+        trial.envelope, trial.eeprom = _copied(self.envelope), _copied(self.eeprom)
+        trial.packet = [list(member) for member in self.packet]
+        if self.motion_confirmed is None and self.before_motion is not None:
+            trial.before_motion = lambda: False
+        return trial
+
+    def book_any(self, body: str, address: int | None = None) -> None:
+        """Book the frame ``body`` as though it got any answer at all: what it may have
+        done counted whichever way reaches farther (an unclear outcome), and a `C` while
+        a packet may be open both as a member and as a vector (answered, the unit did not
+        take it as one). What only an answer tells (the unit at rest, where the axes
+        are) is not learnt."""
+        address = self.address if address is None else address
+        if address not in self.addresses:
+            return
+        command = Body.parse(body)
+        if command.name in _PACKET_MEMBERS and self.packet_open:
+            self.envelope.vector(command.fields(self.envelope.axes), Outcome.UNCLEAR,
+                                 stand_alone=False)
+        self.accepted(body, None, address)
+
     def restarted(self) -> None:
         """The unit restarted by other means than `J` (a test rig's power cycle): booked
         as a `J` it accepted (counters zeroed, queue and packet gone, the axes stay)."""
@@ -669,6 +700,16 @@ _EVENTS: dict[str, Callable[[Envelope, Outcome], None]] = {
     "G": lambda e, o: e.unsettle(),                  # resumes what is already counted
     "SW6": lambda e, o: e.unsettle(),
 }
+
+
+def _copied(record: object) -> object:
+    """A copy of ``record`` with containers of its own (their items, frozen spans and
+    paths or numbers, shared): what the guard's bookkeeping can change in place."""
+    twin = copy.copy(record)
+    for name, value in vars(record).items():
+        if isinstance(value, (list, dict, set)):
+            setattr(twin, name, copy.copy(value))
+    return twin
 
 
 def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:

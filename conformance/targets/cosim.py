@@ -277,7 +277,11 @@ class CosimLine:
             goal = min(max(t, end), end + STEP_NS)
             if self._ahead:
                 head = self._ahead.popleft()
-                if (head.data, head.start, head.goal) == (data, start, goal):
+                # told with its answer's due instant, earlier than the read's goal: a CR
+                # by then is the same outcome, none leaves the read to go on from there
+                if (head.data, head.start) == (data, start) and (
+                        head.goal == goal or (head.goal < goal and "batch-stops"
+                                              in self.extensions)):
                     self._rx += head.rx
                     self.now = head.now
                     return head.cr
@@ -326,27 +330,34 @@ class CosimLine:
             raise
 
     # -- frames told ahead (the `batch` extension) ---------------------------------------------
-    def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
+    def expect(self, frames: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]]
+               ) -> int:
         """The frames the host is about to send one after the other, each with the seconds
-        its answer is to be awaited. A simulator that offers `batch` runs them all in one
-        exchange; each frame's write and read then take their part of its reply, checked,
-        timed and read exactly as one exchange a frame would be. One that also offers
-        `batch-stops` ends the batch after a frame that got no CR: a frame awaited longer
-        than one command may ask for (H, answered once the axes have stopped) is told
-        with that much, and the frames after it run only if it was answered meanwhile."""
+        its answer is to be awaited (and, where known, the ns from its first byte by which
+        its answer is due). A simulator that offers `batch` runs them all in one exchange;
+        each frame's write and read then take their part of its reply, checked, timed and
+        read exactly as one exchange a frame would be. One that also offers `batch-stops`
+        ends the batch after a frame that got no CR: a frame awaited longer than one
+        command may ask for (H, answered once the axes have stopped) is told with that
+        much, and the frames after it run only if it was answered meanwhile; a frame
+        whose answer is due is told with that, so that one answered later (or not at
+        all) ends the batch, its read going on from there.
+        Returns how many of the frames the simulator ran (0: none was told)."""
         if ("batch" not in self.extensions or self._tx is not None or self._rx
                 or self._ahead or self._inflight is not None):
-            return
+            return 0
         self._usable()
         stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
-        for data, timeout in frames:
+        for data, timeout, *due in frames:
             wait = round(timeout * SECOND)
             if not data or (wait > STEP_NS and not stops):
                 break
+            if stops and due and due[0] is not None:
+                wait = min(wait, max(due[0] - len(data) * self.byte_ns, 0))
             plan.append((bytes(data), min(wait, STEP_NS)))
         if len(plan) < 2:
-            return
+            return 0
         command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
         here, ahead = self.now, []
         with self._exchange(command):
@@ -361,6 +372,7 @@ class CosimLine:
                     break                         # the simulator ran none after it
         self.now = here
         self._ahead.extend(ahead)
+        return len(ahead)
 
     def _catch_up(self) -> None:
         """Frames told ahead and then not sent as told (Ctrl-C, a frame the guard
@@ -379,8 +391,12 @@ class CosimLine:
             self._step(self.now)
 
     def advance_to(self, t: int) -> None:
-        """Let virtual time pass up to the instant ``t``."""
-        self._flush()
+        """Let virtual time pass up to the instant ``t`` (a write not sent yet goes out
+        with it: `tx HEX T`, one exchange)."""
+        if self._inflight is not None:
+            self._land()
+        if self._tx is not None:
+            self._step(t)
         self._catch_up()
         while self.now < t:
             self._step(t)
@@ -484,9 +500,11 @@ class CosimPort:
     def write(self, data: bytes) -> int:
         return self.line.write(bytes(data))
 
-    def expect(self, frames: Sequence[tuple[bytes, float]]) -> None:
-        """The frames about to be sent, each with its answer's timeout (CosimLine.expect)."""
-        self.line.expect(frames)
+    def expect(self, frames: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]]
+               ) -> int:
+        """The frames about to be sent, each with its answer's timeout and due instant
+        (CosimLine.expect): how many the simulator ran."""
+        return self.line.expect(frames)
 
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""

@@ -35,6 +35,17 @@ i64 st_acc_count(i64 v, i64 a, i64 tau) {
     return q < (u128)NEVER ? (i64)q : NEVER;
 }
 
+int64_t st_walk(int64_t v, int64_t a, int64_t m, int64_t count, int64_t *out) {
+    if (count <= 0 || m < 0 || m > NEVER - count) return -1;
+    i64 tau_max = acc_time(v, a, m + count - 1);
+    if (!walk_fits(v, a, m + count - 1, tau_max)) return -1;
+    walk_t w;
+    walk_start(&w, v, a, m);
+    out[0] = w.tau;
+    for (i64 i = 1; i < count; i++) out[i] = walk_next(&w);
+    return count;
+}
+
 uint64_t st_isqrt_u128(uint64_t hi, uint64_t lo) {
     return (uint64_t)isqrt_u128(((u128)hi << 64) | lo);
 }
@@ -417,30 +428,20 @@ int st_instant_of_position(stepper *m, int axis, int64_t value, int64_t *out) {
     return found;
 }
 
-/* Steps first..last of a piece: their instants and masks. The plan's segments follow
- * each other over the steps, so they are walked in order; each axis's count at the step
- * before is carried from one step to the next. */
-static void piece_train(const piece_t *p, int axes, i64 first, i64 last, i64 *times,
-                        uint8_t *masks) {
-    i64 before[ST_AXES];
+/* Steps first..last of a piece: their instants, segment by segment (the plan's
+ * segments follow each other over the steps), and the axes each moves (Bresenham over
+ * the whole stretch), both carried from one step to the next (seg_instants, axis_steps). */
+static void piece_train(const piece_t *p, i64 first, i64 last, i64 *times, uint8_t *masks) {
     uint8_t sign = 0;
-    for (int a = 0; a < axes; a++) {
-        before[a] = axis_count(first - 1, p->steps[a], p->n);
+    for (int a = 0; a < ST_AXES; a++)
         if (p->steps[a] < 0) sign |= (uint8_t)(1 << (4 + a));
-    }
-    i64 k = first;
-    for (int i = 0; i < p->nseg && k <= last; i++) {
+    axis_steps(p->steps, p->n, first, last, masks);
+    if (sign)
+        for (i64 i = 0; i <= last - first; i++) masks[i] |= sign & (uint8_t)(masks[i] << 4);
+    for (int i = 0; i < p->nseg; i++) {
         const seg_t *s = &p->plan[i];
-        for (i64 top = min64(last, s->k0 + s->length); k <= top; k++) {
-            uint8_t mask = 0;
-            for (int a = 0; a < axes; a++) {
-                i64 c = axis_count(k, p->steps[a], p->n);
-                if (c != before[a]) mask |= (uint8_t)(1 << a);
-                before[a] = c;
-            }
-            *times++ = seg_step_instant(s, k - s->k0);
-            *masks++ = mask | (sign & (uint8_t)(mask << 4));
-        }
+        i64 lo = max64(first, s->k0 + 1), hi = min64(last, s->k0 + s->length);
+        if (lo <= hi) seg_instants(s, lo - s->k0, hi - s->k0, times + (lo - first));
     }
 }
 
@@ -465,7 +466,7 @@ int64_t st_pulses(stepper *m, int64_t t0, int64_t t1, int64_t *times, uint8_t *m
             const piece_t *p = timeline_piece(&tl, i);
             piece_range(p, t0, t1, &first, &last);
             if (last < first) continue;
-            piece_train(p, m->axes, first, last, times + at, masks + at);
+            piece_train(p, first, last, times + at, masks + at);
             at += last - first + 1;
         }
     }

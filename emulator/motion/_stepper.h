@@ -26,6 +26,10 @@ void st_free(stepper *m);
 void st_set_deviations(stepper *m, int flags);
 int64_t st_acc_time(int64_t v, int64_t a, int64_t m);
 int64_t st_acc_count(int64_t v, int64_t a, int64_t tau);
+/* acc_time(v, a, m + i) for i = 0..count-1 into out, one from the other as pulse
+ * trains take them (the walk of _stepper_math.h); -1 (nothing written) where that walk
+ * does not fit (rates, accelerations and counts beyond every profile's) */
+int64_t st_walk(int64_t v, int64_t a, int64_t m, int64_t count, int64_t *out);
 /* floor(sqrt(hi·2^64 + lo)), exact */
 uint64_t st_isqrt_u128(uint64_t hi, uint64_t lo);
 void st_advance(stepper *m, int64_t t);

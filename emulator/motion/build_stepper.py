@@ -23,9 +23,9 @@ if TYPE_CHECKING:
 HERE = Path(__file__).resolve().parent
 MODULE = "emulator.motion._stepper_c"
 #: the headers whose declarations the module exposes (cffi's cdef)
-HEADERS = ("_stepper.h", "_reference.h")
-#: the C files compiled into the module (the core, the benchmark's reference loop)
-C_FILES = ("_stepper.c", "_reference.c")
+HEADERS = ("_stepper.h", "_kernel.h")
+#: the C files compiled into the module (the core, the benchmark's plain kernel)
+C_FILES = ("_stepper.c", "_kernel.c")
 #: the most axes the core drives: ``ST_AXES`` of the header, the one place it is written
 AXES = int(re.search(r"^#define ST_AXES (\d+)$", (HERE / "_stepper.h").read_text(),
                      re.MULTILINE)[1])

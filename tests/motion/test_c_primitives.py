@@ -118,3 +118,28 @@ def test_isqrt_u128_of_squares_and_neighbours(r):
     for n in (r * r, r * r + 2 * r, max(0, r * r - 1)):
         got = c.st_isqrt_u128(n >> 64, n & (2**64 - 1))
         assert got * got <= n < (got + 1) * (got + 1)
+
+
+@given(rates, accels, counts, st.integers(1, 3000))
+@example(0, 10_000_000, 0, 3000)            # a ramp from rest: its first steps are far apart
+@example(0, 1, 0, 50)
+@example(14_142, 0, 0, 3000)                # cruising: the increments alternate by 1 ns
+@example(1, 0, 2**35 - 3000, 3000)          # 1 step/s: the instants near "never"
+@example(8_000_000, 160_000_000, 2**20, 3000)
+@SETTINGS
+def test_the_walk_gives_acc_time_step_after_step(v, a, m, count):
+    # pulse trains take a curve's instants one from the other (no division, no square
+    # root): every one must be the first instant reaching its step, as acc_time's
+    from emulator.motion._stepper_c import ffi
+    assume(v or a)
+    out = ffi.new("int64_t[]", count)
+    got = lib().st_walk(v, a, m, count, out)
+    if got < 0:
+        # refused only beyond what any plan reaches: a rate past 2**61 / 2e9 steps/s
+        # (plans stay below the unit's maximum rate) or an instant at "never"
+        tau = ref_time(v, a, m + count - 1)
+        assert tau >= NEVER or 2 * SECOND * v + 2 * a * tau >= 2**61
+        return
+    for i, tau in enumerate(out):
+        assert reached(v, a, m + i, tau)
+        assert tau == 0 or not reached(v, a, m + i, tau - 1)

@@ -124,3 +124,21 @@ def test_twins_agree_step_by_step(axes, max_rate, data):
     first, second = c.pulses(0, cut), c.pulses(cut, window)
     assert np.array_equal(np.concatenate([first[0], second[0]]), c_times)
     assert np.array_equal(np.concatenate([first[1], second[1]]), c_masks)
+
+
+@given(st.lists(st.integers(-5000, 5000), min_size=2, max_size=2),
+       st.integers(2**31, 2**33), st.integers(2**40, 2**44))
+@settings(max_examples=20, deadline=None, derandomize=True)
+def test_trains_beyond_the_walks_range_are_the_twins_too(steps, velocity, accel):
+    # accelerations and rates no profile reaches (from 2**40 steps/s², or past 2**61 / 2e9
+    # steps/s, the C core's trains take each instant by its definition, not one from the
+    # other): still the twin's, bit for bit
+    vector = Vector(tuple(steps), False, velocity, accel, velocity, 0, 0, False,
+                    (2**34,) * 2)
+    trains = []
+    for stepper in ("python", "c"):
+        m = create(2, 2**34, stepper=stepper)
+        m.push(vector, 0)
+        trains.append(m.pulses(0, (m.drain_instant() or 0) + 1))
+    assert all(np.array_equal(p, c) for p, c in zip(*trains, strict=True))
+    assert len(trains[0][0]) == max(abs(d) for d in steps)

@@ -2,7 +2,7 @@
 virtual time: positions while moving and the instants of answers too), the unit lives on
 between sequences (its known state, index and EEPROM as found); the clean emulator
 agrees with itself over hundreds of sequences, a mutant is found, shrunk, written and
-replayed."""
+replayed; every mutant is found as in process, with frames told ahead as without."""
 
 from __future__ import annotations
 
@@ -15,9 +15,10 @@ import pytest
 from conformance.cli.diff import main as diff_main
 from conformance.cli.replay import main as replay_main
 from conformance.diff.engine import Budget, Pair, search
-from conformance.diff.grammar import Options
+from conformance.diff.grammar import Options, probes
 from conformance.diff.sides import Side
 from conformance.targets import parse_target
+from tests.conformance.diff.test_engine import EVERYTHING, ON_THE_WIRE, PROFILE, in_area
 
 
 def cosim(*options: str) -> str:
@@ -74,3 +75,53 @@ def test_a_mutant_found_the_run_goes_on_to_its_end(capsys):
     assert "FAIL        10.cmd.exchange-velocity" in out
     assert "not responding" not in out
     assert "\n2000 sequences, " in out, out
+
+
+#: a few mutants of other kinds for the default run (every mutant: slow)
+FEW = ["lower-case-command", "velocity-ignored"]
+#: mutants whose `H` answers before the axes have stopped: the known state, which begins
+#: with `H`, does not bring the unit to rest before the next sequence, so what a sequence
+#: left running (the frames told after its disagreement too) shows in later sequences;
+#: told ahead or not, the probes name its rule
+KNOWN_STATE_UNREACHED = {"halt-answers-early"}
+
+
+def _probes_through_a_co_simulator(mutant: str, *, ahead: bool) -> list[tuple]:
+    """The findings of the probes through a co-simulated mutant (its rule and kind, and
+    the steps shrunk to), with frames told ahead or one exchange a frame."""
+    profile = PROFILE.get(mutant, "GVE84-100")
+    spec = "exec:" + shlex.join([sys.executable, "-m", "emulator", "--model", profile,
+                                 "--cosim", "--mutant", mutant])
+    target = parse_target(spec, profile=profile, allow_destructive=True, max_travel=65535)
+    target.preflight()
+    try:
+        p = Pair(Side(target, target.begin()), Side(parse_target(f"emu:{profile}")),
+                 target.profile)
+        p.ahead = ahead
+        budget = Budget(examples=len(probes(p.profile, EVERYTHING)))
+        found = search(p, EVERYTHING, budget)
+    finally:
+        target.session.finish()
+        target.close()
+    return [(f.disagreement.rule, f.disagreement.kind, [str(s) for s in f.steps])
+            for f in found]
+
+
+def _found_as_in_process(mutant: str) -> None:
+    ahead = _probes_through_a_co_simulator(mutant, ahead=True)
+    assert any(in_area(rule, mutant) for rule, _, _ in ahead), (mutant, ahead)
+    if mutant not in KNOWN_STATE_UNREACHED:
+        assert ahead == _probes_through_a_co_simulator(mutant, ahead=False)
+
+
+@pytest.mark.parametrize("mutant", FEW)
+def test_through_a_co_simulator_the_probes_find_a_mutant_told_ahead_as_not(mutant):
+    """As in process (tests/conformance/diff/test_engine.py), the probes name a rule of
+    the mutant's area; told ahead, they find what they find one exchange a frame."""
+    _found_as_in_process(mutant)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mutant", ON_THE_WIRE)
+def test_through_a_co_simulator_the_probes_find_every_mutant(mutant):
+    _found_as_in_process(mutant)

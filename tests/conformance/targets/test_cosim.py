@@ -384,3 +384,45 @@ def test_a_write_launched_before_its_read_is_the_exchange_the_read_would_send():
     launched = _launched(True)
     assert launched == _launched(False)
     assert [c.split()[0] for c in launched[2]] == ["tx"] * 3 and all(launched[0])
+
+
+def _waited(data: bytes, seconds: float):
+    """The commands, bytes received and clock of a write then a wait of ``seconds`` on a
+    co-simulated emulator."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        commands = []
+        send = port.line.program.send
+        port.line.program.send = lambda text: commands.append(text) or send(text)
+        start = port.line.now
+        port.write(data)
+        port.line.advance(seconds)
+        return [c.split()[0] for c in commands], port.read(port.in_waiting), \
+            port.line.now - start
+    finally:
+        target.close()
+
+
+def test_a_write_and_the_wait_after_it_go_in_one_exchange():
+    # no answer: `tx HEX T` runs the clock to T; an answer stops it at its CR, and the
+    # wait goes on from there
+    assert _waited(b"!0*S\r", 0.01) == (["tx"], b"", 10_000_000 + 5 * 86806)
+    assert _waited(b"!0?\r", 0.05) == (["tx", "until"], b"0,IP84 v3 27.1.2010\r",
+                                       50_000_000 + 4 * 86806)
+
+
+@pytest.mark.parametrize(("second", "ran"), [(b"!0SR0\r", 4), (b"!0*S\r", 2)])
+def test_telling_frames_ahead_says_how_many_the_simulator_ran(second, ran):
+    # `batch-stops`: the batch ends after a frame that got no answer (*S)
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        frames = [b"!0SR6\r", second, b"!0SR6\r", b"!0PF\r"]
+        assert port.expect([(f, 0.25) for f in frames]) == ran
+        assert len(port.line._ahead) == ran
+        assert port.expect([(frames[0], 0.25)]) == 0, "frames told already wait first"
+    finally:
+        target.close()

@@ -1,0 +1,210 @@
+"""A co-simulator told a sequence's frames ahead (conformance/diff/told.py): the same
+sequence runs as it does one exchange a frame — the same bytes at the same instants,
+the same answers, the same disagreement — in fewer exchanges; frames told that the
+sequence did not reach are sent all the same and booked by the guard; and where the
+target's answers drift from the reference's instants the sequence is run again frame by
+frame."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import conformance.diff.told as told_module
+from conformance.diff.engine import ExampleRun, Pair
+from conformance.diff.grammar import Options, sequences
+from conformance.diff.index import QUERIES
+from conformance.diff.labels import command_of
+from conformance.diff.sides import Side
+from conformance.diff.steps import FRAME, Step
+from conformance.link.virtual import line_of
+from conformance.targets import parse_target
+from gve_fixtures.profile import load_profile
+
+
+def cosim(*options: str) -> str:
+    return "exec:" + shlex.join([sys.executable, "-m", "emulator", "--model", "GVE84-100",
+                                 "--cosim", *options])
+
+
+@pytest.fixture(scope="module")
+def pairs():
+    """A co-simulated mutant and the clean emulator, each against the reference, with the
+    exchanges each sends counted."""
+    made, targets = {}, []
+    for name, spec in (("mutant", cosim("--mutant", "velocity-ignored")), ("clean", cosim())):
+        # the widest envelope: the guard's bookkeeping of earlier runs (a unit that lives
+        # on) decides no refusal that would make two runs of one sequence differ
+        target = parse_target(spec, profile="GVE84-100", allow_destructive=True,
+                              max_travel=65535)
+        target.preflight()
+        targets.append(target)
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        made[name] = pair
+    yield made
+    for target in targets:
+        target.session.finish()
+        target.close()
+
+
+def counted(pair: Pair) -> list[str]:
+    """The commands the pair's co-simulator is sent from now on (its first words)."""
+    if pair.target.link is None:
+        pair.run([])
+    program = line_of(pair.target.link.port).program
+    sent: list[str] = []
+    send = program.send
+    program.send = lambda text: sent.append(text.split()[0]) or send(text)
+    return sent
+
+
+def outcome(run: ExampleRun) -> tuple:
+    """What a run showed: each exchange on both sides (its bytes, how long its answer
+    took, how long after the exchange before it it began), where it disagreed, what was
+    refused and why it ended. The unit's index lives on between runs: an answer to a
+    read of it is taken by its code alone (its digits, and so how long it took and
+    where the frame after it began on each side, are not the same in every run)."""
+    return [_sides(r, prev) for prev, r in zip([None, *run.records[:-1]], run.records,
+                                               strict=True)], \
+        run.disagreement and (run.disagreement.index, run.disagreement.rule,
+                              run.disagreement.kind), run.refused, run.ended, run.frames
+
+
+def _sides(rec, prev) -> tuple:
+    def seen(trip, before):
+        if trip is None:
+            return None
+        index = command_of(rec.step.body) in QUERIES and trip.response is not None
+        took = None if index else trip.received_at - trip.sent_at
+        after = prev is not None and command_of(prev.step.body) in QUERIES
+        gap = None if after or before is None else trip.sent_at - before.received_at
+        return (trip.response.code if index else trip.answer, took, gap)
+    return (rec.step, rec.target and rec.target.sent,
+            seen(rec.target, prev and prev.target), seen(rec.reference, prev and prev.reference))
+
+
+def both(pair: Pair, steps: list[Step]) -> tuple[ExampleRun, ExampleRun]:
+    pair.ahead = True
+    ahead = pair.run(steps)
+    pair.ahead = False
+    try:
+        return ahead, pair.run(steps)
+    finally:
+        pair.ahead = True
+
+
+@given(data=st.data())
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=list(HealthCheck))
+@pytest.mark.parametrize("name", ["mutant", "clean"])
+def test_a_sequence_told_ahead_runs_as_it_does_frame_by_frame(pairs, name, data):
+    pair = pairs[name]
+    steps = data.draw(sequences(load_profile("GVE84-100"), Options(destructive=True, rig=True)))
+    ahead, single = both(pair, steps)
+    assert outcome(ahead) == outcome(single)
+
+
+def test_frames_told_ahead_take_fewer_exchanges(pairs, monkeypatch):
+    pair = pairs["clean"]
+    steps = [Step(FRAME, body=body) for body in
+             ("V400", "SR0", "L100,0,0", "SR6", "C10,0,0", "C10,0,0", "?", "F")]
+    sent = counted(pair)
+    begin = Pair._begin
+
+    def begun(self, out):            # the sequence's exchanges only, not the known state's
+        try:
+            return begin(self, out)
+        finally:
+            sent.clear()
+
+    monkeypatch.setattr(Pair, "_begin", begun)
+    pair.ahead = True
+    pair.run(steps)
+    told = list(sent)
+    pair.ahead = False
+    try:
+        pair.run(steps)
+    finally:
+        pair.ahead = True
+    assert sent == ["tx"] * len(steps)
+    assert told == ["batch"], told
+
+
+def test_frames_told_after_a_disagreement_are_sent_and_booked(pairs):
+    # the mutant answers V0 (out of range) 4, not 5: as soon as the reference, so the
+    # frames told after it run
+    target = parse_target(cosim("--mutant", "range-error-code"), profile="GVE84-100",
+                          allow_destructive=True)
+    target.preflight()
+    try:
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        guard = target.session.guard
+        guard.motion_confirmed = True
+        steps = [Step(FRAME, body=body) for body in ("V0", "C120,0,0", "C120,0,0")]
+        run = pair.run(steps)
+        assert run.disagreement is not None and run.disagreement.index == 0
+        assert len(run.records) == 1, "the sequence stops at its disagreement"
+        # the two vectors told with it ran on the simulator: the guard counts them
+        assert guard.envelope.seen[0].hi >= 240 * guard.scale
+        wire = b"".join(r.data for r in pair.target.link.log)
+        assert wire.count(b"!0C120,0,0\r") == 2
+        pair.ahead = False
+        before = guard.envelope.seen[0].hi
+        pair.run(steps)
+        assert b"".join(r.data for r in pair.target.link.log).count(b"C120") == 0
+        assert guard.envelope.seen[0].hi == before
+    finally:
+        target.session.finish()
+        target.close()
+
+
+def test_a_target_drifting_from_the_frames_told_is_run_again_frame_by_frame(pairs,
+                                                                             monkeypatch):
+    # the co-simulator's index is not the fresh reference's: `@` answered alike (counted
+    # from each side's start) in more digits, so the frames told after it begin later on
+    # the target than on the reference (`@` ends what is told ahead; here it does not)
+    monkeypatch.setattr(told_module, "ENDS", frozenset({"%", "J"}))
+    pair = pairs["clean"]
+    redone = []
+    real_run = Pair._run
+
+    def run(self, steps, *, ahead):
+        redone.append(ahead)
+        return real_run(self, steps, ahead=ahead)
+
+    monkeypatch.setattr(Pair, "_run", run)
+    steps = [Step(FRAME, body=body) for body in ("@", "SR0", "SR0", "@")]
+    ahead = pair.run(steps)
+    assert redone == [True, False], "drifted, and run again frame by frame"
+    pair.ahead = False
+    try:
+        single = pair.run(steps)
+    finally:
+        pair.ahead = True
+    assert outcome(ahead) == outcome(single)
+    assert ahead.disagreement is None and not ahead.ended
+
+
+def test_a_target_answering_later_than_the_reference_stops_what_was_told(pairs):
+    # the mutant reads a lower-case command as its upper case and answers it at length,
+    # where the reference refuses it at once: the simulator ran nothing after it
+    target = parse_target(cosim("--mutant", "lower-case-command"), profile="GVE84-100",
+                          allow_destructive=True)
+    target.preflight()
+    try:
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        target.session.guard.motion_confirmed = True
+        run = pair.run([Step(FRAME, body=body) for body in ("sr0", "C120,0,0", "C120,0,0")])
+        assert run.disagreement is not None and run.disagreement.index == 0
+        assert b"C120" not in b"".join(r.data for r in pair.target.link.log)
+        assert target.session.guard.envelope.seen[0].hi == 0
+    finally:
+        target.session.finish()
+        target.close()
