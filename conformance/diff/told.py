@@ -30,13 +30,14 @@ from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, Step
 from conformance.link.ahead import Ahead
 from conformance.link.safety import SafetyStop
+from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
 from gve_fixtures.protocol import ErrorCode
 
 #: frames after which none is told in the same exchange: they change how the host frames
 #: (the checksum mode) or restart the unit, or their answers may be alike without being
 #: the same bytes (the index), so the frames after them may start elsewhere on each side
-ENDS = frozenset({"%", "J"}) | QUERIES
+ENDS = classes(summing=True) | classes(restart=True) | QUERIES
 #: the most frames told in one exchange
 MOST = 64
 
