@@ -428,6 +428,13 @@ class CosimLine:
             self.now += len(data) * self.byte_ns
         return len(data)
 
+    def ran(self, data: bytes) -> bool:
+        """Whether the host's bytes ``data``, written now, are the next frame told ahead:
+        the simulator has run them already (their write only takes its part of the
+        reply)."""
+        return (self._tx is None and self._inflight is None and bool(self._ahead)
+                and (self._ahead[0].data, self._ahead[0].start) == (data, self.now))
+
     def _take(self, size: int, terminator: bytes | None) -> bytes:
         end = min(size, len(self._rx))
         if terminator:
@@ -505,6 +512,10 @@ class CosimPort:
         """The frames about to be sent, each with its answer's timeout and due instant
         (CosimLine.expect): how many the simulator ran."""
         return self.line.expect(frames)
+
+    def ran(self, data: bytes) -> bool:
+        """Whether ``data`` written now was told ahead and run already (CosimLine.ran)."""
+        return self.line.ran(data)
 
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""

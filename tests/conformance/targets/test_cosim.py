@@ -357,6 +357,29 @@ def test_frames_told_ahead_and_not_sent_as_told_leave_the_clock_on_the_simulator
         target.close()
 
 
+def test_only_the_next_frame_told_ahead_is_one_the_simulator_ran_already():
+    """A frame told ahead is run before the suite writes it: its write puts nothing on
+    the simulator's line (the link holds no signals for it); any other write does."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        port.timeout = 0.25
+        frames = [b"!0SR6\r", b"!0SR0\r"]
+        assert not port.ran(frames[0]), "nothing told yet"
+        port.expect([(f, 0.25) for f in frames])
+        assert port.ran(frames[0]) and not port.ran(frames[1]), "in turn"
+        port.write(frames[0])
+        assert not port.ran(frames[1]), "its answer not read yet"
+        assert port.read_until(b"\r") == b"0,00\r"
+        assert port.ran(frames[1]) and not port.ran(b"!0PF\r")
+        port.write(b"!0PF\r")                      # not as told: SR0 ran, is dropped
+        assert port.read_until(b"\r").startswith(b"0,")
+        assert not port.ran(frames[1])
+    finally:
+        target.close()
+
+
 def _launched(launch: bool):
     """The answers, clock and commands of three frames written and read on a co-simulated
     emulator, each write launched before its read or not."""
