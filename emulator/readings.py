@@ -72,6 +72,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                          "@ is remembered for > like any received command: > after @ "
                          "answers !0@ and the index it gave (the manual's > repeats the "
                          "last received command and its answer)"),
+    "cause-first-only": (("10.3.inputs.cause-accumulates",),
+                         "ST4/ST5 keep the cause of the interrupt that stopped the unit: an "
+                         "input interrupting while INTA is already set adds no bit (the "
+                         "manual's cause is \"the interrupt\", not every one since)"),
     "next-vectors-B": (("10.2.motion.junction-own-b",),
                        "a junction of two C is passed at the B the next C captured, not the "
                        "one of the C that ends there"),

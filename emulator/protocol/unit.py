@@ -109,13 +109,16 @@ class Unit:
         deaf = self.device.deaf_until
         if deaf > now and (best is None or deaf < best):
             best = deaf
-        if self.framer.buf is not None or self._pending:
-            for c in (self.framer.deadline(), *(d.instant for _, d, _ in self._pending)):
+        if self.framer.buf is not None or self._pending or self.device.due:
+            for c in (self.framer.deadline(), *(d.instant for _, d, _ in self._pending),
+                      self.device.next_due()):
                 if c is not None and c > now and (best is None or c < best):
                     best = c
         return best
 
     def advance(self, t: int) -> None:
+        if self.device.due:
+            self.device.run_due(t)
         if self._pending or self.framer.buf is not None:
             while True:
                 expiry = self.framer.deadline()
