@@ -21,10 +21,11 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.diff.engine import Budget, Finding, Pair, search
+from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
-from conformance.diff.gvt import transcript, write
-from conformance.diff.results import agreement_result, finding_result, rig_lost_result
+from conformance.diff.kept import Kept
+from conformance.diff.reach import Reach
+from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
@@ -33,7 +34,7 @@ from conformance.metadata import RunMeta
 from conformance.operator import Console
 from conformance.runner import RunResult
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
-from conformance.verdict import COULD_NOT_TEST, FAIL
+from conformance.verdict import COULD_NOT_TEST, FAIL, CouldNotTest
 
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given
@@ -122,7 +123,12 @@ def main(argv: list[str] | None = None) -> int:
     run_id = new_run_id()
     folder = None if args.no_reports else Path(args.report_dir) / run_id
     interrupts = Interrupts()
-    session = target.begin(interrupts)
+    try:
+        session = target.begin(interrupts)
+    except (CouldNotTest, SessionError) as err:
+        target.close()
+        print(f"{PROG}: {COULD_NOT_TEST}: {one_line(err)}", file=sys.stderr)
+        return 1
     ask_first(args, target)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     options = Options(destructive=args.allow_destructive,
@@ -135,30 +141,15 @@ def main(argv: list[str] | None = None) -> int:
         f"({target.profile.name}), seed {args.seed}, "
         + (f"{examples} sequences" if examples else f"{args.seconds:g} s"))
 
-    def found(f: Finding) -> None:
-        n = len(run.results) + 1
-        t = transcript(f, profile=target.profile.name, target=target.info.spec,
-                       reference=reference.info.spec, seed=args.seed)
-        path = ""
-        if folder is not None:
-            folder.mkdir(parents=True, exist_ok=True)
-            path = str(write(folder / f"diff-{n:02d}.gvt", t))
-        r = finding_result(f, profile=target.profile.name, target=target.info.spec,
-                           transcript=list(t.lines()), path=path)
-        run.results.append(r)
-        d = f.disagreement
-        say(f"{d.verdict:11} {d.rule or '(no known rule)'}: {readable(d.target.sent)} "
-            f"target {readable(d.target.answer) or '(none)'} / reference "
-            f"{readable(d.reference.answer) or '(none)'} ({d.kind}; {f.frames} frame(s))"
-            + (f"  -> {path}" if path else ""))
-        if folder is None or args.verbose:
-            say("\n".join("    " + line for line in t.lines()))
-
+    kept = Kept(run, folder, profile=target.profile.name, target=target.info.spec,
+                reference=reference.info.spec, seed=args.seed, say=say, verbose=args.verbose)
+    reach = Reach(target.profile, options)
     try:
         with interrupts.catching():
             search(pair, options, budget, seed=args.seed, with_probes=not args.no_probes,
-                   on_finding=found)
-    except (TargetNotResponding, SessionError) as err:
+                   on_finding=kept.kept, on_seen=kept.seen, on_dropped=kept.dropped,
+                   reach=reach)
+    except (TargetNotResponding, SessionError, CouldNotTest) as err:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
         r.verdict, r.stopped = (FAIL if isinstance(err, TargetNotResponding)
@@ -171,7 +162,11 @@ def main(argv: list[str] | None = None) -> int:
         run.interrupted = True
         session.emergency_stop()
     finally:
-        report = session.finish() if session.real else None
+        try:
+            report = session.finish() if session.real else None
+        except CouldNotTest as err:         # an ending that could not be done: said
+            report = None
+            run.problems.append(f"the unit could not be left as it should: {err}")
         target.close()
     if report is not None:
         run.sessions[target.info.spec] = report.to_dict()
@@ -197,6 +192,12 @@ def main(argv: list[str] | None = None) -> int:
                        "sent, the search not finished"]
         run.results.append(r)
     run.frames, run.seconds = budget.frames, budget.elapsed
+    say(reach.line())
+    if args.verbose:
+        say("\n".join("  not reached: " + line for line in reach.not_reached()))
+    for r in run.results:
+        if r.id == "diff.search.agreement":
+            r.notes.append(reach.line())
     say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))

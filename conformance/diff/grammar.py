@@ -123,7 +123,9 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
         return st.sampled_from(rest.split("|"))
     lo, hi = _range_of(profile, kind)
     if head == "range" and rest in ("position",):
-        lo, hi = max(lo, -moves["vector"]), min(hi, moves["vector"])
+        # counters near where the moves go, now and then at an end of their range
+        near = st.integers(max(lo, -moves["vector"]), min(hi, moves["vector"]))
+        return st.one_of(near, near, near, st.sampled_from([lo, hi])).map(str)
     numbers = st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi]))
     if head == "hex":
         # EEPROM addresses and bytes from a few values, so a write is read back
@@ -207,8 +209,12 @@ class Grammar:
         self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self._can(s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
-        ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
-        self.ports = ports or [1]
+        self.tables = [s for idiom in g["tables"]["list"] for s in _tabled(profile, idiom)
+                       if self._can(s)]
+        if self.tables:
+            self.kinds += ["tables"] * g["tables"]["weight"]
+        # every input port (the GVE54's I0 too: its bits are read, none interrupts)
+        self.ports = list(profile.input_ports) or [1]
         self.member_names = [n for n, c in commands().items()
                              if c.packet == "member" and n in profile.commands]
         self.other_members = [n for n in g["packet"]["others"] if n in profile.commands]
@@ -347,6 +353,8 @@ class Grammar:
             return self.readback(draw)
         if kind == "scenario":
             return self.scenario(draw)
+        if kind == "tables":
+            return self.idiom(self.pick(draw, self.tables))
         return self.fill(draw)
 
     def scenario(self, draw) -> list[Step]:
@@ -417,6 +425,33 @@ class Grammar:
         first = body[len(text):].split(",")[0]
         place = "" if read == "PF" else first
         return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+
+
+def _tabled(profile: Profile, idiom: list[str]) -> list[tuple[str, ...]]:
+    """An idiom of `[tables]` once per value of the profile's table its placeholder
+    names (none where the profile has no such table)."""
+    tables: dict[str, list[str]] = {}
+    if profile.mpg is not None:
+        listed = sorted(profile.mpg.enabling_values)
+        beside = sorted({(v + d) & 0xFF for v in listed for d in (-1, 1)} - set(listed))
+        tables["mpg"] = ["%02X" % v for v in listed + beside]
+        tables["mpg_address"] = ["%02X" % profile.mpg.enable_address]
+    if profile.spindle is not None:
+        r = profile.spindle.range
+        tables["spindle"] = [str(v) for v in (r.lo + 1, r.hi)]
+    if profile.microstep is not None:
+        tables["microstep"] = [*profile.microstep.factors, *profile.microstep.currents]
+    wanted = sorted(set(_PLACEHOLDER.findall(" ".join(idiom))))
+    if any(name not in tables for name in wanted):
+        return []
+    out: list[tuple[str, ...]] = [tuple(idiom)]
+    for name in wanted:
+        out = [tuple(line.replace("{%s}" % name, value) for line in lines)
+               for lines in out for value in tables[name]]
+    return out
+
+
+_PLACEHOLDER = re.compile(r"\{([a-z_]+)\}")
 
 
 def _silent_in_packets(steps: list[Step]) -> list[Step]:
