@@ -60,6 +60,8 @@ class RunMeta:
     # the certification's own options in force (they replace the suite's flags)
     host_command: list[str] = field(default_factory=list)
     host_flags: dict[str, object] = field(default_factory=dict)
+    #: another job's own options in force (diff's), which replace the suite's flags too
+    job_flags: dict[str, object] = field(default_factory=dict)
     # the spec's rules the selected cases can fail, per profile: {profile, covered, total,
     # sections: [{section, covered (a count), uncovered (rule IDs)}]}
     coverage: list[dict] = field(default_factory=list)
@@ -78,6 +80,8 @@ class RunMeta:
         if self.host_flags:
             return {"host command": shlex.join(self.host_command) or "attended",
                     **self.host_flags}
+        if self.job_flags:
+            return dict(self.job_flags)
         return {"--settings": self.settings,
                 "--seed": "derandomized" if self.seed is None else self.seed,
                 "--mutant": self.mutant or "none",

@@ -2,9 +2,23 @@
 items with ``pytest --gve-target emu:GVE84-100`` (any target of the command line).
 
 Inert unless ``--gve-target`` is given (or ``pytest --pyargs conformance``, which runs
-against the default emulator target), so it never changes other pytest runs. A mistake
-in the options is a usage error before anything is sent; one session per target lasts
-the whole pytest run and puts the unit back at its end (also after Ctrl-C).
+against the default emulator target), so it never changes other pytest runs. Given, it
+is the collector: the session collects the suite's cases and nothing else (no test
+file of the directory pytest runs in), one collector per target and per spec section,
+one item per case; ``--collect-only``, ``-k``, ``-m`` and ``--gve-cases`` choose among
+them. A mistake in the options is a usage error before anything is sent; one session
+per target lasts the whole pytest run and puts the unit back at its end (also after
+Ctrl-C).
+
+Verdicts as pytest shows them (docs/ci.md): PASS passed, FAIL and ERROR failed (the
+deciding check, its rule, tag and the rule's sentence in the report); NON-STRICT and
+INFO outcomes of their own (``N`` and ``I``, counted in the last line, listed with why in
+the short summary); COULD-NOT-TEST and MISSING skipped, naming the case and why. In
+``--junitxml`` a case's classname is the suite's (``gve.<profile>.section<N_M>``), its
+properties say its verdict, tag and section, and NON-STRICT and INFO are skipped
+testcases whose message begins with the verdict, as in the suite's own JUnit file.
+Markers choose by tag and need: ``-m "not destructive"``, ``-m "tag_M"`` (see
+``pytest --markers`` with ``--gve-target``).
 
 Fleets (pytest-xdist, ``-n N``): the items of a target that holds a port (serial, TCP)
 form one xdist group (``--dist loadgroup``, which the plugin sets), so that one worker has
@@ -16,17 +30,22 @@ a worker opens a target's port at its first item of that target.
 from __future__ import annotations
 
 import re
+from collections.abc import Generator
 from contextlib import ExitStack
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
 from conformance import settings as settings_profiles
+from conformance.case import Case
+from conformance.explain import reason
 from conformance.link.interrupts import Interrupts
+from conformance.quoting import quoted
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING
+from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT
 
 _TARGETS = pytest.StashKey[list[Target]]()
 _INTERRUPTS = pytest.StashKey[Interrupts]()
@@ -54,16 +73,116 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      f"(default: {settings_profiles.DEFAULT_DATABASE}/ in the rootdir)")
 
 
+#: an item's markers by its case's tag (-m "tag_M") and by what it needs
+TAG_MARKERS = {"M": "tag_M", "M-ex": "tag_M_ex", "D": "tag_D", "D-info": "tag_D_info"}
+NEEDS = {"rig": "needs the test rig or a technician's hands",
+         "destructive": "restarts the unit, runs to a switch or writes EEPROM "
+                        "(--gve-allow-destructive)",
+         "timing": "judges when the unit answers or where it is in time",
+         "hands": "needs a hand on the machine: the rig or an operator"}
+#: the verdicts pytest shows as outcomes of their own: (category, letter, word)
+OWN_OUTCOMES = {NON_STRICT: ("non-strict", "N", "NON-STRICT"), INFO: ("info", "I", "INFO")}
+#: the verdicts reported as skipped, with the verdict and why as the reason
+SKIPPED = (NON_STRICT, INFO, COULD_NOT_TEST, MISSING)
+
+
 class CaseFailed(Exception):
     def __init__(self, result: CaseResult) -> None:
         super().__init__(result.verdict)
         self.result = result
 
 
+@dataclass(frozen=True)
+class _Crash:
+    """Where a failed case is and its one line (pytest's short summary and JUnit
+    message read ``message``)."""
+
+    path: str
+    lineno: int
+    message: str
+
+
+class CaseReport:
+    """A FAIL or ERROR as pytest shows it: its one line (the verdict, the case and why),
+    the rule's sentence, every failed check, the notes and the wire log."""
+
+    def __init__(self, lines: list[str], crash: _Crash) -> None:
+        self.lines = lines
+        self.reprcrash = crash
+
+    def toterminal(self, tw) -> None:
+        for line in self.lines:
+            tw.line(line)
+
+    def __str__(self) -> str:
+        return "\n".join(self.lines)
+
+
+def verdict_line(r: CaseResult) -> str:
+    """``NON-STRICT 8.repeat.answer [emu:GVE84-100]: 8.repeat.answer [D] ...``."""
+    return f"{r.verdict} {r.id} [{r.target}]: {reason(r).line()}"
+
+
+def _where(case: Case) -> tuple[str, int]:
+    """The case's file and the line its @case starts on (1-based)."""
+    code = case.func.__code__
+    return code.co_filename, code.co_firstlineno
+
+
+class GveTarget(pytest.Collector):
+    """The suite's cases on one target, a collector per spec section."""
+
+    def __init__(self, *, target: Target, **kw) -> None:
+        super().__init__(**kw)
+        self.target = target
+
+    def collect(self) -> list[GveSection]:
+        from conformance.catalogue import select
+        sections: dict[str, list[Case]] = {}
+        for case in select(self.config.getoption("--gve-cases") or None):
+            sections.setdefault(case.section, []).append(case)
+        return [GveSection.from_parent(self, name=f"section{s.replace('.', '_')}",
+                                       nodeid=f"{self.nodeid}::{s}", cases=cases)
+                for s, cases in sections.items()]
+
+
+class GveSection(pytest.Collector):
+    """The cases of one spec section on the parent's target."""
+
+    def __init__(self, *, cases: list[Case], **kw) -> None:
+        super().__init__(**kw)
+        self.cases = cases
+
+    def collect(self) -> list[GveItem]:
+        from conformance.reports.junit import classname
+        target = self.parent.target
+        # on an xdist worker the node ID names the group, as xdist_group marks do
+        group = worker_group(target) if _on_xdist_worker(self.config) else None
+        settings_name = self.config.getoption("--gve-settings")
+        items = []
+        for case in self.cases:
+            # the node ID is the suite's JUnit classname as a path: pytest's JUnit file
+            # then gives the case the classname the suite's own gives it
+            where = classname(target.profile.name, case.section).replace(".", "/")
+            name = f"{case.id}[{target.info.spec}]"
+            item = GveItem.from_parent(self, name=name,
+                                       nodeid=f"{where}::{name}" + (f"@{group}" if group
+                                                                    else ""),
+                                       case=case, target=target, settings_name=settings_name)
+            item.add_marker(TAG_MARKERS[case.tag])
+            for need in NEEDS:
+                if getattr(case, need):
+                    item.add_marker(need)
+            items.append(item)
+        return items
+
+
 class GveItem(pytest.Item):
-    def __init__(self, *, case, target, settings_name: str | None, **kw) -> None:
+    def __init__(self, *, case: Case, target: Target, settings_name: str | None,
+                 **kw) -> None:
         super().__init__(**kw)
         self.case, self.target, self.settings_name = case, target, settings_name
+        self.result: CaseResult | None = None
 
     def runtest(self) -> None:
         interrupts = self.config.stash[_INTERRUPTS]
@@ -75,24 +194,31 @@ class GveItem(pytest.Item):
             pytest.fail(str(err), pytrace=False)
         with interrupts.catching():
             result = run_case(self.case, self.target, self.settings_name)
+        self.result = result
+        self.user_properties += [("verdict", result.verdict), ("tag", self.case.tag),
+                                 ("section", self.case.section)]
         if result.interrupted:
             raise KeyboardInterrupt
-        if result.verdict in (MISSING, COULD_NOT_TEST):
-            pytest.skip(f"{result.verdict}: {'; '.join(result.notes)[:200]}")
         if result.verdict in (FAIL, ERROR):
             raise CaseFailed(result)
 
-    def repr_failure(self, excinfo, style=None) -> str:
+    def repr_failure(self, excinfo, style=None):
         if isinstance(excinfo.value, CaseFailed):
             r = excinfo.value.result
-            lines = [f"{r.verdict} {r.id} [{r.profile}]: {r.rule} ({r.source})"]
-            lines += [f"  [{c['tag']}] {c['what']}: observed {c['observed']!r}, "
-                      f"expected {c['expected']!r}" for c in r.failed_checks]
-            return "\n".join(lines + r.notes + ["wire log:", *r.wire_log])
+            why = reason(r)
+            lines = [verdict_line(r)]
+            lines += [f"the rule: {why.cites()}"] if why.rule else []
+            lines += [f"the case: {r.rule} ({r.source})"]
+            lines += [f"  [{c['tag']}] {c['what']}: observed {quoted(c['observed'])}, "
+                      f"expected {quoted(c['expected'])}" for c in r.failed_checks]
+            path, line = _where(self.case)
+            return CaseReport(lines + r.notes + ["wire log:", *r.wire_log],
+                              _Crash(path, line, lines[0]))
         return super().repr_failure(excinfo, style)
 
     def reportinfo(self):
-        return "gve-conformance", None, f"{self.case.id} [{self.target.profile.name}]"
+        path, line = _where(self.case)
+        return path, line - 1, f"{self.case.id} on {self.target.info.spec}"
 
 
 def _specs(config: pytest.Config) -> list[str]:
@@ -146,6 +272,11 @@ def pytest_configure(config: pytest.Config) -> None:
     if globs and not select(globs):
         raise pytest.UsageError(f"--gve-cases {' '.join(globs)}: no case matches")
     _example_database(config)
+    for marker in TAG_MARKERS.values():
+        config.addinivalue_line("markers", f"{marker}: a case of the suite whose tag is "
+                                           f"{marker[4:].replace('_', '-')}")
+    for marker, what in NEEDS.items():
+        config.addinivalue_line("markers", f"{marker}: a case of the suite that {what}")
     controller, worker = _xdist_controller(config), _on_xdist_worker(config)
     if controller and config.option.dist != "loadgroup":
         config.option.dist = "loadgroup"    # only groups keep a port on one worker
@@ -172,21 +303,59 @@ def pytest_configure(config: pytest.Config) -> None:
     config.stash[_INTERRUPTS] = interrupts
 
 
-def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
-                                  items: list[pytest.Item]) -> None:
-    targets = config.stash.get(_TARGETS, [])
-    if not targets:
+@pytest.hookimpl(tryfirst=True)
+def pytest_make_collect_report(collector: pytest.Collector) -> pytest.CollectReport | None:
+    """With --gve-target the session collects the suite's cases, one collector per
+    target, and nothing else (the test files of where pytest runs are not the suite)."""
+    if not isinstance(collector, pytest.Session) or _TARGETS not in collector.config.stash:
+        return None
+    found = [GveTarget.from_parent(collector, name=t.info.spec, nodeid=f"gve[{t.info.spec}]",
+                                   target=t)
+             for t in collector.config.stash[_TARGETS]]
+    return pytest.CollectReport(collector.nodeid, "passed", None, found)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo
+                              ) -> Generator[None, pytest.TestReport, pytest.TestReport]:
+    """A case's verdict on its report; the verdicts pytest knows as skipped (NON-STRICT,
+    INFO, COULD-NOT-TEST, MISSING) skipped with the case and why as the reason."""
+    report = yield
+    r = getattr(item, "result", None)
+    if call.when == "call" and r is not None:
+        report.gve_verdict = r.verdict
+        report.gve_why = reason(r).line()
+        if r.verdict in SKIPPED and report.passed:
+            path, line = _where(item.case)
+            report.outcome = "skipped"
+            report.longrepr = (path, line, verdict_line(r))
+    return report
+
+
+def pytest_report_teststatus(report: pytest.TestReport, config: pytest.Config
+                             ) -> tuple[str, str, str] | None:
+    """NON-STRICT and INFO as outcomes of their own: a letter while running, a word with
+    -v, their own count in the last line."""
+    if report.when != "call":
+        return None
+    return OWN_OUTCOMES.get(getattr(report, "gve_verdict", ""))
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config
+                            ) -> Generator[None, None, None]:
+    """After pytest's short summary: the NON-STRICT and INFO cases with why, wherever
+    the summary lists what did not pass (``-r`` with f, s or p: the default, -ra, -rA)."""
+    yield
+    chars = getattr(terminalreporter, "reportchars", "")
+    if not any(c in chars for c in "fsp"):
         return
-    from conformance.catalogue import select
-    globs = config.getoption("--gve-cases") or None
-    for target in targets:
-        # on an xdist worker the node ID names the group, as xdist_group marks do
-        group = worker_group(target) if _on_xdist_worker(config) else None
-        for case in select(globs):
-            name = f"{case.id}[{target.info.spec}]"
-            items.append(GveItem.from_parent(
-                session, name=name, nodeid=f"::{name}@{group}" if group else None, case=case,
-                target=target, settings_name=config.getoption("--gve-settings")))
+    reports = [rep for word in ("non-strict", "info")
+               for rep in terminalreporter.stats.get(word, [])]
+    if reports:
+        terminalreporter.write_sep("=", "gve-conformance: NON-STRICT and INFO", yellow=True)
+        for rep in reports:
+            terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -66,6 +66,12 @@ def run_seed(names: list[str], seed: int | None = None) -> int | None:
         return seed
     if all(get(name).derandomize for name in names):
         return None
+    return fresh_seed()
+
+
+def fresh_seed() -> int:
+    """A seed of its own for a run given none, printed and recorded so it can be
+    replayed."""
     return secrets.randbits(32)
 
 

@@ -79,7 +79,7 @@ def _positive(text: str) -> int:
 def tcp_address(text: str) -> tuple[str, int]:
     """HOST:PORT (HOST defaults to 127.0.0.1; PORT 0 picks a free one)."""
     host, colon, port = text.rpartition(":")
-    if not colon or not port.isdigit() or int(port) > 65535:
+    if not colon or not (port.isascii() and port.isdigit()) or int(port) > 65535:
         raise UsageError(f"--tcp takes HOST:PORT with PORT 0..65535, not {text!r}")
     return host or "127.0.0.1", int(port)
 

@@ -4,8 +4,9 @@ It speaks the whole protocol (tx, until, next, baud, quit; the rig's commands an
 `error:`, so the suite runs no rig case against it), takes the host's bytes at their
 instants and answers when a frame's CR is complete, one byte time per answer byte. The
 unit knows only a few commands (`?`, the checksum mode, modal values, status words,
-position counters, H and G, the EEPROM): enough for the golden transcripts G1, G2,
-G4a, G4b, G4d, G4e, G4f and G9. An L moves the counters at once (no motion model).
+position counters, H, G, D, N, K, R and the EEPROM): enough for the suite's known state
+and the golden transcripts G1, G2, G4a, G4b, G4d, G4e, G4f and G9. An L moves the
+counters at once (no motion model); a frame it cannot read is refused with 4.
 
     python examples/cosim_minimal.py      # then type: tx 21303F0D 10000000
 """
@@ -13,7 +14,8 @@ G4a, G4b, G4d, G4e, G4f and G9. An L moves the counters at once (no motion model
 import sys
 
 CR = 0x0D
-TWO_LETTERS = ("%+", "%-", "SW", "SR", "EW", "ER", "PF", "NX", "NY", "NZ")
+TWO_LETTERS = ("%+", "%-", "SW", "SR", "EW", "ER", "PF", "NX", "NY", "NZ", "O0", "XM", "VL", "VN")
+MODAL = ("A", "V", "B", "T", "$", "O0", "XM", "VL", "VN", "K", "R")   # taken, not kept
 
 
 class Unit:
@@ -27,11 +29,13 @@ class Unit:
         if value != CR or not self.frame.startswith(b"!0"):
             return b""
         frame, self.frame = self.frame, b""
-        if not self.checksums:
-            return self.answer(*self.execute(frame[2:-1].decode("latin-1")))
-        if frame[-4:-3] != b"," or frame[-3:-1].upper() != b"%02X" % (sum(frame[:-3]) & 0xFF):
+        if self.checksums and (frame[-4:-3] != b"," or
+                               frame[-3:-1].upper() != b"%02X" % (sum(frame[:-3]) & 0xFF)):
             return self.answer(4)                 # a wrong or missing checksum
-        return self.answer(*self.execute(frame[2:-4].decode("latin-1")))
+        try:
+            return self.answer(*self.execute(frame[2:-4 if self.checksums else -1].decode()))
+        except (ValueError, IndexError, UnicodeDecodeError):   # fields it cannot read
+            return self.answer(4)
 
     def execute(self, body):
         """(error code, values) for one command."""
@@ -49,22 +53,24 @@ class Unit:
             return 0, ["%02X" % self.status[int(args[0])]]
         elif name in ("NX", "NY", "NZ"):
             self.counters["XYZ".index(name[1])] = int(args[0])
+        elif name == "N":
+            self.counters = [0, 0, 0]
         elif name == "PF":
             return 0, [str(c) for c in self.counters]
         elif name == "L":
             self.counters = [c + int(a) for c, a in zip(self.counters, args, strict=False)]
-        elif name in ("H", "G"):
+        elif name in ("H", "G", "D"):
             self.inta = name == "H"
         elif name == "EW":
             self.eeprom[int(args[0], 16)] = int(args[1], 16)
         elif name == "ER":
             return 0, ["%02X" % self.eeprom[int(args[0], 16)]]
-        elif name not in ("A", "V", "B", "T", "$"):
+        elif name not in MODAL:
             return 3, []                          # unknown command
         return 0, []
 
     def answer(self, code, values=()):
-        text = ",".join([str(code | (8 if self.inta else 0)), *values])
+        text = ",".join(["%X" % (code | (8 if self.inta else 0)), *values])
         if self.checksums:
             text += ",%02X" % (sum(text.encode() + b",") & 0xFF)
         return text.encode("latin-1") + b"\r"
@@ -99,25 +105,37 @@ def main():
         words = line.split()
         if not words:
             continue
-        if words[0] == "tx":
-            data = bytes.fromhex(words[1])
-            to_unit.extend((now + (i + 1) * byte_ns, b) for i, b in enumerate(data))
-            sent = run(now + len(data) * byte_ns, False)
-            if len(words) == 3 and all(b != CR for _, b in sent):
-                sent += run(int(words[2]), True)
-            out = [f"rx {t} {b:02X}" for t, b in sent] + [f"now {now}"]
-        elif words[0] == "until":
-            out = [f"rx {t} {b:02X}" for t, b in run(int(words[1]), True)] + [f"now {now}"]
-        elif words[0] == "next":
-            out = [f"next {to_host[0][0]}" if to_host else "next none"]
-        elif words[0] == "baud":
-            byte_ns, out = round(1e10 / int(words[1])), ["ok"]
-        elif words[0] in ("quit", "exit"):
-            return
-        else:
-            out = [f"error: {words[0]} is not in this simulator"]
+        try:
+            if words[0] == "tx":
+                data = bytes.fromhex(words[1])
+                end = now + len(data) * byte_ns
+                until = instant(words[2], end) if len(words) == 3 else None
+                to_unit.extend((now + (i + 1) * byte_ns, b) for i, b in enumerate(data))
+                sent = run(end, False)
+                if until is not None and all(b != CR for _, b in sent):
+                    sent += run(until, True)
+                out = [f"rx {t} {b:02X}" for t, b in sent] + [f"now {now}"]
+            elif words[0] == "until":
+                out = [f"rx {t} {b:02X}" for t, b in run(instant(words[1], now), True)]
+                out.append(f"now {now}")
+            elif words[0] == "next":
+                out = [f"next {to_host[0][0]}" if to_host else "next none"]
+            elif words[0] == "baud":
+                byte_ns, out = round(1e10 / instant(words[1], 1)), ["ok"]
+            elif words[0] in ("quit", "exit"):
+                return
+            else:
+                out = [f"error: {words[0]} is not in this simulator"]
+        except (ValueError, IndexError) as err:      # a bad number, a missing word
+            out = [f"error: {err}"]
         print("\n".join(out), flush=True)
 
+
+def instant(word, least):
+    """A number of the protocol: ASCII digits, and not below ``least``."""
+    if not (word.isascii() and word.isdigit()) or int(word) < least:
+        raise ValueError(f"{word!r} is not a whole number from {least} on")
+    return int(word)
 
 if __name__ == "__main__":
     main()

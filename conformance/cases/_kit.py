@@ -5,25 +5,35 @@ from __future__ import annotations
 from conformance.case import CaseContext, case
 from conformance.link.framing import Response
 from conformance.motion.probe import Probe
-from gve_fixtures.protocol import INTA_BIT, ErrorCode
+from conformance.quoting import answer_text
+from gve_fixtures.protocol import ErrorCode
 
 
 def show(r: Response | None) -> str:
-    return "nothing" if r is None else r.text
+    """An answer in a message, as checks write it (``8,D0``: without its final CR)."""
+    return "nothing" if r is None else answer_text(r.raw)
 
 
 def answers(ctx: CaseContext, r: Response | None, text: str, what: str, *,
             tag: str | None = None, rule: str | None = None) -> bool:
     """Expect the answer's exact bytes (``text`` without the final CR)."""
     return ctx.expect(r is not None and r.raw == text.encode() + b"\r", what,
-                      observed=show(r), expected=text, tag=tag, rule=rule)
+                      observed=r, expected=text, tag=tag, rule=rule)
+
+
+def code_text(value: int, inta: bool | None = None) -> str:
+    """A response code as every check writes it: ``code 5``; ``code 5, INTA set`` where
+    the check judges the INTA bit (the answer's first digit then reads D)."""
+    return f"code {value}" + ("" if inta is None else f", INTA {'set' if inta else 'clear'}")
 
 
 def code(ctx: CaseContext, r: Response | None, value: ErrorCode, what: str, *,
          tag: str | None = None, inta: bool | None = None, rule: str | None = None) -> bool:
     ok = r is not None and r.code == value and (inta is None or r.inta == inta)
-    shown = f"{value | (INTA_BIT if inta else 0):X}" if inta is not None else str(value)
-    return ctx.expect(ok, what, observed=show(r), expected=f"code {shown}", tag=tag, rule=rule)
+    seen = (r if r is None or r.code is None
+            else code_text(r.code, None if inta is None else bool(r.inta)))
+    return ctx.expect(ok, what, observed=seen, expected=code_text(int(value), inta), tag=tag,
+                      rule=rule)
 
 
 def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
@@ -123,7 +133,8 @@ def fill_queue(ctx: CaseContext, count: int | None = None, *,
     for i in range(ctx.profile.buffer if count is None else count):
         r = ctx.link.send("C" + vector(ctx, 1 if i % 2 == 0 else -1))
         if not ctx.expect(r is not None and r.ok, f"vector {i + 1} is accepted",
-                          observed=show(r), expected="code 0", rule=rule):
+                          observed=r if r is None or r.code is None
+                          else code_text(r.code), expected=code_text(0), rule=rule):
             return False
     return True
 

@@ -10,13 +10,14 @@ import sys
 from pathlib import Path
 
 from conformance.cli.ending import counted, end, new_run_id
+from conformance.cli.progress import Progress
 from conformance.cli.unit import ask_before_motion, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,
-    add_loudness,
     one_line,
     positive,
+    report_options,
     seconds,
     summary,
     writable_folder,
@@ -30,9 +31,10 @@ from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
-from conformance.metadata import RunMeta
+from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.runner import RunResult
+from conformance.settings import fresh_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
 from conformance.verdict import COULD_NOT_TEST, FAIL, CouldNotTest
 
@@ -63,23 +65,21 @@ def common(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--strict", action="store_true",
                     help="grade the target by the project's decisions too: a [D] "
                          "difference FAILs instead of NON-STRICT")
-    add_loudness(ap, "print every line: for diff each disagreement's transcript too, "
-                 "for replay every frame (its default)")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES)
+    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES,
+                parents=[report_options(
+                    "also print each disagreement's transcript (the reports keep it too)",
+                    seed="the search's seed: the same N draws the same sequences "
+                         "(default: a fresh one, printed and recorded in the reports)")])
     common(ap)
     ap.add_argument("--examples", type=positive, metavar="N",
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
     ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
-    ap.add_argument("--seed", type=int, default=0, help="the search's seed (default 0)")
     ap.add_argument("--no-probes", action="store_true",
                     help="draw sequences only (the written probes, run first by default, "
                     "are left out)")
-    ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
-    ap.add_argument("--no-reports", action="store_true",
-                    help="write no reports (the transcripts are printed instead)")
     args = ap.parse_args(argv)
     if not args.no_reports:
         writable_folder(args.report_dir)
@@ -106,22 +106,69 @@ def targets(args: argparse.Namespace) -> tuple[Target, Target]:
     return target, reference
 
 
-def ask_first(args: argparse.Namespace, target: Target) -> None:
+def ask_first(args: argparse.Namespace, target: Target, meta: RunMeta | None = None
+              ) -> None:
     """Real units: the question before the first frame that can move an axis, as the
-    suite's run asks it (no terminal and no --yes: nothing moves)."""
+    suite's run asks it (no terminal and no --yes: nothing moves); the answer goes to
+    ``meta``."""
     if target.info.real and not args.yes:
-        target.session.before_motion = ask_before_motion(target, Console(), RunMeta())
+        target.session.before_motion = ask_before_motion(target, Console(),
+                                                         meta or RunMeta())
+
+
+def meta_of(args: argparse.Namespace, argv: list[str], target: Target, reference: Target,
+            seed: int) -> RunMeta:
+    """What the reports say about the search, as a run's say about the run: when, the
+    command as given, the seed, the target and the profile it is judged as, and diff's
+    own options in force."""
+    meta = RunMeta(started=now_iso(), command=["diff", *argv], settings="diff", seed=seed,
+                   destructive=args.allow_destructive, max_travel=args.max_travel,
+                   strict=args.strict)
+    t = meta.target(target.info.spec)
+    t.kind, t.profile = target.info.kind, target.profile.name
+    t.profile_chosen = "emulated" if not target.info.real and args.profile is None \
+        else "--profile"
+    t.envelope = target.info.max_travel if target.info.real else None
+    t.graded = "strict" if target.info.strict else "by the tags"
+    if target.info.real:
+        meta.confirmed = "--yes" if args.yes else "asked"
+    meta.job_flags = {
+        "--against": reference.info.spec, "--seed": seed,
+        "--examples": args.examples if args.examples is not None else (
+            "none (--seconds)" if args.seconds else DEFAULT_EXAMPLES),
+        "--seconds": args.seconds if args.seconds else "none",
+        "--no-probes": args.no_probes, "--allow-destructive": args.allow_destructive,
+        "--max-travel": args.max_travel, "--strict": args.strict,
+        "motion confirmed": meta.confirmed or "not asked"}
+    return meta
+
+
+class _Watched(Budget):
+    """The search's budget, which tells ``progress`` how far the search is each time
+    the search asks whether it is spent (before every sequence)."""
+
+    def __init__(self, progress: Progress, **kw: object) -> None:
+        super().__init__(**kw)
+        self.progress = progress
+
+    def spent(self) -> bool:
+        self.progress.advance_to(self.used if self.examples is not None
+                                 else int(self.elapsed))
+        return super().spent()
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
         args = parse_args(argv)
         target, reference = targets(args)
     except (UsageError, TargetError, LookupError, ValueError) as err:
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
-    run_id = new_run_id()
+    seed = args.seed if args.seed is not None else fresh_seed()
+    run_id = args.run_id or new_run_id()
     folder = None if args.no_reports else Path(args.report_dir) / run_id
+    meta = meta_of(args, argv, target, reference, seed)
     interrupts = Interrupts()
     try:
         session = target.begin(interrupts)
@@ -129,24 +176,29 @@ def main(argv: list[str] | None = None) -> int:
         target.close()
         print(f"{PROG}: {COULD_NOT_TEST}: {one_line(err)}", file=sys.stderr)
         return 1
-    ask_first(args, target)
+    ask_first(args, target, meta)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     options = Options(destructive=args.allow_destructive,
                       rig=target.info.has_rig and reference.info.has_rig)
     examples = args.examples if args.examples is not None or args.seconds else DEFAULT_EXAMPLES
-    budget = Budget(examples=examples, seconds=args.seconds)
-    run = RunResult(run_id, targets=[target.info.spec], settings="diff")
-    say = _nothing if args.quiet else _say                 # -q: the last line only
+    run = RunResult(run_id, targets=[target.info.spec], settings="diff", meta=meta)
+    say = _nothing if args.quiet else _say                 # -q: the recap and last line
     say(f"diff: {target.info.spec} against {reference.info.spec} "
-        f"({target.profile.name}), seed {args.seed}, "
+        f"({target.profile.name}), seed {seed} (the same sequences again: --seed {seed}), "
         + (f"{examples} sequences" if examples else f"{args.seconds:g} s"))
+    progress = Progress(examples or int(args.seconds), unit="seq" if examples else "s",
+                        quiet=args.quiet, verbose=args.verbose,
+                        status=lambda: (f"{budget.used} sequences, {budget.frames} frames, "
+                                        f"{len(run.results)} disagreement(s)"))
+    budget = _Watched(progress, examples=examples, seconds=args.seconds)
 
     kept = Kept(run, folder, profile=target.profile.name, target=target.info.spec,
-                reference=reference.info.spec, seed=args.seed, say=say, verbose=args.verbose)
+                reference=reference.info.spec, seed=seed,
+                say=_nothing if args.quiet else progress.print, verbose=args.verbose)
     reach = Reach(target.profile, options)
     try:
         with interrupts.catching():
-            search(pair, options, budget, seed=args.seed, with_probes=not args.no_probes,
+            search(pair, options, budget, seed=seed, with_probes=not args.no_probes,
                    on_finding=kept.kept, on_seen=kept.seen, on_dropped=kept.dropped,
                    reach=reach)
     except (TargetNotResponding, SessionError, CouldNotTest) as err:
@@ -162,12 +214,14 @@ def main(argv: list[str] | None = None) -> int:
         run.interrupted = True
         session.emergency_stop()
     finally:
+        progress.close()
         try:
             report = session.finish() if session.real else None
         except CouldNotTest as err:         # an ending that could not be done: said
             report = None
             run.problems.append(f"the unit could not be left as it should: {err}")
         target.close()
+    meta.finished = now_iso()
     if report is not None:
         run.sessions[target.info.spec] = report.to_dict()
         run.problems += report.problems
@@ -201,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
     say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))
-    return end(run, None if args.no_reports else args.report_dir, quiet=args.quiet)
+    return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
 
 
 def _say(text: str) -> None:

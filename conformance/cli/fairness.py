@@ -17,7 +17,8 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive, summary
+from conformance.cli.progress import Progress
+from conformance.cli.usage import Parser, UsageError, add_loudness, positive, summary
 from conformance.link.framing import readable
 from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
 
@@ -50,6 +51,7 @@ def trial(reading: str, readings: list[str], profiles: list[str],
           include: list[str] | None) -> Trial:
     """Run the catalogue on ``profiles`` with the emulator taking ``readings``."""
     from conformance.catalogue import select
+    from conformance.explain import reason
     from conformance.runner import run_case
     from conformance.targets import parse_target
     result = Trial(reading, profiles)
@@ -61,8 +63,7 @@ def trial(reading: str, readings: list[str], profiles: list[str],
             where = f"{c.id} [{p}]"
             failed = [ch for ch in r.checks if not ch["ok"]]
             if r.verdict in (FAIL, ERROR):
-                first = failed[0] if failed else {"what": (r.notes or ["?"])[0][:200]}
-                result.unfair.append(f"{r.verdict} {where}: {first['what']}")
+                result.unfair.append(f"{r.verdict} {where}: {reason(r).line()[:300]}")
             elif r.verdict in (NON_STRICT, INFO):
                 unnamed = [ch for ch in failed if not ch.get("rule")]
                 if unnamed:
@@ -127,8 +128,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
     ap.add_argument("--jobs", type=positive, default=1, help="readings tried in parallel")
-    ap.add_argument("-v", "--verbose", action="store_true",
-                    help="also list every difference each reading made")
+    add_loudness(ap, "also list every difference each reading made")
     try:
         args = ap.parse_args(argv)
         known = emulator_readings()
@@ -146,30 +146,32 @@ def main(argv: list[str] | None = None) -> int:
         jobs.append((ALL, names, available_profiles(), args.cases or None))
     start = time.perf_counter()
     trials: list[Trial] = []
-    with workers(args.jobs) as pool:
+    with workers(args.jobs) as pool, Progress(len(jobs), unit="reading", quiet=args.quiet,
+                                              verbose=args.verbose, every_step=True) as shown:
         for t in pool.map(_trial, jobs):
             trials.append(t)
-            _show(t, args.verbose)
+            shown.step("\n".join(_lines(t, args.verbose)), routine=t.fair)
     fair = sum(t.fair for t in trials)
     score = 100.0 * fair / len(trials) if trials else 100.0
-    print(f"\nfairness score: {fair}/{len(trials)} = {score:.1f} % in "
+    unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
+    for line in [f"what failed ({len(trials) - fair} reading(s)):", *unfair] if unfair else []:
+        print(line, flush=True)
+    print(f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
           f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
           f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO")
     return 0 if fair == len(trials) else 1
 
 
-def _show(t: Trial, verbose: bool) -> None:
+def _lines(t: Trial, verbose: bool) -> list[str]:
+    """What a reading made: fair or not, what diff said, what was unfair (and with
+    ``verbose`` every difference)."""
     head = "fair  " if t.fair else "UNFAIR"
-    print(f"{head}  {t.reading:24} {len(t.differences)} difference(s) on "
-          f"{', '.join(t.profiles) if t.reading != ALL else 'every profile'} "
-          f"in {t.seconds:.1f} s", flush=True)
-    for line in t.diffs:
-        print(f"        diff {line}", flush=True)
-    for line in t.unfair:
-        print(f"        {line}", flush=True)
-    for line in t.differences if verbose else []:
-        print(f"        {line}", flush=True)
-
+    return [f"{head}  {t.reading:24} {len(t.differences)} difference(s) on "
+            f"{', '.join(t.profiles) if t.reading != ALL else 'every profile'} "
+            f"in {t.seconds:.1f} s",
+            *(f"        diff {line}" for line in t.diffs),
+            *(f"        {line}" for line in t.unfair),
+            *(f"        {line}" for line in (t.differences if verbose else []))]
 
 
 if __name__ == "__main__":

@@ -35,7 +35,10 @@ from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from conformance.cli.ending import recap, say_all
+from conformance.cli.progress import Progress
 from conformance.cli.usage import exit_status
+from conformance.runner import CaseResult, RunResult
 from conformance.targets import Target
 from conformance.verdict import FAILED, ORDER, PASSED
 
@@ -88,38 +91,53 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
                             run_id=m.label), "argv": argv}
         (folder / f"{m.label}.job.json").write_text(json.dumps(job), encoding="utf-8")
     jobs = min(args.jobs, len(members))
-    quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's last line only
+    quiet = bool(getattr(args, "quiet", False))          # -q: the fleet's end only
     if not quiet:
         print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
-    interrupted = _run_members(members, folder, jobs, start, quiet)
+    with Progress(len(members), unit="target", quiet=quiet,
+                  verbose=bool(getattr(args, "verbose", False)), every_step=True) as shown:
+        interrupted = _run_members(members, folder, jobs, start, shown)
     seconds = time.perf_counter() - start
     for m in members:
         (folder / f"{m.label}.job.json").unlink(missing_ok=True)
-        path = folder / m.label / "results.json"
-        if path.is_file():
-            m.result = json.loads(path.read_text(encoding="utf-8"))
+        m.result = m.result or _results(folder, m)
     summary = _summary(members, run_id, seconds, interrupted)
     if not quiet:
         _print_summary(summary)
+    say_all([line for m in members for line in _recap(m)])
     if args.junitxml:
-        written = merge_junit(folder, members, args.junitxml, seconds)
-        if not quiet:
-            print(f"JUnit XML: {written}")
+        print(f"JUnit XML: {merge_junit(folder, members, args.junitxml, seconds)}")
     if args.no_reports:
         shutil.rmtree(folder, ignore_errors=True)
     else:
         (folder / SUMMARY_JSON).write_text(json.dumps(summary, indent=1), encoding="utf-8")
         (folder / INDEX_HTML).write_text(_index_html(summary), encoding="utf-8")
-        if not quiet:
-            print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
+        print(f"reports: {folder}/{INDEX_HTML} (one folder per target), {SUMMARY_JSON}")
     print(f"{summary['verdict']}: {summary['reason']}")
     return exit_status(summary["verdict"] == PASSED, interrupted or any(
         row["interrupted"] for row in summary["targets"]))
 
 
+def _results(folder: Path, m: Member) -> dict:
+    """The member's results.json ({} when it wrote none)."""
+    path = folder / m.label / "results.json"
+    return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+
+
+def _recap(m: Member) -> list[str]:
+    """What failed on the member's target, as a single run's recap says it."""
+    data = m.result
+    results = [CaseResult(d["id"], d["section"], data["cases"][d["id"]]["rule"], d["tag"],
+                          data["cases"][d["id"]]["source"], d["profile"], d["target"],
+                          d["verdict"], checks=d["checks"], notes=d["notes"])
+               for d in data.get("results", [])]
+    lines = recap(RunResult(data.get("run_id", m.label), results))
+    return [f"[{m.label}] {line}" for line in lines]
+
+
 def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
-                 quiet: bool = False) -> bool:
+                 shown: Progress) -> bool:
     """Run the members' processes, at most ``jobs`` at once; True when interrupted."""
     pending, running = deque(members), []
     wake: queue.Queue[Member] = queue.Queue()     # a member's process has ended
@@ -136,7 +154,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
                 while pending and len(running) < jobs and not interrupted:
                     m = pending.popleft()
                     running.append(m)
-                    _start(m, folder, start, wake, out_lock, quiet)
+                    _start(m, folder, start, wake, out_lock, shown)
                 with contextlib.suppress(queue.Empty):
                     wake.get(timeout=0.5)
                 running = [m for m in running if m.status is None]
@@ -155,7 +173,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
 
 
 def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
-           out_lock: threading.Lock, quiet: bool = False) -> None:
+           out_lock: threading.Lock, shown: Progress) -> None:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     m.started = time.perf_counter() - start
     m.process = subprocess.Popen(
@@ -167,12 +185,16 @@ def _start(m: Member, folder: Path, start: float, wake: queue.Queue,
     def relay() -> None:
         assert m.process is not None and m.process.stdout is not None
         for line in m.process.stdout:
-            if quiet:
+            if shown.quiet:
                 continue                # read all the same, so that the member never blocks
             with out_lock:
-                print(f"[{m.label}] {line}".rstrip(), flush=True)
+                shown.print(f"[{m.label}] {line}".rstrip())
         status = m.process.wait()
         m.ended = time.perf_counter() - start
+        m.result = _results(folder, m)
+        with out_lock:
+            shown.step(f"{m.spec}: {m.result.get('verdict', FAILED)} — "
+                       f"{m.result.get('reason', 'the target wrote no results')}")
         m.status = status               # last: the member counts as done from here
         wake.put(m)
 
@@ -222,6 +244,7 @@ def merge_junit(folder: Path, members: list[Member], path: str, seconds: float) 
         if not source.is_file():
             continue
         for suite in ET.parse(source).getroot().iter("testsuite"):
+            suite.set("id", str(len(root)))          # numbered from 0 across the fleet
             root.append(suite)
             tests += int(suite.get("tests", "0"))
     root.set("tests", str(tests))

@@ -20,19 +20,20 @@ from conformance.cli.ending import counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
-    add_loudness,
     positive,
+    report_options,
     seconds,
     summary,
     writable_folder,
 )
+from conformance.explain import reason
 from conformance.host.certify import HostStartError, Plan, certify
 from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
-from conformance.quoting import quoted
+from conformance.operator import Console
 from conformance.runner import CaseResult
-from conformance.verdict import ORDER, PASS, grade
+from conformance.verdict import PASS
 from gve_fixtures.profile import Profile, ProfileError
 
 #: where the played unit is served to the host (--port), for --help
@@ -42,6 +43,10 @@ ports (--port): the suite plays the unit here, the host opens it ({port} in its 
   tcp:HOST:PORT                     a raw TCP port (the host opens socket://HOST:PORT;
                                     port 0 picks a free one)
   /dev/ttyX                         a serial device, to a host on another machine"""
+#: why an attended certification (no host command) does not start without a terminal
+NOBODY_TO_SAY = ("attended (no host command): someone at a terminal says how each job "
+                 "ended, and standard input is not a terminal; give the host's command "
+                 "after --")
 EXAMPLES = (
     "gve-conformance host --profile GVE84-100 -- python -m gve_host {port} "
     "--job gve_host/jobs/square.job",
@@ -56,7 +61,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         at = argv.index("--")
         argv, command = argv[:at], argv[at + 1:]
     ap = Parser(prog="gve-conformance host", description=summary(__doc__),
-                epilog=PORT_FORMS, examples=EXAMPLES)
+                epilog=PORT_FORMS, examples=EXAMPLES, parents=[report_options(
+                    "print a line for every scenario (the default)", seed=None)])
     ap.add_argument("--profile", help="the unit played to the host, at its default address")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable; instead of --profile)")
@@ -76,10 +82,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                     help="the full steps each axis travels in the host's job (the sum of "
                          "its vectors' lengths): the clean run must execute exactly that "
                          "(2.link.host-drives); per unit, default its first")
-    ap.add_argument("--report-dir", default="reports")
-    ap.add_argument("--no-reports", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the scenarios and exit")
-    add_loudness(ap, "print a line for every scenario (the default)")
     args = ap.parse_args(argv)
     args.command = command or None
     return args
@@ -160,20 +163,18 @@ def main(argv: list[str] | None = None) -> int:
         plan = plan_of(args)
         if not args.no_reports:
             writable_folder(args.report_dir)
+        if plan.command is None and not Console().interactive:
+            raise UsageError(NOBODY_TO_SAY)
     except UsageError as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
-    def worst(r: CaseResult) -> str | None:
-        """The check that graded the scenario worst, or why it did not run."""
-        failed = sorted((c for c in r.checks if not c["ok"]),
-                        key=lambda c: ORDER.index(grade(c["tag"], plan.strict)))
-        if failed:
-            return f"{failed[0]['what']} ({quoted(failed[0]['observed'])})"
-        return r.notes[0] if r.verdict != PASS and r.notes else None
+    def why(r: CaseResult) -> str | None:
+        """Why a scenario did not pass: its deciding check, or why it did not run."""
+        return reason(r).line() if r.verdict != PASS else None
 
     try:
-        result = certify(plan, new_run_id(), progress(args.quiet, worst), console=sys.stdout,
-                         operator=sys.stdin)
+        result = certify(plan, args.run_id or new_run_id(), progress(args.quiet, why),
+                         console=sys.stdout, operator=sys.stdin)
     except (HostStartError, ValueError) as err:
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
@@ -188,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         if clean is not None:
             print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the "
                   f"clean line; {result.frames} frames")
-    return end(result, None if args.no_reports else args.report_dir, quiet=args.quiet)
+    return end(result, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
 
 
 if __name__ == "__main__":

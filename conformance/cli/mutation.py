@@ -21,7 +21,8 @@ import time
 from dataclasses import dataclass, field
 
 from conformance.cli.pool import workers
-from conformance.cli.usage import Parser, UsageError, positive, summary
+from conformance.cli.progress import Progress
+from conformance.cli.usage import Parser, UsageError, add_loudness, positive, summary
 from conformance.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
@@ -127,6 +128,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sweep", action="store_true",
                     help="also run the rest of the catalogue against each mutant (one "
                          "profile per family), failing on any ERROR")
+    add_loudness(ap, "print a line for every mutant on a terminal too (a log always has "
+                     "them)")
     try:
         args = ap.parse_args(argv)
     except UsageError as err:
@@ -144,31 +147,35 @@ def main(argv: list[str] | None = None) -> int:
     jobs = [(m, args.profile or None, args.cases or None, args.sweep) for m in names]
     start = time.perf_counter()
     results = []
-    with workers(args.jobs) as pool:
+    with workers(args.jobs) as pool, Progress(len(jobs), unit="mutant", quiet=args.quiet,
+                                              verbose=args.verbose, every_step=True) as shown:
         for h in pool.map(_hunt, jobs):
             results.append(h)
-            _show(h)
+            shown.step("\n".join(_lines(h)), routine=h.caught and not h.errors
+                       and not h.clean_fails)
     caught = sum(h.caught for h in results)
     score = 100.0 * caught / len(results) if results else 100.0
     errors = sum(len(h.errors) for h in results)
-    print(f"\nmutation score: {caught}/{len(results)} = {score:.1f} % "
+    failed = [line for h in results if not h.caught or h.errors for line in _lines(h)]
+    for line in [f"what failed ({sum(not h.caught or bool(h.errors) for h in results)} "
+                 "mutant(s)):", *failed] if failed else []:
+        print(line, flush=True)
+    print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
           f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
           f"{sum(h.runs for h in results)} case runs, {errors} ERROR")
     return 0 if caught == len(results) and not errors else 1
 
 
-def _show(h: Hunt) -> None:
+def _lines(h: Hunt) -> list[str]:
+    """What a hunt found: caught (by what, how fast) or missed, and the ERRORs and
+    clean-failing cases met on the way."""
     if h.caught:
         line = f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s ({h.runs} runs)"
     else:
         line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {h.runs} runs "
                 f"in {h.seconds:.1f} s")
-    print(line, flush=True)
-    for e in h.errors:
-        print(f"        ERROR on the way (a defect of the suite): {e}", flush=True)
-    for e in h.clean_fails:
-        print(f"        not counted: {e} fails the clean emulator too", flush=True)
-
+    return [line, *(f"        ERROR on the way (a defect of the suite): {e}" for e in h.errors),
+            *(f"        not counted: {e} fails the clean emulator too" for e in h.clean_fails)]
 
 
 if __name__ == "__main__":

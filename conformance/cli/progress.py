@@ -1,13 +1,17 @@
-"""What a run shows while it runs.
+"""What a long job shows while it runs: the suite's run (a line per case), and the
+subcommands' steps (a mutant hunted, a reading tried, a fleet's target done, diff's
+sequences).
 
-- On a terminal: a progress bar (tqdm: case runs done/total, elapsed, estimate) and
-  above it only the lines that need reading: every verdict but PASS and MISSING
-  (``-v``: every case).
-- Elsewhere (a CI log, a pipe): one plain line per case, numbered ``[done/total]``.
-- ``-q``: nothing (the run prints its last line only).
+- On a terminal: a progress bar (tqdm: steps done/total, elapsed, estimate) and above it
+  only the lines that need reading: every case's verdict but PASS and MISSING, every
+  step that is not routine (``-v``: every line).
+- Elsewhere (a CI log, a pipe): the same lines, numbered ``[done/total]``, and no bar;
+  where routine lines are not shown, a line at every tenth of the way
+  (``[130/1296] 10 %, 4.1 s``), so that a log shows the job is moving.
+- ``-q``: nothing (the job prints its recap and last line only).
 
 The verdict of each line is coloured when colour is on (colour.py). The bar is cleared
-when the run ends, Ctrl-C included: while it is shown the terminal does not echo ``^C``,
+when the job ends, Ctrl-C included: while it is shown the terminal does not echo ``^C``,
 whose two characters would wrap a full-width bar onto a line of its own and leave the
 old bar above the summary.
 """
@@ -16,50 +20,57 @@ from __future__ import annotations
 
 import contextlib
 import sys
+import time
+from collections.abc import Callable
 from typing import TextIO
 
 from tqdm import tqdm
 
 from conformance.cli.colour import paint
-from conformance.quoting import quoted
+from conformance.explain import reason
 from conformance.runner import CaseResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, MISSING, PASS
+from conformance.verdict import MISSING, PASS, UNTESTED
 
-#: verdicts whose line gives the reason (the case's first note)
-_WHY = (COULD_NOT_TEST, MISSING, ERROR)
 #: verdicts a terminal does not show a line for (the bar counts them)
 _ROUTINE = (PASS, MISSING)
+#: a log without routine lines says how far the job is at every tenth of it
+_TENTHS = 10
 
 
 def describe(r: CaseResult, colour: bool = False) -> str:
-    """One console line for a result: its verdict, ID, profile and why it is not a PASS."""
+    """One console line for a result: its verdict, ID, profile and why it is not a PASS
+    (the deciding check's rule, tag, what was seen and wanted: conformance/explain.py)."""
     line = f"{paint(r.verdict, f'{r.verdict:15}', colour)} {r.id} [{r.profile}]"
-    if r.failed_checks:
-        c = r.failed_checks[0]
-        line += (f"  -- {c['what']}: observed {quoted(c['observed'])}, "
-                 f"expected {quoted(c['expected'])}")
-    elif r.verdict in _WHY and r.notes:
-        line += f"  -- {r.notes[0].splitlines()[0]}"
+    if r.verdict != PASS and (r.verdict not in UNTESTED or r.notes):
+        line += f"  -- {reason(r).line()}"
     return line
 
 
 class Progress:
-    """``quiet``: no lines and no bar; ``verbose``: a line for every case on a terminal
-    too; ``colour``: coloured verdicts."""
+    """``total`` steps of ``unit`` (a case run, a mutant, a sequence...). ``quiet``: no
+    lines and no bar; ``verbose``: every line, on a terminal too; ``every_step``: a log
+    shows routine lines too (a few long steps: a mutant, a reading); ``colour``:
+    coloured verdicts; ``status``: what a log's tenth line says besides the count."""
 
-    def __init__(self, total: int, *, quiet: bool = False, verbose: bool = False,
-                 colour: bool = False, stream: TextIO | None = None,
-                 terminal: bool | None = None, refresh: float = 0.1) -> None:
+    def __init__(self, total: int, *, unit: str = "case", quiet: bool = False,
+                 verbose: bool = False, colour: bool = False, every_step: bool = False,
+                 stream: TextIO | None = None, terminal: bool | None = None,
+                 refresh: float = 0.1, status: Callable[[], str] | None = None) -> None:
         self.stream = stream or sys.stdout
-        self.total = total
+        self.total = max(total, 1)
+        self.unit = unit
         self.done = 0
         self.quiet = quiet
         self.verbose = verbose
         self.colour = colour
+        self.every_step = every_step
+        self.status = status
+        self.started = time.perf_counter()
+        self._tenth = 0
         terminal = self.stream.isatty() if terminal is None else terminal
         self._echo = _NoControlEcho() if terminal and not quiet else None
         # the bar redraws at most every ``refresh`` seconds
-        self.bar = tqdm(total=total, unit="case", file=self.stream, dynamic_ncols=True,
+        self.bar = tqdm(total=total, unit=unit, file=self.stream, dynamic_ncols=True,
                         leave=False, mininterval=refresh) if terminal and not quiet else None
 
     def print(self, text: str) -> None:
@@ -69,19 +80,43 @@ class Progress:
         else:
             print(text, file=self.stream, flush=True)
 
+    def step(self, text: str | None = None, *, routine: bool = False, advance: int = 1,
+             label: str | None = None) -> None:
+        """``advance`` steps done; ``text`` the line they give (``routine``: one a
+        terminal and, unless ``every_step``, a log leave out); ``label`` shown beside
+        the bar (the profile being run)."""
+        shown = text is not None and (
+            not routine or self.verbose or (self.bar is None and self.every_step))
+        self.advance_to(self.done + advance, label=label, shown=shown)
+        if self.quiet or text is None or not shown:
+            return
+        if self.bar is not None:
+            self.print(text)
+        else:
+            self.print(f"[{self.done:{len(str(self.total))}}/{self.total}] {text}")
+
+    def advance_to(self, done: int, *, label: str | None = None, shown: bool = False
+                   ) -> None:
+        """``done`` steps done so far (diff: sequences or seconds); a log that showed no
+        line for them says so at every tenth of the way."""
+        done = min(done, self.total)
+        if self.bar is not None:
+            if label is not None:
+                self.bar.set_description_str(label, refresh=False)
+            self.bar.update(done - self.done)
+        self.done = max(self.done, done)
+        tenth = self.done * _TENTHS // self.total
+        if tenth <= self._tenth:
+            return
+        self._tenth = tenth
+        if self.bar is None and not self.quiet and not shown:
+            more = f": {self.status()}" if self.status else ""
+            self.print(f"[{self.done}/{self.total}] {100 * self.done // self.total} % "
+                       f"in {time.perf_counter() - self.started:.1f} s{more}")
+
     def result(self, r: CaseResult) -> None:
-        self.done += 1
-        if self.bar is not None:
-            self.bar.set_description_str(r.profile, refresh=False)
-            self.bar.update(1)
-        if self.quiet:
-            return
-        if self.bar is not None:
-            if self.verbose or r.verdict not in _ROUTINE:
-                self.print(describe(r, self.colour))
-            return
-        width = len(str(self.total))
-        self.print(f"[{self.done:{width}}/{self.total}] {describe(r, self.colour)}")
+        """A case run done: its line (every verdict but PASS and MISSING)."""
+        self.step(describe(r, self.colour), routine=r.verdict in _ROUTINE, label=r.profile)
 
     def close(self) -> None:
         """The bar gone from the screen, the terminal's echo as it was."""
@@ -94,6 +129,12 @@ class Progress:
         if self._echo is not None:
             self._echo.restore()
             self._echo = None
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 class _NoControlEcho:

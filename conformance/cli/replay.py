@@ -11,7 +11,14 @@ import sys
 from dataclasses import replace
 
 from conformance.cli.diff import ask_first, common, targets
-from conformance.cli.usage import INTERRUPTED, Parser, UsageError, one_line, summary
+from conformance.cli.usage import (
+    INTERRUPTED,
+    Parser,
+    UsageError,
+    add_loudness,
+    one_line,
+    summary,
+)
 from conformance.diff.engine import Pair
 from conformance.diff.gvt import expected_of, steps_of
 from conformance.diff.replayed import Verdict, frame_lines, header, verdict
@@ -34,6 +41,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES)
     ap.add_argument("file", help="a .gvt transcript")
     common(ap)
+    add_loudness(ap, "print every frame (the default)")
     try:
         args = ap.parse_args(argv)
         t = load(args.file)

@@ -10,16 +10,15 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
-import uuid
 from contextlib import ExitStack
 from pathlib import Path
 
 from serial import SerialException
 
 from conformance.catalogue import select
-from conformance.cli.colour import paint, wanted
+from conformance.cli.colour import wanted
 from conformance.cli.commands import subcommands_help
+from conformance.cli.ending import counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
     ask_before_motion,
@@ -33,24 +32,23 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
-    add_loudness,
-    exit_status,
     positive,
-    run_id,
+    report_options,
     summary,
     writable_folder,
 )
 from conformance.coverage import coverage, format_coverage
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
-from conformance.reports import write_junit, write_reports
 from conformance.runner import RunResult, run, settings_for
 from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import FAILED, ORDER, last_line, overall
 from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"
+#: what the run's --seed seeds
+SEED_HELP = ("the Hypothesis machines' seed: the same N replays the same examples "
+             "(default: a fresh one, printed and recorded; none for derandomized settings)")
 ABOUT = ("The conformance and fuzz suite for GVE54, GVE84 and GVE114 serial motion "
          "controllers. With no subcommand (or with `run`) it runs the suite against the "
          "targets, shows its progress and writes the reports.")
@@ -66,7 +64,9 @@ EXAMPLES = (
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = Parser(prog=PROG, description=f"{summary(ABOUT)}\n\n{subcommands_help()}",
-                targets=True, examples=EXAMPLES)
+                targets=True, examples=EXAMPLES, parents=[report_options(
+                    "print a line for every case (a terminal and a log show only those "
+                    "that did not PASS)", seed=SEED_HELP)])
     ap.add_argument("--target", action="append", default=[],
                     help="where the suite runs (forms below; default: the embedded "
                          "emulator on every profile); repeatable")
@@ -83,14 +83,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                          "s skips it); default: when standard input is a terminal")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="run only cases whose ID matches (repeatable)")
-    ap.add_argument("--exclude", action="append", default=[], metavar="GLOB")
+    ap.add_argument("--exclude", action="append", default=[], metavar="GLOB",
+                    help="leave out cases whose ID matches (repeatable; after --cases)")
     ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
                     help="Hypothesis settings profile (default: ci in virtual time, the "
                          "emulator's or a co-simulator's; hardware on serial/tcp/exec "
                          "targets)")
-    ap.add_argument("--seed", type=int, metavar="N",
-                    help="the Hypothesis machines' seed: the same N replays the same examples "
-                         "(default: a fresh one, printed; none for derandomized settings)")
     ap.add_argument("--max-travel", type=positive, default=DEFAULT_MAX_TRAVEL,
                     help="real units: the motion envelope in full steps per axis either side "
                          "of where the run began (default %(default)s)")
@@ -102,9 +100,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="grade a serial/tcp/exec target by the project's decisions too: a "
                          "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
                          "always is)")
-    ap.add_argument("--report-dir", default="reports", help="where reports/<run id>/ go")
-    ap.add_argument("--run-id", type=run_id, metavar="NAME",
-                    help="the report folder's name (default: date, time and a random tag)")
     ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
                     help="run the targets in N parallel processes: one report per target "
                          "under reports/<run id>/ and a summary across them")
@@ -112,8 +107,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="where the machines keep failing examples, tried first by the next "
                          "run (redis: by every bench sharing it); default: "
                          f"REPORT_DIR/{DEFAULT_DATABASE}, none with --no-reports")
-    ap.add_argument("--no-reports", action="store_true")
-    ap.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
     ap.add_argument("--full-logs", action="store_true",
                     help="whole wire logs in the reports for passing cases too")
     ap.add_argument("--operator-name", default="", metavar="NAME",
@@ -122,7 +115,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    add_loudness(ap, "print a line for every case, on a terminal too")
     ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
                     default="auto", help="colour the verdicts: auto (a terminal without "
                     "NO_COLOR set), always or never (default auto)")
@@ -224,7 +216,7 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
         raise Stopped("interrupted before the run, nothing was sent") from None
     _preflight(targets)
     unattended(targets, args.yes, console)
-    run_id = args.run_id or time.strftime("%Y%m%d-%H%M%S") + "-" + uuid.uuid4().hex[:6]
+    run_id = args.run_id or new_run_id()
     seed = run_seed([settings_for(t, args.settings) for t in targets], args.seed)
     meta = _meta(args, argv, targets, how, cases, seed, console)
     if args.jobs > 1 and len(targets) > 1:
@@ -250,22 +242,13 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     meta.finished = now_iso()
     _from_sessions(result, meta)
     result.meta = meta
-    counts = result.counts()
-    summary = ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
-    say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {summary}")
+    say(f"\n{len(result.results)} case runs on {len(targets)} target(s): {counted(result)}")
     say(f"took {result.seconds:.1f} s, {result.frames} frames exchanged"
         f"{' (interrupted by Ctrl-C)' if result.interrupted else ''}")
     for line in _session_lines(result):
         say(line)
-    if not args.no_reports:
-        folder = write_reports(result, args.report_dir)
-        say(f"reports: {folder}/report.html, results.json, junit.xml")
-    if args.junitxml:
-        say(f"JUnit XML: {write_junit(result, args.junitxml)}")
-    verdict, _ = overall(result.results, result.interrupted, result.problems)
-    line = last_line(result.results, result.interrupted, result.problems)
-    _say(paint(verdict, verdict, colour) + line[len(verdict):])
-    return exit_status(verdict != FAILED, result.interrupted)
+    return end(result, None if args.no_reports else args.report_dir,
+               junitxml=args.junitxml, colour=colour)
 
 
 class Stopped(Exception):

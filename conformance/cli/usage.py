@@ -51,13 +51,39 @@ def summary(doc: str | None) -> str:
     return textwrap.fill(" ".join(first.split()), 88)
 
 
-def add_loudness(ap: argparse.ArgumentParser, verbose: str) -> None:
-    """``-q`` (only the verdict's line) or ``-v`` (``verbose``: what every line is), one
-    or the other, alike on every subcommand."""
+def add_loudness(ap: argparse.ArgumentParser | argparse._ArgumentGroup, verbose: str) -> None:
+    """``-q`` (the recap and the verdict's line only) or ``-v`` (``verbose``: what every
+    line is), one or the other, alike on every subcommand."""
     loud = ap.add_mutually_exclusive_group()
     loud.add_argument("-q", "--quiet", action="store_true",
-                      help="print only the last line (the verdict)")
+                      help="print only the end: what failed, where the reports are and "
+                           "the verdict's line")
     loud.add_argument("-v", "--verbose", action="store_true", help=verbose)
+
+
+#: --seed's help, the same wherever a job draws at random
+SEED_HELP = ("the seed of what the job draws at random: the same N draws the same again "
+             "(default: a fresh one, printed and recorded in the reports)")
+
+
+def report_options(verbose: str, seed: str | None = SEED_HELP) -> argparse.ArgumentParser:
+    """The options of every subcommand that writes reports, with the same names,
+    defaults and help everywhere: a parent parser (``Parser(parents=[...])``).
+    ``verbose``: what -v shows on this subcommand; ``seed``: what its seed seeds (None:
+    a job that draws nothing at random has no --seed)."""
+    ap = argparse.ArgumentParser(add_help=False)
+    out = ap.add_argument_group("reports and output")
+    out.add_argument("--report-dir", default="reports",
+                     help="where reports/<run id>/ go (default %(default)s)")
+    out.add_argument("--run-id", type=run_id, metavar="NAME",
+                     help="the report folder's name (default: date, time and a random tag)")
+    out.add_argument("--no-reports", action="store_true",
+                     help="write no report folder (--junitxml still writes its file)")
+    out.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
+    if seed is not None:
+        out.add_argument("--seed", type=int, metavar="N", help=seed)
+    add_loudness(out, verbose)
+    return ap
 
 
 class _Version(argparse.Action):

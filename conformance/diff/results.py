@@ -9,6 +9,7 @@ import re
 
 from conformance.diff.engine import Finding
 from conformance.link.framing import readable
+from conformance.quoting import answer_text
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures.rules import load_rules
@@ -31,8 +32,8 @@ def finding_result(f: Finding, *, profile: str, target: str, transcript: list[st
                    d.verdict)
     sent = readable(d.target.sent)
     r.checks = [{"ok": False, "what": f"{sent} answered differently ({d.kind})",
-                 "observed": readable(d.target.answer) or "(no answer)",
-                 "expected": readable(d.reference.answer) or "(no answer)",
+                 "observed": answer_text(d.target.answer),
+                 "expected": answer_text(d.reference.answer),
                  "tag": d.tag, "rule": d.rule or ""}]
     r.notes = [f"rule touched: {d.rule or 'none known'}",
                f"shrunk to {f.frames} frame(s): " + " | ".join(str(s) for s in f.steps)]

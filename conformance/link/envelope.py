@@ -16,6 +16,12 @@ Each event takes an :class:`Outcome`: what the answer says happened. ``UNCLEAR``
 answer, or bytes that are not one) assumes whichever of "done" and "not done" reaches
 farther, so the bookkeeping never underestimates where an axis can be; the guard judges
 a frame before it is sent by applying its event as ``UNCLEAR`` to a copy.
+
+The counters are not the axes: a unit that restarts by itself (a brown-out, a watchdog
+reset) comes back with its counters at 0 (spec 9) wherever its axes stopped. So the
+envelope keeps the *trail* of each axis, every place it may have been since a read at
+rest last agreed with the frames, and a read that could be a restart's (:meth:`observe`)
+puts the axis anywhere on that trail, its counter counting from there.
 """
 
 from __future__ import annotations
@@ -104,6 +110,16 @@ class Outcome(enum.Enum):
     UNCLEAR = "unclear"        # no answer, or bytes that are not one: maybe either
 
 
+class Read(enum.Enum):
+    """What a position read told the bookkeeping (:meth:`Envelope.observe`)."""
+
+    MOVING = "moving"          # taken while something may move: it tells nothing
+    AGREES = "agrees"          # where the frames put the axes: the trail starts again
+    UNHELD = "unheld"          # a counter set with N<axis> that does not hold its value
+    RESTARTED = "restarted"    # the power-on counters (spec 9) where the frames say other
+    CONTRADICTS = "contradicts"   # other counters than the frames allow: restarted, or moved
+
+
 class Envelope:
     """One unit's axes for the whole run, in counter units from where the run began."""
 
@@ -119,6 +135,7 @@ class Envelope:
         self.factor = Span(min(factors), max(factors))   # counter units per commanded step
         self.reset_factor = reset_factor
         self.seen = [ZERO] * axes                # every place an axis may have been
+        self.trail = [ZERO] * axes               # ... since a read at rest last agreed
         self.set_counters = False                # N/N<axis> taken since the last read at rest
         self.unheld: list[int] = []              # axes whose set counter read back otherwise
 
@@ -257,30 +274,89 @@ class Envelope:
         """The first position read: the counters where the run begins."""
         for axis, value in counters.items():
             self.offset[axis] = point(-value)
+        self.trail = list(self.start)
 
-    def observe(self, counters: dict[int, int]) -> None:
+    def expected(self, axes: Sequence[int]) -> list[Span]:
+        """What the counters of ``axes`` should read now, by the frames."""
+        return [self.start[a] + self.queue[a].total - self.offset[a] for a in axes]
+
+    def observe(self, counters: dict[int, int], *, silence: bool = False) -> Read:
         """A position read (`PF`, `P`). Only while nothing can move does it tell where an
-        axis rests; a read that contradicts the bookkeeping wins (the unit moved by
-        other means, e.g. a hand-wheel)."""
+        axis rests. Counters the frames cannot explain are not believed over them: all 0
+        where the frames say otherwise are the power-on counters of a unit that
+        restarted by itself (spec 9); others the counters of a restart the unit has moved
+        on from, or of axes moved by other means (a hand-wheel). Either way the axes may
+        be anywhere their trail has been, the counters counting from there
+        (:meth:`lose_track`). So may they after ``silence`` (frames went unanswered since
+        the last read that agreed, as they do while a unit restarts) when all 0 agrees
+        only because the frames ended the axes where the counters began."""
         if not self.settled or any(q != EMPTY for q in self.queue):
-            return
-        for axis, value in counters.items():
-            if not self.offset[axis].bounded:
-                continue
-            read = point(value) + self.offset[axis]
-            met = self.start[axis].meet(read)
-            if met is None and self.set_counters and self.outside([read]) is not None:
-                # a counter set since the last read at rest reads the axis beyond the
-                # envelope the guard never let it leave: taken for a counter that does
-                # not hold the value set (a narrow one wraps), not for axes moved
-                # millions of steps; the frames' bookkeeping stays and the counter is
-                # anchored to it again
-                self.offset[axis] = self.start[axis] - point(value)
-                self.unheld.append(axis)
-                continue
-            self.start[axis] = met or read
+            return Read.MOVING
+        known = {a: v for a, v in counters.items() if self.offset[a].bounded}
+        met = {a: self.start[a].meet(point(v) + self.offset[a]) for a, v in known.items()}
+        zeros = bool(counters) and all(v == 0 for v in counters.values())
+        wrong = [a for a, m in met.items() if m is None]
+        unheld = [a for a in wrong if self.set_counters
+                  and self.outside([point(known[a]) + self.offset[a]]) is not None]
+        if wrong and len(unheld) == len(wrong):
+            # a counter set since the last read at rest reads the axis beyond the
+            # envelope the guard never let it leave: taken for a counter that does not
+            # hold the value set (a narrow one wraps), not for axes moved millions of
+            # steps; the frames' bookkeeping stays and the counter is anchored to it again
+            for a in unheld:
+                self.offset[a] = self.start[a] - point(known[a])
+            self.unheld += unheld
+            wrong = []
+        elif wrong or (zeros and silence and not all(t.exact for t in self.trail)):
+            self.lose_track(counters, restarted=zeros)
+            return Read.RESTARTED if zeros else Read.CONTRADICTS
+        for a, m in met.items():
+            if m is not None:
+                self.start[a] = m
         self.set_counters = False
+        self.trail = list(self.start)
+        self._see()
+        return Read.UNHELD if unheld else Read.AGREES
+
+    def lose_track(self, counters: dict[int, int], *, restarted: bool) -> None:
+        """The counters read ``counters`` at rest and the frames cannot explain them. A
+        unit that restarted stopped somewhere on its trail and counts from 0 there
+        (spec 9), then from every frame since: the axis is on its trail plus what it
+        reads. Unless ``restarted`` (every counter 0), it may also be where the counter
+        says, as the frames counted it (moved by other means). Nothing is queued or saved
+        any more; an axis not read stays anywhere on its trail."""
+        for a in range(self.axes):
+            trail = self.trail[a]
+            read = counters.get(a)
+            if read is None:
+                self.start[a], self.offset[a] = trail, UNKNOWN
+                continue
+            here = trail + point(read)
+            if restarted or not self.offset[a].bounded:
+                self.start[a], self.offset[a] = here, trail
+            else:
+                self.start[a] = here.hull(point(read) + self.offset[a])
+                self.offset[a] = self.offset[a].hull(trail)
+        if restarted:
+            self.factor = point(self.reset_factor)
+        self.queue, self.saved, self.settled = [EMPTY] * self.axes, None, True
+        self.set_counters = False
+        self.trail = list(self.start)
+        self._see()
+
+    def locate(self, physical: dict[int, int], counters: dict[int, int]) -> None:
+        """The axes are at rest at ``physical`` (counter units from where the run began,
+        as a test rig's eyes saw them) while the counters read ``counters``: where they
+        are is known again."""
+        self.queue, self.settled = [EMPTY] * self.axes, True
+        for a, value in physical.items():
+            self.start[a] = point(value)
+            if a in counters:
+                self.offset[a] = point(value - counters[a])
+        self.trail = list(self.start)
         self._see()
 
     def _see(self) -> None:
-        self.seen = [a.hull(b) for a, b in zip(self.seen, self.reach(), strict=True)]
+        reach = self.reach()
+        self.seen = [a.hull(b) for a, b in zip(self.seen, reach, strict=True)]
+        self.trail = [a.hull(b) for a, b in zip(self.trail, reach, strict=True)]

@@ -332,7 +332,7 @@ class Link:
             if r is not None:
                 r.received_at = self.now
         if not self._dropped:
-            self.guard.answered(real)
+            self.guard.answered(real, self._origin + self.wrote_at)
         return r
 
     def rest_of_answer(self, seconds: float = MARGIN) -> bytes:

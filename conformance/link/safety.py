@@ -12,6 +12,13 @@ before any frame once Ctrl-C was pressed (except the session's `H`, `D` and
 restorations), and :class:`TargetNotResponding` after a few frames in a row got no
 answer.
 
+A unit that restarts by itself is seen in what it reads back (the envelope's
+:meth:`~conformance.link.envelope.Envelope.observe`): the case in which it is seen ends
+(:class:`UnitRestarted`), the restart is kept in :attr:`Guard.restarts` for the
+report, and where the axes are is no longer known unless they cannot have moved since
+they last were: then no motion frame goes out (:attr:`Guard.lost`) until the session
+locates them again (:meth:`Guard.locate`).
+
 Public interface (docs/suite.md, "The session and its guard")::
 
     guard.check(body, address)           # before sending: raises SafetyStop / Interrupted
@@ -26,7 +33,17 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from conformance.link.envelope import EMPTY, INF, UNKNOWN, ZERO, Envelope, Outcome, Span, point
+from conformance.link.envelope import (
+    EMPTY,
+    INF,
+    UNKNOWN,
+    ZERO,
+    Envelope,
+    Outcome,
+    Read,
+    Span,
+    point,
+)
 from conformance.link.framing import HostFrame, Response
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
@@ -49,6 +66,24 @@ class BeyondEnvelope(SafetyStop):
     its vectors may draw another instead: :meth:`Guard.fits`)."""
 
 
+@dataclass
+class Restart:
+    """A restart the guard saw: what the unit showed, where the axes may have been, and
+    what the run did about it."""
+
+    seen: str
+    where: str
+    then: str
+
+    def __str__(self) -> str:
+        return f"{self.seen}; {self.where}: {self.then}"
+
+
+class UnitRestarted(SafetyStop):
+    """The unit restarted by itself (or its counters no longer tell where its axes are):
+    the case in which it was seen ends COULD-NOT-TEST with what was seen."""
+
+
 class TargetNotResponding(BaseException):
     """Several frames in a row got no answer: the run stops for this target."""
 
@@ -67,6 +102,10 @@ _PACKET_MEMBERS = classes(packet="member")
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 #: consecutive frames without an answer after which the target is given up
 SILENCE_LIMIT = 4
+#: ... once they have been silent for this many of the unit's restart times (spec 2: a
+#: unit that restarts answers again after about 2 s): a unit that restarted by itself is
+#: not given up in virtual time, where frames time out quickly
+SILENT_RESTARTS = 2
 
 
 class _Depth:
@@ -150,6 +189,18 @@ class Guard:
         self.silences = 0
         self.garbage = ""                         # the last bytes that were not an answer
         self.dead = False
+        self._silent_from: int | None = None      # when the frames in a row went unanswered (ns)
+        self.unanswered = 0                       # frames unanswered since a read agreed
+        self._restarting = False                  # after J or the rig's power-on: deaf a while
+        self._last = ""                           # the command booked last
+        self._summing = False                     # %+ booked since a frame went unanswered
+        #: the unit's restarts seen (and counters that no longer told where the axes
+        #: were), for the report
+        self.restarts: list[Restart] = []
+        self._told = 0                            # restarts a case has been stopped for
+        #: why no motion frame may go out (the axes are not known to be anywhere exact
+        #: since a restart); "" while they are
+        self.lost = ""
         self._own = _Depth()                      # inside the session's own frames
         self._emergency = _Depth()
         self._hands_on = _Depth()                 # a technician's hand step is open
@@ -183,6 +234,14 @@ class Guard:
             raise Interrupted
         if self.dead:
             raise TargetNotResponding(self._not_responding())
+        self._tell_restart()
+
+    def _tell_restart(self) -> None:
+        """End the case that is running when a restart was seen (once per restart; the
+        session's own frames go on: it reports the restart)."""
+        if self._told < len(self.restarts) and not self._own and not self._emergency:
+            self._told = len(self.restarts)
+            raise UnitRestarted(str(self.restarts[-1]))
 
     def check(self, body: str, address: int | None = None) -> None:
         """Raise if the frame ``body`` for ``address`` may not be sent now."""
@@ -266,6 +325,8 @@ class Guard:
         if reach != e.reach() or (waiting and any(p != EMPTY for p in waiting)):
             if self.interrupts.stopped:
                 raise SafetyStop(f"{body}: no motion after Ctrl-C")
+            if self.lost:
+                raise SafetyStop(f"{body}: no motion: {self.lost}")
             self._confirm_motion(body)
 
     def _confirm_motion(self, body: str) -> None:
@@ -293,6 +354,10 @@ class Guard:
         event = self._event(command, outcome, None if response is None else response.code)
         if event is not None:
             event(self.envelope)
+        self._last = command.name
+        self._summing = self._summing or command.name == "%+"
+        if command.name == "J" and outcome is not Outcome.REFUSED:
+            self._restarting = True          # its silence is the suite's own doing
         self._learn(command, response, outcome)
 
     def restarted(self) -> None:
@@ -300,6 +365,17 @@ class Guard:
         as a `J` it accepted (counters zeroed, queue and packet gone, the axes stay)."""
         self.envelope.discard(Outcome.ACCEPTED, restart=True)
         self.packet_open = False
+        self._restarting = True
+
+    def locate(self, physical: dict[int, int], counters: dict[int, int]) -> None:
+        """The axes stand still at ``physical`` (counter units from where the run began,
+        as a test rig's eyes see them) while the counters read ``counters``: motion may
+        go out again."""
+        self.envelope.locate(physical, counters)
+        if self.lost and self.restarts:
+            self.restarts[-1].then = (f"the test rig then located them at "
+                                      f"{self.whereabouts()}, and motion went on from there")
+        self.lost, self.unanswered = "", 0
 
     def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -373,6 +449,7 @@ class Guard:
         unit shows it rests, a position is read."""
         name = command.name
         if name == "*S":
+            self._drop_packet()
             self.packet, self.packet_open = [], True
         elif name == "*E":
             self.packet_open = False
@@ -381,7 +458,7 @@ class Guard:
         elif name in _PACKET_BREAKERS and r is not None:
             # unanswered, it may have been taken as a member: that a breaker closes the
             # packet is our reading [D], and only *E is sure to (spec 7)
-            self.packet_open = False
+            self._drop_packet()
         if outcome is not Outcome.ACCEPTED or r is None:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
@@ -391,22 +468,101 @@ class Guard:
         elif name in classes(position=True):
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             if len(r.values) >= axes and all(re.fullmatch(r"-?\d+", v) for v in r.values[:axes]):
-                self.envelope.observe({i: int(r.values[i]) for i in range(axes)})
+                self._read(name, {i: int(r.values[i]) for i in range(axes)})
+
+    def _read(self, name: str, counters: dict[int, int]) -> None:
+        """A position read: when it tells the counters no longer count from where the
+        frames say, the axes are located on their trail, the event is kept for the
+        report and the case ends; motion stops unless they cannot have moved since."""
+        e = self.envelope
+        expected = e.expected(sorted(counters))
+        read = e.observe(counters, silence=self.unanswered > 0)
+        if read in (Read.AGREES, Read.UNHELD):
+            self.unanswered = 0
+        if read not in (Read.RESTARTED, Read.CONTRADICTS):
+            return
+        shown = ",".join(str(v) for v in counters.values())
+        frames = ",".join(_counts(s) for s in expected)
+        silent = (f" after {self.unanswered} frame(s) went unanswered" if self.unanswered
+                  else "")
+        if read is Read.CONTRADICTS:
+            what = (f"the position counters no longer tell where the axes are: {name} read "
+                    f"{shown} at rest where the frames put them at {frames}{silent} (the "
+                    "unit restarted by itself and moved on, or its axes were moved by "
+                    "other means)")
+        elif any(not s.exact or s.lo != 0 for s in expected):
+            what = (f"the unit restarted by itself: {name} read {shown} at rest, the "
+                    f"power-on counters (spec 9), where the frames put them at "
+                    f"{frames}{silent}")
+        else:
+            what = (f"the unit restarted by itself, as far as the suite can tell: "
+                    f"{self.unanswered} frame(s) went unanswered, then {name} read {shown}, "
+                    "the power-on counters (spec 9), after the axes had moved")
+        self.unanswered = 0
+        if all(s.exact for s in e.start):
+            self.restarts.append(Restart(what, f"the axes stood at {self.whereabouts()} "
+                                         "(they had not moved since they were last known)",
+                                         "the run went on from there"))
+            return
+        where = f"the axes stopped somewhere in {self.whereabouts()}"
+        self.lost = f"{what}; {where}, and nothing tells where exactly"
+        self.restarts.append(Restart(what, where, "no motion frame went out after it"))
+
+    def whereabouts(self) -> str:
+        """Where each axis is, in full steps from where the run began: ``X 0..1500, Y 0``."""
+        return ", ".join(f"{a} {self.where(i)}" for i, a in enumerate(self.profile.axes))
+
+    def where(self, axis: int) -> str:
+        """Where ``axis`` may be, in full steps from where the run began: ``0..1500``."""
+        return _span(self.envelope.reach()[axis], self.scale)
+
+    def _drop_packet(self) -> None:
+        """An open packet discarded without `*E` (a breaker, a second `*S`): that nothing
+        of it is committed is our reading [D]; a unit may have committed its members as
+        they arrived, so they count as maybe committed."""
+        if self.packet_open and self.packet:
+            _commit(self.envelope, self.packet, Outcome.UNCLEAR)
+        self.packet, self.packet_open = [], False
 
     # -- answers and silences ----------------------------------------------------------------
-    def answered(self, response: Response | None) -> None:
-        """Count frames in a row that got no answer (or bytes that are not one)."""
+    def answered(self, response: Response | None, at: int | None = None) -> None:
+        """Count frames in a row that got no answer (or bytes that are not one); ``at``:
+        the instant the frame went out (ns on the line's clock). A frame unanswered
+        outside a restart the suite caused may be a restart's (spec 2: bytes are lost
+        while a unit restarts): the next position read is weighed with it
+        (:meth:`_read`)."""
         if response is not None and response.code is not None:
-            self.silences, self.garbage = 0, ""
+            self.silences, self.garbage, self._silent_from = 0, "", None
+            if self._last != "J":                # the J's own answer comes before its silence
+                self._restarting = False
+            if response.checksum_ok and not self._summing:
+                # summed without a %+ since: the checksum mode outlived the silence, and a
+                # unit that restarts leaves it off (spec 6, 9)
+                self.unanswered = 0
+            self._tell_restart()
             return
         if response is None and self.packet_open:
             return              # a packet's members are answered by nothing (spec 7)
         self.silences += 1
+        if self._silent_from is None:
+            self._silent_from = at
+        if not self._restarting:
+            self.unanswered += 1
+            self._summing = False
         if response is not None:
             self.garbage = response.text
-        if self.silences >= SILENCE_LIMIT and not self._emergency:
+        if self.silences >= SILENCE_LIMIT and self._silent_long(at) and not self._emergency:
             self.dead = True
             self.check_idle()
+
+    def _silent_long(self, at: int | None) -> bool:
+        """Whether the frames unanswered in a row went out over long enough to give the
+        unit up: longer than it would take to restart (spec 2), so that one that did is
+        heard again (a frame sent while it was deaf, `H` above all, may wait long for an
+        answer that cannot come: the instants are when the frames went out)."""
+        if at is None or self._silent_from is None:
+            return True
+        return at - self._silent_from >= SILENT_RESTARTS * self.profile.restart_ms * 1_000_000
 
     def _not_responding(self) -> str:
         last = f" (the last bytes were not an answer: {self.garbage})" if self.garbage else ""
@@ -467,6 +623,9 @@ class EmulatorGuard(Guard):
     def restarted(self) -> None:
         return None
 
+    def _silent_long(self, at: int | None) -> bool:
+        return True              # a fresh unit per link: its silence is no restart's
+
 
 #: commands whose effect needs nothing but the outcome
 _EVENTS: dict[str, Callable[[Envelope, Outcome], None]] = {
@@ -482,6 +641,19 @@ _EVENTS: dict[str, Callable[[Envelope, Outcome], None]] = {
 def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:
     for steps in members:
         e.vector(steps, outcome, stand_alone=False)
+
+
+def _counts(span: Span) -> str:
+    """Counter values as a unit reads them: ``1500``, ``0..1500``, ``?``."""
+    if not span.bounded:
+        return "?"
+    return str(int(span.lo)) if span.exact else f"{int(span.lo)}..{int(span.hi)}"
+
+
+def _span(span: Span, scale: int) -> str:
+    """A span of counter units as full steps: ``300``, ``0..1500``."""
+    lo, hi = _steps(span.lo, scale), _steps(span.hi, scale)
+    return f"{lo:g}" if lo == hi else f"{lo:g}..{hi:g}"
 
 
 def _steps(counter: float, scale: int) -> float:

@@ -12,22 +12,28 @@ from conformance.case import CaseContext
 from conformance.link.framing import Response
 from conformance.model.unit import ModelUnit
 from conformance.protocol.parse import parse
+from conformance.quoting import as_text
 from gve_fixtures.protocol import ErrorCode
 
 
 class Broken(AssertionError):
     """A machine's invariant that failed, with the rule it checks: graded by that
-    rule's tag, as a directed case's check is."""
+    rule's tag, as a directed case's check is; what the unit did and what the rule
+    wants where the machine knows them (written as a directed case's check writes them:
+    conformance/quoting.py)."""
 
-    def __init__(self, rule: str, message: str) -> None:
+    def __init__(self, rule: str, message: str, observed: object = None,
+                 expected: object = None) -> None:
         super().__init__(message)
         self.rule = rule
+        self.observed, self.expected = as_text(observed), as_text(expected)
 
 
-def holds(ok: object, rule: str, message: str) -> None:
+def holds(ok: object, rule: str, message: str, *, observed: object = None,
+          expected: object = None) -> None:
     """Assert ``ok`` as a check of ``rule`` (Broken when it fails)."""
     if not ok:
-        raise Broken(rule, message)
+        raise Broken(rule, message, observed, expected)
 
 
 class UnitMachine(RuleBasedStateMachine):

@@ -63,16 +63,19 @@ def run_machine(ctx: CaseContext, machine: type[UnitMachine]) -> None:
 
 
 def _failed(ctx: CaseContext, machine: type, err: BaseException) -> None:
-    """The failed invariant as a check graded by the rule it names."""
+    """The failed invariant as a check graded by the rule it names: what it says, and
+    what the unit did and the rule wants where the machine said (never the whole error:
+    the example's steps are in the wire log and its transcript)."""
     rule = getattr(err, "rule", None)
     what = f"{machine.__name__}: {err}".splitlines()[0][:300]
+    seen = {"observed": getattr(err, "observed", ""), "expected": getattr(err, "expected", "")}
     if rule is not None and rule not in ctx.case.rules:
         # a rule of the machinery the case does not list (the index, PF): its own tag
-        ctx.expect(False, f"{what} [{rule}]", observed=str(err)[-500:],
-                   expected="every invariant holds", tag=load_rules()[rule].tag)
+        ctx.expect(False, f"{what} [{rule}]", **seen, tag=load_rules()[rule].tag)
     else:
-        ctx.expect(False, what, observed=str(err)[-500:], expected="every invariant holds",
-                   rule=rule)
+        ctx.expect(False, what, **seen, rule=rule)
+    if len(str(err).strip().splitlines()) > 1:
+        ctx.note(f"{machine.__name__}: {err}")         # the rest of what it said
     link = ctx.links[-1] if ctx.links else None
     if link is not None:
         ctx.artifact("failing-example.gvt", "# gve-transcript 1\n# title: failing "

@@ -7,6 +7,7 @@ and wire log. No external assets; every text from a unit goes through :func:`htm
 
 from __future__ import annotations
 
+import shlex
 from collections import Counter
 from importlib import resources
 
@@ -59,7 +60,7 @@ def _header(run: RunResult) -> list[str]:
                 ("operator", m.operator or "(not given: --operator-name)"),
                 ("suite version", m.suite_version),
                 ("host", f"{m.host} ({m.platform}, Python {m.python})"),
-                ("command", " ".join(["gve-conformance", *m.command])),
+                ("command", shlex.join(["gve-conformance", *m.command])),
                 *((flag, value) for flag, value in m.flags().items())]) + "</table>",
             *units_table(run), *state_section(run)]
 
@@ -80,11 +81,15 @@ def _failed(run: RunResult) -> list[str]:
         for f in found:
             profiles = h(f.runs[0].profile) if len(f.runs) == 1 else ", ".join(
                 f"<a href='#{h(_anchor(r))}'>{h(r.profile)}</a>" for r in f.runs)
-            rule = f"{f.rule_id}: {f.rule}" if f.rule_id else f.rule
+            why = f.why
+            seen = (f"<td>{h(quoted(why.observed))}</td><td>{h(quoted(why.expected))}</td>"
+                    if why.checked else "<td></td><td></td>")
+            rule = (f"<b>{h(why.head())}</b> " if why.checked else "") + (
+                f"<q>{h(why.rule)}</q>" + (f" ({h(why.source)})" if why.source else "")
+                if why.rule else "")
             out.append(f"<tr class='{h(f.verdict)}'><td><a href='#{h(_anchor(f.runs[0]))}'>"
                        f"<b>{h(f.verdict)}</b> {h(f.id)}</a> [{profiles}]</td>"
-                       f"<td>{h(f.what)}</td><td>{h(quoted(f.observed))}</td><td>{h(quoted(f.expected))}</td>"
-                       f"<td>{h(rule)}</td></tr>")
+                       f"<td>{h(why.what)}</td>{seen}<td>{rule}</td></tr>")
         out.append("</table>")
     if untested:
         out.append(f"<p class='why'>Not judged: {h(', '.join(untested))} (each says why on "

@@ -1,6 +1,6 @@
 """``emu:PROFILE[?mutant=NAME]``: the embedded emulator in virtual time, a fresh unit per
 link. The only place the suite imports the emulator, and only to open its ``gve://`` URL
-and to read its registry of mutants."""
+(here, and for ``serial:gve://``) and to read its registries of mutants and readings."""
 
 from __future__ import annotations
 
@@ -12,6 +12,11 @@ from conformance.link.virtual import line_of
 from conformance.targetinfo import EMULATOR, TargetInfo
 from conformance.targets.base import Target, TargetError
 from gve_fixtures.profile import load_profile
+
+
+def register_url_scheme() -> None:
+    """Make pyserial open the emulator's ``gve://`` URLs (importing it registers them)."""
+    import emulator  # noqa: F401
 
 
 def mutants() -> dict[str, tuple[str, str]]:
@@ -43,7 +48,7 @@ class EmuTarget(Target):
                               f"(known: {', '.join(sorted(mutants()))})")
 
     def connect(self, address: int | None):
-        import emulator  # noqa: F401  (registers gve://)
+        register_url_scheme()
         address = self.address if address is None else address
         query = f"model={self.profile.name}&address={address}"
         if self.mutant:

@@ -12,12 +12,15 @@ import serial
 from conformance.link.exclusive import open_serial
 from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
+from conformance.targets.emu import register_url_scheme
 from conformance.targets.targetport import TargetPort
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
 OURS = ("baud", "address")
+#: the emulator's pyserial URL scheme (README, "The emulator")
+EMULATOR_SCHEME = "gve"
 
 
 def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
@@ -26,6 +29,8 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
         parts = urlsplit(rest)
         q = parse_qs(parts.query, keep_blank_values=True)
         ours = {k: q.pop(k) for k in OURS if k in q}
+        if parts.scheme == EMULATOR_SCHEME:
+            _emulator_url(q, ours)
         query = urlencode(q, doseq=True)
         return f"{parts.scheme}://{parts.netloc}{parts.path}{'?' * bool(query)}{query}", ours
     if kind == "serial":
@@ -34,6 +39,19 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
         return parts.path if rest.startswith("/") else parts.path[1:], parse_qs(parts.query)
     where, _, q_text = rest.partition("?")
     return f"socket://{_host_port(where)}", parse_qs(q_text)
+
+
+def _emulator_url(q: dict[str, list[str]], ours: dict[str, list[str]]) -> None:
+    """``gve://``, the emulator's pyserial URL, judged as any unit on a port: in real time
+    (the emulator registers the scheme when it is imported, as for ``emu:``), its unit at
+    the address the suite talks to."""
+    if "address" in ours:
+        q["address"] = ours["address"]
+    if q.setdefault("realtime", ["1"]) != ["1"]:
+        raise TargetError("serial:gve:// is the emulator judged as a unit on a port, in real "
+                          "time: leave out realtime (for virtual time: --target emu:MODEL, or "
+                          "exec:'python -m emulator --model MODEL --cosim')")
+    register_url_scheme()
 
 
 def _host_port(where: str) -> str:

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
-from conformance.link.framing import HostFramer, Response, frame
+from conformance.link.framing import HostFramer, Response, frame, readable
 from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
@@ -38,7 +38,7 @@ from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode, St6
+from gve_fixtures.protocol import SECOND, ErrorCode, St6
 
 
 class Reachable(Protocol):
@@ -55,6 +55,9 @@ PACKET_CLOSER = "*E-1"
 #: status words restored at the end, polarity before causes before enables (an enable
 #: written last finds its polarity and cause already in place)
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
+#: during the way back, a frame at least every this many of the unit's restart times
+#: (spec 2: about 2 s), so that a restart on the way is heard
+WATCH = 0.25
 #: EEPROM bytes read back in one go (one exchange with a co-simulator that takes frames
 #: told ahead, docs/cosim.md: `batch`; a frame at a time on any other unit)
 EEPROM_READS = 64
@@ -215,6 +218,8 @@ class RealSession(Session):
         self.status: dict[int, int] = {}           # ST0..ST5 as found
         self.checksums: bool | None = None         # the checksum mode as found
         self.counters: dict[int, int] = {}         # position counters as found (PF)
+        #: where a test rig with eyes saw the axes as found (docs/rig.md, `physical`)
+        self._rig_origin: dict[int, int] | None = None
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return Guard(self.profile, self.target.address, max_travel=info.max_travel,
@@ -272,6 +277,7 @@ class RealSession(Session):
                 raise SessionError(self.failed)
         self.counters = self._position(link)
         self.guard.envelope.origin(self.counters)
+        self._rig_origin = self._rig_physical(link)
         if self.target.info.allow_destructive and "ER" in self.profile.commands:
             self._backup_eeprom(link)
 
@@ -375,7 +381,7 @@ class RealSession(Session):
     def _has_mpg(self) -> bool:
         return self.profile.mpg is not None and "Y" in self.profile.commands
 
-    def _stop(self, link: Link, then: Sequence[str] = ()) -> None:
+    def _stop(self, link: Link, then: Sequence[str] = ()) -> list[Response | None]:
         """`H`, checksums off, the hand wheel (MPG) off, interrupts off (ST0..ST5 = 00),
         then `D`: the queue empty and ST6 clear (an input still enabled would set INTA
         again at once); then the frames ``then``. An MPG that EEPROM 06 made effective
@@ -389,17 +395,18 @@ class RealSession(Session):
         self._halt(link)
         if link.checksums:
             link.send("%-", checksum=True)
-        link.send_each(frames)
+        return link.send_each(frames)
 
-    def _settle(self, link: Link, then: Sequence[str] = ()) -> None:
+    def _settle(self, link: Link, then: Sequence[str] = ()) -> dict[str, Response | None]:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped,
         interrupts off, queue and save empty, the reset values of what cannot be read. A
         KEEP left by the last case leaves a queue that takes only L (spec 10.5): K saves
         the empty queue over it and R restores that, which moves nothing. Then the
-        frames ``then``."""
+        frames ``then``; returns the answers to those after the stop, by frame."""
         if link.rig is not None:
             link.rig.hands_off()
-        self._stop(link, [*self._reset_frames(), "K", "R", *then])
+        after = [*self._reset_frames(), "K", "R", *then]
+        return dict(zip(after, self._stop(link, after)[-len(after):], strict=True))
 
     def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
         self._settle(link, ["PF"])                 # where the axes are, for the way back
@@ -407,12 +414,16 @@ class RealSession(Session):
         link.tell(["N", *tell])
         link.send("N")
 
-    def _go_back(self, link: Link, *, read: bool = True) -> None:
+    def _go_back(self, link: Link, *, read: bool = True) -> tuple[str, dict[int, int]]:
         """Move the axes back to where the run began (known exactly only at rest; the
-        counters read first unless ``read`` is False: just read)."""
-        if read:
-            self._position(link)
+        counters read first unless ``read`` is False: just read). After a restart that
+        left them anywhere on their trail, a test rig's eyes locate them first, when the
+        rig has eyes. Returns the frame that moved them ("" none) and the counters read
+        at the end."""
+        read_now = self._position(link) if read else {}
         envelope = self.guard.envelope
+        if None in envelope.position():
+            self._relocate(link)
         if envelope.unheld:
             axes = ", ".join(sorted({self.profile.axes[i] for i in envelope.unheld}))
             why = (f"position counters ({axes}) set with N<axis> read back other values at "
@@ -424,7 +435,7 @@ class RealSession(Session):
         here = envelope.position()
         back = [0 if h is None else -int(h) for h in here]
         if not any(back):
-            return
+            return "", read_now
         speed = self.profile.reset.V
         body = "L" + ",".join(str(b) for b in back)
         if not self.guard.fits(body):
@@ -434,16 +445,57 @@ class RealSession(Session):
                    "the envelope (the counters read contradict the frames sent)")
             if why not in self.report.problems:
                 self.report.problems.append(why)
-            return
+            return "", read_now
         r = link.send(body)
         if r is None or not r.ok:
-            raise CouldNotTest(f"the return to where the run began (L{back}) answered {r}")
+            raise CouldNotTest(f"the return to where the run began ({body}) answered "
+                               f"{_shown(r)}")
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
-        link.wait(cruise)                                  # asking before it ends is moot
+        self._watch(link, cruise)
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
             raise CouldNotTest("the return to where the run began did not end in time")
-        self._position(link)
+        return body, self._position(link)
+
+    def _watch(self, link: Link, seconds: float) -> None:
+        """Let ``seconds`` of the way back pass with a frame at least every WATCH of the
+        unit's restart time: a unit that restarts on the way (spec 2: deaf for about
+        2 s) leaves one unanswered, which the guard weighs with the read at the end."""
+        step = WATCH * self.profile.restart_ms / 1000
+        end = link.now + round(seconds * SECOND)
+        while link.now < end:
+            link.wait(min(step, (end - link.now) / SECOND))
+            if link.now < end:
+                link.send("SR6")
+
+    def _relocate(self, link: Link) -> None:
+        """Where the axes are when the frames no longer tell (a restart left them anywhere
+        on their trail, a `W` at a switch the suite cannot see): a test rig's eyes (a
+        simulator's `physical`, docs/rig.md) tell, when the rig has them; the guard then
+        lets motion go out again."""
+        if self._rig_origin is None:
+            return
+        now = self._rig_physical(link)
+        counters = self._position(link)
+        if now is None or len(counters) < min(3, len(self.profile.axes)):
+            return
+        self.guard.locate({a: now[a] - self._rig_origin[a] for a in now}, counters)
+
+    def _rig_physical(self, link: Link) -> dict[int, int] | None:
+        """Where the rig sees each axis (`physical`, counter units since the simulator
+        started), or None: no rig, or one without eyes, or a `state` without them."""
+        state = getattr(link.rig, "state", None)
+        if state is None:
+            return None
+        try:
+            seen = state().get("physical")
+        except (CouldNotTest, AttributeError):
+            return None
+        axes = len(self.profile.axes)
+        if not isinstance(seen, list) or len(seen) < axes or \
+                not all(type(v) is int and abs(v) < 2**31 for v in seen[:axes]):
+            return None
+        return dict(enumerate(seen[:axes]))
 
     # -- Ctrl-C and the end --------------------------------------------------------------------
     def emergency_stop(self) -> None:
@@ -475,6 +527,8 @@ class RealSession(Session):
                 self.report.problems.append(f"restorations stopped: {err}")
                 self._unrestored()
             self._keep_log(link)
+        # what happened to the unit first: it explains what could not be put back
+        self.report.problems[:0] = [str(r) for r in self.guard.restarts]
         self.report.excursion = [list(e) for e in self.guard.excursion()]
 
     def _restore(self, link: Link) -> None:
@@ -484,53 +538,117 @@ class RealSession(Session):
                 self._halt(link, timeout=MARGIN, urgent=True)
                 link.send("D")
             raise TargetNotResponding("the target is not responding")
-        self._settle(link)
-        self.report.reset.append("set to the reset state (they cannot be read): "
-                                 + ", ".join(self._reset_frames()))
-        if self.profile.microstep:
-            self.report.reset.append("GVE54 micro-step mode and current set to "
-                                     f"M{self.profile.microstep.reset_mode}, "
-                                     f"M{self.profile.microstep.reset_current} (the reset state)")
-        if not self.interrupts.stopped:
-            self._go_back(link)
-            here = self.guard.envelope.position()
-            self.report.restored.append(
-                "axes back where the run began" if all(h == 0 for h in here) else
-                "axes: the way back is not known exactly for "
-                + ", ".join(a for a, h in zip(self.profile.axes, here, strict=True) if h is None))
+        self._say_reset(self._settle(link))
+        self._restore_axes(link)
         self._restore_counters(link)
         self._restore_eeprom(link)
         self._restore_status(link)
-        if self.checksums:
-            r = link.send("%+", checksum=False)
-            if r is None or not r.ok:
-                self.report.problems.append(f"checksum mode not turned back on: %+ answered {r}")
+        self._restore_checksums(link)
+
+    def _say_reset(self, answers: dict[str, Response | None]) -> None:
+        """What cannot be read back, set to the reset state: said of the frames the unit
+        took (answered 0), a problem for the others."""
+        frames = self._reset_frames()
+        taken = [body for body in frames if _taken(answers.get(body))]
+        refused = [f"{body} answered {_shown(answers.get(body))}" for body in frames
+                   if body not in taken]
+        if taken:
+            self.report.reset.append("set to the reset state, each answered 0 (they cannot "
+                                     "be read back): " + ", ".join(taken))
+        if refused:
+            self.report.problems.append("not set to the reset state: " + "; ".join(refused))
+        micro = self.profile.microstep
+        if micro and all(f"M{m}" in taken for m in (micro.reset_mode, micro.reset_current)):
+            self.report.reset.append("GVE54 micro-step mode and current set to "
+                                     f"M{micro.reset_mode}, M{micro.reset_current} (the reset "
+                                     "state)")
+
+    def _restore_axes(self, link: Link) -> None:
+        """The axes back where the run began, as the counters then read; where they are
+        not, a problem saying where they are. An axis no position read shows (the
+        GVE114's A: PF reads X, Y, Z, M114 13.6.6) cannot be verified: said as such."""
+        names = self.profile.axes
+        stopped = self.interrupts.stopped
+        if not stopped and None in self.guard.envelope.position():
+            self._relocate(link)
+        body, read = "", {}
+        if stopped or self.guard.lost:
+            read = self._position(link)
+        else:
+            try:
+                body, read = self._go_back(link)
+            except CouldNotTest as err:
+                self._axes_left(str(err))
+                return
+        here = self.guard.envelope.position()
+        shown = min(3, len(names))
+        away = [a for a, h in zip(names[:shown], here, strict=False) if h != 0]
+        if away:
+            unknown = [a for a, h in zip(names, here, strict=True) if h is None]
+            self._axes_left("no motion after a signal" if stopped else
+                            f"no motion after it: {self.guard.lost}" if self.guard.lost else
+                            f"where {', '.join(unknown)} stand is not known exactly" if unknown
+                            else "the way back would have left the envelope")
+            return
+        moved = (f"moved back with {body} at V{self.profile.reset.V}" if body else
+                 "no motion after the signal" if stopped else "no move needed")
+        which = "" if shown == len(names) else f" {', '.join(names[:shown])}"
+        self.report.restored.append(f"axes{which} back where the run began ({moved}); PF then "
+                                    f"read {_counters(read)}, where the frames put them")
+        for i in range(shown, len(names)):
+            if here[i] != 0:
+                self.report.reset.append(
+                    f"axis {names[i]} not verified: no position read shows it (PF reads "
+                    f"{', '.join(names[:shown])}), and the frames leave it anywhere in "
+                    f"{self.guard.where(i)} full steps from where the run began")
             else:
-                self.report.restored.append("checksum mode back on")
+                self.report.reset.append(f"axis {names[i]} back where the run began by the "
+                                         "frames (no position read shows it)")
+
+    def _axes_left(self, why: str) -> None:
+        self.report.problems.append(f"axes not brought back where the run began ({why}): "
+                                    f"{self.guard.whereabouts()} full steps from there")
 
     def _restore_counters(self, link: Link) -> None:
-        """The position counters read as they would had the run never zeroed them: as
-        found plus how far each axis now is from where the run began (N<axis>)."""
+        """The position counters count as they did before the run: as found where the
+        axes are back where the run began, found plus how far they are from there where
+        they are not (N<axis>), read back with PF."""
         names = self.profile.axes
-        self._position(link)
+        if not self.counters:
+            self.report.problems.append("position counters not restored: PF could not be "
+                                        "read before the run")
+            return
         here = self.guard.envelope.position()
+        unknown = [names[i] for i in self.counters if here[i] is None]
+        if unknown:
+            self.report.problems.append(
+                f"position counters {', '.join(unknown)} not restored: where the axes "
+                "stand is not known exactly, so the counts found cannot be carried to them")
         wanted = {i: c + int(here[i]) for i, c in self.counters.items() if here[i] is not None}
         settable = {i: v for i, v in wanted.items() if f"N{names[i]}" in self.profile.commands}
-        if not settable:
-            if self.counters:
-                self.report.reset.append(
-                    "position counters not restored (the unit cannot set them): they read "
-                    + ",".join(str(c) for c in self.counters.values()) + " when found")
-            return
-        for i, value in settable.items():
-            link.send(f"N{names[i]}{value}")
+        sent = [f"N{names[i]}{v}" for i, v in settable.items()]
+        for body in sent:
+            link.send(body)
         read = self._position(link)
-        if all(read.get(i) == v for i, v in settable.items()):
-            self.report.restored.append("position counters as found: " + ", ".join(
-                f"{names[i]} {v}" for i, v in settable.items()))
-        else:
-            self.report.problems.append(f"position counters not restored: PF reads {read}, "
-                                        f"expected {settable}")
+        found = _counters(self.counters)
+        if any(read.get(i) != v for i, v in settable.items()):
+            self.report.problems.append(
+                f"position counters not restored: {', '.join(sent)} sent, PF then read "
+                f"{_counters(read)}")
+        elif any(read.get(i) != v for i, v in wanted.items()):
+            # no N<axis> (the GVE54): left as the run's N set them where it began
+            self.report.reset.append(
+                f"position counters left reading {_counters(read)} (found {found}; the "
+                f"{self.profile.name} has no N<axis> to set them)")
+        elif wanted == self.counters:
+            self.report.restored.append(f"position counters as found: PF reads "
+                                        f"{_counters(read)}"
+                                        + (f" (set with {', '.join(sent)})" if sent else ""))
+        elif wanted:
+            self.report.restored.append(
+                f"position counters count from where they did before the run (found {found}, "
+                f"the axes now {self.guard.whereabouts()} full steps from there): "
+                f"{', '.join(sent)}; PF reads {_counters(read)}")
 
     def after_case(self) -> None:
         """EEPROM bytes a case wrote are put back as soon as it ends, so that no later
@@ -558,17 +676,21 @@ class RealSession(Session):
             if _hex_ok(r) and r.hex() == value:
                 changed.append("%02X" % address)
             else:
-                self.report.problems.append(f"EEPROM {address:02X} not restored to {value:02X} "
-                                            f"(reads {r})")
+                self.report.problems.append(f"EEPROM {address:02X} not restored to {value:02X}: "
+                                            f"written back, ER{address:02X} then answered "
+                                            f"{_shown(r)}")
         self.guard.eeprom.put_back(addresses)
         return changed
 
     def _restore_eeprom(self, link: Link) -> None:
         if not self.guard.eeprom.ever_written:
             return
+        before = len(self.report.problems)
         changed = self._eeprom_back(link, sorted(self.eeprom))
-        self.report.restored.append(f"EEPROM: {len(self.eeprom)} bytes verified"
-                                    + (f", {' '.join(changed)} written back" if changed else ""))
+        wrong = len(self.report.problems) - before
+        self.report.restored.append(
+            f"EEPROM: {len(self.eeprom) - wrong} of {len(self.eeprom)} bytes verified, read "
+            "back as found" + (f" ({' '.join(changed)} written back first)" if changed else ""))
 
     def _restore_status(self, link: Link) -> None:
         for n in RESTORE_ORDER:
@@ -578,16 +700,41 @@ class RealSession(Session):
         for n, value in sorted(self.status.items()):
             r = link.send(f"SR{n}")
             if not (_hex_ok(r) and r.hex() == value):
-                wrong.append(f"ST{n} reads {r}, found {value:02X}")
+                wrong.append(f"SR{n} answered {_shown(r)}, found {value:02X}")
         wrong += [f"ST{n} could not be read before the run, left 00" for n in range(6)
                   if n not in self.status]
         if wrong:
             self.report.problems.append("status words not restored: " + "; ".join(wrong))
         elif self.status:
-            self.report.restored.append("ST0..ST5 as found: " + " ".join(
-                "%02X" % v for _, v in sorted(self.status.items())))
+            self.report.restored.append("ST0..ST5 written back and read back as found: "
+                                        + " ".join("%02X" % v for _, v in
+                                                   sorted(self.status.items())))
+
+    def _restore_checksums(self, link: Link) -> None:
+        """The checksum mode as found (the known state left it off), read back as it was
+        found: `?` without a checksum is refused (4) in the mode (spec 6)."""
+        if self.checksums:
+            r = link.send("%+", checksum=False)
+            if r is None or not r.ok:
+                self.report.problems.append(f"checksum mode not turned back on: %+ answered "
+                                            f"{_shown(r)}")
+                return
+        r = link.send("?", checksum=False)
+        on = r is not None and r.code == ErrorCode.SYNTAX
+        off = r is not None and r.ok
+        if on if self.checksums else off:
+            self.report.restored.append(
+                "checksum mode " + ("back on: %+ answered, then ? without a checksum was "
+                                    "refused (4)" if self.checksums else
+                                    "off as found: ? without a checksum answered"))
+        else:
+            self.report.problems.append(
+                f"checksum mode not {'on' if self.checksums else 'off'} as found: ? without "
+                f"a checksum answered {_shown(r)}")
 
     def _unrestored(self) -> None:
+        if not any(line.startswith("axes") for line in self.report.restored + self.report.problems):
+            self._axes_left("the restorations stopped before")
         if self.guard.eeprom.written:
             written = sorted(self.guard.eeprom.written)
             self.report.problems.append("EEPROM not verified: bytes written by the run: "
@@ -622,6 +769,21 @@ def _read_eeprom(link: Link, addresses: list[int]) -> dict[int, Response | None]
         chunk = addresses[start:start + EEPROM_READS]
         read.update(zip(chunk, link.send_each(["ER%02X" % a for a in chunk]), strict=True))
     return read
+
+
+def _shown(r: Response | None) -> str:
+    """An answer as a report says it: its bytes escaped but its last CR, or that none
+    came."""
+    return "nothing" if r is None else readable(r.raw.removesuffix(b"\r"))
+
+
+def _taken(r: Response | None) -> bool:
+    return r is not None and r.ok
+
+
+def _counters(read: dict[int, int]) -> str:
+    """Counters as PF shows them: ``394,0,0`` (``?`` for an axis not read)."""
+    return ",".join(str(v) for v in read.values()) if read else "nothing readable"
 
 
 def _hex_ok(r: Response | None) -> bool:

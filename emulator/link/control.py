@@ -19,6 +19,7 @@ from collections.abc import Callable
 
 from emulator.link.line import Line
 from emulator.link.url import parse_address
+from emulator.link.words import decimal, hex_byte
 
 HELP = "commands: in PORT HEX | switch AXIS POS|none | power-on | state | quit  [@ADDRESS]"
 
@@ -28,16 +29,19 @@ class Quit(Exception):
 
 
 def _input(line: Line, args: list[str], address: int | None) -> str:
-    port, value = int(args[0]), int(args[1], 16)
-    if port not in (0, 1, 2) or not 0 <= value <= 0xFF:
-        return "error: in PORT HEX with PORT 0..2 and HEX 00..FF"
-    line.set_input(port, value, address)
+    if args[0] not in ("0", "1", "2"):
+        return f"error: in PORT HEX: PORT is 0, 1 or 2, not {args[0][:40]!r}"
+    line.set_input(int(args[0]), hex_byte(args[1], "in PORT HEX: HEX"), address)
     return "ok"
 
 
 def _switch(line: Line, args: list[str], address: int | None) -> str:
-    position = None if args[1].lower() == "none" else int(args[1])
-    line.set_switch(args[0].upper(), position, address)
+    axis = args[0].upper()
+    if axis not in ("X", "Y", "Z", "A"):
+        return f"error: switch AXIS POS: AXIS is X, Y, Z or A, not {args[0][:40]!r}"
+    position = (None if args[1].lower() == "none" else
+                decimal(args[1], "switch AXIS POS: POS", signed=True))
+    line.set_switch(axis, position, address)
     return "ok"
 
 

@@ -26,11 +26,14 @@ from emulator.link import control
 from emulator.link.control import Quit
 from emulator.link.line import Line, TimeRangeError, byte_time
 from emulator.link.server import CONTROL_LIMIT, StdoutGone
+from emulator.link.words import decimal
 
 VERSION = 1
 #: the optional extensions this simulator speaks, named on its first line (docs/cosim.md)
 EXTENSIONS = ("batch", "batch-stops")
 CR = b"\r"
+#: the fastest line `baud` takes: a byte must take at least a nanosecond
+MAX_BAUD = 10**9
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
         "| in PORT HEX | switch AXIS POS|none | power-on | state | quit  "
         "[@ADDRESS on in, switch, power-on, state]")
@@ -40,10 +43,15 @@ class CosimError(ValueError):
     """A malformed command: one `error: ...` line, nothing changed."""
 
 
+def _whole(text: str, what: str) -> int:
+    try:
+        return decimal(text, what)
+    except ValueError as err:
+        raise CosimError(str(err)) from None
+
+
 def _instant(text: str) -> int:
-    if not text.isdigit():
-        raise CosimError(f"an instant is whole nanoseconds (0 or more), not {text!r}")
-    return int(text)
+    return _whole(text, "an instant (whole nanoseconds)")
 
 
 def _hex(text: str) -> bytes:
@@ -146,9 +154,12 @@ class Cosim:
         return [f"next {due}" if due is not None else "next none"]
 
     def _baud(self, args: list[str]) -> list[str]:
-        if len(args) != 1 or not args[0].isdigit() or int(args[0]) <= 0:
-            raise CosimError("baud N with N a whole number above 0")
-        self.line.baud = int(args[0])
+        if len(args) != 1:
+            raise CosimError("baud N")
+        baud = _whole(args[0], "baud N: N")
+        if not 0 < baud <= MAX_BAUD:
+            raise CosimError(f"baud N with N from 1 to {MAX_BAUD}, not {baud}")
+        self.line.baud = baud
         self.line.byte_ns = byte_time(self.line.baud)
         return ["ok"]
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from urllib.parse import parse_qs, urlsplit
 
+from emulator.link.words import decimal
 from emulator.protocol.unit import Unit
 from emulator.readings import parse_readings
 from gve_fixtures.profile import load_profile
@@ -52,9 +53,13 @@ class LineSpec:
 
 def positive(name: str, text: str) -> int:
     """A whole number above 0 (a baud rate, a watchdog time)."""
-    if not text.isdigit() or int(text) <= 0:
-        raise ValueError(f"{name} must be a whole number above 0, not {text!r}")
-    return int(text)
+    try:
+        value = decimal(text, name)
+    except ValueError:
+        value = 0
+    if value <= 0:
+        raise ValueError(f"{name} must be a whole number above 0, not {text[:40]!r}")
+    return value
 
 
 def parse_address(text: str) -> int:

@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 from emulator.motion.interface import EMPTY_SAVE, KeepSave
 from emulator.protocol.device import Device
-from emulator.protocol.params import CommandError, dec, fields, within
+from emulator.protocol.params import CommandError, dec, fields, plain, within
 from emulator.protocol.reply import Answer, Deferred, Reply
 from emulator.protocol.session import Session
 from emulator.protocol.state import INTA, INTCOM, Saved
@@ -75,10 +75,10 @@ def modal(key: str, attr: str) -> Handler:
     """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
-        head = p.split(",")[0]
-        if key == "V" and "," in p and head.isdigit() and r.lo <= int(head) <= r.hi \
+        head = plain(p.split(",")[0])
+        if key == "V" and "," in p and head is not None and r.lo <= head <= r.hi \
                 and dev.mutant.active("velocity-syntax-refused-stored"):
-            dev.state.modal.V = int(head)
+            dev.state.modal.V = head
         value = dec(p)
         if not r.lo <= value <= r.hi and _stores_refused(dev, key):
             setattr(dev.state.modal, attr, min(max(value, r.lo), r.hi))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from emulator.protocol.cmd_motion import parse_steps
 from emulator.protocol.device import Device
-from emulator.protocol.params import CommandError, dec, within
+from emulator.protocol.params import CommandError, dec, plain, within
 from emulator.protocol.reply import Answer, Plain, Reply
 from emulator.protocol.session import Member, Session
 from gve_fixtures.protocol import ErrorCode
@@ -48,9 +48,10 @@ def member(dev: Device, name: str | None, params: str) -> Member:
         return Member(None, None, ErrorCode.UNKNOWN)
     if name not in ("C", "B"):
         r = dev.profile.ranges["V"]
+        value = plain(params)
         if name == "V" and dev.mutant.active("failed-packet-applies-v") \
-                and params.isdigit() and r.lo <= int(params) <= r.hi:
-            dev.state.modal.V = int(params)
+                and value is not None and r.lo <= value <= r.hi:
+            dev.state.modal.V = value
         return Member(name, None, ErrorCode.SYNTAX)
     try:
         if name == "C":

@@ -40,6 +40,12 @@ def dec(text: str) -> int:
     return int(text)
 
 
+def plain(text: str) -> int | None:
+    """``text`` as ASCII digits without a sign, else None: for the mutants that keep a
+    refused value (``str.isdigit`` takes ``²``, which ``int`` then refuses)."""
+    return int(text) if _DEC.match(text) and text[:1] != "-" else None
+
+
 def hexa(text: str) -> int:
     """A hexadecimal field of one or more digits of either case (syntax only)."""
     if not _HEX.match(text):

@@ -58,3 +58,10 @@ def test_reasons_come_from_the_notes():
         "need a hand at the unit"
     assert why(["missing: the profile lacks W"]) == "not in the profile"
     assert why(["something nobody foresaw"]) == OTHER
+
+
+def test_a_case_that_needs_a_reset_says_what_to_run_with():
+    """A real unit is restarted with J only with --allow-destructive: the last line
+    says so rather than "other reasons"."""
+    phrase = why(["could not test: needs a reset (J): run with --allow-destructive"])
+    assert phrase != OTHER and "reset" in phrase and "--allow-destructive" in phrase

@@ -17,9 +17,10 @@ import serial
 class Emulator:
     """The emulator process, its first stdout line, and its control channel."""
 
-    def __init__(self, *args: str, stdin: int | None = subprocess.PIPE) -> None:
+    def __init__(self, *args: str, stdin: int | None = subprocess.PIPE,
+                 module: str = "emulator") -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "emulator", *args], stdin=stdin,
+            [sys.executable, "-m", module, *args], stdin=stdin,
             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         self._pending = b""
         self.first = self.readline(20.0)

@@ -7,9 +7,11 @@ interleaved with valid frames; after every valid frame the invariants are checke
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from emulator.mutants import MUTANTS
 from tests.emulator.replay import open_line
 
 FRAMES = ["V1000", "V5", "L5,0,0", "L-3,2,1", "C7,0,0", "C1,1,1", "T99", "SW8,F1", "SR6",
@@ -90,3 +92,25 @@ def test_bad_input_never_breaks_the_unit(model, items):
 def _had_reset(items) -> bool:
     """Frames that legitimately move the counters apart from the vectors."""
     return any(kind == "frame" and value in ("N", "D", "K", "R") for kind, value in items)
+
+
+#: fields with digits that are not ASCII (``str.isdigit`` takes them, ``int`` does not),
+#: in every place a field stands: a lone modal value, one before a comma, a packet member
+UNREADABLE_DIGITS = [b"!0V\xb2\r", b"!0V\xb2,5\r", b"!0V1\xb9,5\r", b"!0L\xb2,0,0\r",
+                     b"!0T\xb3\r", b"!0SW\xb2,00\r", b"!0*S\r", b"!0V\xb2\r", b"!0C\xb2,0,0\r",
+                     b"!0*E1\r"]
+
+
+@pytest.mark.parametrize("mutant", [None, *sorted(MUTANTS)])
+def test_digits_outside_ascii_are_a_syntax_error_for_every_mutant_too(mutant):
+    """A frame is bytes from the line, read as Latin-1: '²' is a digit to Python's
+    isdigit; the unit (and each planted bug, whose branches read the fields before they
+    look at the mutant) answers it as a field it cannot read, never with a crash."""
+    port = open_line("GVE114-500", 0, **({} if mutant is None else {"mutant": mutant}))
+    answers = []
+    for frame in UNREADABLE_DIGITS:
+        port.write(frame)
+        port.line.advance(0.05)
+        answers.append(port.read(port.in_waiting))
+    assert all(a == b"" or a.endswith(b"\r") for a in answers), answers
+    assert answers[0] == b"4\r" or mutant is not None

@@ -1,6 +1,7 @@
-"""-q and -v where they are offered beside the run: `diff`, `replay` and a fleet print
-only their last line with -q (the verdict, which the exit status agrees with); -v on
-`diff` prints each disagreement's transcript although the reports keep it too."""
+"""-q and -v where they are offered beside the run: with -q `diff` and a fleet print
+only their end (what failed, where the reports are, the verdict, which the exit status
+agrees with) and `replay` its verdict; -v on `diff` prints each disagreement's
+transcript although the reports keep it too."""
 
 from __future__ import annotations
 
@@ -16,11 +17,16 @@ def _verdict_only(lines: list[str]) -> str:
     return lines[0]
 
 
-def test_diff_quiet_prints_the_verdict_only(tmp_path, capsys):
+def test_diff_quiet_prints_its_end_only(tmp_path, capsys):
     assert main([*DIFF, "-q", "--report-dir", str(tmp_path)]) == 1
-    last = _verdict_only(capsys.readouterr().out.splitlines())
-    assert last.startswith("FAILED")
-    assert (next(tmp_path.iterdir()) / "diff-01.gvt").is_file()    # the reports all the same
+    lines = capsys.readouterr().out.splitlines()
+    folder = next(tmp_path.iterdir())
+    assert (folder / "diff-01.gvt").is_file()                     # the reports all the same
+    assert lines[-1].startswith("FAILED") and lines[-2].startswith(f"reports: {folder}/")
+    # the disagreement listed once, in the recap: neither the search's header nor
+    # its progress
+    assert lines[0].startswith("what failed (1)") and "3.frame.upper-case [D]" in lines[2]
+    assert not any(line.startswith(("diff:", "[")) for line in lines)
 
 
 def test_diff_verbose_prints_the_transcripts_beside_the_reports(tmp_path, capsys):

@@ -31,8 +31,8 @@ def test_two_tcp_units_run_in_parallel_on_two_workers(tcp_units, tmp_path):
                           check=False)
     out = done.stdout + done.stderr
     assert done.returncode == 0, out
-    # "[gw1] [ 50%] PASSED ::5.errors.ok[tcp:127.0.0.1:40001]@gve-port:..."
-    ran = re.findall(r"\[(gw\d+)\] \[[ \d%]+\] (\w+) ::\S+\[tcp:([\d.:]+)\]", out)
+    # "[gw1] [ 50%] PASSED gve/GVE84-100/section5::5.errors.ok[tcp:127.0.0.1:40001]@gve-..."
+    ran = re.findall(r"\[(gw\d+)\] \[[ \d%]+\] (\w+) \S+::\S+\[tcp:([\d.:]+)\]", out)
     workers = {where: {w for w, _, port in ran if port == where} for where in ports}
     assert all(len(w) == 1 for w in workers.values()), workers     # a port, one worker
     assert workers[ports[0]] != workers[ports[1]]                   # in parallel

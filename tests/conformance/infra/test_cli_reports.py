@@ -57,7 +57,7 @@ def test_list(capsys):
 
 def test_emu_all_means_every_profile(capsys):
     assert main(["--target", "emu:all", "--cases", "5.errors.go-without-inta",
-                 "--no-reports"]) == 0
+                 "--no-reports", "-v"]) == 0
     out = capsys.readouterr().out
     assert "8 case runs on 8 target(s)" in out and "[GVE54]" in out and "[GVE114-500]" in out
 

@@ -86,12 +86,12 @@ def test_a_set_counter_read_back_otherwise_is_a_counter_not_a_move():
     assert x(g) == (0, 0)
 
 
-def test_without_a_counter_set_a_read_that_contradicts_the_frames_wins():
+def test_without_a_counter_set_a_read_that_contradicts_the_frames_wins_nothing():
     g = guard()
     sent(g, "L300,0,0")
     sent(g, "L0,0,0")
-    sent(g, "PF", "0,450,0,0")             # moved by other means (a hand-wheel)
-    assert x(g) == (450, 450) and g.envelope.unheld == []
+    sent(g, "PF", "0,450,0,0")             # moved by other means, or restarted and moved on
+    assert x(g) == (450, 750) and g.envelope.unheld == [] and g.lost
 
 
 def test_a_halted_and_deleted_vector_leaves_the_axis_anywhere_on_it_until_read():
@@ -201,3 +201,17 @@ def test_unreadable_numbers_in_a_motion_frame_are_unbounded():
     refused(g, "l600,0,0")                 # lower case: a lenient unit may take it
     sent(g, "L+5, 5,")                     # lenient readings stay bounded
     assert x(g) == (0, 5)
+
+
+def test_a_packet_a_breaker_discards_may_have_been_committed_as_it_arrived():
+    g = guard()
+    sent(g, "*S", None)
+    sent(g, "C0,200,0", None)
+    sent(g, "C0,200,0", None)
+    sent(g, "@", "0,3")                    # discards the packet (our reading [D]) ...
+    # ... but a unit may have queued the members as they came (spec 7 is silent)
+    assert g.envelope.reach()[1] == Span(0, 400)
+    sent(g, "*S", None)
+    sent(g, "C0,-50,0", None)
+    sent(g, "*S", None)                    # a second *S restarts it: the same
+    assert g.envelope.reach()[1] == Span(-50, 400)

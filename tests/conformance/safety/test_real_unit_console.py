@@ -28,7 +28,7 @@ def test_the_console_says_what_the_session_did(tmp_path, capsys):
     assert "largest excursion (full steps, envelope ±800): X +0..+500, Y +0..+0, Z +0..+0" \
         in out
     assert "restored: axes back where the run began" in out
-    assert "restored: ST0..ST5 as found: 00 00 00 00 00 00" in out
+    assert "restored: ST0..ST5 written back and read back as found: 00 00 00 00 00 00" in out
     (folder,) = tmp_path.iterdir()
     html = (folder / "report.html").read_text()
     assert "restored: axes back where the run began" in html and "±800" in html
@@ -46,8 +46,9 @@ def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
     result.assert_outcomes(passed=2)
     assert state["status"][0] == "05" and state["physical"] == [0, 0, 0]
     # one session for the whole pytest run: the unit as found is read once (the checksum
-    # probe and the identity ask ? once each, then the ones that measure the line's round trip)
-    assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 2 + ROUND_TRIPS
+    # probe and the identity ask ? once each, then the ones that measure the line's round
+    # trip), and the checksum mode is read back once at the end
+    assert sum(f.startswith(b"!0?") for f in proxy.sent()) == 3 + ROUND_TRIPS
 
 
 def _mpg_unit(tmp_path) -> list[str]:

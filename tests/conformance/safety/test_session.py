@@ -86,7 +86,7 @@ def test_a_destructive_run_leaves_random_eeprom_byte_for_byte(tmp_path, profile,
     assert any(f.startswith((b"!0EW", b"!0EFW", b"!0EUW")) for f in unit.frames)
     assert image.read_bytes() == found
     assert result.problems == []
-    assert any("EEPROM: 256 bytes verified" in line
+    assert any("EEPROM: 256 of 256 bytes verified, read back as found" in line
                for line in result.sessions[unit.info.spec]["restored"])
 
 

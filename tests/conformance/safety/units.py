@@ -13,6 +13,9 @@ import serial
 import emulator  # noqa: F401  (registers gve://)
 from conformance.case import TargetInfo
 from conformance.targets.port import PortTarget
+from conformance.targets.rig import ControlRig
+from conformance.verdict import CouldNotTest
+from emulator.link.control import handle
 from gve_fixtures.profile import load_profile
 
 
@@ -80,3 +83,45 @@ def in_process_unit(profile: str = "GVE84-100", *, max_travel: int = 2000,
         + (f"&reading={','.join(readings)}" if readings else "")
     info = TargetInfo("serial", f"serial:{url}", False, False, allow_destructive, max_travel)
     return InProcessUnit(info, p, p.address, p.default_baud, url)
+
+
+class VirtualUnit(PortTarget):
+    """The emulator in process in virtual time, judged as a real unit (its session
+    guards, restores and books every frame), its line the rig: what a co-simulator is,
+    without a process. ``unit`` is the emulator's unit (tests may reach inside it)."""
+
+    with_rig = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._keep = serial.serial_for_url(self.url, timeout=0.25)
+        self.line = self._keep.line
+        self.unit = self.line.units[0]
+        # the rig over the emulator's control channel, as an exec: target's is
+        self.rig = ControlRig(lambda command: handle(self.line, command), self.line.state(),
+                              self.address, self._power_cycled)
+
+    def _power_cycled(self) -> None:
+        self.session.guard.restarted()
+
+    def connect(self, address: int | None):
+        if address is not None and address != self.address:
+            raise CouldNotTest(f"needs a unit at address {address}")
+        return self._keep, self.line.baud, True, self.rig if self.with_rig else None
+
+    def close(self) -> None:
+        return None
+
+    def state(self) -> dict:
+        return self.line.state()
+
+
+def virtual_unit(profile: str = "GVE84-100", *, max_travel: int = 2000,
+                 allow_destructive: bool = False, rig: bool = True,
+                 readings: tuple[str, ...] = ()) -> VirtualUnit:
+    p = load_profile(profile)
+    url = f"gve://?model={profile}" + (f"&reading={','.join(readings)}" if readings else "")
+    info = TargetInfo("serial", f"virtual:{profile}", True, rig, allow_destructive, max_travel)
+    unit = VirtualUnit(info, p, p.address, p.default_baud, url)
+    unit.with_rig = rig
+    return unit

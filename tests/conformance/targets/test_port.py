@@ -5,8 +5,11 @@ from __future__ import annotations
 
 import pytest
 
+from conformance.catalogue import select
+from conformance.runner import run
 from conformance.targets import TargetError, parse_target
 from conformance.targets.port import locate
+from conformance.verdict import PASS
 
 
 @pytest.mark.parametrize(("rest", "url", "ours"), [
@@ -44,3 +47,22 @@ def test_a_tcp_target_needs_a_host_and_a_port(rest):
 ])
 def test_a_tcp_target_with_a_host_and_a_port(rest, url):
     assert parse_target(f"tcp:{rest}", profile="GVE84-100").url == url
+
+
+def test_the_emulator_s_own_url_is_a_unit_on_a_port_in_real_time():
+    """`serial:gve://…` (the handler the project ships) opens, in real time, and is judged
+    as a unit that is not the suite's own: the known state, the envelope, the grading."""
+    t = parse_target("serial:gve://?model=GVE84-100&address=3", profile="GVE84-100")
+    assert t.url == "gve://?model=GVE84-100&address=3&realtime=1" and t.address == 3
+    t.preflight()
+    try:
+        result = run([t], select(["5.errors.ok"]))
+    finally:
+        t.close()
+    assert [r.verdict for r in result.results] == [PASS]
+    assert t.info.real
+
+
+def test_the_emulator_s_url_in_virtual_time_points_to_the_targets_that_run_it_so():
+    with pytest.raises(TargetError, match="emu:MODEL"):
+        parse_target("serial:gve://?model=GVE84-100&realtime=0", profile="GVE84-100")

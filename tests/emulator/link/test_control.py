@@ -34,7 +34,9 @@ def test_state_of_several_units_is_keyed_by_address() -> None:
 
 @pytest.mark.parametrize("text", ["fly 1", "in 1", "in 1 ZZ", "in 9 00", "in 1 100",
                                   "switch Y here", "state 3", "in 1 FE @7", "power-on now",
-                                  "state @z", "@"])
+                                  "state @z", "@", "in \u00b2 00", "in 1 \u00b2F",
+                                  "switch X \u00b2", "switch X " + "9" * 5000, "switch Q 5",
+                                  "in 1 +F"])
 def test_malformed_lines_answer_an_error(text: str) -> None:
     line = Line([FakeUnit()], 9600)
     answer = handle(line, text)

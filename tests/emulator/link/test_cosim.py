@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 import serial
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import emulator  # noqa: F401  (registers gve://)
 from emulator.link.control import Quit
@@ -97,7 +99,9 @@ def test_next_names_what_is_due():
 
 @pytest.mark.parametrize("text", ["tx", "tx 2", "tx ZZ", "tx 21 22 23", "until", "until -5",
                                   "until 1.5", "until 0 0", "next 1", "baud 0", "baud x",
-                                  "fly", "tx 210D 1"])
+                                  "fly", "tx 210D 1", "until \u00b2", "until " + "9" * 5000,
+                                  "baud \u00b2", "baud " + "9" * 40, "tx 210D \u00b2",
+                                  "batch \u00b2 210D", "in 1 \u00b2F", "switch X \u00b2"])
 def test_malformed_commands_are_one_error_line_and_change_nothing(text):
     c = cosim()
     c.handle("until 1000")
@@ -227,3 +231,137 @@ def test_a_malformed_batch_is_one_error_line_and_changes_nothing(text):
     reply = c.handle(text)
     assert len(reply) == 1 and reply[0].startswith("error: ")
     assert c.handle("until 1000") == ["now 1000"] and c.handle("next") == ["next none"]
+
+
+words = st.sampled_from(["tx", "until", "next", "baud", "batch", "in", "switch", "state",
+                         "power-on", "help", "210D", "1", "X", "none", "@0", "@9", "-5",
+                         "\u00b2", "\u0663", "9" * 30, "", "0D" * 3, "1e5"])
+
+
+@given(st.lists(st.one_of(words, st.text(max_size=6)), max_size=5).map(" ".join))
+@settings(max_examples=300, deadline=None, derandomize=True)
+def test_any_line_is_replies_never_a_crash(text):
+    """Whatever a driver sends, the reply is lines (an error among them), and the clock
+    never goes back: numbers are ASCII digits of bounded length, or an error."""
+    c = cosim()
+    before = c.line.now
+    try:
+        replies = c.handle(text)
+    except Quit:
+        return
+    assert all(isinstance(r, str) and "\n" not in r for r in replies)
+    assert c.line.now >= before
+
+
+# -- the answers docs/cosim.md and docs/rig.md give a simulator's author ------------------------
+def tx(c: Cosim, frame: bytes, until: int | None = None) -> list[str]:
+    """`tx HEX [T]` of ``frame``."""
+    return c.handle(f"tx {frame.hex().upper()}" + ("" if until is None else f" {until}"))
+
+
+def test_an_empty_line_is_no_command_and_gets_no_reply():
+    c = cosim()
+    assert c.handle("") == [] and c.handle("  \r\n") == []
+    assert c.line.now == 0
+
+
+def test_help_is_one_line():
+    (reply,) = cosim().handle("help")
+    assert reply.startswith("commands: ")
+
+
+def test_an_input_port_the_unit_lacks_is_taken_and_changes_nothing():
+    """The GVE84 reads I1 only (its I2 is refused, 3) and has no interrupt behind port 2
+    (ST1 enables nothing): `in 2 00` is a hand on a pin with nothing behind it."""
+    c = cosim("GVE84-100")
+    for frame in (b"!0SW1,FF\r", b"!0SW3,00\r"):
+        tx(c, frame, 100000000)
+    assert c.handle("in 2 00") == ["ok"]
+    *got, _ = tx(c, b"!0SR6\r", 100000000)
+    assert rx(got) == b"0,00\r"                          # no INTA: no interrupt
+    *got, _ = tx(c, b"!0I2\r", 100000000)
+    assert rx(got) == b"3\r"
+
+
+def test_a_switch_is_seen_by_w_alone():
+    """A rig's switch is a point W finds, releasing one step back: the input ports (I1)
+    and the interrupts do not see it (the inputs enabled, their polarity as at reset)."""
+    c = cosim("GVE84-100")
+    tx(c, b"!0SW0,07\r", 100000000)
+    assert c.handle("switch X -150") == ["ok"]
+    for frame, answer in ((b"!0I1\r", b"0,FF\r"), (b"!0SR6\r", b"0,00\r")):
+        *got, _ = tx(c, frame, 100000000)
+        assert rx(got) == answer
+    *got, _ = tx(c, b"!0WX,-1000,1000,100,500\r", 1000000000)
+    assert rx(got) == b"0\r"                              # found, released, zeroed
+    state = json.loads(c.handle("state")[0])
+    assert state["position"][0] == 0 and state["physical"][0] == -149
+
+
+def test_power_on_loses_what_arrives_while_it_restarts_and_keeps_what_is_on_the_line():
+    """An answer already on its way to the host completes; bytes to the unit during the
+    restart (the profile's restart_ms, 2 s) are lost; then it answers as after a reset."""
+    c = cosim("GVE84-100")
+    tx(c, b"!0?\r")                     # its answer has begun
+    assert c.handle("power-on") == ["ok"]
+    *got, _ = c.handle("until 100000000")
+    assert rx(got).startswith(b"0,IP84")
+    *got, _ = tx(c, b"!0?\r", 1900000000)
+    assert rx(got) == b""                                 # deaf: lost
+    c.handle("until 2100000000")
+    *got, _ = tx(c, b"!0@\r", 2200000000)
+    assert rx(got) == b"0,0\r"                            # the index of a fresh start
+
+
+def test_an_answer_due_later_is_dropped_by_power_on():
+    c = cosim("GVE84-100")
+    tx(c, b"!0L5000,0,0\r", 100000000)
+    c.handle("until 500000000")                           # at speed
+    tx(c, b"!0H\r")                                       # answered once the axes stop
+    assert c.handle("power-on") == ["ok"]
+    assert c.handle("until 2000000000") == ["now 2000000000"]
+
+
+def test_tx_with_an_instant_before_the_bytes_end_is_refused():
+    c = cosim()
+    (reply,) = tx(c, b"!0?\r", 3 * B)
+    assert reply.startswith("error: ") and c.line.now == 0
+
+
+def test_next_tells_the_watchdog_and_the_end_of_a_vector():
+    c = cosim("GVE84-100")
+    tx(c, b"!0")                                          # a frame left unfinished
+    watchdog_ms = c.line.units[0].profile.watchdog_ms
+    assert c.handle("next") == [f"next {2 * B + watchdog_ms * 1_000_000}"]
+    *got, _ = c.handle("until 1000000000")
+    assert rx(got) == b"2\r"                             # dropped, answered 2
+    *_, now = tx(c, b"!0L100,0,0\r", c.line.now + 100000000)
+    (due,) = c.handle("next")
+    assert int(due.split()[1]) > int(now.split()[1])      # the vector's end, by itself
+    c.handle(f"until {due.split()[1]}")
+    *got, _ = tx(c, b"!0SR6\r", c.line.now + 100000000)
+    assert rx(got) == b"0,00\r"                          # it had ended: idle
+
+
+def test_an_event_at_the_instant_a_byte_completes_comes_first():
+    """The watchdog drops an unfinished frame at its deadline (answering 2, the frame
+    having its address); a CR completing at that very instant then ends no frame."""
+    c = cosim("GVE84-100")
+    tx(c, b"!0?")
+    deadline = int(c.handle("next")[0].split()[1])
+    c.handle(f"until {deadline - B}")
+    *got, _ = tx(c, b"\r", deadline + 100000000)
+    assert rx(got) == b"2\r"
+
+
+def test_a_baud_change_keeps_the_byte_begun_and_times_the_rest_anew():
+    c = cosim("GVE84-100")
+    tx(c, b"!0?\r")                     # the answer's first byte begins
+    assert c.handle("baud 9600") == ["ok"]
+    *got, _ = c.handle("until 1000000000")
+    instants = [int(r.split()[1]) for r in got if r.startswith("rx")]
+    slow = byte_time(9600)
+    assert instants[0] == 5 * B                           # begun at 115200 baud
+    runs = [(int(t), len(bytes.fromhex(d))) for _, t, d in (r.split() for r in got)]
+    ends = [t + (n - 1) * slow for t, n in runs]
+    assert ends[-1] == 5 * B + 19 * slow                   # 19 bytes more at 9600 baud

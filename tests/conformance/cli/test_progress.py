@@ -1,0 +1,84 @@
+"""Long jobs show they are moving: in a log (not a terminal) `mutation`, `fairness` and
+a fleet print a numbered line per step (n/N), `diff` a line at every tenth of its
+sequences with how many it ran; a terminal gets a bar instead."""
+
+from __future__ import annotations
+
+import io
+import re
+
+from conformance.cli import main
+from conformance.cli.progress import Progress
+
+STEP = re.compile(r"\[(\d+)/(\d+)\] ")
+
+
+def _steps(out: str) -> list[tuple[int, int, str]]:
+    return [(int(m.group(1)), int(m.group(2)), line[m.end():])
+            for line in out.splitlines() if (m := STEP.match(line))]
+
+
+def test_mutation_numbers_each_mutant_in_a_log(capsys):
+    mutants = ["range-error-code", "lower-case-command"]
+    argv = ["mutation", "--profile", "GVE84-100", "--cases", "1.*", "--cases", "3.*"]
+    for m in mutants:
+        argv += ["--mutant", m]
+    assert main(argv) == 0
+    steps = _steps(capsys.readouterr().out)
+    assert [(n, total) for n, total, _ in steps] == [(1, 2), (2, 2)]
+    assert all(m in text for m, (_, _, text) in zip(mutants, steps, strict=True))
+
+
+def test_mutation_quiet_prints_its_score_only_when_nothing_failed(capsys):
+    assert main(["mutation", "--profile", "GVE84-100", "--cases", "1.*",
+                 "--mutant", "range-error-code", "-q"]) == 0
+    (line,) = capsys.readouterr().out.splitlines()
+    assert line.startswith("mutation score: 1/1")
+
+
+def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
+    # `?` answers alike whatever the range code: that case alone misses the mutant
+    assert main(["mutation", "--profile", "GVE84-100", "--cases", "1.profile.version",
+                 "--mutant", "range-error-code", "-q"]) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("what failed") and "range-error-code" in lines[1]
+    assert lines[-1].startswith("mutation score: 0/1")
+
+
+def test_fairness_numbers_each_reading_in_a_log(capsys):
+    assert main(["fairness", "--reading", "plus-sign", "--cases", "3.params.*"]) == 0
+    (step,) = _steps(capsys.readouterr().out)
+    assert step[:2] == (1, 1) and "plus-sign" in step[2]
+
+
+def test_diff_says_how_far_it_is_at_every_tenth(capsys):
+    assert main(["diff", "--target", "emu:GVE84-100", "--examples", "20", "--no-probes",
+                 "--no-reports", "--seed", "3"]) == 0
+    steps = _steps(capsys.readouterr().out)
+    assert [n for n, _, _ in steps] == list(range(2, 21, 2))
+    assert all(total == 20 for _, total, _ in steps)
+    assert all(f"{n} sequences" in text for n, _, text in steps)
+
+
+def test_a_fleet_numbers_each_target_as_it_ends(capsys):
+    targets = ["emu:GVE54", "emu:GVE84-100"]
+    argv = ["--jobs", "2", "--cases", "1.profile.version", "--no-reports"]
+    for t in targets:
+        argv += ["--target", t]
+    assert main(argv) == 0
+    steps = _steps(capsys.readouterr().out)
+    assert sorted(n for n, _, _ in steps) == [1, 2]
+    assert sorted(text.split(":", 1)[0] + ":" + text.split(":")[1] for _, _, text in steps) \
+        == sorted(targets)
+    assert all("PASSED" in text for _, _, text in steps)
+
+
+def test_a_terminal_gets_a_bar_of_the_steps_and_the_lines_that_need_reading():
+    out = io.StringIO()
+    with Progress(3, unit="mutant", stream=out, terminal=True, refresh=0,
+                  every_step=True) as shown:
+        shown.step("caught  a", routine=True)
+        shown.step("MISSED  b")
+        shown.step("caught  c", routine=True)
+    text = out.getvalue()
+    assert "3/3" in text and "MISSED  b" in text and "caught" not in text
