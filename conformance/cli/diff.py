@@ -30,7 +30,7 @@ from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
-from conformance.link.safety import TargetNotResponding
+from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.runner import RunResult
@@ -201,7 +201,8 @@ def main(argv: list[str] | None = None) -> int:
             search(pair, options, budget, seed=seed, with_probes=not args.no_probes,
                    on_finding=kept.kept, on_seen=kept.seen, on_dropped=kept.dropped,
                    reach=reach)
-    except (TargetNotResponding, SessionError, CouldNotTest) as err:
+    except (TargetNotResponding, SafetyStop, SessionError, CouldNotTest) as err:
+        # the guard's stop outside a sequence's frames (each frame's is the sequence's)
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
         r.verdict, r.stopped = (FAIL if isinstance(err, TargetNotResponding)

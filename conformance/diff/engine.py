@@ -144,16 +144,17 @@ class Pair:
         """Both sides in the known state; False when the guard refused it."""
         try:
             self.target.open(tell=PRELUDE if self.target.real else ())
+            self.reference.open()
+            self.timing.begin()
+            self._index = IndexBase()
+            if self.target.real:
+                self._prelude()
         except SafetyStop as err:
-            # the known state itself was refused (a minimiser's candidate left the unit
-            # where the guard cannot bring it back): the candidate shows nothing
+            # the known state or the reads after it were refused (a minimiser's candidate
+            # left the unit where the guard cannot bring it back, or the guard saw the
+            # unit restart there): the candidate shows nothing
             out.refused.append(f"the known state: {err}")
             return False
-        self.reference.open()
-        self.timing.begin()
-        self._index = IndexBase()
-        if self.target.real:
-            self._prelude()
         self.course = Course(self.profile)
         return True
 

@@ -14,6 +14,7 @@ from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.labels import label
 from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME, WAIT
+from conformance.link.safety import UnitRestarted
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
 from gve_fixtures.profile import load_profile
@@ -225,3 +226,22 @@ def test_a_disagreement_is_told_before_it_is_shrunk_and_again_when_kept():
                    on_finding=lambda f: told.append(("kept", f.number, f.frames)))
     assert found and [t[:2] for t in told] == [("seen", 1), ("kept", 1)]
     assert told[1][2] <= told[0][2]                 # shrunk: no more frames than seen
+
+
+def test_a_restart_seen_in_the_reads_after_the_known_state_ends_only_that_sequence(
+        monkeypatch):
+    # a unit living on between sequences: the guard may see it restart by itself in the
+    # reads that follow the known state; that sequence shows nothing, the search goes on
+    p = pair(None)
+    monkeypatch.setattr(Side, "real", property(lambda self: self is p.target))
+    preludes = []
+
+    def restarted():
+        preludes.append(1)
+        raise UnitRestarted("the unit restarted by itself: PF read 0,0,0 at rest")
+
+    monkeypatch.setattr(p, "_prelude", restarted)
+    out = p.run(Grammar(p.profile, EVERYTHING).idiom(["L10,0,0", "PF"]))
+    assert out.disagreement is None and out.frames == 0 and preludes
+    assert out.refused == ["the known state: the unit restarted by itself: PF read 0,0,0 "
+                           "at rest"]
