@@ -78,8 +78,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
     ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
     ap.add_argument("--no-probes", action="store_true",
-                    help="draw sequences only (the written probes, run first by default, "
-                    "are left out)")
+                    help="draw sequences only (the written probes and the sweep of every "
+                    "table value, run first by default, are left out)")
     args = ap.parse_args(argv)
     if not args.no_reports:
         writable_folder(args.report_dir)

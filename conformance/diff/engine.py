@@ -629,12 +629,12 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
            reach: Reach | None = None) -> list[Finding]:
     """Disagreements between the pair's sides, each shrunk and kept once (by its rule
     and kind), until the budget is spent (or ``stop_after`` findings): first the probes
-    (unless ``with_probes`` is false), each run whole, then the sequences Hypothesis
-    draws. ``on_seen`` is told of a disagreement as soon as it is seen (before it is
-    shrunk), ``on_finding`` once it is kept, ``on_dropped`` when one seen is not (the
-    same as one kept, or not seen again in real time); ``reach`` counts what the
-    sequences reached. ``--seconds`` holds everywhere: no sequence, step or shrink
-    begins once the time is up."""
+    and the tables' sweep (unless ``with_probes`` is false), each run whole, then the
+    sequences Hypothesis draws. ``on_seen`` is told of a disagreement as soon as it is
+    seen (before it is shrunk), ``on_finding`` once it is kept, ``on_dropped`` when one
+    seen is not (the same as one kept, or not seen again in real time); ``reach`` counts
+    what the sequences reached. ``--seconds`` holds everywhere: no sequence, step or
+    shrink begins once the time is up."""
     hunt = _Search(pair, budget, stop_after, on_finding, on_seen, on_dropped)
     pair.out_of_time, pair.reach = budget.out_of_time, reach
     try:
@@ -646,7 +646,10 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
 def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int,
           with_probes: bool) -> list[Finding]:
     grammar = Grammar(pair.profile, options)
-    for _, steps in grammar.probes() if with_probes else ():
+    # the probes, then every table value once (the tables' sweep)
+    written = ([steps for _, steps in grammar.probes()] + grammar.sweep()) if with_probes \
+        else []
+    for steps in written:
         if not hunt.more():
             return hunt.findings
         found = hunt.trial(steps)

@@ -11,19 +11,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from conformance.diff.grammar import Options, command_names, load_grammar
+from conformance.diff.grammar import Options, command_names, load_grammar, table_values
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import FILL, FRAME, INPUT, Step
 from conformance.protocol.catalogue import commands
 from conformance.protocol.parse import parse
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
-
-#: the field kinds (grammar.toml) whose values are a range's ends, and those whose values
-#: are drawn otherwise (short moves and travels, rates of a travel, floats: no table)
-_ENDS = ("range", "dec", "hex")
-#: a fixed range of fewer values than this counts each of them
-SMALL = 8
 
 
 @dataclass(frozen=True)
@@ -64,8 +58,9 @@ class Reach:
         self.values: dict[str, bool] = {}
         for name in names:
             entry = g["command"][name]
-            for i, kind in enumerate(entry.get("params", [])):
-                ends = _values_of(profile, kind)
+            for i, kind in enumerate(entry.get("params", []) if entry.get("tables", True)
+                                     else []):
+                ends = table_values(profile, kind)
                 if ends:
                     self._fields.setdefault(name, []).append((i, kind, ends))
                     for v in ends:
@@ -162,26 +157,6 @@ class Reach:
 
     def not_reached(self) -> list[str]:
         return [f"{k}: {', '.join(f.missing)}" for k, f in self.figures().items() if f.missing]
-
-
-def _values_of(profile: Profile, kind: str) -> list[str]:
-    """The table values of a field kind: a range's two ends, or each word."""
-    head, _, rest = kind.partition(":")
-    if head == "choice":
-        return rest.split("|")
-    if head == "axis":
-        return list(profile.axes)
-    if head not in _ENDS:
-        return []
-    if head == "range":
-        if rest not in profile.ranges:
-            return []
-        r = profile.range(rest)
-        return [str(r.lo), str(r.hi)]
-    lo, hi = (int(x) for x in rest.split(":"))
-    # a few values (a status word's number, the one output port): each; else the ends
-    values = range(lo, hi + 1) if hi - lo < SMALL else (lo, hi)
-    return ["%02X" % v if head == "hex" else str(v) for v in values]
 
 
 def _read(kind: str, text: str) -> str:

@@ -2,7 +2,10 @@
 ends, each word, the profile's listed values), states the reference's answers show;
 the grammar's tables idioms reach every value the profile lists."""
 
-from conformance.diff.engine import Pair
+import pytest
+
+from conformance.cli.diff import DEFAULT_EXAMPLES
+from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Grammar, Options
 from conformance.diff.reach import Reach
 from conformance.diff.sides import RoundTrip, Side
@@ -54,16 +57,29 @@ def test_states_and_values_the_run_cannot_reach_are_not_counted():
     assert "M=4" in plain.values and "M=U" in plain.values
 
 
-def test_the_tables_idioms_reach_every_listed_value():
-    for name in ("GVE114-500", "GVE54"):
-        profile = load_profile(name)
-        target = parse_target(f"emu:{name}")
-        pair = Pair(Side(target), Side(parse_target(f"emu:{name}")), profile)
-        reach = Reach(profile, EVERYTHING)
-        pair.reach = reach
-        grammar = Grammar(profile, EVERYTHING)
-        for idiom in grammar.tables:
-            assert pair.run(grammar.idiom(idiom)).disagreement is None
-        listed = [k for k in reach.values if k.startswith(("EW06=", "!7V=", "M="))]
-        assert listed and all(reach.values[k] for k in listed), [
-            k for k in listed if not reach.values[k]]
+@pytest.mark.parametrize("name", ["GVE114-500", "GVE54", "GVE84-100"])
+def test_the_sweep_of_the_tables_reaches_every_table_value(name):
+    # every value of every command's fields, each value the profile's tables list, each
+    # input bit grounded: all once, whatever the search then draws
+    profile = load_profile(name)
+    target = parse_target(f"emu:{name}")
+    pair = Pair(Side(target), Side(parse_target(f"emu:{name}")), profile)
+    reach = Reach(profile, EVERYTHING)
+    pair.reach = reach
+    for steps in Grammar(profile, EVERYTHING).sweep():
+        assert pair.run(steps).disagreement is None
+    assert reach.values and all(reach.values.values()), [
+        k for k, ok in reach.values.items() if not ok]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])
+def test_the_default_budget_reaches_every_command_value_and_state(profile):
+    """What `gve-conformance diff --allow-destructive` tries by default (the probes, then
+    the search; the emulator against itself, both with a rig) reaches every command the
+    grammar sends, every table value and every state the profile can show."""
+    pair = Pair(Side(parse_target(f"emu:{profile}")), Side(parse_target(f"emu:{profile}")),
+                load_profile(profile))
+    reach = Reach(pair.profile, EVERYTHING)
+    search(pair, EVERYTHING, Budget(examples=DEFAULT_EXAMPLES), reach=reach)
+    assert reach.not_reached() == [], reach.line()
