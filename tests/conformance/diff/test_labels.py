@@ -103,6 +103,11 @@ def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
     assert label("PF", "position", set(), {"V", "V-refused", "L"}, 0) == \
         "4.response.failed-not-executed"
     assert label("PF", "position", set(), {"A", "L"}, 0) == "10.2.motion.trapezoid"
+    # ST6 read after the MPG's enable byte was written (or the MPG switched): whether the
+    # MPG holds RUN is that byte's; after a vector alone, whether the unit took it
+    assert label("SR", "data", set(), {"EW", "J", "L"}, 0) == "9.reset.mpg"
+    assert label("F", "data", set(), {"Y"}, 0) == "9.reset.mpg"
+    assert label("SR", "data", set(), {"L"}, 0) == "10.cmd.vector"
 
 
 def test_an_input_interrupting_is_the_manuals_and_when_it_does_the_decision():
