@@ -76,7 +76,7 @@ class InterruptMachine(UnitMachine):
         super().__init__(ctx)
         p = ctx.profile
         self.rig = self.link.rig
-        self.ports = [port for port in p.input_ports]
+        self.ports = list(p.input_ports)
         self.level = {port: RELEASED for port in self.ports}
         self.enable = [0, 0]
         self.polarity = [0, 0]
