@@ -211,12 +211,13 @@ def _two_stated(ctx: CaseContext, word: int) -> tuple[int, int, int] | None:
 
 @case("10.3.interrupt.several-at-once", rig=True,
       rules=("10.3.status.meaning", "10.3.inputs.interrupt", "10.3.inputs.polarity",
-             "10.3.st6.bits", "10.4.go.resume", "10.3.inputs.cause-accumulates"))
+             "10.3.st6.bits", "10.4.delete", "10.3.inputs.cause-accumulates"))
 def several_at_once(ctx: CaseContext) -> None:
     """Two enabled inputs become active in one step, one grounded at polarity 0 and one
     released at polarity 1, beside a third that is grounded but not enabled: the cause
-    word names both enabled ones and not the third; G clears it. Then the two one after
-    the other: the second's bit added to the first's is the decision [D]."""
+    word names both enabled ones and not the third; D clears it (not G: with nothing
+    queued G may answer 6 and leave the flags, spec 5). Then the two one after the other:
+    the second's bit added to the first's is the decision [D]."""
     for port, word in ((1, 0), (2, 1)):
         picked = _two_stated(ctx, word)
         if port not in ctx.profile.input_ports or picked is None:
@@ -236,10 +237,10 @@ def several_at_once(ctx: CaseContext) -> None:
         ctx.expect(r is not None and r.values[:1] == ["80"], "INTA set, INTCOM not (no H)",
                    observed=show(r), expected="8,80", rule="10.3.st6.bits")
         link.rig.set_input(port, 0xFF ^ b)          # every input inactive again
-        code(ctx, link.send("G"), ErrorCode.OK, "G clears the interrupt", inta=False,
-             rule="10.4.go.resume")
-        answers(ctx, link.send(f"SR{word + 4}"), "0,00", f"G cleared ST{word + 4}",
-                rule="10.4.go.resume")
+        code(ctx, link.send("D"), ErrorCode.OK, "D clears the interrupt", inta=False,
+             rule="10.4.delete")
+        answers(ctx, link.send(f"SR{word + 4}"), "0,00", f"D cleared ST{word + 4}",
+                rule="10.4.delete")
         link.rig.set_input(port, 0xFF ^ a ^ b)      # a active: it interrupts
         link.rig.set_input(port, 0xFF ^ a)          # then b (released) while INTA = 1
         r = link.send(f"SR{word + 4}")
