@@ -239,8 +239,8 @@ def answers_after_travel(ctx: CaseContext) -> None:
         ctx.require(start is not None, "PF did not answer with positions")
         body = f"W{axis},-100,1000,50,1000"
         r = link.send(body)
-        _answered_after_the_run(ctx, r, body, 100 if r is not None and r.code == 5 else 0,
-                                1000)
+        ran = 100 if r is not None and r.code == ErrorCode.RANGE else 0
+        _answered_after_the_run(ctx, r, body, ran, 1000)
         if r is not None and r.code == ErrorCode.RANGE:
             want = [s - 100 * (j == i) for j, s in enumerate(start)]
             ctx.expect(position(ctx) == want, f"{body}: not found, the axis where the travel "
