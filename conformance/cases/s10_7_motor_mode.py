@@ -97,18 +97,16 @@ def motor_busy(ctx: CaseContext) -> None:
 #: the commands acting on the motors that each micro-step mode is combined with (the
 #: catalogue's vectors, stops, resumes, exchanges, the queue's emptying and saving, the
 #: counters' zeroing): each a scenario from rest back to rest whose end is exact in any
-#: mode, as (commands it combines, frames and waits, the move it makes in commanded
-#: steps). `V500` first: a 200-step vector runs 0.4 s, halted 0.1 s in.
-COMBINED: dict[str, tuple[tuple[str, ...], list, tuple[int, int, int]]] = {
-    "L": (("L",), ["L60,-30,15"], (60, -30, 15)),
-    "C": (("C",), ["C60,-30,15", "C60,-30,15"], (120, -60, 30)),
-    "H, G": (("H", "G"), ["V500", "L200,0,0", 0.1, "H", "G"], (200, 0, 0)),
-    "SW6": (("SW6",), ["V500", "L200,0,0", 0.1, "SW6,80", 0.1, "SW6,00"], (200, 0, 0)),
-    "H, K, R, G": (("H", "K", "R", "G"),
-                   ["V500", "C200,0,0", 0.1, "H", "K", "L0,0,-10", "rest", "L0,0,10",
+#: mode, named by the commands it combines, as (frames and waits, the move it makes in
+#: commanded steps). `V500` first: a 200-step vector runs 0.4 s, halted 0.1 s in.
+COMBINED: dict[str, tuple[list, tuple[int, int, int]]] = {
+    "L": (["L60,-30,15"], (60, -30, 15)),
+    "C": (["C60,-30,15", "C60,-30,15"], (120, -60, 30)),
+    "H, G": (["V500", "L200,0,0", 0.1, "H", "G"], (200, 0, 0)),
+    "SW6": (["V500", "L200,0,0", 0.1, "SW6,80", 0.1, "SW6,00"], (200, 0, 0)),
+    "H, K, R, G": (["V500", "C200,0,0", 0.1, "H", "K", "L0,0,-10", "rest", "L0,0,10",
                     "rest", "R", "G"], (200, 0, 0)),
-    "XU, XD, XA": (("XU", "XD", "XA"),
-                   ["V500", "C200,0,0", "C100,0,0", 0.05, "XU", 0.05, "XD", 0.05, "V800",
+    "XU, XD, XA": (["V500", "C200,0,0", "C100,0,0", 0.05, "XU", 0.05, "XD", 0.05, "V800",
                     "XA"], (300, 0, 0)),
 }
 
@@ -128,7 +126,7 @@ def with_motion_commands(ctx: CaseContext) -> None:
     alike; D after H leaves the position where H stopped, N zeroes it in any mode."""
     ms, link = ctx.profile.microstep, ctx.link
     for mode, factor in ms.factors.items():
-        for name, (_, scenario, move) in COMBINED.items():
+        for name, (scenario, move) in COMBINED.items():
             start = _settled(ctx, name)
             setup(ctx, f"M{mode}")
             for step in scenario:
