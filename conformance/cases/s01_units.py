@@ -30,7 +30,8 @@ def _ranged(profile) -> list[tuple[str, str, str]]:
         count = len(profile.axes) if c.repeat == "axes" else 1
         out.append((key, name + ",".join(["{}"] * count),
                     rules[0] if rules else RANGE_RULES.get(name, "5.code.range")))
-    return out
+    order = list(profile.ranges)               # in the order the profile lists its ranges
+    return sorted(out, key=lambda r: order.index(r[0]))
 
 
 def _applies(rule: str, profile) -> bool:
