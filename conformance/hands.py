@@ -207,6 +207,9 @@ class HandRig:
     def spindle(self, address: int | None = None) -> int:
         raise CouldNotTest(self.words["spindle"]["exact"])
 
+    def state(self, address: int | None = None) -> dict:
+        raise CouldNotTest(self.words["state"]["exact"])
+
     def outputs(self, address: int | None = None) -> int:
         """The output port as the technician sees it (the outputs lit), active low."""
         words = self.words["outputs"]

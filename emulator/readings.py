@@ -77,6 +77,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                             "since) is refused with 4 and changes nothing: their manuals "
                             "allow KEEP without its RESTORE only once (the GVE54's, whose "
                             "manual says the save is lost, is not read so)"),
+    "cause-first-only": (("10.3.inputs.cause-accumulates",),
+                         "ST4/ST5 keep the cause of the interrupt that stopped the unit: an "
+                         "input interrupting while INTA is already set adds no bit (the "
+                         "manual's cause is \"the interrupt\", not every one since)"),
     "next-vectors-B": (("10.2.motion.junction-own-b",),
                        "a junction of two C is passed at the B the next C captured, not the "
                        "one of the C that ends there"),

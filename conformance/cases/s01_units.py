@@ -7,18 +7,36 @@ from __future__ import annotations
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import answers, code, position, setup, show
+from conformance.protocol.catalogue import commands
 from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.rules import load_rules
 
-# parameter -> (frame template, the rule its range belongs to on GVE54 / on GVE84, GVE114)
-RANGES = {
-    "V": ("V{}", "1.profile.v-b-range-gve54", "1.profile.v-b-range"),
-    "B": ("B{}", "1.profile.v-b-range-gve54", "1.profile.v-b-range"),
-    "$": ("${}", "1.profile.dollar-range", "1.profile.dollar-range"),
-    "T": ("T{}", "10.cmd.modal", "10.cmd.modal"),
-    "A": ("A{}", "10.cmd.accel-range", "10.cmd.accel-range"),
-    "XM": ("XM{}", None, "10.cmd.override"),
-    "VL": ("VL{},{},{}", None, "10.cmd.axis-limits"),
-}
+#: what a range refusal of a modal parameter breaks where the catalogue names no rule of
+#: its own (its `rules`)
+RANGE_RULES = {"XM": "10.cmd.override"}
+
+
+def _ranged(profile) -> list[tuple[str, str, str]]:
+    """Every modal command of the catalogue the profile has whose parameter is one of the
+    profile's [rates] ranges: (command, frame template, the rule a refusal breaks)."""
+    out = []
+    for name, c in commands().items():
+        if not c.modal or len(c.fields) != 1 or name not in profile.commands:
+            continue
+        key = c.fields[0].range
+        if not isinstance(key, str) or key not in profile.ranges:
+            continue
+        rules = [r for r in c.rules if _applies(r, profile)]
+        count = len(profile.axes) if c.repeat == "axes" else 1
+        out.append((key, name + ",".join(["{}"] * count),
+                    rules[0] if rules else RANGE_RULES.get(name, "5.code.range")))
+    order = list(profile.ranges)               # in the order the profile lists its ranges
+    return sorted(out, key=lambda r: order.index(r[0]))
+
+
+def _applies(rule: str, profile) -> bool:
+    r = load_rules()[rule]
+    return not r.profiles or profile.family in r.profiles or profile.name in r.profiles
 
 
 @case("1.profile.axes.count", rules=("1.profile.axes", "10.cmd.vector-components"))
@@ -78,10 +96,7 @@ def wired(ctx: CaseContext) -> None:
              "10.cmd.axis-limits-clamped", "5.code.range"))
 def ranges(ctx: CaseContext) -> None:
     p = ctx.profile
-    for name, (template, rule54, rule) in RANGES.items():
-        rule = rule54 if p.family == "GVE54" else rule
-        if rule is None or name not in p.ranges:
-            continue
+    for name, template, rule in _ranged(p):
         lo, hi = p.ranges[name].lo, p.ranges[name].hi
         for value, want in ((lo - 1, ErrorCode.RANGE), (lo, ErrorCode.OK), (hi, ErrorCode.OK),
                             (hi + 1, ErrorCode.RANGE)):

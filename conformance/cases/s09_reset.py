@@ -106,3 +106,54 @@ def reset_state(ctx: CaseContext) -> None:
     ctx.expect(here == [0, 0, 0], "position 0", observed=here, expected=[0, 0, 0],
                rule="9.reset.state")
     index_moved(ctx, before, 8, "the index counted the SR and PF frames", rule="8.index.counts")
+
+
+def _mpg_values(ctx: CaseContext) -> list[tuple[int, bool]]:
+    """Every value EEPROM's MPG byte lists as enabling, and the values beside each (and
+    0, and the erased byte) that it does not list: (value, enables)."""
+    mpg, erased = ctx.profile.mpg, ctx.profile.eeprom.erased
+    listed = set(mpg.enabling_values)
+    beside = {(v + d) & 0xFF for v in listed for d in (-1, 1)} | {0x00, erased}
+    return sorted([(v, True) for v in listed] + [(v, False) for v in beside - listed])
+
+
+@case("9.reset.mpg-enabling-values", requires=("Y",), destructive=True,
+      rules=("9.reset.mpg", "10.cmd.mpg", "9.reset.mpg-inert"))
+def mpg_values(ctx: CaseContext) -> None:
+    """Each value of the MPG enable byte the manual lists (M114 12.2: 01, 02, 81, 82)
+    holds the axes after J (RUN = 1, vectors 7) and `Y-`, `Y&`, `Y+` switch it off and
+    on; every value beside them leaves the MPG inert, `Y&` too."""
+    mpg, link = ctx.profile.mpg, ctx.link
+    enable = "%02X" % mpg.enable_address
+    for value, enables in _mpg_values(ctx):
+        answers(ctx, link.send("Y-"), "0,Y-", "Y- before the EEPROM write", rule="10.cmd.mpg")
+        setup(ctx, f"EW{enable},{value:02X}")
+        setup(ctx, "J")
+        link.wait(ctx.profile.restart_ms / 1000 + 0.5)
+        shown = f"EEPROM {enable} = {value:02X}"
+        r = link.send("SR6")
+        if enables:
+            ctx.expect(r is not None and r.values == ["40"], f"{shown}: after J the MPG holds "
+                       "RUN = 1", observed=show(r), expected="0,40", rule="9.reset.mpg")
+            code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.BUSY,
+                 f"{shown}: a vector → 7", rule="9.reset.mpg")
+            answers(ctx, link.send("Y-"), "0,Y-", f"{shown}: Y- turns it off",
+                    rule="10.cmd.mpg")
+            answers(ctx, link.send("SR6"), "0,00", f"{shown}: after Y- RUN = 0",
+                    rule="10.cmd.mpg")
+            for on in ("Y&", "Y+"):
+                answers(ctx, link.send(on), f"0,{on}", f"{shown}: {on}", rule="10.cmd.mpg")
+                r = link.send("SR6")
+                ctx.expect(r is not None and r.values == ["40"], f"{shown}: {on} holds RUN = 1",
+                           observed=show(r), expected="0,40", rule="10.cmd.mpg")
+                answers(ctx, link.send("Y-"), "0,Y-", f"{shown}: Y-", rule="10.cmd.mpg")
+            continue
+        ctx.expect(r is not None and r.values == ["00"], f"{shown}: MPG inert, ST6 = 00",
+                   observed=show(r), expected="0,00", rule="9.reset.mpg-inert")
+        answers(ctx, link.send("Y&"), "0,Y&", f"{shown}: Y&", rule="10.cmd.mpg")
+        code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.OK,
+             f"{shown}: not a listed value, the MPG is not allowed: a vector is taken",
+             rule="9.reset.mpg")
+        link.poll("L" + vector(ctx, -1), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
+        link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
+    answers(ctx, link.send("Y-"), "0,Y-", "the MPG off at the end", rule="10.cmd.mpg")

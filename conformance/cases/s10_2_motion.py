@@ -97,3 +97,53 @@ def targets(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == expected, "the sum of the vectors",
                observed=position(ctx), expected=expected, rule="10.1.queue.relative")
     ctx.step_train("the step train of the three vectors")
+
+
+#: a parameter's range ends measured in motion: the parameter (a key of the profile's
+#: [rates]) -> (the rule its readings judge, the scenario at each end, with `{v}` for the
+#: end and `{axes}` for the profile's VL components of `{v}`). The low ends move a few
+#: steps (V10 moves ten steps a second); the high ones stay short.
+RATE_ENDS: dict[str, tuple[str, dict[str, list]]] = {
+    "V": ("10.2.motion.dominant-rate", {
+        "lo": ["A10000", "V{v}", "L4,0,0", 0.45],
+        "hi": ["A10000", "V{v}", "L300,0,0", [300, 0, 0]]}),
+    "XM": ("10.cmd.override", {
+        "lo": ["A10000", "V1000", "XM{v}", "L4,0,0", 0.45, "XM100"],
+        "hi": ["A10000", "V1000", "XM{v}", "L300,0,0", [300, 0, 0], "XM100"]}),
+    "VL": ("10.2.motion.axis-caps", {
+        "lo": ["A10000", "V1000", "VL{axes}", "L4,0,0", 0.45]}),
+    "B": ("10.2.motion.junction", {
+        "lo": ["A10000", "V1000", "$1", "B{v}", "C100,0,0", "C100,0,0", 0.35],
+        "hi": ["A100", "V5000", "$1", "B{v}", "C100,0,0", "C100,0,0", 0.35]}),
+    "A": ("10.2.motion.trapezoid", {
+        "lo": ["A{v}", "V1000", "L150,0,0", 0.5],
+        "hi": ["A{v}", "V3000", "L150,0,0", [150, 0, 0]]}),
+    "T": ("10.2.motion.dwell", {
+        "lo": ["A10000", "V5000", "T{v}", "L50,0,0", [50, 0, 0], "L50,0,0", (0.01, 0.001)],
+        "hi": ["A10000", "V5000", "T{v}", "L50,0,0", [50, 0, 0], "L50,0,0", (0.04, 0.002)]}),
+    "$": ("10.2.motion.short-vector", {
+        "lo": ["A10000", "V2000", "B300", "${v}", "L150,0,0", 0.2],
+        "hi": ["A10000", "V2000", "B300", "${v}", "L150,0,0", 0.2]}),
+}
+
+
+@case("10.2.measured.range-ends", timing=True,
+      rules=("10.2.motion.dominant-rate", "10.cmd.override", "10.2.motion.axis-caps",
+             "10.2.motion.junction", "10.2.motion.trapezoid", "10.2.motion.dwell",
+             "10.2.motion.short-vector"))
+def range_ends(ctx: CaseContext) -> None:
+    """Every rate, ramp, dwell and threshold of the profile's [rates] at both ends of its
+    range (from the profile), the motion each gives measured against the model: a unit
+    whose slowest rate is above the range's low end, or whose dwell stops short of its
+    top, moves elsewhere."""
+    p = ctx.profile
+    for key, (rule, scenarios) in RATE_ENDS.items():
+        if key not in p.ranges or key not in p.commands:
+            continue
+        for end, scenario in scenarios.items():
+            v = getattr(p.ranges[key], end)
+            steps = [s.format(v=v, axes=",".join([str(v)] * len(p.axes)))
+                     if isinstance(s, str) else s for s in scenario]
+            ctx.fresh_link()
+            Probe(ctx, f"{key} at the {'low' if end == 'lo' else 'high'} end of its range "
+                  f"({v})", rule).script(steps)

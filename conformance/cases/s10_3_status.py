@@ -197,3 +197,58 @@ def sw6(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[300, 0, 0], rule="10.3.sw6.acts")
     code(ctx, link.send("L" + vector(ctx, 0)), ErrorCode.OK, "idle again: L0,0,0 → 0",
          rule="10.3.sw6.live-bits")
+
+
+def _two_stated(ctx: CaseContext, word: int) -> tuple[int, int, int] | None:
+    """Two inputs a manual names behind a status word, and a third input of its port
+    (wired or not): the sources of the several-at-once case."""
+    mask = ctx.profile.stated_masks[word]
+    named = [1 << b for b in range(8) if mask >> b & 1]
+    if len(named) < 2:
+        return None
+    third = next(1 << b for b in range(8) if (1 << b) not in named[:2])
+    return named[0], named[1], third
+
+
+@case("10.3.interrupt.several-at-once", rig=True,
+      rules=("10.3.status.meaning", "10.3.inputs.interrupt", "10.3.inputs.polarity",
+             "10.3.st6.bits", "10.4.delete", "10.3.inputs.cause-accumulates"))
+def several_at_once(ctx: CaseContext) -> None:
+    """Two enabled inputs become active in one step, one grounded at polarity 0 and one
+    released at polarity 1, beside a third that is grounded but not enabled: the cause
+    word names both enabled ones and not the third; D clears it (not G: with nothing
+    queued G may answer 6 and leave the flags, spec 5). Then the two one after the other:
+    the second's bit added to the first's is the decision [D]."""
+    for port, word in ((1, 0), (2, 1)):
+        picked = _two_stated(ctx, word)
+        if port not in ctx.profile.input_ports or picked is None:
+            continue
+        a, b, c = picked
+        link = ctx.fresh_link()
+        link.rig.set_input(port, 0xFF ^ b)          # b grounded: inactive at polarity 1
+        setup(ctx, "SW%d,%02X" % (word + 2, b))
+        setup(ctx, "SW%d,%02X" % (word, a | b))      # a, b enabled; none active yet
+        link.rig.set_input(port, 0xFF ^ a ^ c)      # a, c grounded, b released: at once
+        r = link.send(f"SR{word + 4}")
+        want = "8,%02X" % (a | b)
+        answers(ctx, r, want, f"I{port} inputs {a:02X} (grounded, polarity 0) and {b:02X} "
+                f"(released, polarity 1) active at once, {c:02X} grounded but not enabled: "
+                f"ST{word + 4} names the two enabled", rule="10.3.status.meaning")
+        r = link.send("SR6")
+        ctx.expect(r is not None and r.values[:1] == ["80"], "INTA set, INTCOM not (no H)",
+                   observed=show(r), expected="8,80", rule="10.3.st6.bits")
+        link.rig.set_input(port, 0xFF ^ b)          # every input inactive again
+        code(ctx, link.send("D"), ErrorCode.OK, "D clears the interrupt", inta=False,
+             rule="10.4.delete")
+        answers(ctx, link.send(f"SR{word + 4}"), "0,00", f"D cleared ST{word + 4}",
+                rule="10.4.delete")
+        link.rig.set_input(port, 0xFF ^ a ^ b)      # a active: it interrupts
+        link.rig.set_input(port, 0xFF ^ a)          # then b (released) while INTA = 1
+        r = link.send(f"SR{word + 4}")
+        ctx.expect(r is not None and r.inta and r.values[:1] and int(r.values[0], 16) & a,
+                   f"the first input's bit ({a:02X}) names what stopped the unit",
+                   observed=show(r), expected="8,%02X" % (a | b), rule="10.3.inputs.interrupt")
+        answers(ctx, r, "8,%02X" % (a | b), "the second input's bit is added",
+                rule="10.3.inputs.cause-accumulates")
+    if not ctx.checks:
+        ctx.require(False, "no status word with two interrupt inputs a manual names")

@@ -109,3 +109,30 @@ def halt_final(ctx: CaseContext) -> None:
             rule="10.4.halt.ramp")
     answers(ctx, link.send("SR6"), "8,90", "INTA and INTCOM; RUN = 0: nothing is left",
             rule="10.3.st6.inta-run")
+
+
+@case("10.4.halt.at-rest-on-the-rig", rig=True, timing=True, rules=("10.4.halt.ramp",))
+def halt_at_rest_on_the_rig(ctx: CaseContext) -> None:
+    """H answers only when stopped, judged where the rig reads every axis (the GVE114's A
+    too): from H's answer on, where each axis physically stands and its counter no longer
+    change, and the counters are where the axes stand."""
+    link = ctx.link
+    axes = len(ctx.profile.axes)
+    setup(ctx, "V1500")
+    setup(ctx, "L" + ",".join(["1500"] + ["-700"] * (axes - 1)))
+    link.wait(0.3)
+    r = link.send("H")
+    ctx.require(r is not None and r.inta, f"H answered {show(r)}")
+    first = link.rig.state()
+    link.wait(0.3)
+    later = link.rig.state()
+    for key in ("physical", "position"):
+        ctx.expect(first.get(key) == later.get(key) and first.get(key) is not None,
+                   f"from H's answer on, every axis's {key} stands still",
+                   observed=f"{first.get(key)} then {later.get(key)}",
+                   expected="the same", rule="10.4.halt.ramp")
+    here = position(ctx)
+    ctx.expect(here is not None and here == (later.get("position") or [])[:3],
+               "PF reads the counters the rig reads", observed=here,
+               expected=(later.get("position") or [])[:3], rule="10.4.halt.ramp")
+    setup(ctx, "D")

@@ -98,3 +98,84 @@ def motor_busy(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [1000, 500, 400], "the manual's example: L-1,0,1",
                observed=position(ctx), expected=[1000, 500, 400], rule="10.7.motor.any-position")
     answers(ctx, link.send("M4"), "0", "then M4", rule="10.7.motor.any-position")
+
+
+#: the commands acting on the motors that each micro-step mode is combined with (the
+#: catalogue's vectors, stops, resumes, exchanges, the queue's emptying and saving, the
+#: counters' zeroing): each a scenario from rest back to rest whose end is exact in any
+#: mode, named by the commands it combines, as (frames and waits, the move it makes in
+#: commanded steps). `V500` first: a 200-step vector runs 0.4 s, halted 0.1 s in.
+COMBINED: dict[str, tuple[list, tuple[int, int, int]]] = {
+    "L": (["L60,-30,15"], (60, -30, 15)),
+    "C": (["C60,-30,15", "C60,-30,15"], (120, -60, 30)),
+    "H, G": (["V500", "L200,0,0", 0.1, "H", "G"], (200, 0, 0)),
+    "SW6": (["V500", "L200,0,0", 0.1, "SW6,80", 0.1, "SW6,00"], (200, 0, 0)),
+    "H, K, R, G": (["V500", "C200,0,0", 0.1, "H", "K", "L0,0,-10", "rest", "L0,0,10",
+                    "rest", "R", "G"], (200, 0, 0)),
+    "XU, XD, XA": (["V500", "C200,0,0", "C100,0,0", 0.05, "XU", 0.05, "XD", 0.05, "V800",
+                    "XA"], (300, 0, 0)),
+}
+
+
+def _settled(ctx: CaseContext, what: str) -> list[int]:
+    _rest(ctx)
+    here = position(ctx)
+    ctx.require(here is not None, f"{what}: PF did not answer with positions")
+    return here
+
+
+@case("10.7.microstep.with-motion-commands", requires=("M",), timing=True,
+      rules=("10.7.motor.modes", "10.cmd.positions", "10.4.delete", "10.cmd.zero"))
+def with_motion_commands(ctx: CaseContext) -> None:
+    """Every micro-step mode with every command that acts on the motors: where each
+    scenario ends (exact, in sixteenths: the mode's factor times its move), P and PF
+    alike; D after H leaves the position where H stopped, N zeroes it in any mode."""
+    ms, link = ctx.profile.microstep, ctx.link
+    for mode, factor in ms.factors.items():
+        for name, (scenario, move) in COMBINED.items():
+            start = _settled(ctx, name)
+            setup(ctx, f"M{mode}")
+            for step in scenario:
+                if step == "rest":
+                    _rest(ctx)
+                elif isinstance(step, str):
+                    r = link.send(step)
+                    ctx.require(r is not None and r.code is not None and r.code & 7 == 0,
+                                f"M{mode}, {name}: {step} answered {show(r)}")
+                else:
+                    link.wait(step)
+            want = [s + factor * d for s, d in zip(start, move, strict=True)]
+            got = _settled(ctx, f"M{mode}, {name}")
+            ctx.expect(got == want, f"M{mode} with {name}: ends {factor} sixteenths a "
+                       "commanded step on", observed=got, expected=want,
+                       rule="10.7.motor.modes")
+            r = link.send("P")
+            ctx.expect(r is not None and r.ok and r.values == [str(v) for v in got[:2]],
+                       f"M{mode} with {name}: P reads PF's X and Y", observed=show(r),
+                       expected="0,%d,%d" % tuple(got[:2]), rule="10.cmd.positions")
+            setup(ctx, "V1000")
+            setup(ctx, "L" + vector(ctx, *(-d for d in move)))
+        before = _settled(ctx, f"M{mode}, D")
+        setup(ctx, "V500")
+        setup(ctx, "C200,0,0")
+        link.wait(0.1)
+        setup(ctx, "H", expect="8")
+        stopped = position(ctx)
+        setup(ctx, "D")
+        ctx.expect(position(ctx) == stopped, f"M{mode}: D after H leaves the position",
+                   observed=position(ctx), expected=stopped, rule="10.4.delete")
+        setup(ctx, "N")
+        setup(ctx, "V1000")
+        setup(ctx, "L" + vector(ctx, *MODE_MOVE))
+        got = _settled(ctx, f"M{mode}, N")
+        want = [factor * d for d in MODE_MOVE]
+        ctx.expect(got == want, f"M{mode}: after N, L{vector(ctx, *MODE_MOVE)} reads "
+                   f"{factor} sixteenths a step from 0", observed=got, expected=want,
+                   rule="10.cmd.zero")
+        setup(ctx, f"M{ms.reset_mode}")
+        ctx.require(stopped is not None, f"M{mode}: PF did not answer after H")
+        # in sixteenths (the reset mode's step): back where the C began
+        back = [b - s - g for b, s, g in zip(before, stopped, got, strict=True)]
+        setup(ctx, "L" + vector(ctx, *back))
+        _rest(ctx)
+        setup(ctx, "N")

@@ -217,19 +217,64 @@ def ports(ctx: CaseContext) -> None:
                expected=0xFF, rule="10.cmd.output")
 
 
+def _answered_after_the_run(ctx: CaseContext, r, body: str, steps: int, rate: int) -> None:
+    """W answers when its run has ended (the manual's rule), judged by every means the
+    unit itself gives: not before the ``steps`` it ran at ``rate`` could have taken, RUN
+    clear right after its answer, its counters standing still from its answer on."""
+    rule = "10.cmd.reference"
+    ctx.require(r is not None, f"{body} got no answer")
+    took = (r.received_at - r.sent_at) / SECOND
+    ctx.expect(took >= steps / rate, f"{body} answers once its {steps} steps at {rate}/s "
+               "are done", observed=f"{took:.3f} s", expected=f"at least {steps / rate:.3f} s",
+               rule=rule)
+    run = ctx.link.send("SR6")
+    ctx.expect(run is not None and run.ok and run.values[:1] and not run.hex() & 0x40,
+               f"{body}: RUN clear right after its answer", observed=show(run),
+               expected="RUN (bit 6) clear", rule=rule)
+    here = position(ctx)
+    ctx.link.wait(0.2)
+    ctx.expect(position(ctx) == here, f"{body}: the counters stand still from its answer on",
+               observed=position(ctx), expected=here, rule=rule)
+
+
+@case("10.cmd.reference.answers-after-travel", destructive=True, requires=("W",),
+      rules=("10.cmd.reference", "10.cmd.reference-fails"))
+def answers_after_travel(ctx: CaseContext) -> None:
+    """W on each axis with a short travel and no switch expected within it: the answer
+    comes after the run, by the unit's own time, flags and counters (no rig needed); not
+    found, it is 5 with the axis where the travel ended."""
+    link = ctx.link
+    for i, axis in enumerate(ctx.profile.axes[:3]):
+        start = position(ctx)
+        ctx.require(start is not None, "PF did not answer with positions")
+        body = f"W{axis},-100,1000,50,1000"
+        r = link.send(body)
+        ran = 100 if r is not None and r.code == ErrorCode.RANGE else 0
+        _answered_after_the_run(ctx, r, body, ran, 1000)
+        if r is not None and r.code == ErrorCode.RANGE:
+            want = [s - 100 * (j == i) for j, s in enumerate(start)]
+            ctx.expect(position(ctx) == want, f"{body}: not found, the axis where the travel "
+                       "ended", observed=position(ctx), expected=want,
+                       rule="10.cmd.reference-fails")
+            setup(ctx, "L" + vector(ctx, *[100 * (j == i) for j in range(3)]))
+            _settle(ctx)
+
+
 @case("10.cmd.reference.inputs", rig=True, destructive=True, requires=("W",),
-      rules=("10.cmd.reference-switch", "10.cmd.reference-fails"))
+      rules=("10.cmd.reference-switch", "10.cmd.reference-fails", "10.cmd.reference"))
 def inputs(ctx: CaseContext) -> None:
     link = ctx.link
     link.rig.set_input(1, 0xFD)              # IN1 grounded: Y's switch, active at polarity 0
-    answers(ctx, link.send("WX,-100,1000,50,1000"), "5",
-            "X watches IN0, which is not active: not found within 100 steps",
+    r = link.send("WX,-100,1000,50,1000")
+    answers(ctx, r, "5", "X watches IN0, which is not active: not found within 100 steps",
             rule="10.cmd.reference-fails")
+    _answered_after_the_run(ctx, r, "WX,-100,1000,50,1000", 100, 1000)
     ctx.expect(position(ctx) == [-100, 0, 0], "X stayed where the travel ended",
                observed=position(ctx), expected=[-100, 0, 0], rule="10.cmd.reference-fails")
-    answers(ctx, link.send("WY,-100,1000,50,1000"), "5",
-            "Y watches IN1, active all the way back: still active after 50 steps back",
-            rule="10.cmd.reference-switch")
+    r = link.send("WY,-100,1000,50,1000")
+    answers(ctx, r, "5", "Y watches IN1, active all the way back: still active after 50 "
+            "steps back", rule="10.cmd.reference-switch")
+    _answered_after_the_run(ctx, r, "WY,-100,1000,50,1000", 50, 1000)
     ctx.expect(position(ctx) == [-100, 50, 0], "Y stayed 50 steps back from where it found it",
                observed=position(ctx), expected=[-100, 50, 0], rule="10.cmd.reference-fails")
     link = ctx.fresh_link()
@@ -238,6 +283,7 @@ def inputs(ctx: CaseContext) -> None:
     r = link.send("WZ,-100,1000,30,1000")
     answers(ctx, r, "5", "Z watches IN2 under the polarity rule (active at 1, reads 1)",
             rule="10.cmd.reference-switch")
+    _answered_after_the_run(ctx, r, "WZ,-100,1000,30,1000", 30, 1000)
     ctx.expect(position(ctx) == [0, 0, 30], "Z found it at once and backed off 30 steps",
                observed=position(ctx), expected=[0, 0, 30], rule="10.cmd.reference-switch")
 
@@ -253,6 +299,7 @@ def to_switch(ctx: CaseContext) -> None:
     ctx.expect(took is not None and took >= 150 / 2000, "W answers once the axis has stopped",
                observed=f"{took} s", expected="at least the 75 ms to the switch",
                rule="2.link.answer-promptly")
+    _answered_after_the_run(ctx, r, "WX,-1000,2000,200,1000", 150, 2000)
     ctx.expect(position(ctx) == [0, 0, 0], "the counter is 0 where the switch releases",
                observed=position(ctx), expected=[0, 0, 0], rule="10.cmd.reference")
     link.rig.set_switch("X", None)
@@ -352,3 +399,98 @@ def set_axis(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("N"), "0", "N", rule="10.cmd.zero")
     ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx),
                rule="10.cmd.zero")
+
+
+#: each axis's own count in the read-back moves (commanded steps): different sizes and
+#: signs, so that a count read on the wrong axis, or one axis's move taken for another's,
+#: shows
+AXIS_COUNTS = (37, -53, 71, -89)
+
+
+def _subsets(n: int) -> list[tuple[int, ...]]:
+    """Every non-empty set of axes, each alone first, then by size: (0,), (1,), ..."""
+    return sorted((tuple(i for i in range(n) if m >> i & 1) for m in range(1, 1 << n)),
+                  key=lambda s: (len(s), s))
+
+
+#: the rate of the read-back moves: slow enough that the shortest (37 steps) still runs
+#: for 185 ms, so that `SR6` right after it shows it running on any line
+AXIS_RATE = 200
+
+
+def _move(ctx: CaseContext, kind: str, axes: tuple[int, ...], sign: int) -> list[int]:
+    """A vector moving ``axes`` by their own counts; right after it, while it must still
+    run (its dominant count at the rate, less what the exchanges took), RUN shows it
+    being processed: an axis the unit took as not moving ends it at once."""
+    counts = [sign * AXIS_COUNTS[i] if i in axes else 0 for i in range(len(ctx.profile.axes))]
+    body = kind + ",".join(map(str, counts))
+    r = setup(ctx, body)
+    run = ctx.link.send("SR6")
+    lasts = max(map(abs, counts)) * SECOND // AXIS_RATE
+    if r is not None and run is not None and run.received_at - r.sent_at < lasts:
+        ctx.expect(run.ok and run.values[:1] and run.hex() & 0x40,
+                   f"{body}: right after it the vector runs (RUN)", observed=show(run),
+                   expected="RUN (bit 6) set", rule="10.cmd.vector")
+    _settle(ctx)
+    return counts
+
+
+@case("10.cmd.positions.each-axis", timing=True,
+      rules=("10.cmd.positions", "10.cmd.vector"))
+def each_axis(ctx: CaseContext) -> None:
+    """Every axis the protocol reads (PF: X, Y, Z; P: X, Y) after moving alone, in each
+    pair and all together, with L and with C: each counter moved by its own count and no
+    other moved. The GVE114's A is moved too (it leads no counter PF shows)."""
+    scale = step_factor(ctx)
+    start = position(ctx)
+    ctx.require(start is not None, "PF did not answer with positions")
+    setup(ctx, f"V{AXIS_RATE}")
+    for kind in ("L", "C"):
+        for axes in _subsets(len(ctx.profile.axes)):
+            counts = _move(ctx, kind, axes, 1)
+            want = [s + scale * c for s, c in zip(start, counts, strict=False)]
+            names = "".join(ctx.profile.axes[i] for i in axes)
+            ctx.expect(position(ctx) == want, f"{kind} moving {names}: PF", observed=position(ctx),
+                       expected=want, rule="10.cmd.positions")
+            r = ctx.link.send("P")
+            ctx.expect(r is not None and r.ok and r.values == [str(v) for v in want[:2]],
+                       f"{kind} moving {names}: P", observed=show(r),
+                       expected="0,%d,%d" % tuple(want[:2]), rule="10.cmd.positions")
+            _move(ctx, kind, axes, -1)
+            ctx.expect(position(ctx) == start, f"{kind} moving {names} back",
+                       observed=position(ctx), expected=start, rule="10.cmd.vector")
+
+
+def _rig_axes(ctx: CaseContext, key: str) -> list[int]:
+    """The rig's reading of every axis (``position``: the counters; ``physical``)."""
+    got = ctx.link.rig.state().get(key)
+    ctx.require(isinstance(got, list) and len(got) == len(ctx.profile.axes)
+                and all(isinstance(v, int) for v in got),
+                f"the rig's state gives no {key!r} for {len(ctx.profile.axes)} axes: {got!r}")
+    return got
+
+
+@case("10.cmd.vector.every-axis-on-the-rig", rig=True, timing=True,
+      rules=("10.cmd.vector", "10.cmd.positions"))
+def every_axis_on_the_rig(ctx: CaseContext) -> None:
+    """Every axis, A included (no command reads it), read where the rig reads it after
+    moving alone, in every set of axes and all together: its counter and where it
+    physically stands moved by its own count, no other axis moved."""
+    scale = step_factor(ctx)
+    counters, physical = _rig_axes(ctx, "position"), _rig_axes(ctx, "physical")
+    setup(ctx, f"V{AXIS_RATE}")
+    for kind in ("L", "C"):
+        for axes in _subsets(len(ctx.profile.axes)):
+            counts = _move(ctx, kind, axes, 1)
+            names = "".join(ctx.profile.axes[i] for i in axes)
+            for key, was in (("position", counters), ("physical", physical)):
+                want = [w + scale * c for w, c in zip(was, counts, strict=True)]
+                got = _rig_axes(ctx, key)
+                ctx.expect(got == want, f"{kind} moving {names}: every axis's {key} on the rig",
+                           observed=got, expected=want, rule="10.cmd.vector")
+            here = position(ctx)
+            ctx.expect(here == _rig_axes(ctx, "position")[:3],
+                       f"{kind} moving {names}: PF reads the rig's X, Y, Z counters",
+                       observed=here, expected=_rig_axes(ctx, "position")[:3],
+                       rule="10.cmd.positions")
+            _move(ctx, kind, axes, -1)

@@ -56,3 +56,32 @@ def spindle_unchanged(ctx: CaseContext) -> None:
         ctx.expect(link.rig.spindle() == 300, f"the spindle still at 300 after !0{feed}",
                    observed=link.rig.spindle(), expected=300, rule=rule)
     answers(ctx, link.send("V0", address=7), "0", "!7V0", rule="12.spindle.speed")
+
+
+@case("12.spindle.range-ends", rig=True, applies=lambda p: p.spindle is not None,
+      rules=("12.spindle.speed", "5.code.range"))
+def range_ends(ctx: CaseContext) -> None:
+    """The spindle's range from the profile, at both ends and one beyond each: 0 switches
+    OUT0 off, every value from 1 to the top switches it on (1 too), and a refused value
+    changes neither the setting nor OUT0."""
+    link, r = ctx.link, ctx.profile.spindle.range
+    speed = "12.spindle.speed"
+    for value in (r.lo + 1, r.hi, r.lo, r.hi, r.lo + 1, r.lo):
+        answers(ctx, link.send(f"V{value}", address=7), "0", f"!7V{value}", rule=speed)
+        ctx.expect(link.rig.spindle() == value, f"!7V{value}: the spindle at {value}",
+                   observed=link.rig.spindle(), expected=value, rule=speed)
+        on = value > 0
+        ctx.expect(link.rig.outputs() & 1 == (0 if on else 1),
+                   f"!7V{value}: OUT0 {'on' if on else 'off'}",
+                   observed="%02X" % link.rig.outputs(),
+                   expected=f"OUT0 {'on (bit 0 = 0)' if on else 'off (bit 0 = 1)'}",
+                   rule=speed)
+    answers(ctx, link.send(f"V{r.hi}", address=7), "0", f"!7V{r.hi}", rule=speed)
+    for beyond in (r.hi + 1, r.lo - 1):
+        code(ctx, link.send(f"V{beyond}", address=7), ErrorCode.RANGE, f"!7V{beyond} → 5",
+             rule="5.code.range")
+        ctx.expect(link.rig.spindle() == r.hi and link.rig.outputs() & 1 == 0,
+                   f"the refused !7V{beyond} left the spindle at {r.hi}, OUT0 on",
+                   observed=f"{link.rig.spindle()}, outputs {link.rig.outputs():02X}",
+                   expected=f"{r.hi}, bit 0 clear", rule=speed)
+    answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from conformance.cli.ending import claimed, counted, end, new_run_id, written
+from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import ask_before_motion, unattended
 from conformance.cli.usage import (
@@ -21,14 +21,15 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.diff.engine import Budget, Finding, Pair, search
+from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
-from conformance.diff.gvt import transcript, write
-from conformance.diff.results import agreement_result, finding_result, rig_lost_result
+from conformance.diff.kept import Kept
+from conformance.diff.reach import Reach
+from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
-from conformance.link.safety import TargetNotResponding
+from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.metadata import RunMeta, now_iso
 from conformance.operator import Console
 from conformance.reports.files import release
@@ -77,8 +78,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
     ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
     ap.add_argument("--no-probes", action="store_true",
-                    help="draw sequences only (the written probes, run first by default, "
-                    "are left out)")
+                    help="draw sequences only (the written probes and the sweep of every "
+                    "table value, run first by default, are left out)")
     args = ap.parse_args(argv)
     if not args.no_reports:
         writable_folder(args.report_dir)
@@ -172,10 +173,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     seed = args.seed if args.seed is not None else fresh_seed()
     run_id = (args.run_id or new_run_id()) if folder is None else folder.name
-    lost: list[str] = []                   # the transcripts that could not be written
     meta = meta_of(args, argv, target, reference, seed)
     interrupts = Interrupts()
-    session = target.begin(interrupts)
+    try:
+        session = target.begin(interrupts)
+    except (CouldNotTest, SessionError) as err:
+        target.close()
+        print(f"{PROG}: {COULD_NOT_TEST}: {one_line(err)}", file=sys.stderr)
+        return 1
     ask_first(args, target, meta)
     pair = Pair(Side(target, session), Side(reference), target.profile)
     options = Options(destructive=args.allow_destructive,
@@ -192,44 +197,26 @@ def main(argv: list[str] | None = None) -> int:
                                         f"{len(run.results)} disagreement(s)"))
     budget = _Watched(progress, examples=examples, seconds=args.seconds)
 
-    def found(f: Finding) -> None:
-        n = len(run.results) + 1
-        t = transcript(f, profile=target.profile.name, target=target.info.spec,
-                       reference=reference.info.spec, seed=seed)
-        path = ""
-        if folder is not None and not lost:     # one line says a full disk, not one a finding
-            where = folder / f"diff-{n:02d}.gvt"
-            path = str(written(lambda: write(where, t), PROG) or "")
-            if not path:
-                lost.append(where.name)
-        r = finding_result(f, profile=target.profile.name, target=target.info.spec,
-                           transcript=list(t.lines()), path=path)
-        run.results.append(r)
-        d = f.disagreement
-        if args.quiet:
-            return
-        progress.print(
-            f"{d.verdict:11} {d.rule or '(no known rule)'}: {readable(d.target.sent)} "
-            f"target {readable(d.target.answer) or '(none)'} / reference "
-            f"{readable(d.reference.answer) or '(none)'} ({d.kind}; {f.frames} frame(s))"
-            + (f"  -> {path}" if path else ""))
-        if folder is None or args.verbose:
-            progress.print("\n".join("    " + line for line in t.lines()))
-
+    kept = Kept(run, folder, profile=target.profile.name, target=target.info.spec,
+                reference=reference.info.spec, seed=seed, prog=PROG,
+                say=_nothing if args.quiet else progress.print, verbose=args.verbose)
+    reach = Reach(target.profile, options)
     try:
         with interrupts.catching():
             search(pair, options, budget, seed=seed, with_probes=not args.no_probes,
-                   on_finding=found)
-    except (TargetNotResponding, SessionError) as err:
+                   on_finding=kept.kept, on_seen=kept.seen, on_dropped=kept.dropped,
+                   reach=reach)
+    except TargetNotResponding as err:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
-        r.verdict, r.stopped = (FAIL if isinstance(err, TargetNotResponding)
-                                else COULD_NOT_TEST), str(err)
+        r.verdict, r.stopped = FAIL, str(err)
         r.checks = [{"ok": False, "what": str(err), "observed": "", "expected": "",
                      "tag": "always", "rule": SILENT}]
         run.results.append(r)
         print(f"{r.verdict}: {err}", file=sys.stderr)
-    except CouldNotTest as err:            # an example could not start from the known state
+    except (SafetyStop, SessionError, CouldNotTest) as err:
+        # the guard's stop outside a sequence's frames (each frame's is the sequence's), or
+        # an example that could not start from the known state
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
         r.verdict, r.stopped, r.checks = COULD_NOT_TEST, str(err), []
@@ -241,7 +228,11 @@ def main(argv: list[str] | None = None) -> int:
         session.emergency_stop()
     finally:
         progress.close()
-        report = session.finish() if session.real else None
+        try:
+            report = session.finish() if session.real else None
+        except CouldNotTest as err:         # an ending that could not be done: said
+            report = None
+            run.problems.append(f"the unit could not be left as it should: {err}")
         target.close()
     meta.finished = now_iso()
     for r in step_results(session, target):   # a known-state step the target broke
@@ -273,6 +264,12 @@ def main(argv: list[str] | None = None) -> int:
                        "sent, the search not finished"]
         run.results.append(r)
     run.frames, run.seconds = budget.frames, budget.elapsed
+    say(reach.line())
+    if args.verbose:
+        say("\n".join("  not reached: " + line for line in reach.not_reached()))
+    for r in run.results:
+        if r.id == "diff.search.agreement":
+            r.notes.append(reach.line())
     say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))

@@ -23,6 +23,7 @@ from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.index import QUERIES, IndexBase
 from conformance.diff.labels import allowed, command_of, label, verdict_of
+from conformance.diff.reach import Reach
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
@@ -118,6 +119,10 @@ class Pair:
         #: them (told.py); False: one exchange a frame
         self.ahead = True
         self._teller: Teller | None = None     # the example's frames told ahead
+        #: when the search's time is up (``--seconds``): a sequence stops between steps
+        self.out_of_time: Callable[[], bool] = _never
+        #: what the sequences reached (commands, table values, states), if counted
+        self.reach: Reach | None = None
 
     @property
     def exact(self) -> bool:
@@ -142,6 +147,9 @@ class Pair:
         earlier: set[str] = set()          # what the sequence did before (labels read it)
         try:
             for place, step in enumerate(steps):
+                if self.out_of_time():
+                    out.ended = "the search's time ran out"
+                    break
                 if step.kind == WAIT:
                     self.target.wait(step.seconds)
                     self.timing.waited()
@@ -168,9 +176,9 @@ class Pair:
             if self.target.real:
                 self._prelude()
         except SafetyStop as err:
-            # the known state itself was refused (a minimiser's candidate left the unit
-            # where the guard cannot bring it back), or the reads that begin the sequence
-            # showed the unit restarted: the candidate shows nothing
+            # the known state or the reads after it were refused (a minimiser's candidate
+            # left the unit where the guard cannot bring it back, or the guard saw the
+            # unit restart there): the candidate shows nothing
             out.refused.append(f"the known state: {err}")
             return False
         self.course = Course(self.profile)
@@ -188,6 +196,8 @@ class Pair:
         if done and self.reference.set_input(step.port, step.value):
             out.records.append(StepRecord(step, place=place))
             earlier.add("input")
+            if self.reach is not None:
+                self.reach.took(step, None)
 
     def _frames(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:
         """A frame (a fill: until the queue is full) to both sides; True when the example
@@ -210,6 +220,8 @@ class Pair:
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
+            if self.reach is not None:
+                self.reach.took(step, rec.reference)
             if step.kind == FILL and rec.reference.code != ErrorCode.OK:
                 break
         if out.ended:
@@ -418,6 +430,7 @@ class Finding:
 
     steps: list[Step]
     outcome: ExampleRun
+    number: int = 0                    # the search's count of disagreements seen, from 1
 
     @property
     def disagreement(self) -> Disagreement:
@@ -442,6 +455,10 @@ class Budget:
     def spent(self) -> bool:
         if self.examples is not None and self.used >= self.examples:
             return True
+        return self.out_of_time()
+
+    def out_of_time(self) -> bool:
+        """``--seconds`` passed: no further sequence, shrink or step begins."""
         return self.seconds is not None and time.perf_counter() - self.start >= self.seconds
 
     @property
@@ -486,7 +503,7 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
         return trial if d is not None and (d.command, d.kind) == want else None
 
     i = 0
-    while i < len(steps) and runs < MINIMISE_RUNS:
+    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time():
         found = False
         lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
             if frames_only else _lesser(steps, i, outcome)
@@ -571,13 +588,18 @@ class _Search:
     """One search's findings, the signatures already kept, and its budget."""
 
     def __init__(self, pair: Pair, budget: Budget, stop_after: int | None,
-                 on_finding: Callable[[Finding], None] | None) -> None:
+                 on_finding: Callable[[Finding], None] | None,
+                 on_seen: Callable[[Finding], None] | None = None,
+                 on_dropped: Callable[[Finding], None] | None = None) -> None:
         self.pair = pair
         self.budget = budget
         self.stop_after = stop_after
         self.on_finding = on_finding
+        self.on_seen = on_seen
+        self.on_dropped = on_dropped
         self.findings: list[Finding] = []
         self.known: set[tuple] = set()
+        self.seen = 0                  # disagreements seen so far (each one's number)
 
     def more(self) -> bool:
         return not self.budget.spent() and (self.stop_after is None
@@ -629,8 +651,14 @@ class _Search:
         slow rates are what make it show beyond the timing band), and stays as written
         unless the lesser one shows again."""
         pair, repeatable = self.pair, self.pair.timing.repeatable
+        self.seen += 1
+        found.number = self.seen
+        if self.on_seen is not None:       # on disk before the shrinking: a kill keeps it
+            self.on_seen(found)
         finding = minimise(pair, found, self.budget, frames_only=written and not repeatable)
+        finding.number = found.number
         if finding.disagreement.signature in self.known:
+            self._dropped(found)
             return
         self.known.add(finding.disagreement.signature)
         confirmed = repeatable or _again(pair, finding, self.budget)
@@ -639,22 +667,46 @@ class _Search:
             confirmed = _again(pair, found, self.budget)
         if not confirmed:
             pair.unconfirmed.append(finding)
+            self._dropped(found)
             return
         self.findings.append(finding)
         if self.on_finding is not None:
             self.on_finding(finding)
 
+    def _dropped(self, found: Finding) -> None:
+        if self.on_dropped is not None:
+            self.on_dropped(found)
+
 
 def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
            stop_after: int | None = None, with_probes: bool = True,
-           on_finding: Callable[[Finding], None] | None = None) -> list[Finding]:
+           on_finding: Callable[[Finding], None] | None = None,
+           on_seen: Callable[[Finding], None] | None = None,
+           on_dropped: Callable[[Finding], None] | None = None,
+           reach: Reach | None = None) -> list[Finding]:
     """Disagreements between the pair's sides, each shrunk and kept once (by its rule
     and kind), until the budget is spent (or ``stop_after`` findings): first the probes
-    (unless ``with_probes`` is false), each run whole, then the sequences Hypothesis
-    draws."""
-    hunt = _Search(pair, budget, stop_after, on_finding)
+    and the tables' sweep (unless ``with_probes`` is false), each run whole, then the
+    sequences Hypothesis draws. ``on_seen`` is told of a disagreement as soon as it is
+    seen (before it is shrunk), ``on_finding`` once it is kept, ``on_dropped`` when one
+    seen is not (the same as one kept, or not seen again in real time); ``reach`` counts
+    what the sequences reached. ``--seconds`` holds everywhere: no sequence, step or
+    shrink begins once the time is up."""
+    hunt = _Search(pair, budget, stop_after, on_finding, on_seen, on_dropped)
+    pair.out_of_time, pair.reach = budget.out_of_time, reach
+    try:
+        return _hunt(hunt, pair, options, budget, seed, with_probes)
+    finally:
+        pair.out_of_time, pair.reach = _never, None
+
+
+def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int,
+          with_probes: bool) -> list[Finding]:
     grammar = Grammar(pair.profile, options)
-    for _, steps in grammar.probes() if with_probes else ():
+    # the probes, then every table value once (the tables' sweep)
+    written = ([steps for _, steps in grammar.probes()] + grammar.sweep()) if with_probes \
+        else []
+    for steps in written:
         if not hunt.more():
             return hunt.findings
         found = hunt.trial(steps)
@@ -671,3 +723,7 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
             continue
         hunt.keep(found)
     return hunt.findings
+
+
+def _never() -> bool:
+    return False

@@ -63,6 +63,8 @@ def _drawn(c: Command, draw: dict) -> dict:
         params = params * 3
     if params:
         entry["params"] = params
+    if draw.get("tables") is False:
+        entry["tables"] = False
     for key, value in (("weight", draw.get("weight", 1)), ("answer", c.answer),
                        ("lines", c.lines), ("destructive", c.destructive)):
         if value != _DEFAULTS[key]:
@@ -123,7 +125,9 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
         return st.sampled_from(rest.split("|"))
     lo, hi = _range_of(profile, kind)
     if head == "range" and rest in ("position",):
-        lo, hi = max(lo, -moves["vector"]), min(hi, moves["vector"])
+        # counters near where the moves go, now and then at an end of their range
+        near = st.integers(max(lo, -moves["vector"]), min(hi, moves["vector"]))
+        return st.one_of(near, st.sampled_from([lo, hi])).map(str)
     numbers = st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi]))
     if head == "hex":
         # EEPROM addresses and bytes from a few values, so a write is read back
@@ -207,8 +211,14 @@ class Grammar:
         self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self._can(s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
-        ports = [p for p in profile.input_ports if p in (1, 2)] or list(profile.input_ports)
-        self.ports = ports or [1]
+        self.tables = [s for idiom in g["tables"]["list"] for s in _tabled(profile, idiom)
+                       if self._can(s)]
+        # every table value of every command, each a frame of its own
+        self.tables += [(body,) for body in value_frames(profile, self.names)]
+        if self.tables:
+            self.kinds += ["tables"] * g["tables"]["weight"]
+        # every input port (the GVE54's I0 too: its bits are read, none interrupts)
+        self.ports = list(profile.input_ports) or [1]
         self.member_names = [n for n, c in commands().items()
                              if c.packet == "member" and n in profile.commands]
         self.other_members = [n for n in g["packet"]["others"] if n in profile.commands]
@@ -347,6 +357,8 @@ class Grammar:
             return self.readback(draw)
         if kind == "scenario":
             return self.scenario(draw)
+        if kind == "tables":
+            return self.idiom(self.pick(draw, self.tables))
         return self.fill(draw)
 
     def scenario(self, draw) -> list[Step]:
@@ -401,6 +413,17 @@ class Grammar:
                 if self.profile.family in p.get("families", [self.profile.family])
                 and self._can(p["steps"])]
 
+    def sweep(self) -> list[list[Step]]:
+        """The tables run whole once, after the probes: every table value of a command in
+        one sequence (its frames one after the other), then each idiom of the profile's
+        tables, so that the default budget reaches every value whatever the draw."""
+        single = [t[0] for t in self.tables if len(t) == 1]
+        by_command: dict[str, list[str]] = {}
+        for body in single:
+            by_command.setdefault(command_of(body), []).append(body)
+        return ([self.idiom(bodies) for bodies in by_command.values()]
+                + [self.idiom(t) for t in self.tables if len(t) > 1])
+
     def sequences(self) -> st.SearchStrategy[list[Step]]:
         """A sequence of steps for one example (groups flattened)."""
         group = st.composite(lambda draw: self.group(draw))()
@@ -417,6 +440,98 @@ class Grammar:
         first = body[len(text):].split(",")[0]
         place = "" if read == "PF" else first
         return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+
+
+#: the field kinds whose values are a range's ends (the others have no table)
+_ENDS = ("range", "dec", "hex")
+#: a fixed range of fewer values than this: each of them
+SMALL = 8
+#: a field's value where another field of the frame is the one at an end of its table
+_PLAIN = {"vector": "0", "travel": "100", "seek-rate": "1000", "float": "1.5"}
+
+
+def table_values(profile: Profile, kind: str) -> list[str]:
+    """The table values of a field kind (what `diff` counts it reached, and draws each
+    of through `[tables]`): a range's two ends (each value of a range of a few), each
+    word, each axis; none for the kinds drawn otherwise (short moves and travels, a
+    travel's rates, floats)."""
+    head, _, rest = kind.partition(":")
+    if head == "choice":
+        return rest.split("|")
+    if head == "axis":
+        return list(profile.axes)
+    if head not in _ENDS:
+        return []
+    if head == "range":
+        if rest not in profile.ranges:
+            return []
+        r = profile.range(rest)
+        return [str(r.lo), str(r.hi)]
+    lo, hi = (int(x) for x in rest.split(":"))
+    # a few values (a status word's number, the one output port): each; else the ends
+    values = range(lo, hi + 1) if hi - lo < SMALL else (lo, hi)
+    return ["%02X" % v if head == "hex" else str(v) for v in values]
+
+
+def value_frames(profile: Profile, names: list[str]) -> list[str]:
+    """A frame for each table value of each command in ``names``: that field at the
+    value, the others at their table's first value (or a plain one)."""
+    g = load_grammar()
+    out = []
+    for name in names:
+        entry = g["command"][name]
+        kinds = entry.get("params", []) if entry.get("tables", True) else []
+        plain = [(table_values(profile, k) or [_PLAIN.get(k, "0")])[0] for k in kinds]
+        for i, kind in enumerate(kinds):
+            for value in table_values(profile, kind):
+                out.append(_body(name, entry, [*plain[:i], value, *plain[i + 1:]]))
+    return list(dict.fromkeys(out))
+
+
+def _tabled(profile: Profile, idiom: list[str]) -> list[tuple[str, ...]]:
+    """An idiom of `[tables]` once per value of the profile's table its placeholder
+    names (none where the profile has no such table)."""
+    tables: dict[str, list[str]] = {}
+    if profile.mpg is not None:
+        listed = sorted(profile.mpg.enabling_values)
+        beside = sorted({(v + d) & 0xFF for v in listed for d in (-1, 1)} - set(listed))
+        tables["mpg"] = ["%02X" % v for v in listed + beside]
+        tables["mpg_address"] = ["%02X" % profile.mpg.enable_address]
+    if profile.spindle is not None:
+        r = profile.spindle.range
+        tables["spindle"] = [str(v) for v in (r.lo + 1, r.hi)]
+    if profile.microstep is not None:
+        tables["microstep"] = [*profile.microstep.factors, *profile.microstep.currents]
+    axes = len(profile.axes)
+    tables["axis_alone"] = [",".join("100" if j == i else "0" for j in range(axes))
+                            for i in range(axes)]
+    tables["port"] = [str(port) for port in profile.input_ports]
+    # the interrupt inputs behind each status word with several of them: enabled, grounded
+    # at once, the cause word read (ST0/2/4 are I1's, ST1/3/5 I2's)
+    tables["sources"] = [{"enable": str(word), "mask": "%02X" % mask, "port": str(word + 1),
+                          "cause": str(word + 4), "one": "%02X" % (mask & -mask)}
+                         for word, mask in enumerate((profile.low_mask, profile.high_mask))
+                         if bin(mask).count("1") > 1 and word + 1 in profile.input_ports]
+    wanted = sorted({m.group(1) for m in _PLACEHOLDER.finditer(" ".join(idiom))})
+    if any(not tables.get(name) for name in wanted):
+        return []
+    out: list[tuple[str, ...]] = [tuple(idiom)]
+    for name in wanted:
+        out = [tuple(_filled(line, name, value) for line in lines)
+               for lines in out for value in tables[name]]
+    return out
+
+
+#: `{name}`, or `{name.key}` for one of a table's values that are several together
+_PLACEHOLDER = re.compile(r"\{([a-z_]+)(?:\.([a-z_]+))?\}")
+
+
+def _filled(line: str, name: str, value: str | dict[str, str]) -> str:
+    if isinstance(value, dict):
+        for key, part in value.items():
+            line = line.replace("{%s.%s}" % (name, key), part)
+        return line
+    return line.replace("{%s}" % name, value)
 
 
 def _silent_in_packets(steps: list[Step]) -> list[Step]:

@@ -24,6 +24,8 @@ class Rig(Protocol):
 
     def spindle(self, address: int | None = None) -> int: ...
 
+    def state(self, address: int | None = None) -> dict: ...
+
 
 class VirtualLine(Rig, Protocol):
     """A line in virtual time: its clock moves only when asked (or by the bytes written),

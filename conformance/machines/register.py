@@ -4,6 +4,7 @@ from conformance.machines import (  # noqa: F401
     checksum,
     errors,
     index,
+    interrupts,
     keep,
     packet,
     queue,

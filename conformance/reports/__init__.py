@@ -45,7 +45,8 @@ def to_json(run: RunResult) -> dict:
         d["wire_log"] = compact(r.wire_log, r.verdict, run.meta.full_logs)
         d["checks_total"] = len(r.checks)
         d["checks"] = [{k: v for k, v in c.items() if k != "rule" or v != r.rule}
-                       for c in compact_checks(r.checks, r.verdict, run.meta.full_logs)]
+                       for c in compact_checks(r.checks, r.verdict, run.meta.full_logs,
+                                                said=False)]
         d["traces_total"] = len(r.traces)
         d["traces"] = compact_traces(r.traces, r.verdict, run.meta.full_logs)
         results.append(d)

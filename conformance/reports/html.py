@@ -160,11 +160,16 @@ def _filters(sections: list[str]) -> str:
             "placeholder='case ID contains'></div>")
 
 
+#: the traces a passing case draws (the rest: --full-logs)
+PASSING_PLOTS = 3
+
+
 def _pictures(r: CaseResult, full_logs: bool) -> list[str]:
-    """The case's traces drawn (for a passing case the position only: the report must
-    stay small; --full-logs draws the rate too)."""
+    """The case's traces drawn (for a passing case the position only and its first few
+    traces: the report must stay small; --full-logs draws the rate and every one)."""
     out = []
-    for i, trace in enumerate(r.traces):
+    shown = r.traces if full_logs or r.verdict != PASS else r.traces[:PASSING_PLOTS]
+    for i, trace in enumerate(shown):
         key = f"{_anchor(r)}-{i}"
         if "pulses" in trace:
             svg = plots.step_train_chart(trace["pulses"], trace.get("axes", "XYZA"), key,
@@ -173,6 +178,9 @@ def _pictures(r: CaseResult, full_logs: bool) -> list[str]:
             svg = plots.trace_chart(trace, key, rate=full_logs or r.verdict != PASS)
         out.append(f"<figure>{svg}</figure>" if svg else
                    f"<p class='why'>{h(trace.get('name', 'trace'))}: plots are off.</p>")
+    if len(shown) < len(r.traces):
+        out.append(f"<p class='why'>... {len(r.traces) - len(shown)} more traces passed "
+                   "(all of them drawn: --full-logs) ...</p>")
     return out
 
 

@@ -136,5 +136,6 @@ def cmd_spindle(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.state.spindle = value
     if value and dev.mutant.active("spindle-sets-feed-rate"):
         dev.state.modal.V = value
-    dev.state.outputs = dev.state.outputs & 0xFE if value else dev.state.outputs | 0x01
+    on = value >= 10 if dev.mutant.active("spindle-low-end-off") else value > 0
+    dev.state.outputs = dev.state.outputs & 0xFE if on else dev.state.outputs | 0x01
     return []

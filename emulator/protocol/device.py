@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -29,6 +30,8 @@ from gve_fixtures.protocol import ErrorCode
 MS = 1_000_000
 #: the reading steps-a-period-late: how far back a step period is looked for
 LATE_WINDOW = 100 * MS
+#: the mutant slow-rates-floored: the slowest rate its timer runs (pulses/s)
+SLOWEST = 100
 #: input ports read FF with nothing connected (spec 10.3)
 UNCONNECTED = {0: 0xFF, 1: 0xFF, 2: 0xFF}
 
@@ -53,6 +56,8 @@ class Device:
         self.state: DeviceState = reset_state(profile)
         self.deaf_until = origin          # restarting (power-on, J) until then
         self._was_active = self._active()  # the reading edge-triggered-inputs: last seen
+        #: work due later that answers nothing (the mutant reference-answers-early's run)
+        self.due: list[tuple[int, Callable[[int], object]]] = []
 
     # -- power ------------------------------------------------------------------------
     def reset(self, t: int) -> None:
@@ -68,6 +73,21 @@ class Device:
             self.inputs = dict(UNCONNECTED)
         self._was_active = self._active()
         self.deaf_until = t + p.restart_ms * MS
+        self.due = []
+
+    def later(self, at: int, work: Callable[[int], object]) -> None:
+        """Do ``work(at)`` at the instant ``at``, answering nothing."""
+        self.due.append((at, work))
+
+    def next_due(self) -> int | None:
+        return min((at for at, _ in self.due), default=None)
+
+    def run_due(self, t: int) -> None:
+        """The work due by ``t``, each at its own instant."""
+        now = [d for d in self.due if d[0] <= t]
+        self.due = [d for d in self.due if d[0] > t]
+        for at, work in sorted(now, key=lambda d: d[0]):
+            work(at)
 
     # -- derived state ----------------------------------------------------------------
     def factor(self) -> int:
@@ -83,10 +103,13 @@ class Device:
     def mpg_active(self) -> bool:
         """The GVE114's MPG holds the axes (RUN = 1): on, and allowed by EEPROM 06."""
         mpg = self.profile.mpg
-        return (mpg is not None and self.state.mpg in ("+", "&")
-                and self.eeprom.read(mpg.enable_address)[0] in mpg.enabling_values
-                and (not self.readings.active("mpg-needs-parameters")
-                     or self.mpg_parameters_in_range()))
+        if mpg is None or self.state.mpg not in ("+", "&"):
+            return False
+        value = self.eeprom.read(mpg.enable_address)[0]
+        if value & 0x80 and self.mutant.active("mpg-enable-high-values-ignored"):
+            return False
+        return value in mpg.enabling_values and (
+            not self.readings.active("mpg-needs-parameters") or self.mpg_parameters_in_range())
 
     def mpg_parameters_in_range(self) -> bool:
         """The reading mpg-needs-parameters: M114 12.4-12.6, "Pokud je hodnota některého
@@ -187,10 +210,17 @@ class Device:
         accel = p.reset.A if act("accel-ignored") else m.A
         rate_f = 1 if act("microstep-rates-unscaled") else f
         limits = (mr,) * len(m.VL) if act("axis-limit-ignored") else m.VL
+        brake = m.B
+        if act("slow-rates-floored"):
+            v, brake, limits = max(v, SLOWEST), max(brake, SLOWEST), [max(x, SLOWEST)
+                                                                      for x in limits]
+        step_f = 1 if continuous and act("microstep-continuous-unscaled") else f
+        if act("a-axis-alone-ignored") and len(steps) == 4 and not any(steps[:3]):
+            steps = (0, 0, 0, 0)
         self.motion.push(Vector(
-            steps=tuple(s * f for s in steps), continuous=continuous,
+            steps=tuple(s * step_f for s in steps), continuous=continuous,
             velocity=min(v, mr) * rate_f, accel=accel * 1000 * f,
-            brake=min(m.B, mr) * rate_f,
+            brake=min(brake, mr) * rate_f,
             short=0 if act("short-vector-ignored") else m.dollar * f,
             dwell=0 if act("dwell-ignored") else m.T * MS,
             path_speed=m.VK and not act("path-speed-ignored"),
@@ -202,6 +232,8 @@ class Device:
             return
         p, f = self.profile, self.factor()
         v = p.reset.V if self.mutant.active("velocity-ignored") else self.state.modal.V
+        if self.mutant.active("slow-rates-floored"):
+            v = max(v, SLOWEST)
         accel = self.state.modal.A * 1000 * f if p.microstep is not None else None
         self.motion.set_velocity(min(v, p.max_rate) * f, t, accel)
 
@@ -243,9 +275,16 @@ class Device:
         hit1, hit2 = self._hits()
         if not (hit1 or hit2) or self.mutant.active("interrupt-ignored"):
             return
-        s = self.state.status
-        s[4] |= hit1
-        s[5] |= hit2
+        s, act = self.state.status, self.mutant.active
+        if act("cause-lowest-only"):               # the lowest of the two words' 16 bits
+            both = hit1 | hit2 << 8
+            hit1, hit2 = both & -both & 0xFF, (both & -both) >> 8
+        elif act("cause-includes-disabled"):       # every active input, enabled or not
+            active1, active2 = self._active()
+            hit1, hit2 = active1 & self.profile.low_mask, active2 & self.profile.high_mask
+        if not (self.state.inta and self.readings.active("cause-first-only")):
+            s[4] |= hit1
+            s[5] |= hit2
         self.stop(t)
 
     def after_clearing(self, t: int) -> None:

@@ -116,9 +116,10 @@ class Unit:
         deaf = self.device.deaf_until
         if deaf > now and (best is None or deaf < best):
             best = deaf
-        if self.framer.buf is not None or self._pending or self._packet_quiet is not None:
+        if self.framer.buf is not None or self._pending or self._packet_quiet is not None \
+                or self.device.due:
             for c in (self.framer.deadline(), self._packet_deadline(),
-                      *(d.instant for _, d, _ in self._pending)):
+                      *(d.instant for _, d, _ in self._pending), self.device.next_due()):
                 if c is not None and c > now and (best is None or c < best):
                     best = c
         return best
@@ -132,6 +133,8 @@ class Unit:
         return self._packet_quiet + HALF_SECOND_MS * MS
 
     def advance(self, t: int) -> None:
+        if self.device.due:
+            self.device.run_due(t)
         if self._pending or self.framer.buf is not None or self._packet_quiet is not None:
             while True:
                 expiry = self.framer.deadline()

@@ -36,7 +36,7 @@ def test_the_clean_emulator_passes(profile: str) -> None:
 
 
 def test_the_command_prints_the_score(capsys) -> None:
-    mutant = sorted(MUTANTS)[0]
+    mutant = "go-without-inta"          # one every family shows (some show on one only)
     assert main(["--mutant", mutant, "--profile", "GVE84-100"]) == 0
     out = capsys.readouterr().out
     assert f"caught  {mutant}" in out and "mutation score: 1/1 = 100.0 %" in out
@@ -58,7 +58,7 @@ def test_bad_arguments_are_one_line_and_exit_2(argv, capsys) -> None:
 
 def test_an_error_on_the_way_fails_the_command(capsys, monkeypatch) -> None:
     # a broken unit must make a case FAIL, never crash it: the score alone would hide that
-    mutant = sorted(MUTANTS)[0]
+    mutant = "go-without-inta"          # one every family shows (some show on one only)
 
     def crashed(name, *args):
         h = Hunt(name, "6", "")

@@ -92,6 +92,14 @@ PROBES: dict[str, tuple[str, str]] = {
     "go-at-speed": ("m10-halt-ramp", "GVE114-500"),
     "microstep-rates-unscaled": ("m11-microstep-rates", "GVE54"),
     "microstep-modes-swapped": ("m16-each-microstep-mode", "GVE54"),
+    "mpg-enable-high-values-ignored": ("p19-mpg-enabling-values", "GVE114-500"),
+    "spindle-low-end-off": ("p20-spindle-range-ends", "GVE114-500"),
+    "slow-rates-floored": ("m17-slow-rates", "GVE84-100"),
+    "microstep-continuous-unscaled": ("m18-microstep-continuous", "GVE54"),
+    "a-axis-alone-ignored": ("e12-a-axis-alone", "GVE114-500"),
+    "cause-lowest-only": ("e13-cause-several", "GVE84-100"),
+    "cause-includes-disabled": ("e13-cause-several", "GVE54"),
+    "reference-answers-early": ("d6-reference-answers-after-run", "GVE84-100"),
 }
 
 

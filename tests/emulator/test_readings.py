@@ -46,6 +46,10 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # sets again at once (8) unless only its edge interrupts (0)
     "edge-triggered-inputs": ([b"!0SW0,01\r", (1, 0xFE), b"!0D\r", b"!0SR4\r"],
                               b"0\r8\r8,01\r", b"0\r0\r0,00\r"),
+    # IN0 and IN1 enabled; IN0 grounded stops the unit, then IN1 grounded too: its cause
+    # bit is added (03), or only the first interrupt's stays (01)
+    "cause-first-only": ([b"!0SW0,03\r", (1, 0xFE), (1, 0xFC), b"!0SR4\r"],
+                         b"0\r8,03\r", b"0\r8,01\r"),
     # half a second without a byte inside a frame: dropped (2), or the frame runs whole
     "slow-watchdog": ([b"!0V10", 0.5, b"00\r"], b"2\r", b"0\r"),
     "index-remembered": ([b"!0?\r", b"!0@\r", b"!0>\r"],

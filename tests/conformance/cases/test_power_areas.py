@@ -55,18 +55,43 @@ CATCHES = {
                             ("GVE84-100", "GVE114-500", "GVE54")),
     "input-bits-swapped": ("10.cmd.ports.bit-by-bit", "10.cmd.port-bits",
                            ("GVE84-100", "GVE114-500", "GVE54")),
+    # every value of a table, both ends of a range, a mode with every command on it
+    "mpg-enable-high-values-ignored": ("9.reset.mpg-enabling-values", "9.reset.mpg",
+                                       ("GVE114-500", "GVE114-50")),
+    "spindle-low-end-off": ("12.spindle.range-ends", "12.spindle.speed", ("GVE114-500",)),
+    "slow-rates-floored": ("10.2.measured.range-ends", "10.2.motion.dominant-rate",
+                           ("GVE84-100", "GVE114-500", "GVE54")),
+    "microstep-continuous-unscaled": ("10.7.microstep.with-motion-commands",
+                                      "10.7.motor.modes", ("GVE54",)),
+    # an axis alone, read where the protocol reads it and where the rig does
+    "a-axis-alone-ignored": ("10.cmd.positions.each-axis", "10.cmd.vector", ("GVE114-500",)),
+    # several interrupt sources at once
+    "cause-lowest-only": ("10.3.interrupt.several-at-once", "10.3.status.meaning",
+                          ("GVE84-100", "GVE114-500", "GVE54")),
+    "cause-includes-disabled": ("10.3.interrupt.several-at-once", "10.3.status.meaning",
+                                ("GVE84-100", "GVE114-500", "GVE54")),
+    # an answer's instant by the unit's own time, flags and counters (no rig)
+    "reference-answers-early": ("10.cmd.reference.answers-after-travel", "10.cmd.reference",
+                                ("GVE84-100", "GVE114-500")),
 }
 
 #: further cases made for a mutant: (case, mutant, the rule of its failing check, profile)
 ALSO = (
     ("10.3.status.register-ends", "refused-status-write-stored", "10.cmd.status-words",
      "GVE54"),
+    ("10.cmd.vector.every-axis-on-the-rig", "a-axis-alone-ignored", "10.cmd.vector",
+     "GVE114-500"),
+    ("10.cmd.reference.inputs", "reference-answers-early", "10.cmd.reference", "GVE84-100"),
+    ("10.cmd.reference.to-switch", "reference-answers-early", "10.cmd.reference",
+     "GVE114-500"),
 )
 
 #: reading -> (the case that measures its point, the rule it reads, the profiles)
 READ = {
     "next-vectors-B": ("10.2.measured.junction-brake-sides", "10.2.motion.junction-own-b",
                        ("GVE84-100", "GVE54")),
+    "cause-first-only": ("10.3.interrupt.several-at-once", "10.3.inputs.cause-accumulates",
+                         ("GVE84-100", "GVE114-500", "GVE54")),
 }
 
 

@@ -3,6 +3,9 @@ transcript in the reports, the replay saying whether the disagreement is still t
 the emulator against itself over a pseudo-terminal in real time, usage errors."""
 
 import json
+import re
+import signal
+import subprocess
 import sys
 from pathlib import Path
 
@@ -10,7 +13,9 @@ import pytest
 
 from conformance.cli import main
 from conformance.diff.grammar import Options, probes
+from conformance.diff.sides import Side
 from conformance.targets.emu import emulator_readings
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
 from tests.conformance.diff.test_engine import ON_THE_WIRE, PROFILE, in_area
@@ -146,3 +151,77 @@ def test_a_target_whose_d_misbehaves_gets_a_fail_naming_d_and_diff_runs_on(mutan
     assert status == 1 and "Traceback" not in out + err
     assert "FAIL        10.4.delete: the known state: D after H" in out
     assert "100 sequences" in out
+
+
+def _diff_killed_at(tmp_path: Path, first: str) -> tuple[str, Path]:
+    """`diff` against a mutant, SIGKILLed (nothing of its own ending runs) right after it
+    printed a line starting with ``first``: that line and the run's folder."""
+    cmd = [sys.executable, "-m", "conformance", "diff", "--target",
+           "emu:GVE84-100?mutant=lower-case-command", "--examples", "100000", "-v",
+           "--report-dir", str(tmp_path)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+    try:
+        line = next(line for line in proc.stdout if line.startswith(first))
+    finally:
+        proc.kill()
+        proc.wait(30)
+    assert proc.returncode == -signal.SIGKILL
+    (folder,) = tmp_path.iterdir()
+    return line, folder
+
+
+def test_a_diff_killed_while_shrinking_keeps_what_it_saw(tmp_path):
+    line, folder = _diff_killed_at(tmp_path, "seen: ")
+    path = Path(line.rsplit("-> ", 1)[1].strip())
+    assert "# rules: 3.frame.upper-case" in path.read_text()      # shrunk or not yet
+    first = json.loads((folder / "findings.jsonl").read_text().splitlines()[0])
+    assert first["event"] == "seen" and first["rule"] == "3.frame.upper-case"
+    assert first["transcript"] == str(path)
+
+
+def test_a_diff_killed_after_a_finding_keeps_it_in_the_reports(tmp_path):
+    line, folder = _diff_killed_at(tmp_path, "FAIL ")
+    assert "3.frame.upper-case" in line
+    results = json.loads((folder / "results.json").read_text())["results"]
+    assert [r["checks"][0]["rule"] for r in results] == ["3.frame.upper-case"]
+    events = [json.loads(e)["event"] for e in
+              (folder / "findings.jsonl").read_text().splitlines()]
+    assert events[:2] == ["seen", "kept"]
+    assert "# shrunk:" not in (folder / "diff-01.gvt").read_text()
+
+
+def test_a_known_state_that_cannot_be_had_ends_in_a_verdict(tmp_path, capsys, monkeypatch):
+    """A CouldNotTest from a target's known state in the middle of the search: the
+    findings so far are kept, the search ends COULD-NOT-TEST, one line says why."""
+    opened = [0]
+    real_open = Side.open
+
+    def open_(self, tell=()):
+        opened[0] += 1
+        if opened[0] > 40:
+            raise CouldNotTest("the known state: D refused (7)")
+        return real_open(self, tell)
+
+    monkeypatch.setattr(Side, "open", open_)
+    status = main(["diff", "--target", "emu:GVE84-100?mutant=lower-case-command",
+                   "--examples", "500", "--report-dir", str(tmp_path)])
+    captured = capsys.readouterr()
+    assert status == 1 and "Traceback" not in captured.err
+    assert "COULD-NOT-TEST: the known state: D refused (7)" in captured.err
+    (folder,) = tmp_path.iterdir()
+    verdicts = {r["id"]: r["verdict"] for r in
+                json.loads((folder / "results.json").read_text())["results"]}
+    assert verdicts["diff.search.agreement"] == "COULD-NOT-TEST"
+    assert "FAIL" in verdicts.values()
+    assert "reached: commands" in captured.out
+
+
+def test_diff_prints_what_it_reached_beside_its_verdict(capsys):
+    assert main(["diff", "--target", "emu:GVE54", "--examples", "30", "--no-reports",
+                 "-v"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    reached = next(i for i, line in enumerate(out) if line.startswith("reached: "))
+    assert re.fullmatch(r"reached: commands \d+/\d+, table values \d+/\d+, states \d+/\d+ "
+                        r"\(\d+ %\)", out[reached])
+    assert out[reached + 1].startswith("  not reached: ")
+    assert out[-1].startswith("PASSED")

@@ -3,7 +3,16 @@
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conformance.diff.grammar import Grammar, Options, command_names, load_probes, probes, sequences
+from conformance.diff.grammar import (
+    Grammar,
+    Options,
+    command_names,
+    load_probes,
+    probes,
+    sequences,
+    table_values,
+    value_frames,
+)
 from conformance.diff.labels import command_of
 from conformance.diff.steps import FILL, FRAME, INPUT, WAIT
 from gve_fixtures.profile import load_profile
@@ -11,6 +20,7 @@ from gve_fixtures.rules import load_rules
 
 GVE54 = load_profile("GVE54")
 GVE84 = load_profile("GVE84-100")
+GVE114 = load_profile("GVE114-500")
 
 
 def test_destructive_commands_only_when_allowed():
@@ -117,3 +127,50 @@ def test_a_written_packets_frames_await_no_answer_until_one_ends_it():
     assert [(s.body, s.answer) for s in steps] == [
         ("*S", False), ("B10", False), ("v10", False), ("*E2", True), ("C200,0,0", True),
         ("*S", False), ("C10,0,0", False), ("H", True), ("*E1", True), ("F", True)]
+
+
+def test_a_fields_table_values_are_its_ranges_ends_each_word_and_each_axis():
+    feed = GVE84.range("V")
+    assert table_values(GVE84, "range:V") == [str(feed.lo), str(feed.hi)]
+    assert table_values(GVE84, "dec:0:6") == ["0", "1", "2", "3", "4", "5", "6"]
+    assert table_values(GVE84, "hex:0:255") == ["00", "FF"]
+    assert table_values(GVE84, "choice:+|-") == ["+", "-"]
+    assert table_values(GVE114, "axis") == ["X", "Y", "Z", "A"]
+    # drawn otherwise (short moves and travels, a travel's rates, floats): no table
+    assert not any(table_values(GVE84, k) for k in ("vector", "travel", "seek-rate", "float"))
+
+
+def test_each_table_value_is_a_frame_of_its_own_the_other_fields_held():
+    frames = value_frames(GVE84, command_names(GVE84, Options(destructive=True)))
+    feed = GVE84.range("V")
+    assert {f"V{feed.lo}", f"V{feed.hi}", "SR0", "SR6", "ER00", "ERFF"} <= set(frames)
+    # one field at a time at each end, the others at their first value
+    assert {"EW00,00", "EWFF,00", "EW00,FF"} <= set(frames) and "EWFF,FF" not in frames
+    assert len(frames) == len(set(frames))
+    # *E's count is diff's own range, no manual's table
+    assert not any(f.startswith("*E") for f in frames)
+
+
+def test_the_tables_move_each_axis_alone_and_ground_several_inputs_at_once():
+    tables = Grammar(GVE114, Options(destructive=True, rig=True)).tables
+    firsts = {t[0] for t in tables if len(t) > 1}
+    # the GVE114's A alone, which no command reads back: run (ST6, F) right after it
+    assert ("L0,0,0,100", "SR6", "wait 0.2", "PF", "C0,0,0,100", "F") in tables
+    # ST1's two interrupt inputs (I2's bits 6 and 7) enabled and grounded together, the
+    # cause word read; and the first of them alone
+    assert ("SW1,C0", "input 2 00", "SR5", "input 2 FF", "D") in tables
+    assert "SW1,40" in firsts
+    # without a rig no input is set: the idioms that need one are left out
+    plain = Grammar(GVE114, Options(destructive=True)).tables
+    assert not any(line.startswith("input ") for t in plain for line in t)
+
+
+def test_the_sweep_runs_each_commands_values_together_then_each_idiom():
+    g = Grammar(GVE84, Options(destructive=True, rig=True))
+    swept = g.sweep()
+    singles = [t[0] for t in g.tables if len(t) == 1]
+    bodies = [s.body for seq in swept for s in seq if s.kind == FRAME]
+    assert all(b in bodies for b in singles)
+    # a command's values in one sequence
+    v = next(seq for seq in swept if command_of(seq[0].body) == "V")
+    assert {s.body for s in v} == {b for b in singles if command_of(b) == "V"}

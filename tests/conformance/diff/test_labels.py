@@ -105,6 +105,11 @@ def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
     assert label("PF", "position", set(), {"V", "V-refused", "L"}, 0) == \
         "4.response.failed-not-executed"
     assert label("PF", "position", set(), {"A", "L"}, 0) == "10.2.motion.trapezoid"
+    # ST6 read after the MPG's enable byte was written (or the MPG switched): whether the
+    # MPG holds RUN is that byte's; after a vector alone, whether the unit took it
+    assert label("SR", "data", set(), {"EW", "J", "L"}, 0) == "9.reset.mpg"
+    assert label("F", "data", set(), {"Y"}, 0) == "9.reset.mpg"
+    assert label("SR", "data", set(), {"L"}, 0) == "10.cmd.vector"
 
 
 def test_an_input_interrupting_is_the_manuals_and_when_it_does_the_decision():
@@ -268,6 +273,13 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # vectors refused while the MPG holds RUN, its parameters never set
     "9.reset.mpg-parameters": ("9.reset.mpg-enabled",
                                ("L", "code", {"mpg-on"}, {"EW", "J"}, 7, 0, "GVE114")),
+    # a vector refused 7 after an EEPROM 06 value the manual does not list as enabling
+    "9.reset.mpg": ("9.reset.mpg-enabled", ("L", "code", set(), {"EW", "Y"}, 0, 7, "GVE114")),
+    # RUN read right after a vector alone: the unit did not run it
+    "10.cmd.vector": ("10.cmd.positions.each-axis", ("SR", "data", set(), {"L"}, 0, 0)),
+    # W answered before its run ended
+    "10.cmd.reference": ("10.cmd.reference.answers-after-travel",
+                         ("W", "timing", set(), set(), 0, 0)),
 }
 
 
@@ -283,6 +295,7 @@ def test_every_rule_both_use_has_its_behaviour_here():
 
 @pytest.mark.parametrize("rule", sorted(PAIRS))
 def test_diff_names_the_rule_the_catalogue_grades_the_behaviour_by(rule):
+    import conformance.catalogue  # noqa: F401  (registers the cases)
     from conformance.case import REGISTRY
     case_id, facts = PAIRS[rule]
     assert rule in REGISTRY[case_id].rules
