@@ -125,6 +125,9 @@ def mpg_values(ctx: CaseContext) -> None:
     on; every value beside them leaves the MPG inert, `Y&` too."""
     mpg, link = ctx.profile.mpg, ctx.link
     enable = "%02X" % mpg.enable_address
+    # every other MPG parameter in range first (M114 12: otherwise "the MPG cannot be
+    # used"), so that only the enable byte decides
+    configured(ctx, "mpg")
     for value, enables in _mpg_values(ctx):
         answers(ctx, link.send("Y-"), "0,Y-", "Y- before the EEPROM write", rule="10.cmd.mpg")
         setup(ctx, f"EW{enable},{value:02X}")
