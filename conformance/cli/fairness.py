@@ -19,7 +19,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import workers
+from conformance.cli.pool import gate_end, workers
 from conformance.cli.progress import Progress
 from conformance.cli.usage import (
     INTERRUPTED,
@@ -181,12 +181,8 @@ def main(argv: list[str] | None = None) -> int:
     fair = sum(t.fair for t in trials)
     score = 100.0 * fair / len(trials) if trials else 100.0
     unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
-    for line in [f"what failed ({len(trials) - fair} reading(s)):", *unfair] if unfair else []:
-        print(line, flush=True)
-    if pool.interrupted:        # a signal: every worker stopped, no score to give
-        print(f"fairness: interrupted by a signal after {len(trials)} of {len(jobs)} "
-              f"readings ({len(trials) - fair} unfair) in "
-              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
+    if gate_end("fairness", unfair, f"{len(trials) - fair} reading(s)", pool.interrupted,
+                f"{len(trials)} of {len(jobs)} readings ({len(trials) - fair} unfair)", start):
         return INTERRUPTED
     print(f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
           f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "

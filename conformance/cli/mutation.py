@@ -23,7 +23,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import workers
+from conformance.cli.pool import gate_end, workers
 from conformance.cli.progress import Progress
 from conformance.cli.usage import (
     INTERRUPTED,
@@ -188,13 +188,11 @@ def main(argv: list[str] | None = None) -> int:
     score = 100.0 * caught / len(results) if results else 100.0
     errors = sum(len(h.errors) for h in results)
     failed = [line for h in results if not h.caught or h.errors for line in _lines(h)]
-    for line in [f"what failed ({sum(not h.caught or bool(h.errors) for h in results)} "
-                 "mutant(s)):", *failed] if failed else []:
-        print(line, flush=True)
-    if pool.interrupted:        # a signal: every worker stopped, no score to give
-        print(f"mutation: interrupted by a signal after {len(results)} of {len(jobs)} "
-              f"mutants ({caught} caught, {errors} ERROR) in "
-              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
+    if gate_end("mutation", failed,
+                f"{sum(not h.caught or bool(h.errors) for h in results)} mutant(s)",
+                pool.interrupted,
+                f"{len(results)} of {len(jobs)} mutants ({caught} caught, {errors} ERROR)",
+                start):
         return INTERRUPTED
     print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
           f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "

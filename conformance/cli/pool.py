@@ -22,6 +22,7 @@ import os
 import signal
 import sys
 import threading
+import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import Connection, wait
@@ -261,3 +262,16 @@ def _watch_parent() -> None:
 def workers(jobs: int) -> Workers:
     """A pool whose ``map`` runs ``jobs`` at a time (in order of the items)."""
     return Workers(jobs)
+
+
+def gate_end(job: str, failed: list[str], count: str, interrupted: bool, done: str,
+             start: float) -> bool:
+    """The end of a gate run by workers: what failed listed again under ``count`` (how
+    many, and of what), then, when a signal stopped it, one line saying how far it got
+    (``done``) and True: no score is given then."""
+    for line in [f"what failed ({count}):", *failed] if failed else []:
+        print(line, flush=True)
+    if interrupted:
+        print(f"{job}: interrupted by a signal after {done} in "
+              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
+    return interrupted

@@ -7,8 +7,10 @@ frame."""
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 import sys
+from collections.abc import Iterator
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -29,6 +31,23 @@ from gve_fixtures.profile import load_profile
 def cosim(*options: str) -> str:
     return "exec:" + shlex.join([sys.executable, "-m", "emulator", "--model", "GVE84-100",
                                  "--cosim", *options])
+
+
+@contextlib.contextmanager
+def mutant_pair(mutant: str) -> Iterator[Pair]:
+    """A co-simulated mutant against the reference, its motion confirmed (nothing waits
+    for the guard's first look at the axes), finished and closed after."""
+    target = parse_target(cosim("--mutant", mutant), profile="GVE84-100",
+                          allow_destructive=True)
+    target.preflight()
+    try:
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        target.session.guard.motion_confirmed = True
+        yield pair
+    finally:
+        target.session.finish()
+        target.close()
 
 
 @pytest.fixture(scope="module")
@@ -138,14 +157,8 @@ def test_frames_told_ahead_take_fewer_exchanges(pairs, monkeypatch):
 def test_frames_told_after_a_disagreement_are_sent_and_booked(pairs):
     # the mutant answers V0 (out of range) 4, not 5: as soon as the reference, so the
     # frames told after it run
-    target = parse_target(cosim("--mutant", "range-error-code"), profile="GVE84-100",
-                          allow_destructive=True)
-    target.preflight()
-    try:
-        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
-                    target.profile)
-        guard = target.session.guard
-        guard.motion_confirmed = True
+    with mutant_pair("range-error-code") as pair:
+        guard = pair.target.target.session.guard
         steps = [Step(FRAME, body=body) for body in ("V0", "C120,0,0", "C120,0,0")]
         run = pair.run(steps)
         assert run.disagreement is not None and run.disagreement.index == 0
@@ -159,9 +172,6 @@ def test_frames_told_after_a_disagreement_are_sent_and_booked(pairs):
         pair.run(steps)
         assert b"".join(r.data for r in pair.target.link.log).count(b"C120") == 0
         assert guard.envelope.seen[0].hi == before
-    finally:
-        target.session.finish()
-        target.close()
 
 
 def test_a_target_drifting_from_the_frames_told_is_run_again_frame_by_frame(pairs,
@@ -194,17 +204,8 @@ def test_a_target_drifting_from_the_frames_told_is_run_again_frame_by_frame(pair
 def test_a_target_answering_later_than_the_reference_stops_what_was_told(pairs):
     # the mutant reads a lower-case command as its upper case and answers it at length,
     # where the reference refuses it at once: the simulator ran nothing after it
-    target = parse_target(cosim("--mutant", "lower-case-command"), profile="GVE84-100",
-                          allow_destructive=True)
-    target.preflight()
-    try:
-        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
-                    target.profile)
-        target.session.guard.motion_confirmed = True
+    with mutant_pair("lower-case-command") as pair:
         run = pair.run([Step(FRAME, body=body) for body in ("sr0", "C120,0,0", "C120,0,0")])
         assert run.disagreement is not None and run.disagreement.index == 0
         assert b"C120" not in b"".join(r.data for r in pair.target.link.log)
-        assert target.session.guard.envelope.seen[0].hi == 0
-    finally:
-        target.session.finish()
-        target.close()
+        assert pair.target.target.session.guard.envelope.seen[0].hi == 0
