@@ -156,6 +156,28 @@ def test_a_target_whose_d_misbehaves_gets_a_fail_naming_d_and_diff_runs_on(mutan
     assert "100 sequences" in out
 
 
+def test_a_sequence_the_known_state_cannot_undo_is_named_and_ends_the_search(tmp_path, capsys):
+    """A unit that sums checksums its own way is left by `%+` where no frame framed as
+    the manual states reaches it: the disagreement is kept, the known state's H names the
+    checksum's rule with the frames that led there, and the search ends COULD-NOT-TEST,
+    never PASS, without a traceback."""
+    target = (f"exec:{sys.executable} -m emulator --cosim --model GVE84-100 "
+              "--mutant checksum-no-comma")
+    status = main(["diff", "--target", target, "--profile", "GVE84-100", "--yes",
+                   "--examples", "100", "--report-dir", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert status == 1 and "Traceback" not in out + err
+    assert "FAIL        6.checksum.response-sum: !0%+" in out
+    assert "FAIL        6.checksum.sum: the known state: H framed as the manual states" in out
+    assert "COULD-NOT-TEST: the known state could not be had" in err
+    (folder,) = tmp_path.iterdir()
+    results = {r["id"]: r for r in json.loads((folder / "results.json").read_text())
+               ["results"]}
+    assert results["diff.search.agreement"]["verdict"] == "COULD-NOT-TEST"
+    assert any("%+" in note for note in results["diff.search.agreement"]["notes"])
+    assert any("> !0%+" in line for line in results["6.known-state.halt"]["wire_log"])
+
+
 def _diff_killed_at(tmp_path: Path, first: str) -> tuple[str, Path]:
     """`diff` against a mutant, SIGKILLed (nothing of its own ending runs) right after it
     printed a line starting with ``first``: that line and the run's folder."""
