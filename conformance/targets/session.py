@@ -490,7 +490,7 @@ class RealSession(Session):
             link.send("%-", checksum=True)
         answers = link.send_each(frames)
         if halt is not None and halt.code is not None and not halt.ok:
-            self._step_failed(link, self._halt_refused(halt))
+            self._step_failed(link, self._halt_refused(halt, link.checksums))
         why = self._at_rest(link, halt, answers[-2], answers[-1])
         if held and not give_back and not why:
             why = self._keep_not_given_back(link)
@@ -501,12 +501,13 @@ class RealSession(Session):
                 "R accepted"))
         return why, link.send_each(then)
 
-    def _halt_refused(self, halt: Response) -> StepFailure:
-        """`H` answered otherwise than 8. `H` has no parameter: where the unit has a
-        checksum mode and refused it with 4 (the code of a bad or missing checksum) in
-        both framings (:meth:`_halt` tries each), it refuses frames summed as the manual
-        sums them (a FAIL of that rule); any other answer is a FAIL of `H`'s own."""
-        if halt.code == ErrorCode.SYNTAX and "%" in self.profile.commands:
+    def _halt_refused(self, halt: Response, summed: bool) -> StepFailure:
+        """`H` answered otherwise than 8. `H` has no parameter: where the unit took `%+`
+        (``summed``: the link believes the mode on) and refused `H` with 4, the code of a
+        bad or missing checksum, in both framings (:meth:`_halt` tries each), it refuses
+        frames summed as the manual sums them (a FAIL of that rule); any other answer is a
+        FAIL of `H`'s own."""
+        if halt.code == ErrorCode.SYNTAX and summed:
             return StepFailure(
                 "6.checksum.sum", "halt", "H framed as the manual states, summed from ! up "
                 "to and including the comma in checksum mode and plain otherwise, is taken",

@@ -168,16 +168,19 @@ def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
     assert set(verdicts.values()) == {PASS}
 
 
-@pytest.mark.parametrize(("profile", "rule"), [("GVE84-100", "6.checksum.sum"),
-                                               ("GVE54", "10.cmd.halt-answer")])
-def test_an_h_refused_with_4_in_either_framing_fails_the_checksum_sum_where_there_is_one(
-        profile, rule):
+@pytest.mark.parametrize(("summed", "rule"), [(True, "6.checksum.sum"),
+                                              (False, "10.cmd.halt-answer")])
+def test_an_h_refused_with_4_in_either_framing_in_checksum_mode_fails_the_checksum_sum(
+        summed, rule):
     # H has no parameter: refused with 4 (a bad or missing checksum) summed as the manual
-    # sums it and plain alike, the unit breaks the checksum's framing; without a checksum
-    # mode (GVE54), H's own rule
+    # sums it and plain alike, by a unit that took %+ (and never gets the case's %-), it
+    # breaks the checksum's framing; with checksums off, H's own rule
     refused = b"!0?1\r"                              # answered 4
-    u = unit(profile, frames={b"!0H\r": refused, b"!0H,C5\r": refused})
-    result = run([u], select(["5.errors.ok"]))
+    frames = {b"!0H\r": refused, b"!0H,C5\r": refused}
+    if summed:
+        frames[b"!0%-,CF\r"] = refused
+    u = unit(frames=frames)
+    result = run([u], select(["6.checksum.mode-on-off", "5.errors.ok"]))
     rows = [r for r in result.results if r.id.endswith("known-state.halt")]
     assert len(rows) == 1 and rows[0].verdict == FAIL
     assert rows[0].checks[0]["rule"] == rule and rows[0].checks[0]["observed"].startswith("H 4")
