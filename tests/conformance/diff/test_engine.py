@@ -50,9 +50,9 @@ OFF_THE_WIRE = {
 }
 #: the mutants the probes must name
 ON_THE_WIRE = sorted(set(mutants()) - set(OFF_THE_WIRE))
-#: mutants off by one step only, which somebody else's unit is allowed in where it places
-#: its steps (conformance/motion/tolerance.py): against a target that is not the
-#: emulator, named only when it is graded exactly (--strict)
+#: mutants off by one step only, which somebody else's unit in virtual time (a
+#: co-simulator) is allowed in where it places its steps (Pair's placement): named there
+#: only when it is graded exactly (--strict); in real time a read at rest is exact
 WITHIN_PLACEMENT = {"go-loses-step": "G resumes one step past where the vector stopped"}
 
 
