@@ -31,6 +31,8 @@ from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
+from conformance.targets.session import StepFailed
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -93,6 +95,7 @@ class ExampleRun:
     frames: int = 0
     refused: list[str] = field(default_factory=list)     # steps the guard did not send
     ended: str = ""                                      # why the sequence ended early
+    begun: bool = False                  # both sides were brought to the known state
 
 
 class Pair:
@@ -123,6 +126,11 @@ class Pair:
         self.out_of_time: Callable[[], bool] = _never
         #: what the sequences reached (commands, table values, states), if counted
         self.reach: Reach | None = None
+        #: why the target could not be brought to the known state after a sequence ("":
+        #: it could); no sequence is sent to it after that
+        self.lost = ""
+        self._last: list[Step] = []            # the steps of the latest sequence begun
+        self.led_there: list[Step] = []        # the sequence after which it was lost
 
     @property
     def exact(self) -> bool:
@@ -143,6 +151,7 @@ class Pair:
         self._teller = None
         if not self._begin(out):
             return out
+        self._last = list(steps)
         self._teller = Teller(self.target, steps, self._refer) if ahead else None
         earlier: set[str] = set()          # what the sequence did before (labels read it)
         try:
@@ -167,7 +176,11 @@ class Pair:
         return self._end(out)
 
     def _begin(self, out: ExampleRun) -> bool:
-        """Both sides in the known state; False when the guard refused it."""
+        """Both sides in the known state; False when the guard refused it, or when the
+        target could not be brought there (:attr:`lost`)."""
+        if self.lost:
+            out.ended = self.lost
+            return False
         try:
             self.target.open(tell=PRELUDE if self.target.real else ())
             self.reference.open()
@@ -181,7 +194,15 @@ class Pair:
             # unit restart there): the candidate shows nothing
             out.refused.append(f"the known state: {err}")
             return False
+        except StepFailed as err:
+            # the frames before left the unit where the manual's rules cannot bring it to
+            # rest, where the reference's were (the session names the rule its evidence
+            # broke): nothing more is sent, and the search ends there (KnownStateLost)
+            self.lost = out.ended = f"the known state could not be had: {err}"
+            self.led_there = self._last
+            return False
         self.course = Course(self.profile)
+        out.begun = True
         return True
 
     def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
@@ -431,6 +452,8 @@ class Finding:
     steps: list[Step]
     outcome: ExampleRun
     number: int = 0                    # the search's count of disagreements seen, from 1
+    #: why it was not shrunk or replayed as far as others ("": it was)
+    unreplayed: str = ""
 
     @property
     def disagreement(self) -> Disagreement:
@@ -468,9 +491,14 @@ class Budget:
 
 def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
     """Real time: whether the shrunk sequence disagrees the same way once more (a
-    disagreement seen once may be the timing of that run, not the target)."""
-    trial = pair.run(finding.steps)
-    budget.frames += trial.frames
+    disagreement seen once may be the timing of that run, not the target). A run whose
+    known state the guard refused (the finding's own run left the counters where its
+    frames could not put them, say) tried nothing: it is run once more."""
+    for _ in range(2):
+        trial = pair.run(finding.steps)
+        budget.frames += trial.frames
+        if trial.begun or pair.lost:
+            break
     d = trial.disagreement
     return d is not None and d.signature == finding.disagreement.signature
 
@@ -503,7 +531,8 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
         return trial if d is not None and (d.command, d.kind) == want else None
 
     i = 0
-    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time():
+    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time() \
+            and not pair.lost:
         found = False
         lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
             if frames_only else _lesser(steps, i, outcome)
@@ -602,8 +631,8 @@ class _Search:
         self.seen = 0                  # disagreements seen so far (each one's number)
 
     def more(self) -> bool:
-        return not self.budget.spent() and (self.stop_after is None
-                                            or len(self.findings) < self.stop_after)
+        return not self.pair.lost and not self.budget.spent() and (
+            self.stop_after is None or len(self.findings) < self.stop_after)
 
     def trial(self, steps: list[Step]) -> Finding | None:
         """One example run whole; a finding when it shows a disagreement not kept yet."""
@@ -621,7 +650,7 @@ class _Search:
 
         def fails(steps: list[Step]) -> bool:
             nonlocal best
-            if self.budget.spent():
+            if self.budget.spent() or self.pair.lost:
                 raise _Spent           # also while shrinking: the smallest seen is kept
             found = self.trial(steps)
             if found is None:
@@ -662,9 +691,14 @@ class _Search:
             return
         self.known.add(finding.disagreement.signature)
         confirmed = repeatable or _again(pair, finding, self.budget)
-        if not confirmed and written and finding.steps != found.steps:
+        if not confirmed and written and finding.steps != found.steps and not pair.lost:
             finding = found
             confirmed = _again(pair, found, self.budget)
+        if pair.lost:
+            # the unit could not be brought back after it: the disagreement stands as
+            # seen, and the lost known state is a failure of its own (the session's)
+            finding.unreplayed = f"not replayed further: {pair.lost}"
+            confirmed = True
         if not confirmed:
             pair.unconfirmed.append(finding)
             self._dropped(found)
@@ -676,6 +710,17 @@ class _Search:
     def _dropped(self, found: Finding) -> None:
         if self.on_dropped is not None:
             self.on_dropped(found)
+
+
+class KnownStateLost(CouldNotTest):
+    """The target could not be brought to the known state after a sequence: the search
+    stopped there. ``findings``: those kept until then; ``after``: the sequence that
+    left the unit so (empty: the first known state)."""
+
+    def __init__(self, why: str, findings: list[Finding], after: list[Step]) -> None:
+        super().__init__(why)
+        self.findings = findings
+        self.after = after
 
 
 def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
@@ -691,13 +736,17 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
     seen (before it is shrunk), ``on_finding`` once it is kept, ``on_dropped`` when one
     seen is not (the same as one kept, or not seen again in real time); ``reach`` counts
     what the sequences reached. ``--seconds`` holds everywhere: no sequence, step or
-    shrink begins once the time is up."""
+    shrink begins once the time is up. :class:`KnownStateLost` (with the findings kept)
+    when the target could not be brought to the known state: never a search that ended."""
     hunt = _Search(pair, budget, stop_after, on_finding, on_seen, on_dropped)
     pair.out_of_time, pair.reach = budget.out_of_time, reach
     try:
-        return _hunt(hunt, pair, options, budget, seed, with_probes)
+        found = _hunt(hunt, pair, options, budget, seed, with_probes)
     finally:
         pair.out_of_time, pair.reach = _never, None
+    if pair.lost:
+        raise KnownStateLost(pair.lost, found, pair.led_there)
+    return found
 
 
 def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int,

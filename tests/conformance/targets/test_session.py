@@ -166,3 +166,41 @@ def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
     verdicts = {r.id: r.verdict for r in result.results}
     assert verdicts.pop("10.known-state.halt") == FAIL
     assert set(verdicts.values()) == {PASS}
+
+
+@pytest.mark.parametrize(("summed", "rule"), [(True, "6.checksum.sum"),
+                                              (False, "10.cmd.halt-answer")])
+def test_an_h_refused_with_4_in_either_framing_in_checksum_mode_fails_the_checksum_sum(
+        summed, rule):
+    # H has no parameter: refused with 4 (a bad or missing checksum) summed as the manual
+    # sums it and plain alike, by a unit that took %+ (and never gets the case's %-), it
+    # breaks the checksum's framing; with checksums off, H's own rule
+    refused = b"!0?1\r"                              # answered 4
+    frames = {b"!0H\r": refused, b"!0H,C5\r": refused}
+    if summed:
+        frames[b"!0%-,CF\r"] = refused
+    u = unit(frames=frames)
+    result = run([u], select(["6.checksum.mode-on-off", "5.errors.ok"]))
+    rows = [r for r in result.results if r.id.endswith("known-state.halt")]
+    assert len(rows) == 1 and rows[0].verdict == FAIL
+    assert rows[0].checks[0]["rule"] == rule and rows[0].checks[0]["observed"].startswith("H 4")
+    # the frames that led there are its transcript: the known state's own, H first
+    assert any("> !0H" in line for line in rows[0].wire_log), rows[0].wire_log
+
+
+def test_a_return_move_still_running_after_its_wait_idiom_fails_that_rule_and_is_awaited():
+    command = [sys.executable, "-m", "emulator", "--model", "GVE84-100", "--cosim",
+               "--mutant", "line-while-busy"]          # L0,0,0 answered 0 while moving
+    target = parse_target("exec:" + shlex.join(command), profile="GVE84-100",
+                          allow_destructive=True, max_travel=10_000)
+    target.preflight()
+    result = run([target], select(["10.1.*", "10.2.*"]))
+    (row,) = [r for r in result.results if r.id == "10.1.known-state.return-move"]
+    assert row.verdict == FAIL and row.checks[0]["rule"] == "10.1.queue.wait-idiom"
+    assert "SR6 0,40" in row.checks[0]["observed"]
+    # the case before it, whose motion the return move undid, heads the transcript
+    assert "# the known state" in row.wire_log and row.wire_log[0] != "# the known state"
+    # the move's end awaited: no case lost to a unit not at rest
+    assert not [r.id for r in result.results if r.verdict == COULD_NOT_TEST
+                and "not at rest" in " ".join(r.notes)]
+    assert ERROR not in [r.verdict for r in result.results]
