@@ -149,6 +149,9 @@ class Link:
         #: answer, or its absence, is booked with it
         self._exchange: list[int] | None = None
         self._answered_as = Spent.ANSWERS
+        #: work of the caller's done once, while the port runs the next frames told
+        #: ahead (:meth:`tell`), or by the caller when none are told
+        self.meanwhile: Callable[[], None] | None = None
         self._origin = self._clock()
 
     # -- time ------------------------------------------------------------------------------
@@ -380,12 +383,19 @@ class Link:
         """Tell a port that takes frames told ahead (a co-simulator's, docs/cosim.md:
         `batch`) the frames about to be sent with :meth:`send` one after the other, in the
         mode the link believes (any other port is told nothing). Each is still judged,
-        sent and read as it comes; a frame not sent as told drops the rest."""
+        sent and read as it comes; a frame not sent as told drops the rest. The link's
+        :attr:`meanwhile` work is done here (and dropped), while the port runs them."""
         expect = getattr(self.port, "expect", None)
+        work, self.meanwhile = self.meanwhile, None
         if expect is not None and not self._faults:
             framed = [frame(body, self.address, self.checksums) for body in bodies]
-            expect([(data, self.answer_timeout(body, len(data))) for body, data in
-                    zip(bodies, framed, strict=True)])
+            told = [(data, self.answer_timeout(body, len(data))) for body, data in
+                    zip(bodies, framed, strict=True)]
+            # with work to do meanwhile, the port's reply is read when the link next
+            # uses it: the work runs while the port runs the frames
+            (getattr(self.port, "tell", expect) if work is not None else expect)(told)
+        if work is not None:
+            work()
 
     @property
     def takes_ahead(self) -> bool:

@@ -204,13 +204,19 @@ class Session:
         self._link = link
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
         """A link in the known state (on the emulator: a new unit, at ``address``).
         ``tell``: the frames the caller sends first on it, told ahead with the known
-        state's last (Link.tell) where the unit lives on."""
+        state's last (Link.tell) where the unit lives on; ``meanwhile``: work of the
+        caller's, done while the unit runs frames of the known state told ahead (else
+        once the link is open)."""
         self.start()
         self.guard.check_idle()
-        return self._new_link(address)
+        link = self._new_link(address)
+        if meanwhile is not None:
+            meanwhile()
+        return link
 
     def start(self) -> None:
         """Read the unit as found, before the first case (real units only)."""
@@ -302,8 +308,10 @@ class RealSession(Session):
         link.round_trip = self.report.line
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
         link = super().open_link(address)
+        link.meanwhile = meanwhile         # done at the known state's first frames told
         with self.guard.own_frames():
             try:
                 self._known_state(link, tell)
@@ -313,6 +321,9 @@ class RealSession(Session):
                 if not link.violations:
                     raise
         link.log.clear()
+        work, link.meanwhile = link.meanwhile, None
+        if work is not None:
+            work()
         return link
 
     # -- the unit as found ----------------------------------------------------------------------
