@@ -172,7 +172,7 @@ class Pair:
         real = self.target.real
         # the reference's beginning needs nothing more of the target's (its EEPROM as
         # found is known): done while a co-simulator runs the known state's frames
-        alone = not real or (self.target.session is not None and self._same_eeprom_known())
+        alone = real and self.target.session is not None and self._same_eeprom_known()
         try:
             self.target.open(tell=PRELUDE if real else (),
                              meanwhile=self._begin_reference if alone else None)

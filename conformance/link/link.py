@@ -384,17 +384,21 @@ class Link:
         `batch`) the frames about to be sent with :meth:`send` one after the other, in the
         mode the link believes (any other port is told nothing). Each is still judged,
         sent and read as it comes; a frame not sent as told drops the rest. The link's
-        :attr:`meanwhile` work is done here (and dropped), while the port runs them."""
+        :attr:`meanwhile` work is done here once frames are told, while the port runs
+        them."""
         expect = getattr(self.port, "expect", None)
-        work, self.meanwhile = self.meanwhile, None
-        if expect is not None and not self._faults:
-            framed = [frame(body, self.address, self.checksums) for body in bodies]
-            told = [(data, self.answer_timeout(body, len(data))) for body, data in
-                    zip(bodies, framed, strict=True)]
-            # with work to do meanwhile, the port's reply is read when the link next
-            # uses it: the work runs while the port runs the frames
-            (getattr(self.port, "tell", expect) if work is not None else expect)(told)
-        if work is not None:
+        if expect is None or self._faults or not getattr(self.port, "tells", True):
+            return
+        framed = [frame(body, self.address, self.checksums) for body in bodies]
+        told = [(data, self.answer_timeout(body, len(data))) for body, data in
+                zip(bodies, framed, strict=True)]
+        work = self.meanwhile
+        if work is None:
+            expect(told)
+        # with work to do meanwhile, the port's reply is read when the link next uses
+        # it: the work runs while the port runs the frames
+        elif getattr(self.port, "tell", expect)(told):
+            self.meanwhile = None
             work()
 
     @property

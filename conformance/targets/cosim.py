@@ -354,8 +354,7 @@ class CosimLine:
         """:meth:`expect`'s exchange sent and its reply left to be read when the line is
         next used (whatever use): the suite may do other work meanwhile, while the
         simulator runs the frames. Whether they were told."""
-        if ("batch" not in self.extensions or self._tx is not None or self._rx
-                or self._ahead or self._inflight is not None or self._told is not None):
+        if not self.tells:
             return False
         self._usable()
         stops = "batch-stops" in self.extensions
@@ -373,6 +372,13 @@ class CosimLine:
         self._send(command)
         self._told = (command, plan)
         return True
+
+    @property
+    def tells(self) -> bool:
+        """Whether frames may be told now: the simulator takes `batch`, and nothing is
+        under way on the line (a write, bytes unread, frames told before)."""
+        return ("batch" in self.extensions and self._tx is None and not self._rx
+                and not self._ahead and self._inflight is None and self._told is None)
 
     def _land_told(self) -> int:
         """Read the reply to the frames told (:meth:`tell`), checked frame by frame: how
@@ -551,6 +557,11 @@ class CosimPort:
         """The frames about to be sent, their reply read when the line is next used
         (CosimLine.tell): whether they were told."""
         return self.line.tell(frames)
+
+    @property
+    def tells(self) -> bool:
+        """Whether frames may be told now (CosimLine.tells)."""
+        return self.line.tells
 
     def ran(self, data: bytes) -> bool:
         """Whether ``data`` written now was told ahead and run already (CosimLine.ran)."""
