@@ -675,7 +675,9 @@ class RealSession(Session):
             return "", self._position(link)
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
-        self._watch(link, cruise)
+        # watched as long as it takes with its ramps at the reset acceleration (A in
+        # 1000 steps/s²), so that the first L0,0,0 after it is taken (one poll, not two)
+        self._watch(link, cruise + speed / (self.profile.reset.A * 1000))
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
             self._step_failed(link, StepFailure(
                 "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "
