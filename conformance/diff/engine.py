@@ -116,6 +116,7 @@ class Pair:
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
+        self._reference_index = 0          # the reference's index read in the prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
         #: a co-simulator is told each sequence's frames ahead where the guard can judge
@@ -181,12 +182,18 @@ class Pair:
         if self.lost:
             out.ended = self.lost
             return False
+        real = self.target.real
+        # the reference's beginning needs nothing more of the target's (its EEPROM as
+        # found is known): done while a co-simulator runs the known state's frames
+        alone = real and self.target.session is not None and self._same_eeprom_known()
         try:
-            self.target.open(tell=PRELUDE if self.target.real else ())
-            self.reference.open()
+            self.target.open(tell=PRELUDE if real else (),
+                             meanwhile=self._begin_reference if alone else None)
+            if not alone:
+                self._begin_reference()
             self.timing.begin()
             self._index = IndexBase()
-            if self.target.real:
+            if real:
                 self._prelude()
         except SafetyStop as err:
             # the known state or the reads after it were refused (a minimiser's candidate
@@ -297,6 +304,15 @@ class Pair:
                 side.close_example()
         return out
 
+    def _begin_reference(self) -> None:
+        """The reference in its known state, a fresh unit; where the target lives on
+        between examples, the reference's part of the prelude (:meth:`_prelude`)."""
+        self.reference.open()
+        if self.target.real:
+            self._same_eeprom()
+            self.reference.age(AGE_SECONDS)
+            self._reference_index = _index_read(self.reference)
+
     def _prelude(self) -> None:
         """A unit that lives on between examples (a real one, a co-simulator) is not
         reset by the known state: its index is read on both sides and compared from
@@ -305,24 +321,22 @@ class Pair:
         long ago (a vector right away would otherwise wait the dwell T on one side only),
         and the target's too: the known state may have moved its axes back just before,
         so the sequence begins once the longest dwell T after that has passed (waited
-        after the reads, which the known state told a co-simulator ahead with its last)."""
-        self._same_eeprom()
-        self.reference.age(AGE_SECONDS)
-        indexes = []
-        for side in (self.target, self.reference):
-            r = side.link.send_each(PRELUDE)[1]
-            try:
-                indexes.append(r.dec(0) if r is not None else 0)
-            except AssertionError:
-                indexes.append(0)
+        after the reads, which the known state told a co-simulator ahead with its last).
+        The reference's part is done as it begins (:meth:`_begin_reference`)."""
+        index = _index_read(self.target)
         self.target.wait(self.profile.range("T").hi / 1000)
-        self._index = IndexBase((indexes[0] - indexes[1]) % 256)
+        self._index = IndexBase((index - self._reference_index) % 256)
         self.judge = replace(self.judge, index_offset=self._index.offset)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""
         self._index.note(command, context, _values(rec.target), _values(rec.reference))
         self.judge = replace(self.judge, index_offset=self._index.offset or 0)
+
+    def _same_eeprom_known(self) -> bool:
+        """Whether :meth:`_same_eeprom` sends nothing to the target (its bytes as found
+        are read already, or it has none)."""
+        return self._eeprom_changes is not None or "ER" not in self.profile.commands
 
     def _same_eeprom(self) -> None:
         """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
@@ -434,6 +448,15 @@ class Pair:
 
 def _has_lower(text: str) -> bool:
     return any("a" <= ch <= "z" for ch in text)
+
+
+def _index_read(side: Side) -> int:
+    """The index a side reads in the prelude (its second frame, `@`; 0 when unread)."""
+    r = side.link.send_each(PRELUDE)[1]
+    try:
+        return r.dec(0) if r is not None else 0
+    except AssertionError:
+        return 0
 
 
 def _values(exchange: RoundTrip) -> list[str]:

@@ -149,6 +149,9 @@ class Link:
         #: answer, or its absence, is booked with it
         self._exchange: list[int] | None = None
         self._answered_as = Spent.ANSWERS
+        #: work of the caller's done once, while the port runs the next frames told
+        #: ahead (:meth:`tell`), or by the caller when none are told
+        self.meanwhile: Callable[[], None] | None = None
         self._origin = self._clock()
 
     # -- time ------------------------------------------------------------------------------
@@ -380,12 +383,23 @@ class Link:
         """Tell a port that takes frames told ahead (a co-simulator's, docs/cosim.md:
         `batch`) the frames about to be sent with :meth:`send` one after the other, in the
         mode the link believes (any other port is told nothing). Each is still judged,
-        sent and read as it comes; a frame not sent as told drops the rest."""
+        sent and read as it comes; a frame not sent as told drops the rest. The link's
+        :attr:`meanwhile` work is done here once frames are told, while the port runs
+        them."""
         expect = getattr(self.port, "expect", None)
-        if expect is not None and not self._faults:
-            framed = [frame(body, self.address, self.checksums) for body in bodies]
-            expect([(data, self.answer_timeout(body, len(data))) for body, data in
-                    zip(bodies, framed, strict=True)])
+        if expect is None or self._faults or not getattr(self.port, "tells", True):
+            return
+        framed = [frame(body, self.address, self.checksums) for body in bodies]
+        told = [(data, self.answer_timeout(body, len(data))) for body, data in
+                zip(bodies, framed, strict=True)]
+        work = self.meanwhile
+        if work is None:
+            expect(told)
+        # with work to do meanwhile, the port's reply is read when the link next uses
+        # it: the work runs while the port runs the frames
+        elif getattr(self.port, "tell", expect)(told):
+            self.meanwhile = None
+            work()
 
     @property
     def takes_ahead(self) -> bool:

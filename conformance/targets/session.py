@@ -212,13 +212,19 @@ class Session:
         self._link = link
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
         """A link in the known state (on the emulator: a new unit, at ``address``).
         ``tell``: the frames the caller sends first on it, told ahead with the known
-        state's last (Link.tell) where the unit lives on."""
+        state's last (Link.tell) where the unit lives on; ``meanwhile``: work of the
+        caller's, done while the unit runs frames of the known state told ahead (else
+        once the link is open)."""
         self.start()
         self.guard.check_idle()
-        return self._new_link(address)
+        link = self._new_link(address)
+        if meanwhile is not None:
+            meanwhile()
+        return link
 
     def start(self) -> None:
         """Read the unit as found, before the first case (real units only)."""
@@ -314,10 +320,12 @@ class RealSession(Session):
         link.round_trip = self.report.line
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
         before = self._link
         link = super().open_link(address)
         self._before = before
+        link.meanwhile = meanwhile         # done at the known state's first frames told
         with self.guard.own_frames():
             try:
                 self._known_state(link, tell)
@@ -329,6 +337,9 @@ class RealSession(Session):
             finally:
                 self._before = None
         link.log.clear()
+        work, link.meanwhile = link.meanwhile, None
+        if work is not None:
+            work()
         return link
 
     # -- the unit as found ----------------------------------------------------------------------
@@ -721,7 +732,9 @@ class RealSession(Session):
             return "", self._position(link)
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
         seconds = self._return_seconds(body)
-        self._watch(link, cruise)
+        # watched as long as it takes with its ramps at the reset acceleration (A in
+        # 1000 steps/s²), so that the first L0,0,0 after it is taken (one poll, not two)
+        self._watch(link, cruise + speed / (self.profile.reset.A * 1000))
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
             self._step_failed(link, StepFailure(
                 "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "

@@ -219,11 +219,11 @@ def test_a_known_state_that_cannot_be_had_ends_in_a_verdict(tmp_path, capsys, mo
     opened = [0]
     real_open = Side.open
 
-    def open_(self, tell=()):
+    def open_(self, tell=(), meanwhile=None):
         opened[0] += 1
         if opened[0] > 40:
             raise CouldNotTest("the known state: D refused (7)")
-        return real_open(self, tell)
+        return real_open(self, tell, meanwhile)
 
     monkeypatch.setattr(Side, "open", open_)
     status = main(["diff", "--target", "emu:GVE84-100?mutant=lower-case-command",
