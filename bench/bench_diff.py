@@ -3,7 +3,10 @@ against itself), frames per second with the search's own overhead (drawing, shri
 and the time 10,000 frames take as a ratio of a 10 s budget (below 1: met);
 then the same search through a co-simulator (`exec:` of `python -m emulator --cosim`,
 docs/cosim.md: virtual time over the text protocol, the unit's known state before each
-sequence), its sequences per second and their ratio to the in-process figure.
+sequence), its sequences per second and their ratio to the in-process figure; and the
+same ratio per CPU second (this process's and the simulator's): on a loaded machine the
+two processes take turns and the wall-clock ratio falls towards it, on an idle one the
+simulator runs beside the suite.
 
     python -m bench.bench_diff [--frames N]
 """
@@ -11,8 +14,10 @@ sequence), its sequences per second and their ratio to the in-process figure.
 from __future__ import annotations
 
 import argparse
+import resource
 import shlex
 import sys
+import time
 
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
@@ -47,6 +52,22 @@ def frames_per_second(mutant: str | None, frames: int, *, cosim: bool = False
             target.close()
 
 
+def _cpu_seconds() -> float:
+    """CPU seconds this process and its ended children (a simulator, once closed) used."""
+    return sum(u.ru_utime + u.ru_stime for u in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
+def sequences_per_cpu_second(mutant: str | None, frames: int, *, cosim: bool = False
+                             ) -> tuple[float, float, int, float]:
+    """:func:`frames_per_second`, and the sequences per CPU second of this process and the
+    simulator's."""
+    cpu, began = _cpu_seconds(), time.perf_counter()
+    rate, sequences, found = frames_per_second(mutant, frames, cosim=cosim)
+    wall, cpu = time.perf_counter() - began, _cpu_seconds() - cpu
+    return rate, sequences, found, sequences * wall / cpu
+
+
 def _search(pair: Pair, frames: int) -> tuple[float, float, int]:
     budget = Budget(examples=None)
     total = 0.0
@@ -71,10 +92,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--frames", type=int, default=BUDGET_FRAMES)
     args = ap.parse_args(argv)
     print("differential fuzzer, in process (GVE84-100, virtual time on both sides)")
-    in_process = {}
+    in_process, in_process_cpu = {}, {}
     for mutant in (None, "velocity-ignored"):
-        rate, sequences, found = frames_per_second(mutant, args.frames)
-        in_process[mutant] = sequences
+        rate, sequences, found, per_cpu = sequences_per_cpu_second(mutant, args.frames)
+        in_process[mutant], in_process_cpu[mutant] = sequences, per_cpu
         ten_k = BUDGET_FRAMES / rate
         print(f"  against {mutant or 'itself':18} {rate:8.0f} frames/s {sequences:6.1f} "
               f"sequences/s  10,000 frames in {ten_k:5.2f} s = "
@@ -82,10 +103,12 @@ def main(argv: list[str] | None = None) -> None:
     print("through a co-simulator (python -m emulator --cosim, exec:, the reference in "
           "process)")
     for mutant in (None, "velocity-ignored"):
-        rate, sequences, found = frames_per_second(mutant, args.frames, cosim=True)
+        rate, sequences, found, per_cpu = sequences_per_cpu_second(mutant, args.frames,
+                                                                   cosim=True)
         print(f"  against {mutant or 'itself':18} {rate:8.0f} frames/s {sequences:6.1f} "
               f"sequences/s = {sequences / in_process[mutant]:4.2f} x in process  "
-              f"({found} finding(s))")
+              f"({found} finding(s)); per CPU second "
+              f"{per_cpu / in_process_cpu[mutant]:4.2f} x")
 
 
 if __name__ == "__main__":

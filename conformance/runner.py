@@ -205,6 +205,7 @@ def step_results(session: Session, target: Target) -> list[CaseResult]:
         r.notes = ["a step of the known state the suite sets before each case relies on "
                    "this rule of the manual and the unit broke it; the run went on where "
                    "it safely could"]
+        r.wire_log = list(f.led_there)
         out.append(r)
     return out
 

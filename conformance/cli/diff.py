@@ -21,7 +21,7 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.diff.engine import Budget, Pair, search
+from conformance.diff.engine import Budget, KnownStateLost, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.kept import Kept
 from conformance.diff.reach import Reach
@@ -221,6 +221,9 @@ def main(argv: list[str] | None = None) -> int:
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
         r.verdict, r.stopped, r.checks = COULD_NOT_TEST, str(err), []
         r.notes = [f"the search stopped after {budget.used} sequences: {err}"]
+        if isinstance(err, KnownStateLost) and err.after:
+            r.notes.append("the sequence after which the known state could not be had: "
+                           + " | ".join(str(s) for s in err.after))
         run.results.append(r)
         print(f"{r.verdict}: {err}", file=sys.stderr)
     except KeyboardInterrupt:

@@ -31,6 +31,8 @@ from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
+from conformance.targets.session import StepFailed
+from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -93,6 +95,7 @@ class ExampleRun:
     frames: int = 0
     refused: list[str] = field(default_factory=list)     # steps the guard did not send
     ended: str = ""                                      # why the sequence ended early
+    begun: bool = False                  # both sides were brought to the known state
 
 
 class Pair:
@@ -113,6 +116,7 @@ class Pair:
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
+        self._reference_index = 0          # the reference's index read in the prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
         #: a co-simulator is told each sequence's frames ahead where the guard can judge
@@ -123,6 +127,11 @@ class Pair:
         self.out_of_time: Callable[[], bool] = _never
         #: what the sequences reached (commands, table values, states), if counted
         self.reach: Reach | None = None
+        #: why the target could not be brought to the known state after a sequence ("":
+        #: it could); no sequence is sent to it after that
+        self.lost = ""
+        self._last: list[Step] = []            # the steps of the latest sequence begun
+        self.led_there: list[Step] = []        # the sequence after which it was lost
 
     @property
     def exact(self) -> bool:
@@ -143,6 +152,7 @@ class Pair:
         self._teller = None
         if not self._begin(out):
             return out
+        self._last = list(steps)
         self._teller = Teller(self.target, steps, self._refer) if ahead else None
         earlier: set[str] = set()          # what the sequence did before (labels read it)
         try:
@@ -167,13 +177,23 @@ class Pair:
         return self._end(out)
 
     def _begin(self, out: ExampleRun) -> bool:
-        """Both sides in the known state; False when the guard refused it."""
+        """Both sides in the known state; False when the guard refused it, or when the
+        target could not be brought there (:attr:`lost`)."""
+        if self.lost:
+            out.ended = self.lost
+            return False
+        real = self.target.real
+        # the reference's beginning needs nothing more of the target's (its EEPROM as
+        # found is known): done while a co-simulator runs the known state's frames
+        alone = real and self.target.session is not None and self._same_eeprom_known()
         try:
-            self.target.open(tell=PRELUDE if self.target.real else ())
-            self.reference.open()
+            self.target.open(tell=PRELUDE if real else (),
+                             meanwhile=self._begin_reference if alone else None)
+            if not alone:
+                self._begin_reference()
             self.timing.begin()
             self._index = IndexBase()
-            if self.target.real:
+            if real:
                 self._prelude()
         except SafetyStop as err:
             # the known state or the reads after it were refused (a minimiser's candidate
@@ -181,7 +201,15 @@ class Pair:
             # unit restart there): the candidate shows nothing
             out.refused.append(f"the known state: {err}")
             return False
+        except StepFailed as err:
+            # the frames before left the unit where the manual's rules cannot bring it to
+            # rest, where the reference's were (the session names the rule its evidence
+            # broke): nothing more is sent, and the search ends there (KnownStateLost)
+            self.lost = out.ended = f"the known state could not be had: {err}"
+            self.led_there = self._last
+            return False
         self.course = Course(self.profile)
+        out.begun = True
         return True
 
     def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
@@ -276,6 +304,15 @@ class Pair:
                 side.close_example()
         return out
 
+    def _begin_reference(self) -> None:
+        """The reference in its known state, a fresh unit; where the target lives on
+        between examples, the reference's part of the prelude (:meth:`_prelude`)."""
+        self.reference.open()
+        if self.target.real:
+            self._same_eeprom()
+            self.reference.age(AGE_SECONDS)
+            self._reference_index = _index_read(self.reference)
+
     def _prelude(self) -> None:
         """A unit that lives on between examples (a real one, a co-simulator) is not
         reset by the known state: its index is read on both sides and compared from
@@ -284,24 +321,22 @@ class Pair:
         long ago (a vector right away would otherwise wait the dwell T on one side only),
         and the target's too: the known state may have moved its axes back just before,
         so the sequence begins once the longest dwell T after that has passed (waited
-        after the reads, which the known state told a co-simulator ahead with its last)."""
-        self._same_eeprom()
-        self.reference.age(AGE_SECONDS)
-        indexes = []
-        for side in (self.target, self.reference):
-            r = side.link.send_each(PRELUDE)[1]
-            try:
-                indexes.append(r.dec(0) if r is not None else 0)
-            except AssertionError:
-                indexes.append(0)
+        after the reads, which the known state told a co-simulator ahead with its last).
+        The reference's part is done as it begins (:meth:`_begin_reference`)."""
+        index = _index_read(self.target)
         self.target.wait(self.profile.range("T").hi / 1000)
-        self._index = IndexBase((indexes[0] - indexes[1]) % 256)
+        self._index = IndexBase((index - self._reference_index) % 256)
         self.judge = replace(self.judge, index_offset=self._index.offset)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""
         self._index.note(command, context, _values(rec.target), _values(rec.reference))
         self.judge = replace(self.judge, index_offset=self._index.offset or 0)
+
+    def _same_eeprom_known(self) -> bool:
+        """Whether :meth:`_same_eeprom` sends nothing to the target (its bytes as found
+        are read already, or it has none)."""
+        return self._eeprom_changes is not None or "ER" not in self.profile.commands
 
     def _same_eeprom(self) -> None:
         """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
@@ -415,6 +450,15 @@ def _has_lower(text: str) -> bool:
     return any("a" <= ch <= "z" for ch in text)
 
 
+def _index_read(side: Side) -> int:
+    """The index a side reads in the prelude (its second frame, `@`; 0 when unread)."""
+    r = side.link.send_each(PRELUDE)[1]
+    try:
+        return r.dec(0) if r is not None else 0
+    except AssertionError:
+        return 0
+
+
 def _values(exchange: RoundTrip) -> list[str]:
     return [] if exchange.response is None else list(exchange.response.values)
 
@@ -431,6 +475,8 @@ class Finding:
     steps: list[Step]
     outcome: ExampleRun
     number: int = 0                    # the search's count of disagreements seen, from 1
+    #: why it was not shrunk or replayed as far as others ("": it was)
+    unreplayed: str = ""
 
     @property
     def disagreement(self) -> Disagreement:
@@ -468,9 +514,14 @@ class Budget:
 
 def _again(pair: Pair, finding: Finding, budget: Budget) -> bool:
     """Real time: whether the shrunk sequence disagrees the same way once more (a
-    disagreement seen once may be the timing of that run, not the target)."""
-    trial = pair.run(finding.steps)
-    budget.frames += trial.frames
+    disagreement seen once may be the timing of that run, not the target). A run whose
+    known state the guard refused (the finding's own run left the counters where its
+    frames could not put them, say) tried nothing: it is run once more."""
+    for _ in range(2):
+        trial = pair.run(finding.steps)
+        budget.frames += trial.frames
+        if trial.begun or pair.lost:
+            break
     d = trial.disagreement
     return d is not None and d.signature == finding.disagreement.signature
 
@@ -503,7 +554,8 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
         return trial if d is not None and (d.command, d.kind) == want else None
 
     i = 0
-    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time():
+    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time() \
+            and not pair.lost:
         found = False
         lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
             if frames_only else _lesser(steps, i, outcome)
@@ -602,8 +654,8 @@ class _Search:
         self.seen = 0                  # disagreements seen so far (each one's number)
 
     def more(self) -> bool:
-        return not self.budget.spent() and (self.stop_after is None
-                                            or len(self.findings) < self.stop_after)
+        return not self.pair.lost and not self.budget.spent() and (
+            self.stop_after is None or len(self.findings) < self.stop_after)
 
     def trial(self, steps: list[Step]) -> Finding | None:
         """One example run whole; a finding when it shows a disagreement not kept yet."""
@@ -621,7 +673,7 @@ class _Search:
 
         def fails(steps: list[Step]) -> bool:
             nonlocal best
-            if self.budget.spent():
+            if self.budget.spent() or self.pair.lost:
                 raise _Spent           # also while shrinking: the smallest seen is kept
             found = self.trial(steps)
             if found is None:
@@ -662,9 +714,14 @@ class _Search:
             return
         self.known.add(finding.disagreement.signature)
         confirmed = repeatable or _again(pair, finding, self.budget)
-        if not confirmed and written and finding.steps != found.steps:
+        if not confirmed and written and finding.steps != found.steps and not pair.lost:
             finding = found
             confirmed = _again(pair, found, self.budget)
+        if pair.lost:
+            # the unit could not be brought back after it: the disagreement stands as
+            # seen, and the lost known state is a failure of its own (the session's)
+            finding.unreplayed = f"not replayed further: {pair.lost}"
+            confirmed = True
         if not confirmed:
             pair.unconfirmed.append(finding)
             self._dropped(found)
@@ -676,6 +733,17 @@ class _Search:
     def _dropped(self, found: Finding) -> None:
         if self.on_dropped is not None:
             self.on_dropped(found)
+
+
+class KnownStateLost(CouldNotTest):
+    """The target could not be brought to the known state after a sequence: the search
+    stopped there. ``findings``: those kept until then; ``after``: the sequence that
+    left the unit so (empty: the first known state)."""
+
+    def __init__(self, why: str, findings: list[Finding], after: list[Step]) -> None:
+        super().__init__(why)
+        self.findings = findings
+        self.after = after
 
 
 def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
@@ -691,13 +759,17 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
     seen (before it is shrunk), ``on_finding`` once it is kept, ``on_dropped`` when one
     seen is not (the same as one kept, or not seen again in real time); ``reach`` counts
     what the sequences reached. ``--seconds`` holds everywhere: no sequence, step or
-    shrink begins once the time is up."""
+    shrink begins once the time is up. :class:`KnownStateLost` (with the findings kept)
+    when the target could not be brought to the known state: never a search that ended."""
     hunt = _Search(pair, budget, stop_after, on_finding, on_seen, on_dropped)
     pair.out_of_time, pair.reach = budget.out_of_time, reach
     try:
-        return _hunt(hunt, pair, options, budget, seed, with_probes)
+        found = _hunt(hunt, pair, options, budget, seed, with_probes)
     finally:
         pair.out_of_time, pair.reach = _never, None
+    if pair.lost:
+        raise KnownStateLost(pair.lost, found, pair.led_there)
+    return found
 
 
 def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int,

@@ -37,6 +37,8 @@ def finding_result(f: Finding, *, profile: str, target: str, transcript: list[st
                  "tag": d.tag, "rule": d.rule or ""}]
     r.notes = [f"rule touched: {d.rule or 'none known'}",
                f"shrunk to {f.frames} frame(s): " + " | ".join(str(s) for s in f.steps)]
+    if f.unreplayed:
+        r.notes.append(f.unreplayed)
     if f.outcome.refused:
         r.notes.append("not sent (the guard): " + "; ".join(f.outcome.refused))
     r.wire_log = transcript

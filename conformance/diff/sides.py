@@ -64,17 +64,19 @@ class Side:
     def has_rig(self) -> bool:
         return self.link is not None and self.link.rig is not None and self.rig_lost is None
 
-    def open(self, tell: Sequence[str] = ()) -> Link:
+    def open(self, tell: Sequence[str] = (), meanwhile: Callable[[], None] | None = None
+             ) -> Link:
         """A link in the known state for a new example: on the emulator a fresh unit (and
         a session of its own, so one example's silences do not count in the next); on a
-        real unit the run's session's known state, ``tell`` the frames sent first on it
-        (Session.open_link)."""
+        real unit the run's session's known state, ``tell`` the frames sent first on it,
+        ``meanwhile`` work done while a co-simulator runs the known state's frames told
+        ahead (Session.open_link)."""
         if self.virtual and not self.target.info.real:
             self.session = EmuSession(self.target, self.session.interrupts if self.session
                                       else None)
         elif self.session is None:
             self.session = self.target.begin()
-        self.link = self.session.open_link(tell=tell)
+        self.link = self.session.open_link(tell=tell, meanwhile=meanwhile)
         self._origin = self.link.now
         return self.link
 

@@ -55,7 +55,8 @@ from conformance.link.framing import (
     parse_response,
     readable,
 )
-from conformance.link.safety import Guard
+from conformance.link.interrupts import Interrupted
+from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
@@ -88,6 +89,11 @@ LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an
 WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
                   OPEN_PACKET: "7.packet.open-until-end"}
 _PACKET_BREAKERS = classes(packet="breaker")
+#: frames that set no axis moving, whatever the unit is, and those whose answer tells
+#: where the axes are
+_MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
+                        eeprom=0)
+_POSITION_READS = classes(position=True)
 
 #: the rule a second answer breaks (the unit answers every complete frame once), and one
 #: after its frame's timeout (it answers as soon as possible)
@@ -149,6 +155,9 @@ class Link:
         #: answer, or its absence, is booked with it
         self._exchange: list[int] | None = None
         self._answered_as = Spent.ANSWERS
+        #: work of the caller's done once, while the port runs the next frames told
+        #: ahead (:meth:`tell`), or by the caller when none are told
+        self.meanwhile: Callable[[], None] | None = None
         self._origin = self._clock()
 
     # -- time ------------------------------------------------------------------------------
@@ -380,12 +389,48 @@ class Link:
         """Tell a port that takes frames told ahead (a co-simulator's, docs/cosim.md:
         `batch`) the frames about to be sent with :meth:`send` one after the other, in the
         mode the link believes (any other port is told nothing). Each is still judged,
-        sent and read as it comes; a frame not sent as told drops the rest."""
+        sent and read as it comes; a frame not sent as told drops the rest. The link's
+        :attr:`meanwhile` work is done here once frames are told, while the port runs
+        them."""
         expect = getattr(self.port, "expect", None)
-        if expect is not None and not self._faults:
-            framed = [frame(body, self.address, self.checksums) for body in bodies]
-            expect([(data, self.answer_timeout(body, len(data))) for body, data in
-                    zip(bodies, framed, strict=True)])
+        if expect is None or self._faults or not getattr(self.port, "tells", True):
+            return
+        bodies = self._judged_ahead(bodies)
+        if not bodies:
+            return
+        framed = [frame(body, self.address, self.checksums) for body in bodies]
+        told = [(data, self.answer_timeout(body, len(data))) for body, data in
+                zip(bodies, framed, strict=True)]
+        work = self.meanwhile
+        if work is None:
+            expect(told)
+        # with work to do meanwhile, the port's reply is read when the link next uses
+        # it: the work runs while the port runs the frames
+        elif getattr(self.port, "tell", expect)(told):
+            self.meanwhile = None
+            work()
+
+    def _judged_ahead(self, bodies: Sequence[str]) -> list[str]:
+        """The first of ``bodies`` that may be told ahead: a port told them runs them before
+        the run's guard judges any, so each is judged first on a copy of the guard as
+        though the ones before got any answer (Guard.ahead). The first refused ends them,
+        and after a position read, whose answer may move the axes anywhere in the guard's
+        eyes, only frames that set nothing moving follow."""
+        trial = self.guard.ahead()
+        admitted: list[str] = []
+        read = False
+        for body in bodies:
+            name = parse(body).name
+            if read and name not in _MOVE_NOTHING:
+                break
+            try:
+                trial.check(body, self.address)
+            except (SafetyStop, Interrupted, TargetNotResponding):
+                break
+            trial.book_any(body, self.address)
+            read = read or name in _POSITION_READS
+            admitted.append(body)
+        return admitted
 
     @property
     def takes_ahead(self) -> bool:

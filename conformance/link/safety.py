@@ -32,6 +32,7 @@ import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 from conformance.link.envelope import (
     EMPTY,
@@ -101,6 +102,8 @@ _PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
 #: frames that set the checksum mode, and so how the unit reads the frames after them
 _SUMMING = classes(summing=True)
+#: frames whose answer reads the position counters
+_POSITION = classes(position=True)
 #: what a command sets moving again, by name: "queue" or "save"
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 #: consecutive frames without an answer after which the target is given up
@@ -137,6 +140,7 @@ class Body:
     params: str
 
     @classmethod
+    @lru_cache(maxsize=4096)     # every frame is parsed several times; a Body is immutable
     def parse(cls, body: str) -> Body:
         """The frame's class (``SW6`` for a write of ST6, "" for no command of spec 10)
         and its parameters, read leniently."""
@@ -510,7 +514,7 @@ class Guard:
             st6 = r.values[0] if r.values else ""
             if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
                 self.envelope.ended()
-        elif name in classes(position=True):
+        elif name in _POSITION:
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             read = [decimal(v, signed=True) for v in r.values[:axes]]
             if len(read) == axes and None not in read:

@@ -106,6 +106,8 @@ class CosimLine:
         #: a write sent with the read to come (launch), its reply not read yet:
         #: (command, start, end of its bytes, goal)
         self._inflight: tuple[str, int, int, int] | None = None
+        #: frames told ahead whose reply is not read yet (tell): the command, its plan
+        self._told: tuple[str, list[tuple[bytes, int]]] | None = None
         self.broken = ""
 
     # -- the channel -------------------------------------------------------------------------
@@ -267,6 +269,7 @@ class CosimLine:
     def _step(self, t: int) -> bool:
         """One command toward the instant ``t`` (the write not sent yet first): True when
         it stopped at a CR to the host."""
+        self._land_told()
         if self._inflight is not None:
             return self._land()
         self._usable()
@@ -304,6 +307,7 @@ class CosimLine:
         meanwhile, while the simulator runs the frame. Only when that read has to send
         it: nothing waits to be read (bytes received already, say during an injected
         pause, may be the answer the read takes, and the write then waits)."""
+        self._land_told()
         if self._tx is None or self._ahead or self._rx or self.broken:
             return
         data, start = self._tx
@@ -343,9 +347,15 @@ class CosimLine:
         whose answer is due is told with that, so that one answered later (or not at
         all) ends the batch, its read going on from there.
         Returns how many of the frames the simulator ran (0: none was told)."""
-        if ("batch" not in self.extensions or self._tx is not None or self._rx
-                or self._ahead or self._inflight is not None):
-            return 0
+        return self._land_told() if self.tell(frames) else 0
+
+    def tell(self, frames: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]]
+             ) -> bool:
+        """:meth:`expect`'s exchange sent and its reply left to be read when the line is
+        next used (whatever use): the suite may do other work meanwhile, while the
+        simulator runs the frames. Whether they were told."""
+        if not self.tells:
+            return False
         self._usable()
         stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
@@ -357,10 +367,30 @@ class CosimLine:
                 wait = min(wait, max(due[0] - len(data) * self.byte_ns, 0))
             plan.append((bytes(data), min(wait, STEP_NS)))
         if len(plan) < 2:
-            return 0
+            return False
         command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
+        self._send(command)
+        self._told = (command, plan)
+        return True
+
+    @property
+    def tells(self) -> bool:
+        """Whether frames may be told now: the simulator takes `batch`, and nothing is
+        under way on the line (a write, bytes unread, frames told before)."""
+        return ("batch" in self.extensions and self._tx is None and not self._rx
+                and not self._ahead and self._inflight is None and self._told is None)
+
+    def _land_told(self) -> int:
+        """Read the reply to the frames told (:meth:`tell`), checked frame by frame: how
+        many of them the simulator ran (0: none is told)."""
+        if self._told is None:
+            return 0
+        command, plan = self._told
+        self._told = None
+        self._usable()
+        stops = "batch-stops" in self.extensions
         here, ahead = self.now, []
-        with self._exchange(command):
+        try:
             for i, (data, wait) in enumerate(plan):
                 start = self.now
                 end = start + len(data) * self.byte_ns
@@ -370,6 +400,11 @@ class CosimLine:
                 self._rx.clear()
                 if stops and not cr:
                     break                         # the simulator ran none after it
+        except BaseException:
+            if not self.broken:
+                self.broken = (f"the exchange {command[:60]!r}... was cut off before its "
+                               "reply was read: the co-simulation cannot go on")
+            raise
         self.now = here
         self._ahead.extend(ahead)
         return len(ahead)
@@ -384,7 +419,8 @@ class CosimLine:
 
     def _flush(self) -> None:
         """Send the write not sent yet (its clock to the end of its bytes), or read the
-        reply to the one launched."""
+        reply to the one launched, or to the frames told."""
+        self._land_told()
         if self._inflight is not None:
             self._land()
         if self._tx is not None:
@@ -393,6 +429,7 @@ class CosimLine:
     def advance_to(self, t: int) -> None:
         """Let virtual time pass up to the instant ``t`` (a write not sent yet goes out
         with it: `tx HEX T`, one exchange)."""
+        self._land_told()
         if self._inflight is not None:
             self._land()
         if self._tx is not None:
@@ -432,6 +469,7 @@ class CosimLine:
         """Whether the host's bytes ``data``, written now, are the next frame told ahead:
         the simulator has run them already (their write only takes its part of the
         reply)."""
+        self._land_told()
         return (self._tx is None and self._inflight is None and bool(self._ahead)
                 and (self._ahead[0].data, self._ahead[0].start) == (data, self.now))
 
@@ -449,6 +487,7 @@ class CosimLine:
         """Up to ``size`` bytes (stopping after ``terminator``), waiting at most
         ``timeout`` seconds of virtual time: the clock stops when the terminator is there
         (a CR, as every answer ends) or at the timeout."""
+        self._land_told()
         if self._tx is None:
             self._catch_up()
         deadline = self.now + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
@@ -512,6 +551,17 @@ class CosimPort:
         """The frames about to be sent, each with its answer's timeout and due instant
         (CosimLine.expect): how many the simulator ran."""
         return self.line.expect(frames)
+
+    def tell(self, frames: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]]
+             ) -> bool:
+        """The frames about to be sent, their reply read when the line is next used
+        (CosimLine.tell): whether they were told."""
+        return self.line.tell(frames)
+
+    @property
+    def tells(self) -> bool:
+        """Whether frames may be told now (CosimLine.tells)."""
+        return self.line.tells
 
     def ran(self, data: bytes) -> bool:
         """Whether ``data`` written now was told ahead and run already (CosimLine.ran)."""

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Protocol
 
 from conformance.known_state import known_axis_limits
@@ -98,6 +98,13 @@ class StepFailure:
     what: str
     observed: str
     expected: str
+    #: the frames that led there: the traffic before the known state (the case's, the
+    #: sequence's) and the known state's own, as transcript lines
+    led_there: tuple[str, ...] = ()
+
+
+#: the most lines of the traffic before a known state kept with a step that failed in it
+LED_THERE_LINES = 60
 
 
 class StepFailed(CouldNotTest):
@@ -158,6 +165,7 @@ class Session:
         #: the known-state steps that failed, each rule once (:class:`StepFailure`)
         self.failures: list[StepFailure] = []
         self._untaken = 0                           # failures not yet taken by the run
+        self._before: Link | None = None            # the link before the known state's
         self.account = TimeAccount()                # where the session's time goes
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
@@ -204,13 +212,19 @@ class Session:
         self._link = link
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
         """A link in the known state (on the emulator: a new unit, at ``address``).
         ``tell``: the frames the caller sends first on it, told ahead with the known
-        state's last (Link.tell) where the unit lives on."""
+        state's last (Link.tell) where the unit lives on; ``meanwhile``: work of the
+        caller's, done while the unit runs frames of the known state told ahead (else
+        once the link is open)."""
         self.start()
         self.guard.check_idle()
-        return self._new_link(address)
+        link = self._new_link(address)
+        if meanwhile is not None:
+            meanwhile()
+        return link
 
     def start(self) -> None:
         """Read the unit as found, before the first case (real units only)."""
@@ -243,7 +257,11 @@ class Session:
         (answered twice, or late), since then no answer read there is surely its frame's
         (that FAILs the case whatever the tag)."""
         if not link.violations and all(f.rule != failure.rule for f in self.failures):
-            self.failures.append(failure)
+            before = [] if self._before is None else \
+                [rec.line() for rec in self._before.log[-LED_THERE_LINES:]]
+            led = [*before, "# the known state", *link.transcript_lines()] if before \
+                else link.transcript_lines()
+            self.failures.append(replace(failure, led_there=tuple(led)))
 
     def after_case(self) -> None:
         """What a case changed that outlives it, put back (nothing on a fresh unit)."""
@@ -302,8 +320,12 @@ class RealSession(Session):
         link.round_trip = self.report.line
         return link
 
-    def open_link(self, address: int | None = None, tell: Sequence[str] = ()) -> Link:
+    def open_link(self, address: int | None = None, tell: Sequence[str] = (),
+                  meanwhile: Callable[[], None] | None = None) -> Link:
+        before = self._link
         link = super().open_link(address)
+        self._before = before
+        link.meanwhile = meanwhile         # done at the known state's first frames told
         with self.guard.own_frames():
             try:
                 self._known_state(link, tell)
@@ -312,7 +334,12 @@ class RealSession(Session):
                 # what the known state read: the case gets the link and FAILs on them
                 if not link.violations:
                     raise
+            finally:
+                self._before = None
         link.log.clear()
+        work, link.meanwhile = link.meanwhile, None
+        if work is not None:
+            work()
         return link
 
     # -- the unit as found ----------------------------------------------------------------------
@@ -474,8 +501,7 @@ class RealSession(Session):
             link.send("%-", checksum=True)
         answers = link.send_each(frames)
         if halt is not None and halt.code is not None and not halt.ok:
-            self._step_failed(link, StepFailure("10.cmd.halt-answer", "halt", "H is "
-                                                "answered 8", f"H {_shown(halt)}", "8"))
+            self._step_failed(link, self._halt_refused(halt, link.checksums))
         why = self._at_rest(link, halt, answers[-2], answers[-1])
         if held and not give_back and not why:
             why = self._keep_not_given_back(link)
@@ -485,6 +511,20 @@ class RealSession(Session):
                 "accepted (not while moving)", f"R {_shown(answers[-3])} at rest",
                 "R accepted"))
         return why, link.send_each(then)
+
+    def _halt_refused(self, halt: Response, summed: bool) -> StepFailure:
+        """`H` answered otherwise than 8. `H` has no parameter: where the unit took `%+`
+        (``summed``: the link believes the mode on) and refused `H` with 4, the code of a
+        bad or missing checksum, in both framings (:meth:`_halt` tries each), it refuses
+        frames summed as the manual sums them (a FAIL of that rule); any other answer is a
+        FAIL of `H`'s own."""
+        if halt.code == ErrorCode.SYNTAX and summed:
+            return StepFailure(
+                "6.checksum.sum", "halt", "H framed as the manual states, summed from ! up "
+                "to and including the comma in checksum mode and plain otherwise, is taken",
+                f"H {_shown(halt)} in either framing", "8")
+        return StepFailure("10.cmd.halt-answer", "halt", "H is answered 8",
+                           f"H {_shown(halt)}", "8")
 
     def _at_rest(self, link: Link, halt: Response | None, deleted: Response | None,
                  st6: Response | None) -> str:
@@ -513,6 +553,9 @@ class RealSession(Session):
                 st6 = self._to_rest(link)
                 if _rests(st6):
                     return ""
+        if st6 is not None and not st6.ok:
+            return ("the unit refuses the known state's frames, its status unread: H "
+                    f"{_shown(halt)}, SR6 {_shown(st6)}")
         return f"the unit is not at rest after the known state: SR6 reads {_shown(st6)}" \
             + _left(st6)
 
@@ -594,20 +637,25 @@ class RealSession(Session):
         left, _ = self._settle(link, ["PF"])       # where the axes are, for the way back
         if left:
             raise StepFailed(left)
-        self._go_back(link, read=False)
+        returned, _ = self._go_back(link, read=False)
         link.tell(["N", "PF", *tell])
-        self._zero(link)
+        self._zero(link, returned)
 
-    def _zero(self, link: Link) -> None:
+    def _zero(self, link: Link, returned: str = "") -> None:
         """`N`, read back with `PF`: every counter 0 (spec 10 [M]). Where `N` did not zero
         them at rest, a FAIL of its rule, and `N<axis>0` where the unit has it; counters
-        still elsewhere leave the case COULD-NOT-TEST (cases judge positions from 0)."""
+        still elsewhere leave the case COULD-NOT-TEST (cases judge positions from 0).
+        ``returned``: the return move just ended by `L0,0,0` (a unit still running then
+        broke the wait idiom: :meth:`_returning`)."""
         zeroed = link.send("N")
         with self.guard.unmoved():                 # at rest: a counter read is no motion
             here = self._position(link)
         if _taken(zeroed) and here and not any(here.values()):
             return                                 # taken: nothing runs (7 if RUN = 1)
         st6 = link.send("SR6")
+        if not _rests(st6) and returned and self._returning(link, returned, zeroed, st6):
+            self._zero(link)
+            return
         if not _rests(st6):
             raise StepFailed(f"the unit is not at rest after the known state: N answered "
                              f"{_shown(zeroed)}, SR6 reads {_shown(st6)}" + _left(st6))
@@ -625,6 +673,26 @@ class RealSession(Session):
         raise StepFailed(f"the position counters could not be zeroed (N answered "
                          f"{_shown(zeroed)}, PF then {_counters(here)}): the cases judge "
                          "positions from 0")
+
+    def _returning(self, link: Link, body: str, zeroed: Response | None,
+                   st6: Response | None) -> bool:
+        """The return move ``body`` still runs after `L0,0,0` was answered 0, which it is
+        only once everything before it has finished (spec 10.1 [M]): a FAIL of that rule;
+        the end of the move is then awaited by `SR6` (spec 10.3 [M]). Whether the unit
+        came to rest."""
+        if not _hex_ok(st6) or not _bits(st6) & St6.RUN:
+            return False
+        self._step_failed(link, StepFailure(
+            "10.1.queue.wait-idiom", "return-move", "L0,0,0 after the return move answers "
+            "1 until the move has finished, then 0",
+            f"{body} 0, L0,0,0 0, then N {_shown(zeroed)}, SR6 {_shown(st6)}",
+            "L0,0,0 answered 1 while the move runs"))
+        return link.poll("SR6", _rests, self._return_seconds(body)) is not None
+
+    def _return_seconds(self, body: str) -> float:
+        """The longest the return move ``body`` (an `L` at the reset V) may take."""
+        cruise = max(abs(int(v)) for v in body[1:].split(",")) / self.profile.reset.V
+        return cruise * 2 + 2 * self.guard.stop_seconds() + 2
 
     def _go_back(self, link: Link, *, read: bool = True) -> tuple[str, dict[int, int]]:
         """Move the axes back to where the run began (known exactly only at rest; the
@@ -663,8 +731,10 @@ class RealSession(Session):
             self._return_refused(link, body, r)
             return "", self._position(link)
         cruise = max(abs(b) for b in back) / speed        # the least the way back takes
-        seconds = cruise * 2 + 2 * self.guard.stop_seconds() + 2
-        self._watch(link, cruise)
+        seconds = self._return_seconds(body)
+        # watched as long as it takes with its ramps at the reset acceleration (A in
+        # 1000 steps/s²), so that the first L0,0,0 after it is taken (one poll, not two)
+        self._watch(link, cruise + speed / (self.profile.reset.A * 1000))
         if link.poll("L0,0,0", lambda r: r.ok, seconds) is None:
             self._step_failed(link, StepFailure(
                 "10.1.queue.wait-idiom", "return-move", "the return move, an L from rest, "

@@ -112,8 +112,9 @@ def test_every_mutant_is_named_over_exec_by_the_probes(mutant, tmp_path):
                    str(written), "--allow-destructive", "--yes", "--report-dir", str(tmp_path)])
     (folder,) = tmp_path.iterdir()
     results = json.loads((folder / "results.json").read_text())["results"]
-    found = [r for r in results if in_area(r["checks"][0]["rule"], mutant)]
-    assert found, mutant
+    # (a search that stopped, COULD-NOT-TEST, has no check)
+    found = [r for r in results if r["checks"] and in_area(r["checks"][0]["rule"], mutant)]
+    assert found, (mutant, [(r["verdict"], r["checks"][:1], r["notes"]) for r in results])
     # graded by the tag of the rule it breaks: a third party's [D] difference is NON-STRICT
     first = found[0]
     manual = load_rules()[first["checks"][0]["rule"]].tag.startswith("M")
@@ -151,6 +152,28 @@ def test_a_target_whose_d_misbehaves_gets_a_fail_naming_d_and_diff_runs_on(mutan
     assert status == 1 and "Traceback" not in out + err
     assert "FAIL        10.4.delete: the known state: D after H" in out
     assert "100 sequences" in out
+
+
+def test_a_sequence_the_known_state_cannot_undo_is_named_and_ends_the_search(tmp_path, capsys):
+    """A unit that sums checksums its own way is left by `%+` where no frame framed as
+    the manual states reaches it: the disagreement is kept, the known state's H names the
+    checksum's rule with the frames that led there, and the search ends COULD-NOT-TEST,
+    never PASS, without a traceback."""
+    target = (f"exec:{sys.executable} -m emulator --cosim --model GVE84-100 "
+              "--mutant checksum-no-comma")
+    status = main(["diff", "--target", target, "--profile", "GVE84-100", "--yes",
+                   "--examples", "100", "--report-dir", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert status == 1 and "Traceback" not in out + err
+    assert "FAIL        6.checksum.response-sum: !0%+" in out
+    assert "FAIL        6.checksum.sum: the known state: H framed as the manual states" in out
+    assert "COULD-NOT-TEST: the known state could not be had" in err
+    (folder,) = tmp_path.iterdir()
+    results = {r["id"]: r for r in json.loads((folder / "results.json").read_text())
+               ["results"]}
+    assert results["diff.search.agreement"]["verdict"] == "COULD-NOT-TEST"
+    assert any("%+" in note for note in results["diff.search.agreement"]["notes"])
+    assert any("> !0%+" in line for line in results["6.known-state.halt"]["wire_log"])
 
 
 def _diff_killed_at(tmp_path: Path, first: str) -> tuple[str, Path]:
@@ -196,11 +219,11 @@ def test_a_known_state_that_cannot_be_had_ends_in_a_verdict(tmp_path, capsys, mo
     opened = [0]
     real_open = Side.open
 
-    def open_(self, tell=()):
+    def open_(self, tell=(), meanwhile=None):
         opened[0] += 1
         if opened[0] > 40:
             raise CouldNotTest("the known state: D refused (7)")
-        return real_open(self, tell)
+        return real_open(self, tell, meanwhile)
 
     monkeypatch.setattr(Side, "open", open_)
     status = main(["diff", "--target", "emu:GVE84-100?mutant=lower-case-command",

@@ -50,6 +50,10 @@ OFF_THE_WIRE = {
 }
 #: the mutants the probes must name
 ON_THE_WIRE = sorted(set(mutants()) - set(OFF_THE_WIRE))
+#: mutants off by one step only, which somebody else's unit in virtual time (a
+#: co-simulator) is allowed in where it places its steps (Pair's placement): named there
+#: only when it is graded exactly (--strict); in real time a read at rest is exact
+WITHIN_PLACEMENT = {"go-loses-step": "G resumes one step past where the vector stopped"}
 
 
 def pair(mutant: str | None, profile: str = "GVE84-100") -> Pair:

@@ -209,3 +209,27 @@ def test_a_target_answering_later_than_the_reference_stops_what_was_told(pairs):
         assert run.disagreement is not None and run.disagreement.index == 0
         assert b"C120" not in b"".join(r.data for r in pair.target.link.log)
         assert pair.target.target.session.guard.envelope.seen[0].hi == 0
+
+
+def test_the_reference_begins_while_the_co_simulator_runs_the_known_state(pairs,
+                                                                          monkeypatch):
+    """The reference's known state and prelude are done while the target's known-state
+    frames told ahead are on the simulator's line (their reply not read yet), and the
+    sequence then runs as it does with the two done one after the other."""
+    pair = pairs["clean"]
+    steps = [Step(FRAME, body=body) for body in ("V400", "L100,0,0", "SR6", "@", "PF")]
+    pair.run(steps)                        # the EEPROM as found read: nothing waits for it
+    begin_reference = Pair._begin_reference
+    seen: list[bool] = []
+
+    def begins(self):
+        seen.append(line_of(self.target.link.port)._told is not None)
+        begin_reference(self)
+
+    monkeypatch.setattr(Pair, "_begin_reference", begins)
+    overlapped = pair.run(steps)
+    monkeypatch.setattr(Pair, "_same_eeprom_known", lambda self: False)
+    after = pair.run(steps)
+    assert seen == [True, False]
+    assert outcome(overlapped) == outcome(after)
+    assert overlapped.disagreement is None and overlapped.frames == len(steps)

@@ -449,3 +449,39 @@ def test_telling_frames_ahead_says_how_many_the_simulator_ran(second, ran):
         assert port.expect([(frames[0], 0.25)]) == 0, "frames told already wait first"
     finally:
         target.close()
+
+
+def _told_then_sent(later: bool):
+    """The answers and clock of frames told ahead (their reply read at once, or left
+    for the line's next use) and then written and read, and whether the reply was left
+    unread until then."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        port = target.connect(None)[0]
+        port.timeout = 0.25
+        frames = [b"!0SR6\r", b"!0V1000\r", b"!0?\r"]
+        told = [(f, 0.25) for f in frames]
+        if later:
+            assert port.tell(told)
+            unread = port.line._told is not None and not port.line._ahead
+        else:
+            assert port.expect(told) == len(frames)
+            unread = False
+        answers = []
+        for data in frames:
+            assert port.ran(data), "run by the simulator when told"
+            port.write(data)
+            answers.append(port.read_until(b"\r"))
+        return answers, port.line.now, unread
+    finally:
+        target.close()
+
+
+def test_frames_told_with_their_reply_read_later_are_sent_as_those_read_at_once():
+    """A reply left unread while the suite does other work is read, checked, at the
+    line's next use: the same answers at the same instants."""
+    *later, unread = _told_then_sent(True)
+    *at_once, _ = _told_then_sent(False)
+    assert unread, "nothing read before the line's next use"
+    assert later == at_once and all(later[0])

@@ -16,6 +16,7 @@ import pytest
 from conformance.catalogue import select
 from conformance.runner import run
 from conformance.targets import parse_target
+from conformance.targets.session import RealSession
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 from tests.conformance.cases.used import UsedUnit, used_unit
 from tests.conformance.safety.units import Recorder
@@ -166,3 +167,78 @@ def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
     verdicts = {r.id: r.verdict for r in result.results}
     assert verdicts.pop("10.known-state.halt") == FAIL
     assert set(verdicts.values()) == {PASS}
+
+
+@pytest.mark.parametrize(("summed", "rule"), [(True, "6.checksum.sum"),
+                                              (False, "10.cmd.halt-answer")])
+def test_an_h_refused_with_4_in_either_framing_in_checksum_mode_fails_the_checksum_sum(
+        summed, rule):
+    # H has no parameter: refused with 4 (a bad or missing checksum) summed as the manual
+    # sums it and plain alike, by a unit that took %+ (and never gets the case's %-), it
+    # breaks the checksum's framing; with checksums off, H's own rule
+    refused = b"!0?1\r"                              # answered 4
+    frames = {b"!0H\r": refused, b"!0H,C5\r": refused}
+    if summed:
+        frames[b"!0%-,CF\r"] = refused
+    u = unit(frames=frames)
+    result = run([u], select(["6.checksum.mode-on-off", "5.errors.ok"]))
+    rows = [r for r in result.results if r.id.endswith("known-state.halt")]
+    assert len(rows) == 1 and rows[0].verdict == FAIL
+    assert rows[0].checks[0]["rule"] == rule and rows[0].checks[0]["observed"].startswith("H 4")
+    # the frames that led there are its transcript: the known state's own, H first
+    assert any("> !0H" in line for line in rows[0].wire_log), rows[0].wire_log
+
+
+def test_a_return_move_still_running_after_its_wait_idiom_fails_that_rule_and_is_awaited(
+        monkeypatch):
+    # the way back polled at once, as for a unit whose ramps outlast the reset
+    # acceleration's: the first L0,0,0 then goes out while the axes still move
+    monkeypatch.setattr(RealSession, "_watch", lambda self, link, seconds: None)
+    command = [sys.executable, "-m", "emulator", "--model", "GVE84-100", "--cosim",
+               "--mutant", "line-while-busy"]          # L0,0,0 answered 0 while moving
+    target = parse_target("exec:" + shlex.join(command), profile="GVE84-100",
+                          allow_destructive=True, max_travel=10_000)
+    target.preflight()
+    result = run([target], select(["10.1.*", "10.2.*"]))
+    (row,) = [r for r in result.results if r.id == "10.1.known-state.return-move"]
+    assert row.verdict == FAIL and row.checks[0]["rule"] == "10.1.queue.wait-idiom"
+    assert "SR6 0,40" in row.checks[0]["observed"]
+    # the case before it, whose motion the return move undid, heads the transcript
+    assert "# the known state" in row.wire_log and row.wire_log[0] != "# the known state"
+    # the move's end awaited: no case lost to a unit not at rest
+    assert not [r.id for r in result.results if r.verdict == COULD_NOT_TEST
+                and "not at rest" in " ".join(r.notes)]
+    assert ERROR not in [r.verdict for r in result.results]
+
+
+def _opened_with_work(spec: str, extensions: frozenset[str] | None = None
+                      ) -> list[bool]:
+    """For each run of the work given to ``open_link``: whether frames of the known
+    state told to a co-simulator were unread then."""
+    target = parse_target(spec, profile="GVE84-100")
+    target.preflight()
+    try:
+        session = target.begin()
+        line = target.connect(None)[0].line
+        if extensions is not None:
+            line.extensions = extensions
+        seen: list[bool] = []
+        link = session.open_link(meanwhile=lambda: seen.append(
+            getattr(line, "_told", None) is not None))
+        assert link.send("SR6").ok, "the link in the known state, usable"
+        session.finish()
+        return seen
+    finally:
+        target.close()
+
+
+COSIM = "exec:" + shlex.join([sys.executable, "-m", "emulator", "--cosim"])
+
+
+@pytest.mark.parametrize(("spec", "extensions", "while_told"), [
+    ("emu:GVE84-100", None, False),
+    (COSIM, None, True),                                  # while the simulator runs them
+    (COSIM, frozenset(), False),                          # no batch: once the link is open
+])
+def test_work_given_with_a_link_is_done_once(spec, extensions, while_told):
+    assert _opened_with_work(spec, extensions) == [while_told]
