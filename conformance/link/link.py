@@ -55,7 +55,8 @@ from conformance.link.framing import (
     parse_response,
     readable,
 )
-from conformance.link.safety import Guard
+from conformance.link.interrupts import Interrupted
+from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
@@ -88,6 +89,11 @@ LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an
 WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
                   OPEN_PACKET: "7.packet.open-until-end"}
 _PACKET_BREAKERS = classes(packet="breaker")
+#: frames that set no axis moving, whatever the unit is, and those whose answer tells
+#: where the axes are
+_MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
+                        eeprom=0)
+_POSITION_READS = classes(position=True)
 
 #: the rule a second answer breaks (the unit answers every complete frame once), and one
 #: after its frame's timeout (it answers as soon as possible)
@@ -389,6 +395,9 @@ class Link:
         expect = getattr(self.port, "expect", None)
         if expect is None or self._faults or not getattr(self.port, "tells", True):
             return
+        bodies = self._judged_ahead(bodies)
+        if not bodies:
+            return
         framed = [frame(body, self.address, self.checksums) for body in bodies]
         told = [(data, self.answer_timeout(body, len(data))) for body, data in
                 zip(bodies, framed, strict=True)]
@@ -400,6 +409,28 @@ class Link:
         elif getattr(self.port, "tell", expect)(told):
             self.meanwhile = None
             work()
+
+    def _judged_ahead(self, bodies: Sequence[str]) -> list[str]:
+        """The first of ``bodies`` that may be told ahead: a port told them runs them before
+        the run's guard judges any, so each is judged first on a copy of the guard as
+        though the ones before got any answer (Guard.ahead). The first refused ends them,
+        and after a position read, whose answer may move the axes anywhere in the guard's
+        eyes, only frames that set nothing moving follow."""
+        trial = self.guard.ahead()
+        admitted: list[str] = []
+        read = False
+        for body in bodies:
+            name = parse(body).name
+            if read and name not in _MOVE_NOTHING:
+                break
+            try:
+                trial.check(body, self.address)
+            except (SafetyStop, Interrupted, TargetNotResponding):
+                break
+            trial.book_any(body, self.address)
+            read = read or name in _POSITION_READS
+            admitted.append(body)
+        return admitted
 
     @property
     def takes_ahead(self) -> bool:

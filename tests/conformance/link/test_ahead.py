@@ -16,9 +16,14 @@ from hypothesis import strategies as st
 
 from conformance.link.ahead import Ahead
 from conformance.link.framing import frame, parse_response
-from conformance.link.safety import Guard, SafetyStop, TargetNotResponding, UnitRestarted
+from conformance.link.link import Link
+from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding, UnitRestarted
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import load_profile
 
+MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
+                       eeprom=0)
+POSITION_READS = classes(position=True)
 TRAVEL = 300                                   # full steps either side: often reached
 
 steps = st.integers(-250, 250)
@@ -131,3 +136,31 @@ def test_motion_not_confirmed_yet_is_not_told_and_nobody_is_asked():
 @pytest.mark.parametrize("data", [b"junk!0SR0\r", b"!0SR0", b"!0SR0\r!0L1,0,0"])
 def test_only_whole_frames_are_told(data):
     assert not Ahead(link(guard())).admit(data, 1.0)
+
+
+@given(st.lists(st.tuples(bodies, answers), max_size=12),
+       st.lists(st.tuples(bodies, answers), min_size=1, max_size=12))
+@example([], [("L200,0,0", "0"), ("L200,0,0", "0")])
+@example([], [("PF", "0,250,0,0"), ("L200,0,0", "0"), ("SR0", "0,00")])
+@settings(max_examples=300, deadline=None, derandomize=True)
+def test_the_frames_a_link_tells_are_let_through_whatever_the_answers_before_them(
+        before, told):
+    """The link's own bodies told ahead (the known state's, Link.tell) are judged as raw
+    frames are: a prefix, each let through by the guard when it is sent after any
+    answers to those before it; after a position read only frames that set nothing
+    moving are told."""
+    g = guard()
+    for body, text in before:
+        with contextlib.suppress(SafetyStop):
+            sent(g, body, text)
+    bodies_told = Link._judged_ahead(SimpleNamespace(guard=g, address=0),
+                                     [body for body, _ in told])
+    admitted = told[:len(bodies_told)]
+    assert [body for body, _ in admitted] == bodies_told
+    read = False
+    for body, text in admitted:
+        if read:
+            assert Body.parse(body).name in MOVE_NOTHING
+            continue                       # whatever the guard thinks then: nothing moves
+        g.check(body)                      # SafetyStop if the guard refuses it now
+        read = not sent(g, body, text) or Body.parse(body).name in POSITION_READS
