@@ -106,6 +106,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                         "an open packet that receives nothing for 500 ms is dropped and "
                         "answered `2,k` (k members received), as a packet that did not "
                         "arrive whole in time"),
+    "baud-unlisted-high": (("2.link.rate-range-unlisted",),
+                           "GVE114: an EEPROM 0D byte the manual does not list (neither 01 "
+                           "nor FF) selects the 01 range (921600..115200), as any byte but "
+                           "the default"),
     "mpg-needs-parameters": (("9.reset.mpg-parameters",),
                              "the GVE114's MPG takes effect only when every MPG parameter "
                              "(limits, steps per mm, acceleration, speed: M114 12.4-12.6) "

@@ -4,6 +4,7 @@ this package registers every case."""
 from conformance.cases import (  # noqa: F401
     s01_units,
     s02_link,
+    s02_rate,
     s03_frame,
     s04_response,
     s05_errors,

@@ -56,7 +56,7 @@ from conformance.link.framing import (
     readable,
 )
 from conformance.link.interrupts import Interrupted
-from conformance.link.safety import Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
@@ -420,7 +420,7 @@ class Link:
         admitted: list[str] = []
         read = False
         for body in bodies:
-            name = parse(body).name
+            name = Body.parse(body).name            # SW6 apart from the other SW
             if read and name not in _MOVE_NOTHING:
                 break
             try:

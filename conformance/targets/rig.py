@@ -3,9 +3,10 @@ program's standard input (commands) and standard output (one reply a line), or a
 of the co-simulation protocol (docs/cosim.md), whose client asks the commands for it.
 
 It offers what the suite uses of a rig (``link.rig``): ``set_input``, ``set_switch``,
-``power_on``, ``outputs``, ``spindle``, ``state``. What the channel cannot give is not
-there: no ``pulses`` (the reports show no step train) and no clock. Every command waits
-for its reply, so that what the rig's hands did has happened before the next frame.
+``set_rate_switch``, ``power_on``, ``outputs``, ``spindle``, ``state``. What the channel
+cannot give is not there: no ``pulses`` (the reports show no step train) and no clock.
+Every command waits for its reply, so that what the rig's hands did has happened before
+the next frame.
 
 A rig that does not answer in time or refuses a command makes the case COULD-NOT-TEST
 (saying which command); a program that has ended makes the target not responding.
@@ -114,6 +115,11 @@ class ControlRig:
         where = "none" if position is None else position
         self._do(f"switch {axis} {where}{self._at(address)}")
         self._switches.add(axis)
+
+    def set_rate_switch(self, position: int | None, address: int | None = None) -> None:
+        """The unit's rate switch (jumpers) to ``position`` (None: as found), read at the
+        next power-on."""
+        self._do(f"rate {'none' if position is None else position}{self._at(address)}")
 
     def power_on(self, address: int | None = None) -> None:
         self._do("power-on" + ("" if address is None else f" @{address}"))   # None: all

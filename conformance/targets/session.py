@@ -45,11 +45,14 @@ from conformance.link.safety import (
     SafetyStop,
     TargetNotResponding,
 )
+from conformance.protocol.catalogue import classes
+from conformance.protocol.parse import parse_text
 from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, ErrorCode, St6
+from gve_fixtures.transcript import HOST, UNIT, Record
 
 
 class Reachable(Protocol):
@@ -80,6 +83,8 @@ RUN_OUT_POLL_S = 1.0
 #: ST6 bits that keep a unit from being at rest for a case: moving, braking, or
 #: interrupted with vectors waiting for `G` (spec 10.3: INTA/RUN 0/0 is idle [M])
 NOT_AT_REST = St6.RUN | St6.STOP | St6.INTA
+#: frames that can start an axis moving (spec 10)
+MOTION = classes(motion=True)
 
 
 class SessionError(Exception):
@@ -545,10 +550,7 @@ class RealSession(Session):
             # what the bookkeeping took for deleted may still be queued: no position read
             # tells where the axes rest until the unit shows rest
             self.guard.doubt_rest()
-            self._step_failed(link, StepFailure(
-                "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
-                "clears ST6", f"H {_shown(halt)}, D {_shown(deleted)}, SR6 {_shown(st6)}",
-                "D 0, then SR6 with RUN, STOP and INTA clear"))
+            self._step_failed(link, self._not_deleted(link, halt, deleted, st6))
             if not self.interrupts.stopped:
                 st6 = self._to_rest(link)
                 if _rests(st6):
@@ -558,6 +560,35 @@ class RealSession(Session):
                     f"{_shown(halt)}, SR6 {_shown(st6)}")
         return f"the unit is not at rest after the known state: SR6 reads {_shown(st6)}" \
             + _left(st6)
+
+    def _not_deleted(self, link: Link, halt: Response, deleted: Response | None,
+                     st6: Response) -> StepFailure:
+        """`D` after `H` left INTA. Refused as busy (7: "not while moving"), `PF` read
+        twice tells whether the axes still move: moving after `H` was answered, the frame
+        that answers only once they stopped (spec 2) did not — the `W` that last set them
+        moving where one did (spec 10: under simplex `H` cannot meet a `W` run that
+        answered when done; whether `H` stops one is the manuals' silence), else `H`.
+        At rest, `D` broke its own rule."""
+        evidence = f"H {_shown(halt)}, D {_shown(deleted)}, SR6 {_shown(st6)}"
+        if deleted is not None and deleted.code is not None \
+                and deleted.code & 7 == ErrorCode.BUSY:
+            first = self._position(link)
+            link.wait(RUN_OUT_POLL_S, Spent.MOTION)
+            then = self._position(link)
+            evidence += f", PF {_counters(first)} then {_counters(then)}"
+            last = ("", False) if self._before is None else _last_motion(self._before.log)
+            # a W whose answer never came: whether H stops its run is the manuals' silence
+            if first and then and first != then and last != ("W", False):
+                if last == ("W", True):
+                    return StepFailure(
+                        "10.cmd.reference", "reference", "W answers only when its run is "
+                        "over: the axes still moved after its answer (and H's)", evidence,
+                        "the axes at rest from W's answer on")
+                return StepFailure("10.4.halt.ramp", "halt", "H answers only when the unit "
+                                   "has stopped", evidence, "the axes at rest from H's answer on")
+        return StepFailure(
+            "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
+            "clears ST6", evidence, "D 0, then SR6 with RUN, STOP and INTA clear")
 
     def _keep_not_given_back(self, link: Link) -> str:
         """A `K` the last case left whose save `R` would give back beyond the envelope:
@@ -1071,6 +1102,21 @@ def _read_eeprom(link: Link, addresses: list[int]) -> dict[int, Response | None]
         chunk = addresses[start:start + EEPROM_READS]
         read.update(zip(chunk, link.send_each(["ER%02X" % a for a in chunk]), strict=True))
     return read
+
+
+def _last_motion(log: Sequence[Record]) -> tuple[str, bool]:
+    """The class (spec 10) of the last frame in ``log`` that could start motion ("" none),
+    and whether the unit answered it."""
+    answered = False
+    for rec in reversed(log):
+        if rec.direction == UNIT:
+            answered = True
+        elif rec.direction == HOST and rec.data.startswith(b"!"):
+            key = parse_text(rec.data[1:].decode("latin-1").rstrip("\r\n")).key
+            if key in MOTION:
+                return key, answered
+            answered = False
+    return "", False
 
 
 def _shown(r: Response | None) -> str:

@@ -3,6 +3,8 @@
 
     in PORT HEX        set an input port's byte (in 1 7F)
     switch AXIS POS    place a virtual reference switch (switch Y -1500; switch Y none)
+    rate POS           set the rate switch (jumpers) to position POS, 0-based in the
+                       profile's list, read at the next power-on (rate none: as found)
     power-on           power-cycle the unit(s)
     state              print the state as one JSON line
     quit | exit        stop the emulator
@@ -21,7 +23,8 @@ from emulator.link.line import Line
 from emulator.link.url import parse_address
 from emulator.link.words import decimal, hex_byte
 
-HELP = "commands: in PORT HEX | switch AXIS POS|none | power-on | state | quit  [@ADDRESS]"
+HELP = ("commands: in PORT HEX | switch AXIS POS|none | rate POS|none | power-on | state "
+        "| quit  [@ADDRESS]")
 
 
 class Quit(Exception):
@@ -42,6 +45,12 @@ def _switch(line: Line, args: list[str], address: int | None) -> str:
     position = (None if args[1].lower() == "none" else
                 decimal(args[1], "switch AXIS POS: POS", signed=True))
     line.set_switch(axis, position, address)
+    return "ok"
+
+
+def _rate(line: Line, args: list[str], address: int | None) -> str:
+    position = None if args[0].lower() == "none" else decimal(args[0], "rate POS: POS")
+    line.set_rate_switch(position, address)
     return "ok"
 
 
@@ -68,7 +77,7 @@ def _help(line: Line, args: list[str], address: int | None) -> str:
 
 #: command -> (number of arguments, what it does)
 COMMANDS: dict[str, tuple[int, Callable[[Line, list[str], int | None], str]]] = {
-    "in": (2, _input), "switch": (2, _switch), "power-on": (0, _power_on),
+    "in": (2, _input), "switch": (2, _switch), "rate": (1, _rate), "power-on": (0, _power_on),
     "state": (0, _state), "quit": (0, _quit), "exit": (0, _quit), "help": (0, _help),
 }
 

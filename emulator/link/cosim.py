@@ -35,8 +35,8 @@ CR = b"\r"
 #: the fastest line `baud` takes: a byte must take at least a nanosecond
 MAX_BAUD = 10**9
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
-        "| in PORT HEX | switch AXIS POS|none | power-on | state | quit  "
-        "[@ADDRESS on in, switch, power-on, state]")
+        "| in PORT HEX | switch AXIS POS|none | rate POS|none | power-on | state | quit  "
+        "[@ADDRESS on in, switch, rate, power-on, state]")
 
 
 class CosimError(ValueError):

@@ -59,7 +59,7 @@ class Line:
             self.log = (TranscriptWriter.open(log, meta) if isinstance(log, str | Path)
                         else TranscriptWriter(log, meta))
         for unit in self.units:
-            unit.emit = self._emit
+            unit.emit = self._emitter(unit)
 
     # -- time ----------------------------------------------------------------------------
     @property
@@ -113,13 +113,21 @@ class Line:
         if self.log is not None:
             self.log.host(data, first)
         for unit in self.units:
-            unit.receive(data, first, self.byte_ns)
+            if unit.hears(self.baud):
+                unit.receive(data, first, self.byte_ns)
         self._host_free = start + len(data) * self.byte_ns
         if self.clock.virtual:
             self.advance_to(self._host_free)
         return len(data)
 
     # -- units -> host -------------------------------------------------------------------------
+    def _emitter(self, unit: Unit):
+        """What ``unit`` sends: lost when its UART runs at another rate than the line."""
+        def emit(data: bytes, t: int) -> None:
+            if unit.hears(self.baud):
+                self._emit(data, t)
+        return emit
+
     def _emit(self, data: bytes, t: int) -> None:
         start = max(t, self._unit_free)
         b = self.byte_ns
@@ -283,6 +291,9 @@ class Line:
 
     def set_switch(self, axis: str, position: int | None, address: int | None = None) -> None:
         self.unit(address).set_switch(axis, position)
+
+    def set_rate_switch(self, position: int | None, address: int | None = None) -> None:
+        self.unit(address).set_rate_switch(position)
 
     def power_on(self, address: int | None = None) -> None:
         units = self.units if address is None else [self.unit(address)]

@@ -53,6 +53,12 @@ class Device:
         self.motion.advance(origin)
         self.inputs = dict(UNCONNECTED)
         self.switches: dict[str, int | None] = {}
+        #: the rate switch's (or jumpers') position the rig set (None: never set, the
+        #: unit runs at whatever rate its line runs at, as it was ordered or set up)
+        self.rate_position: int | None = None
+        #: the line rate read at the last power-on (None: the line's, as above)
+        self.rate: int | None = None
+        self._position_read: int | None = None     # the position the last power-on read
         self.state: DeviceState = reset_state(profile)
         self.deaf_until = origin          # restarting (power-on, J) until then
         self._was_active = self._active()  # the reading edge-triggered-inputs: last seen
@@ -74,6 +80,32 @@ class Device:
         self._was_active = self._active()
         self.deaf_until = t + p.restart_ms * MS
         self.due = []
+        if self.mutant.active("baud-read-at-restart"):
+            self.read_rate()
+        elif self.mutant.active("baud-range-read-at-restart"):
+            self._take_rate(self._position_read)
+
+    def read_rate(self) -> None:
+        """Power-on: the rate from the switch (jumpers) and the range byte, read once
+        (M114 13.3, 10.1; M54 SERIE); a unit whose switch the rig never set keeps the
+        line's rate."""
+        self._position_read = self.rate_position
+        self._take_rate(self.rate_position)
+
+    def _take_rate(self, position: int | None) -> None:
+        """The rate the switch at ``position`` gives with the range byte as it is now."""
+        choice = self.profile.baud
+        if choice is None or position is None:
+            self.rate = None
+            return
+        code = None
+        if choice.range_address is not None:
+            code = self.eeprom.read(choice.range_address)[0]
+            if self.mutant.active("baud-range-ignored"):
+                code = choice.unlisted_range
+            elif code not in choice.ranges and self.readings.active("baud-unlisted-high"):
+                code = min(c for c in choice.ranges if c != choice.unlisted_range)
+        self.rate = choice.rate(position, code)
 
     def later(self, at: int, work: Callable[[int], object]) -> None:
         """Do ``work(at)`` at the instant ``at``, answering nothing."""
@@ -365,4 +397,6 @@ class Device:
             "mpg": s.mpg or None,
             "kept": s.saved is not None,
             "eeprom": str(self.eeprom.path) if self.eeprom.path else None,
+            "rate_position": self.rate_position,
+            "rate": self.rate,
         }

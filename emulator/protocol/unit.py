@@ -92,6 +92,7 @@ class Unit:
         """Power cycle: the reset state; bytes are lost until the restart ends."""
         self.advance(t)
         self.device.reset(t)
+        self.device.read_rate()
         self.session.reset(self.profile.reset.checksums)
         self.framer.reset()
         self._pending = []
@@ -103,6 +104,22 @@ class Unit:
 
     def set_switch(self, axis: str, position: int | None) -> None:
         self.device.switches[axis] = position
+
+    def set_rate_switch(self, position: int | None) -> None:
+        """The rate switch (jumpers) moved: read at the next power-on only."""
+        choice = self.profile.baud
+        if choice is None:
+            raise ValueError(f"the {self.profile.name}'s rate is fixed at order time: "
+                             "it has no rate switch")
+        if position is not None and not 0 <= position < len(choice.positions):
+            raise ValueError(f"rate switch positions are 0..{len(choice.positions) - 1}, "
+                             f"not {position}")
+        self.device.rate_position = position
+
+    def hears(self, baud: int) -> bool:
+        """Whether the unit's UART runs at the line's rate ``baud`` (else bytes both ways
+        are lost as framing errors)."""
+        return self.device.rate is None or self.device.rate == baud
 
     # -- time -------------------------------------------------------------------------------
     def next_deadline(self) -> int | None:

@@ -89,6 +89,10 @@ def play(port: serial.SerialBase, transcript: Transcript, rig=None) -> list[str]
                        else str(line.spindle()))
                 if got != args[1]:
                     problems.append(f"{where}: {args[0]} is {got}")
+            elif verb == "rate":
+                line.set_rate_switch(None if args[0] == "none" else int(args[0]))
+            elif verb == "baud":
+                port.baudrate = int(args[0])
             elif verb == "power-on":
                 line.power_on()
                 line.advance(2.5)                   # every profile restarts in about 2 s

@@ -100,6 +100,9 @@ PROBES: dict[str, tuple[str, str]] = {
     "cause-lowest-only": ("e13-cause-several", "GVE84-100"),
     "cause-includes-disabled": ("e13-cause-several", "GVE54"),
     "reference-answers-early": ("d6-reference-answers-after-run", "GVE84-100"),
+    "baud-range-ignored": ("p21-rate-read-at-power-on", "GVE114-500"),
+    "baud-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-200"),
+    "baud-range-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-50"),
 }
 
 

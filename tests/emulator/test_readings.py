@@ -90,6 +90,21 @@ POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
 }
 
 
+#: readings of the GVE114's line rate: EEPROM 0D written (a byte the manual does not
+#: list), the rate switch at sw1 OFF sw2 OFF, power-on: the rate read (clean, reading)
+RATE_POINTS: dict[str, tuple[bytes, int, int]] = {
+    "baud-unlisted-high": (b"!0EW0D,00\r", 19200, 921600),
+}
+
+
+def rate_after_power_on(readings: tuple[str, ...], frame: bytes) -> int | None:
+    unit = Unit("GVE114-500", readings=readings)
+    unit.receive(frame, 10**9, 1000)
+    unit.set_rate_switch(0)
+    unit.power_on(2 * 10**9)
+    return unit.device.rate
+
+
 def answers(readings: tuple[str, ...], frames: list[Step], profile: str = "GVE84-100"
             ) -> bytes:
     """What a unit of ``profile`` taking ``readings`` answers ``frames``, a second apart
@@ -112,7 +127,14 @@ def answers(readings: tuple[str, ...], frames: list[Step], profile: str = "GVE84
 
 
 def test_every_reading_has_its_point_here():
-    assert set(POINTS) | set(POINTS_114) == set(READINGS)
+    assert set(POINTS) | set(POINTS_114) | set(RATE_POINTS) == set(READINGS)
+
+
+@pytest.mark.parametrize("name", sorted(RATE_POINTS))
+def test_a_reading_of_the_rate_picks_another_rate(name):
+    frame, clean, read = RATE_POINTS[name]
+    assert rate_after_power_on((), frame) == clean
+    assert rate_after_power_on((name,), frame) == read
 
 
 @pytest.mark.parametrize("name", sorted(POINTS))

@@ -281,6 +281,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # W answered before its run ended
     "10.cmd.reference": ("10.cmd.reference.answers-after-travel",
                          ("W", "timing", set(), set(), 0, 0)),
+    # where the axis stands after a W that found no switch (answered 5)
+    "10.cmd.reference-fails": ("10.cmd.reference.answers-after-travel",
+                               ("PF", "position", set(), {"W", "W-refused"}, 0, 0)),
 }
 
 

@@ -142,6 +142,7 @@ def test_only_whole_frames_are_told(data):
        st.lists(st.tuples(bodies, answers), min_size=1, max_size=12))
 @example([], [("L200,0,0", "0"), ("L200,0,0", "0")])
 @example([], [("PF", "0,250,0,0"), ("L200,0,0", "0"), ("SR0", "0,00")])
+@example([], [("PF", "0,250,0,0"), ("SW6,00", "0")])      # SW6 resumes a queue
 @settings(max_examples=300, deadline=None, derandomize=True)
 def test_the_frames_a_link_tells_are_let_through_whatever_the_answers_before_them(
         before, told):

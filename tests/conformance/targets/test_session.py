@@ -161,6 +161,49 @@ def test_a_k_whose_save_the_envelope_cannot_take_back_is_cleared_by_j_or_said(de
         assert any("KEEP" in p for p in result.problems), result.problems
 
 
+def _known_states(mutant: str, frames: list[str], seconds: float) -> tuple[list, list]:
+    """The known-state failures of a used unit with ``mutant`` before and after
+    ``frames`` (then ``seconds``), and the known state reached all the same."""
+    u = used_unit("GVE84-100", allow_destructive=True, max_travel=4000, mutant=mutant)
+    session = u.begin()
+    link = session.open_link()
+    first = session.take_failures()
+    assert all(r is not None for r in link.send_each(frames))
+    link.wait(seconds)
+    link = session.open_link()
+    after = session.take_failures()
+    assert link.send("SR6").raw == b"0,00\r" and link.send("PF").raw == b"0,0,0,0\r"
+    session.finish()
+    return first, after
+
+
+@pytest.mark.parametrize(("mutant", "frames", "seconds", "rule"), [
+    # W answered at once, its run still going when H is answered and D refused as busy
+    ("reference-answers-early", ["WX,-100,1000,50,1000"], 0, "10.cmd.reference"),
+    # H answered while its ramp still runs
+    ("halt-answers-early", ["V5000", "L3000,0,0"], 0.3, "10.4.halt.ramp"),
+])
+def test_a_d_refused_as_busy_after_h_names_what_still_moved_the_axes(mutant, frames, seconds,
+                                                                      rule):
+    # moving after H's answer (PF read twice): the frame that answers only once the axes
+    # stopped did not, the W that last set them moving or else H
+    first, (failure,) = _known_states(mutant, frames, seconds)
+    assert first == []
+    assert failure.rule == rule, failure
+    assert "D F" in failure.observed and " then " in failure.observed
+    # the frames that led there: the sequence's, then the known state's two PF reads
+    assert any(f"> !0{frames[-1]}" in line for line in failure.led_there)
+    assert sum("> !0PF" in line for line in failure.led_there) >= 2
+
+
+def test_a_d_refused_as_busy_with_the_axes_at_rest_is_ds_own_rule():
+    (failure,), after = _known_states("delete-refused", ["L300,0,0"], 0)
+    assert failure.rule == "10.4.delete" and "D F" in failure.observed
+    first, then = failure.observed.split("PF ")[1].split(" then ")
+    assert first == then
+    assert after == []                           # each rule once a run
+
+
 def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
     u = unit(frames={b"!0H\r": b"!0Z\r"})            # answered 3 (unknown)
     result = run([u], select(["5.errors.ok", "10.3.flags.f-command"]))

@@ -33,6 +33,8 @@ class FakeUnit:
         self.inputs: dict[int, int] = {}
         self.switches: dict[str, int | None] = {}
         self.powered: list[int] = []
+        self.rate_switch: int | None = None      # read at power-on; taken as the rate itself
+        self.rate: int | None = None
 
     def receive(self, data: bytes, t: int, byte_ns: int) -> None:
         for i, byte in enumerate(data):
@@ -64,8 +66,15 @@ class FakeUnit:
     def set_switch(self, axis: str, position: int | None) -> None:
         self.switches[axis] = position
 
+    def set_rate_switch(self, position: int | None) -> None:
+        self.rate_switch = position
+
     def power_on(self, t: int) -> None:
         self.powered.append(t)
+        self.rate = self.rate_switch
+
+    def hears(self, baud: int) -> bool:
+        return self.rate is None or self.rate == baud
 
     def snapshot(self, t: int) -> dict:
         return {"address": self.address, "t": t, "inputs": self.inputs}

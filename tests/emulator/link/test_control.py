@@ -25,6 +25,16 @@ def test_commands_reach_the_unit() -> None:
     assert handle(line, "   ") is None
 
 
+def test_the_rate_switch_is_read_at_power_on() -> None:
+    unit = FakeUnit()
+    line = Line([unit], 9600)
+    assert handle(line, "rate 19200") == "ok" and unit.rate_switch == 19200
+    assert unit.rate is None
+    assert handle(line, "power-on") == "ok" and unit.rate == 19200
+    assert handle(line, "rate none") == "ok" and unit.rate_switch is None
+    assert handle(line, "rate fast").startswith("error: rate POS: POS takes digits")
+
+
 def test_state_of_several_units_is_keyed_by_address() -> None:
     line = Line([FakeUnit(0), FakeUnit(4)], 9600)
     assert handle(line, "in 2 0F @4") == "ok"

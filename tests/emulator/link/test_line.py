@@ -129,3 +129,19 @@ def test_the_transcript_logs_both_directions_with_their_instants() -> None:
     assert [(r.direction, r.data) for r in records] == [(HOST, b"!0?\r"), (UNIT, b"0\r")]
     assert records[0].t == B                    # first byte of the frame complete
     assert records[1].t == 5 * B                # first byte of the answer complete
+
+
+def test_a_unit_at_another_rate_neither_hears_nor_is_heard() -> None:
+    unit = FakeUnit()
+    line = Line([unit], 9600)
+    unit.set_rate_switch(19200)
+    line.power_on()
+    line.write(b"!0V1\r")
+    assert unit.received == [] and line.read(10, 1.0) == b""
+    line.baud, line.byte_ns = 19200, byte_time(19200)
+    line.write(b"!0V1\r")
+    assert line.read(10, 1.0, b"\r") == b"0\r"
+    unit.received.clear()
+    line.baud, line.byte_ns = 9600, byte_time(9600)
+    unit.emit(b"0\r", line.now)                 # what it sends at 19200 is lost at 9600
+    assert line.read(10, 1.0) == b""
