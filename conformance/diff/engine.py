@@ -34,7 +34,7 @@ from conformance.protocol.catalogue import classes
 from conformance.targets.session import StepFailed
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import ErrorCode, St6
 
 try:
     # internals of Hypothesis, used only to empty its pool of constants while a search
@@ -94,6 +94,7 @@ class ExampleRun:
     disagreement: Disagreement | None = None
     frames: int = 0
     refused: list[str] = field(default_factory=list)     # steps the guard did not send
+    inputs: dict[int, int] = field(default_factory=dict)  # each port as the rig last set it
     ended: str = ""                                      # why the sequence ended early
     begun: bool = False                  # both sides were brought to the known state
 
@@ -222,6 +223,7 @@ class Pair:
         self.timing.retimed("input", RoundTrip(b"", b"ok" * done, sent_at, self.target.now,
                                                None))
         if done and self.reference.set_input(step.port, step.value):
+            out.inputs[step.port] = step.value
             out.records.append(StepRecord(step, place=place))
             earlier.add("input")
             if self.reach is not None:
@@ -259,8 +261,11 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
-            if rec is not None and (rec.reference.code or 0) & 7:
+            code = (rec.reference.code or 0) & 7 if rec is not None else 0
+            if code:
                 earlier.add(f"{command}-refused")
+            if code == ErrorCode.QUEUE_FULL:
+                earlier.add(f"{command}-no-room")
         self.course.stepped(command, step)
         return False
 
@@ -282,6 +287,9 @@ class Pair:
             context.add(shipped)
         if self.course.mpg_on:
             context.add("mpg-on")
+        context |= _st6_differs(step.body, rec)
+        if _released(out):
+            context.add("released")
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")
@@ -446,6 +454,34 @@ class Pair:
         return {k for k, on in flags.items() if on}
 
 
+#: the frames whose answer's value is ST6 (F's with its queue bit)
+_ST6_READS = ("SR6", "F")
+
+
+def _st6_differs(body: str, rec: StepRecord) -> set[str]:
+    """The ST6 bits two answers to a read of ST6 differ in (``st6-run``, ``st6-inta``,
+    …): which part of the state the sequence left differs."""
+    if body not in _ST6_READS:
+        return set()
+    try:
+        words = [int(_values(x)[0], 16) for x in (rec.target, rec.reference)]
+    except (IndexError, ValueError):
+        return set()
+    differ = words[0] ^ words[1]
+    return {"st6-" + bit.name.lower().replace("_", "-") for bit in St6 if differ & bit}
+
+
+#: the status words that set the inputs' polarity (an unconnected input made active)
+_POLARITY = ("SW2,", "SW3,")
+
+
+def _released(out: ExampleRun) -> bool:
+    """The rig grounded inputs and has released them all, no polarity written: no input
+    is active, so nothing interrupts again after a clear."""
+    return bool(out.inputs) and all(v == 0xFF for v in out.inputs.values()) and not any(
+        r.step.kind == FRAME and r.step.body.startswith(_POLARITY) for r in out.records)
+
+
 def _has_lower(text: str) -> bool:
     return any("a" <= ch <= "z" for ch in text)
 
@@ -538,8 +574,9 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
     transcript and the steps its label reads are what the disagreement needs: a step
     taken out, else sent plain (its own checksum, no stall), else replaced by a wait as
     long as its exchange took (a frame that only let time pass); two fills of one frame
-    or two waits become one, a fill is tried half as full. With ``frames_only`` a frame
-    may only be taken out: waits and fills stay as they are."""
+    or two waits become one, a fill is tried half as full; the pass is repeated until it
+    changes nothing. With ``frames_only`` a frame may only be taken out: waits and fills
+    stay as they are."""
     steps, outcome = finding.steps, finding.outcome
     want = (outcome.disagreement.command, outcome.disagreement.kind)
     runs = 0
@@ -553,18 +590,22 @@ def minimise(pair: Pair, finding: Finding, budget: Budget, *,
         d = trial.disagreement
         return trial if d is not None and (d.command, d.kind) == want else None
 
-    i = 0
-    while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time() \
-            and not pair.lost:
-        found = False
-        lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
-            if frames_only else _lesser(steps, i, outcome)
-        for candidate in lesser:
-            if (trial := same(candidate)) is not None:
-                steps, outcome, found = candidate, trial, True
-                break
-        if not found:
-            i += 1
+    # passes until one changes nothing: a step that could not go while a later one was
+    # there may go once that one has
+    changed = True
+    while changed:
+        changed, i = False, 0
+        while i < len(steps) and runs < MINIMISE_RUNS and not budget.out_of_time() \
+                and not pair.lost:
+            found = False
+            lesser = ([steps[:i] + steps[i + 1:]] if steps[i].kind == FRAME else []) \
+                if frames_only else _lesser(steps, i, outcome)
+            for candidate in lesser:
+                if (trial := same(candidate)) is not None:
+                    steps, outcome, found, changed = candidate, trial, True, True
+                    break
+            if not found:
+                i += 1
     return Finding(steps, outcome)
 
 

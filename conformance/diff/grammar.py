@@ -109,8 +109,9 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
     head, _, rest = kind.partition(":")
     moves = g["moves"]
     if kind == "vector":
-        v = moves["vector"]
-        return st.one_of(st.integers(-v, v), st.sampled_from([0, 1, -1, v])).map(str)
+        v, far = moves["vector"], moves["long"]
+        return st.one_of(st.integers(-v, v), st.sampled_from([0, 1, -1, v, far, -far])
+                         ).map(str)
     if kind == "travel":
         v = moves["travel"]
         return st.integers(-v, v).filter(bool).map(str)
@@ -129,13 +130,47 @@ def _valid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
         near = st.integers(max(lo, -moves["vector"]), min(hi, moves["vector"]))
         return st.one_of(near, st.sampled_from([lo, hi])).map(str)
     numbers = st.one_of(st.integers(lo, hi), st.sampled_from([lo, hi]))
+    edges = _binary_edges(lo, hi)
+    if edges:
+        numbers = st.one_of(numbers, st.sampled_from(edges))
     if head == "hex":
         # EEPROM addresses and bytes from a few values, so a write is read back
         numbers = st.one_of(st.sampled_from([lo, min(lo + 1, hi), hi]), numbers)
         return numbers.map(lambda n: "%02X" % n)
     if head == "range" and rest in moves["slow_rates"]:
-        numbers = st.one_of(numbers, st.integers(lo, min(hi, max(lo, 5000))))
+        numbers = st.one_of(numbers, st.integers(lo, min(hi, max(lo, moves["slow"]))))
+    reset = _reset_value(profile, rest) if head == "range" else None
+    if reset is not None:
+        # a setting shrinks towards its reset value: a finding keeps only the settings
+        # it needs, at the values it needs (a cap shrinks to no cap, not to a lower one)
+        numbers = st.one_of(st.just(reset), numbers)
     return numbers.map(str)
+
+
+def _reset_value(profile: Profile, key: str) -> int | None:
+    """A modal setting's value after power-on (None: the field is no modal setting)."""
+    r = profile.reset
+    values = {"V": r.V, "A": r.A, "$": r.dollar, "B": r.B, "T": r.T, "XM": r.XM,
+              "VL": r.VL[0] if r.VL else None}
+    return values.get(key)
+
+
+def _beyond(profile: Profile, kind: str) -> list[str]:
+    """The values one past each end of a numeric field's range."""
+    bounds = _range_of(profile, kind)
+    if bounds is None:
+        return []
+    hexa = kind.startswith("hex")
+    return ["%02X" % v if hexa else str(v) for v in (bounds[0] - 1, bounds[1] + 1)
+            if not (hexa and v < 0)]
+
+
+def _binary_edges(lo: int, hi: int) -> list[int]:
+    """The values inside ``lo..hi`` where a field held in fewer bits than the range
+    needs wraps (2^k - 1 and 2^k, and their negatives), as a fuzzer's interesting values
+    are: a unit that decodes or stores a field too narrow shows there, not at the ends."""
+    out = {v for k in range(4, 32) for v in (2 ** k - 1, 2 ** k, -(2 ** k), -(2 ** k) - 1)}
+    return sorted(v for v in out if lo < v < hi)
 
 
 def _invalid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
@@ -152,7 +187,14 @@ def _invalid(profile: Profile, kind: str, g: dict) -> st.SearchStrategy[str]:
             out.append(form)
     if kind.startswith("choice") or kind == "axis":
         out += ["?", "0"]
-    return st.sampled_from(out)
+    forms_of = st.sampled_from(out)
+    if bounds is not None and "above" in forms:
+        # beyond the top by more than one: a unit that keeps what fits of a refused value
+        # keeps other bits than the top's
+        far = st.integers(bounds[1] + 2, max(bounds[1] * 16, bounds[1] + 2) + 15)
+        forms_of = st.one_of(forms_of, far.map(
+            (lambda v: "%X" % v) if kind.startswith("hex") else str))
+    return forms_of
 
 
 def _body(name: str, entry: dict, params: list[str]) -> str:
@@ -187,11 +229,14 @@ class Grammar:
         kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
         self.invalid = {k: _invalid(profile, k, g) for k in kinds}
         self.valid = {k: _valid(profile, k, g) for k in kinds}
+        self.beyond = {k: st.sampled_from(_beyond(profile, k)) for k in kinds
+                       if _beyond(profile, k)}
         self.invalid_chance = round(g["invalid"]["chance"] * 100)
         self.modal = [n for n in g["motion"]["modal"] if n in self.names]
         self.vectors = [n for n in self.names if n in classes(vector=True)]
         self.events = [e for e in g["motion"]["events"]
                        if e.rstrip("0123456789,") in profile.commands]
+        self.states = [r for r in g["motion"]["states"] if command_of(r) in self.names]
         self.checksums = "%" in profile.commands
         self.vector_counts = [3, 4] if profile.family == "GVE114" else [len(profile.axes)]
         steps = g["steps"]
@@ -219,6 +264,8 @@ class Grammar:
             self.kinds += ["tables"] * g["tables"]["weight"]
         # every input port (the GVE54's I0 too: its bits are read, none interrupts)
         self.ports = list(profile.input_ports) or [1]
+        self.input_values = st.one_of(st.sampled_from([0xFF, 0xFE, 0x7F, 0x00, 0xFD]),
+                                      st.integers(0, 255))
         self.member_names = [n for n, c in commands().items()
                              if c.packet == "member" and n in profile.commands]
         self.other_members = [n for n in g["packet"]["others"] if n in profile.commands]
@@ -313,30 +360,130 @@ class Grammar:
                 Step(FRAME, f"*E{max(count + off, 0)}")]
 
     def fill(self, draw) -> list[Step]:
+        f = self.g["fill"]
         zeros = ",0" * (len(self.profile.axes) - 1)
         most = self.profile.buffer + 2
-        times = draw(st.one_of(st.integers(1, most), st.just(most)))
+        # a queue many times `queue` vectors long is filled (to any count) as often as
+        # filling it costs no more than a `queue`-long one does; else a few C are queued
+        if self.number(draw, 0, max(0, most // f["queue"] - 1)) == 0:
+            times = draw(st.one_of(st.integers(1, most), st.just(most)))
+        else:
+            times = self.number(draw, 1, f["queue"])
         return [Step(FILL, f"C{self.g['fill']['vector']}{zeros}", times=times)]
 
     def motion(self, draw) -> list[Step]:
-        m = self.g["motion"]
-        out = []
-        for _ in range(self.number(draw, 0, 2)):
-            if self.modal:
-                out.append(Step(FRAME, self.body(draw, self.pick(draw, self.modal),
-                                                 valid=True)))
+        """A move watched: modal settings, vectors, then reads of where and how it runs."""
+        return self.settings(draw) + self.vectors_drawn(draw) + self.reads(draw)
+
+    def settings(self, draw) -> list[Step]:
+        """Up to ``settings`` modal settings before a move: valid values, now and then one the
+        unit must refuse (a field out of its range or of a wrong form, one parameter too
+        many) or one sent to another address (the GVE114's spindle's): the move after it
+        shows whether it was set all the same."""
+        m, out = self.g["motion"], []
+        for _ in range(self.number(draw, 0, m["settings"]) if self.modal else 0):
+            name = self.pick(draw, self.modal)
+            roll = self.number(draw, 0, 99)
+            if roll < m["refused"] * 100:
+                out.append(Step(FRAME, self.refused_body(draw, name)))
+            elif roll < (m["refused"] + m["elsewhere"]) * 100:
+                out.append(self.elsewhere(self.body(draw, name, valid=True)))
+            else:
+                out.append(Step(FRAME, self.body(draw, name, valid=True)))
+        return out
+
+    def refused_body(self, draw, name: str) -> str:
+        """A frame of ``name`` the unit must refuse: one field in an invalid form (else,
+        for a command without fields, one parameter too many)."""
+        entry = self.g["command"][name]
+        kinds = entry.get("params", [])
+        if kinds == ["vector"]:
+            kinds = ["vector"] * self.pick(draw, self.vector_counts)
+        params = [draw(self.valid[k]) for k in kinds]
+        if not kinds or self.number(draw, 0, 3) == 0:
+            extra = self.pick(draw, ["1", "0,0"])
+            body = _body(name, entry, params)
+            return body + (extra if not kinds else "," + extra)
+        i = self.number(draw, 0, len(kinds) - 1)
+        # half the time just beyond an end of its range (what a unit that clamps keeps)
+        beyond = self.beyond.get(kinds[i])
+        params[i] = draw(beyond if beyond is not None and self.number(draw, 0, 1)
+                         else self.invalid[kinds[i]])
+        return _body(name, entry, params)
+
+    def beside(self, draw, kind: str, place: str) -> str:
+        """Another place of a read: the place with one bit of its number flipped (as a
+        memory's address lines are tested: a unit that decodes one of them wrong reads
+        the write there), else any place of its kind."""
+        bounds = _range_of(self.profile, kind)
+        head = kind.partition(":")[0]
+        try:
+            number = int(place, 16 if head == "hex" else 10)
+        except ValueError:
+            number = None
+        if bounds is not None and number is not None and bounds[1] > 0:
+            # the top bit first (shrinking towards it): the one a narrow decoder drops
+            flipped = number ^ (1 << self.pick(draw, range(bounds[1].bit_length() - 1, -1, -1)))
+            if bounds[0] <= flipped <= bounds[1]:
+                return "%02X" % flipped if head == "hex" else str(flipped)
+        return draw(self.valid[kind])
+
+    def elsewhere(self, body: str) -> Step:
+        """A frame to another address: the spindle's where the profile has one (answered
+        by it), else one no unit answers."""
+        spindle = self.profile.spindle
+        if spindle is not None:
+            return Step(FRAME, body, address=spindle.address)
+        return Step(FRAME, body, address=(self.profile.address + 1) % 8, answer=False)
+
+    def vectors_drawn(self, draw) -> list[Step]:
+        """Up to ``vectors`` vectors with valid values; now and then one moving one axis
+        alone (each axis, the GVE114's A too) or one of zero length."""
+        m, out = self.g["motion"], []
+        # now and then one command for all of them (C after C meet at junctions), and
+        # then now and then one vector cut in pieces (each the same: the junctions at speed)
+        joined = self.pick(draw, self.vectors) if self.number(draw, 0, 1) else None
+        if joined is not None and self.number(draw, 0, 1):
+            body = self.body(draw, joined, valid=True)
+            return [Step(FRAME, body)] * self.number(draw, 2, m["vectors"])
         for _ in range(self.number(draw, 1, m["vectors"])):
-            out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors),
-                                             valid=True)))
+            name = joined or self.pick(draw, self.vectors)
+            roll = self.number(draw, 0, 99)
+            if roll < m["alone"] * 100:
+                count = self.pick(draw, self.vector_counts)
+                axis = self.number(draw, 0, count - 1)
+                size = draw(self.valid["vector"])
+                body = self.g["command"][name].get("text", name) + ",".join(
+                    size if i == axis else "0" for i in range(count))
+                # moved, then read: whether it runs (RUN) shows an axis no read shows
+                out.append(Step(FRAME, body))
+                if self.states:
+                    out.append(self.fixed(self.pick(draw, self.states)))
+                continue
+            elif roll < (m["alone"] + m["zero"]) * 100:
+                count = self.pick(draw, self.vector_counts)
+                body = self.g["command"][name].get("text", name) + ",".join("0" * count)
+            else:
+                body = self.body(draw, name, valid=True)
+            out.append(Step(FRAME, body))
+        return out
+
+    def reads(self, draw) -> list[Step]:
+        """Up to ``reads`` of: a position read, a wait, an event (a command acting on
+        the motion), the status word or the flags (RUN: whether an axis no read shows
+        moves)."""
+        m, out = self.g["motion"], []
         waits = self.g["moves"]["waits"]
         for _ in range(self.number(draw, 1, m["reads"])):
-            what = self.number(draw, 0, 2)
+            what = self.number(draw, 0, 3)
             if what == 0:
                 out.append(Step(FRAME, "PF" if "PF" in self.profile.commands else "P"))
             elif what == 1:
                 out.append(Step(WAIT, seconds=self.pick(draw, waits)))
-            elif self.events:
+            elif what == 2 and self.events:
                 out.append(self.fixed(self.pick(draw, self.events)))
+            elif what == 3 and self.states:
+                out.append(self.fixed(self.pick(draw, self.states)))
         return out
 
     def group(self, draw) -> list[Step]:
@@ -346,9 +493,7 @@ class Grammar:
         if kind == "wait":
             return [Step(WAIT, seconds=self.pick(draw, self.g["moves"]["waits"]))]
         if kind == "input":
-            value = draw(st.one_of(st.sampled_from([0xFF, 0xFE, 0x7F, 0x00, 0xFD]),
-                                   st.integers(0, 255)))
-            return [Step(INPUT, port=self.pick(draw, self.ports), value=value)]
+            return self.input(draw)
         if kind == "packet":
             return self.packet(draw)
         if kind == "motion":
@@ -361,11 +506,22 @@ class Grammar:
             return self.idiom(self.pick(draw, self.tables))
         return self.fill(draw)
 
+    def input(self, draw) -> list[Step]:
+        """A rig input set, now and then read back at once (the port's bits as set)."""
+        port = self.pick(draw, self.ports)
+        out = [Step(INPUT, port=port, value=draw(self.input_values))]
+        if f"I{port}" in self.names and self.number(draw, 0, 1):
+            out.append(self.fixed(f"I{port}"))
+        return out
+
     def scenario(self, draw) -> list[Step]:
+        """An idiom drawn whole, a move before it now and then, and now and then the reads
+        of a move after it (what it left running shows while it runs)."""
         out = []
         if self.vectors and self.number(draw, 0, 1):
             out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors), valid=True)))
-        return out + self.idiom(self.pick(draw, self.scenarios))
+        out += self.idiom(self.pick(draw, self.scenarios))
+        return out + (self.reads(draw) if self.number(draw, 0, 1) else [])
 
     def idiom(self, lines: list[str] | tuple[str, ...]) -> list[Step]:
         """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`,
@@ -434,12 +590,25 @@ class Grammar:
         return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
 
     def readback(self, draw) -> list[Step]:
+        """A write read back at once: the place written, and now and then another place
+        of the same read (a unit that decodes its places too narrowly wrote that one);
+        the write now and then one the unit must refuse (it must store nothing)."""
+        rb = self.g["readback"]
         write, read = self.pick(draw, self.readbacks)
-        body = self.body(draw, write, valid=True)
+        if self.number(draw, 0, 99) < rb["refused"] * 100:
+            body = self.refused_body(draw, write)
+        else:
+            body = self.body(draw, write, valid=True)
         text = self.g["command"][write].get("text", write)
+        reader = self.g["command"][read]
         first = body[len(text):].split(",")[0]
-        place = "" if read == "PF" else first
-        return [Step(FRAME, body), Step(FRAME, self.g["command"][read].get("text", read) + place)]
+        places = [first]
+        kinds = reader.get("params", [])
+        if kinds and self.number(draw, 0, 99) < rb["elsewhere"] * 100:
+            places.append(self.beside(draw, kinds[0], first))
+        return [Step(FRAME, body)] + [
+            Step(FRAME, reader.get("text", read) + ("" if read == "PF" else place))
+            for place in places]
 
 
 #: the field kinds whose values are a range's ends (the others have no table)

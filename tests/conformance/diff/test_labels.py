@@ -246,9 +246,10 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                                  ("%", "code", set(), set(), 0, 4)),
     "6.checksum.response-sum": ("6.checksum.responses-summed",
                                 ("SR", "checksum", set(), {"%"}, 0, 0)),
-    # a failed packet's C ran
+    # a failed packet's C ran (the reference refused its *E)
     "7.packet.all-or-nothing": ("7.packet.failed-leaves-nothing",
-                                ("PF", "position", set(), {"*S", "C", "*E"}, 0, 0)),
+                                ("PF", "position", set(), {"*S", "C", "*E", "*E-refused"},
+                                 0, 0)),
     "7.packet.bad-checksum-member": ("7.packet.bad-checksum-member.corrupted-end",
                                      ("*E", "silence", {"bad-checksum", "in-packet"},
                                       {"*S", "C"}, None, 4)),
