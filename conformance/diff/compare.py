@@ -10,7 +10,9 @@ In virtual time on both sides everything is exact against the reference's own ki
 target graded by the project's decisions: the emulator, --strict); a target of somebody
 else's in virtual time places its steps its own way, so its positions may differ by a step
 of placement on each axis, and an answer given when the motion has come to rest (`H`) by
-a step period (conformance/motion/tolerance.py). With a target in real time, positions
+two step periods (conformance/motion/tolerance.py): its steps placed a period later stop a
+period later, and the stop's last step, the ramp's longest, falls where its own steps put
+it. With a target in real time, positions
 read while moving may differ by the band of ``conformance/motion/tolerance.py`` (the
 fastest rate the reference can have stepped at, times the width of the windows in which
 the two frames were processed, the target's widened by the line's band of
@@ -52,7 +54,7 @@ class Judge:
     line: LineBand = EXACT
     #: virtual time: the steps of placement either side a target of somebody else's may
     #: read (0: the reference's own placement), and how much later or earlier it may
-    #: answer what answers once the motion is at rest (a step period, ns)
+    #: answer what answers once the motion is at rest (two of this step period, ns)
     placement: int = 0
     period_ns: int = 0
 
@@ -64,7 +66,8 @@ def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Jud
     if a == b:
         late = (target.received_at - target.sent_at) - (reference.received_at
                                                          - reference.sent_at)
-        if judge.exact and late and not (command in DEFERRED and abs(late) <= judge.period_ns):
+        if judge.exact and late and not (command in DEFERRED
+                                         and abs(late) <= 2 * judge.period_ns):
             return "timing"
         return None
     if not a or not b:

@@ -98,12 +98,13 @@ def test_real_time_a_repeated_position_read_is_compared_as_that_read():
 
 def test_in_virtual_time_somebody_else_s_unit_may_place_its_steps_its_own_way():
     # a target not graded by our decisions: a step either side on each axis, and H at
-    # rest a step period either side; nothing more, and nothing else
+    # rest two step periods either side (placed a period later, it stops a period later,
+    # and the stop's last step lands where its own steps put it); nothing more
     judge = Judge(placement=1, period_ns=10 * MS)
     assert difference("PF", ex(b"0,305,-102,0\r"), ex(b"0,306,-101,0\r"), judge) is None
     assert difference("PF", ex(b"0,304,-102,0\r"), ex(b"0,306,-102,0\r"), judge) == "position"
-    assert difference("H", ex(b"8\r", 0, 9 * MS), ex(b"8\r", 0, 1 * MS), judge) is None
-    assert difference("H", ex(b"8\r", 0, 12 * MS), ex(b"8\r", 0, 1 * MS), judge) == "timing"
+    assert difference("H", ex(b"8\r", 0, 21 * MS), ex(b"8\r", 0, 1 * MS), judge) is None
+    assert difference("H", ex(b"8\r", 0, 22 * MS), ex(b"8\r", 0, 1 * MS), judge) == "timing"
     assert difference("V", ex(b"0\r", 0, 2 * MS), ex(b"0\r", 0, MS), judge) == "timing"
     assert "±1 step" in alike_because("PF", ex(b"0,305,0,0\r"), ex(b"0,306,0,0\r"), judge)
 
