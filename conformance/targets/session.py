@@ -40,12 +40,12 @@ from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import (
     LONGEST_ANSWER_S,
+    MOTION,
     EmulatorGuard,
     Guard,
     SafetyStop,
     TargetNotResponding,
 )
-from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse_text
 from conformance.protocol.wire import is_hex_byte
 from conformance.targetinfo import TargetInfo
@@ -83,8 +83,6 @@ RUN_OUT_POLL_S = 1.0
 #: ST6 bits that keep a unit from being at rest for a case: moving, braking, or
 #: interrupted with vectors waiting for `G` (spec 10.3: INTA/RUN 0/0 is idle [M])
 NOT_AT_REST = St6.RUN | St6.STOP | St6.INTA
-#: frames that can start an axis moving (spec 10)
-MOTION = classes(motion=True)
 
 
 class SessionError(Exception):
