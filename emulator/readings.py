@@ -121,6 +121,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                   "delay (48, 1..2000) and the default spindle speed (4C, "
                                   "1..1000) out of range keep the MPG off and Y+, Y& "
                                   "refused with 5 too"),
+    "index-hex": (("8.index.decimal",),
+                  "@ writes the index as two upper-case hex digits, as the manuals write "
+                  "every other byte (`0,3B` for 59): no manual gives its number format"),
     "vector-fewer-components": (("10.cmd.vector-components",),
                                 "a vector takes one component or more, the missing ones "
                                 "0 (the manuals' own `!0L1000,100`)"),

@@ -86,7 +86,7 @@ FORMATS = {
     "I2": ("I2", HEX_ANSWER, "10.cmd.inputs"),
     "SR": ("SR0", HEX_ANSWER, "10.cmd.status-words"),
     "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", HEX_ANSWER, "10.cmd.flags"),
-    "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
+    "@": ("@", r"0,(0|[1-9]\d*)", "8.index.decimal"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 
 

@@ -77,6 +77,9 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "vector-fewer-components": ([b"!0L5,3\r", b"!0PF\r"], b"4\r0,0,0,0\r",
                                 b"0\r0,5,3,0\r"),
     "commands-any-case": ([b"!0v1000\r"], b"3\r", b"0\r"),
+    # eleven counted frames: the index 11 in decimal, or two hex digits
+    "index-hex": ([b"!0SR6\r"] * 11 + [b"!0@\r"], b"0,00\r" * 11 + b"0,11\r",
+                  b"0,00\r" * 11 + b"0,0B\r"),
     "eeprom-erased-zero": ([b"!0ER40\r"], b"0,FF\r", b"0,00\r"),
     # 50 ms into L100 at the reset's A20 the X counter shows one step less
     "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
