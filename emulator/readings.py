@@ -124,6 +124,12 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "index-hex": (("8.index.decimal",),
                   "@ writes the index as two upper-case hex digits, as the manuals write "
                   "every other byte (`0,3B` for 59): no manual gives its number format"),
+    "absent-command-syntax": (("1.profile.command-prefix",),
+                              "a command the unit lacks whose first letters begin one it "
+                              "has (`VL1000,1000,1000`, `NX0`, `XM100` on the GVE54) "
+                              "answers 4: the letters after them read as parameters it "
+                              "does not take (its manual never says where a command's "
+                              "name ends)"),
     "vector-fewer-components": (("10.cmd.vector-components",),
                                 "a vector takes one component or more, the missing ones "
                                 "0 (the manuals' own `!0L1000,100`)"),

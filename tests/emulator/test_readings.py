@@ -77,6 +77,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "vector-fewer-components": ([b"!0L5,3\r", b"!0PF\r"], b"4\r0,0,0,0\r",
                                 b"0\r0,5,3,0\r"),
     "commands-any-case": ([b"!0v1000\r"], b"3\r", b"0\r"),
+    # the GVE84 lacks EFR but has ER; it has no command beginning Y
+    "absent-command-syntax": ([b"!0EFR30\r", b"!0Y-\r"], b"3\r3\r", b"4\r3\r"),
     # eleven counted frames: the index 11 in decimal, or two hex digits
     "index-hex": ([b"!0SR6\r"] * 11 + [b"!0@\r"], b"0,00\r" * 11 + b"0,11\r",
                   b"0,00\r" * 11 + b"0,0B\r"),
