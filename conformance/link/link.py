@@ -65,7 +65,7 @@ from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import SECOND, ErrorCode, St6
+from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
 #: processing margin on top of the bytes' own transmission time
@@ -247,7 +247,7 @@ class Link:
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
-                data = self.port.read(self.port.in_waiting)
+                data = self._whole_line(self.port.read(self.port.in_waiting))
             else:
                 data = self._listen(seconds, stop_early=False)
         if data:
@@ -271,7 +271,17 @@ class Link:
             data += got
             if got and stop_early:
                 end = time.monotonic() + seconds
-        return bytes(data)
+        return self._whole_line(bytes(data))
+
+    def _whole_line(self, data: bytes) -> bytes:
+        """``data`` and the rest of the line it ends inside: a unit's bytes arrive one
+        after another, so a read that ends while a line is on its way has its beginning
+        only; what the unit wrote in one go is judged whole, as it came, never its tail
+        as a second or a late answer."""
+        if not data or data.endswith(CR) or self.guard.interrupts.pending:
+            return data
+        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+        return data + self.port.read_until(CR)
 
     def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
@@ -543,7 +553,8 @@ class Link:
         began = self._clock()
         answered_as, self._answered_as = self._answered_as, Spent.ANSWERS
         for i in range(lines):
-            chunk = self.port.read_until(CR)
+            # an answer that began in time is read to its end before it is judged
+            chunk = self._whole_line(self.port.read_until(CR))
             if i == 0 and late and not chunk.endswith(CR) \
                     and not self.guard.interrupts.pending:
                 self.port.timeout = late
@@ -626,6 +637,7 @@ class Link:
         waiting = self.port.in_waiting
         if waiting:
             data += self.port.read(waiting)
+        data = self._whole_line(data)
         if not data:
             if kept_quiet:               # the timed-out frame's answer can come no more
                 self._last = (_UNASKED, b"", b"")
