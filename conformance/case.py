@@ -145,6 +145,7 @@ class CaseContext:
         link = self._open_link(address)
         if self._link is not None:
             self._link.superseded = True
+            link.index_form = self._link.index_form     # the unit's, once measured
         self.links.append(link)
         self._link = link
         return link

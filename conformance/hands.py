@@ -154,12 +154,13 @@ class HandRig:
 
     # -- the power -------------------------------------------------------------------------
     def _index(self) -> int | None:
-        r = self._link().send("@")
+        link = self._link()
+        r = link.send("@")
         if r is None or not r.ok or not r.values:
             return None
         try:
-            return int(r.values[0])
-        except ValueError:
+            return link.index_value(r)
+        except UnitDataError:
             return None
 
     def power_on(self, address: int | None = None) -> None:

@@ -115,6 +115,21 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                              "(limits, steps per mm, acceleration, speed: M114 12.4-12.6) "
                              "is in range; with one out of range (an erased FF) RUN stays 0 "
                              "and Y+, Y& are refused with 5"),
+    "mpg-needs-every-parameter": (("9.reset.mpg-parameters",),
+                                  "as mpg-needs-parameters, the sentence read for every "
+                                  "parameter of M114 chapter 12 with a range: the MPG "
+                                  "delay (48, 1..2000) and the default spindle speed (4C, "
+                                  "1..1000) out of range keep the MPG off and Y+, Y& "
+                                  "refused with 5 too"),
+    "index-hex": (("8.index.decimal",),
+                  "@ writes the index as two upper-case hex digits, as the manuals write "
+                  "every other byte (`0,3B` for 59): no manual gives its number format"),
+    "absent-command-syntax": (("1.profile.command-prefix",),
+                              "a command the unit lacks whose first letters begin one it "
+                              "has (`VL1000,1000,1000`, `NX0`, `XM100` on the GVE54) "
+                              "answers 4: the letters after them read as parameters it "
+                              "does not take (its manual never says where a command's "
+                              "name ends)"),
     "vector-fewer-components": (("10.cmd.vector-components",),
                                 "a vector takes one component or more, the missing ones "
                                 "0 (the manuals' own `!0L1000,100`)"),

@@ -57,6 +57,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="how long to wait for an answer before asking `@` (default 0.25)")
     ap.add_argument("--hold-limit", type=float, default=30.0, metavar="S",
                     help="how long an interrupt may hold the job (default 30)")
+    ap.add_argument("--resend-repeatable", action="store_true",
+                    help="after a lost or damaged answer to a setting or a read (V, A, SW, "
+                         "PF...), send it again at once instead of asking `@` first (the "
+                         "manual: most commands may be repeated)")
     ap.add_argument("--bug", action="append", default=[], metavar="NAME",
                     help="plant a deliberate host bug (see --list-bugs)")
     ap.add_argument("--list-bugs", action="store_true")
@@ -83,7 +87,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"gve_host: {err}", file=sys.stderr)
         return 2
     session = Session(port, args.address, timeout=args.timeout,
-                      char_gap=args.char_gap / 1000, bugs=bugs)
+                      char_gap=args.char_gap / 1000, bugs=bugs,
+                      resend_repeatable=args.resend_repeatable)
     packets = work.packets if args.packets is None else args.packets
     driver = Driver(session, checksums=args.checksums or work.checksums, packets=packets,
                     hold_limit=args.hold_limit)

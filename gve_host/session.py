@@ -10,7 +10,10 @@ When an answer does not come, or comes damaged, it asks `@`:
   unit got and the answer it gave, which the session takes as the answer;
 - anything else: the unit restarted, or another host talks to it; the session stops.
 
-A vector is therefore never sent twice unless the unit says it never got it.
+A vector is therefore never sent twice unless the unit says it never got it. With
+``resend_repeatable`` a setting or a read (V, A, SW, PF…) whose answer went missing is
+sent again at once instead: "Většina příkazů se dá zopakovat (A,V,PF atd..)" (M84
+12.5.12); its index is asked before the next command.
 """
 
 from __future__ import annotations
@@ -35,6 +38,12 @@ SETTLE_S = 0.03
 ASK_FOR_S = 3.0
 #: commands that are not counted in the index (spec 8)
 UNCOUNTED = ("@", ">")
+#: commands that leave the unit alike run once or twice (M84 12.5.12: "Většina příkazů
+#: se dá zopakovat (A,V,PF atd..)"): settings and reads, by their letters
+REPEATABLE = frozenset({"V", "A", "B", "T", "$", "SW", "O", "PF", "P", "SR", "F", "ER",
+                        "%", "?"})
+_LETTERS = re.compile(r"[A-Z$%?]+")
+_ST6_WRITE = re.compile(r"SW0*6,")
 #: a command's letters and its first decimal parameter (for the number bugs)
 _NUMBER = re.compile(r"(L|C|V|A|B|T|\$)(-?\d+)")
 
@@ -45,8 +54,10 @@ class UnitLost(Exception):
 
 class Session:
     def __init__(self, port: serial.SerialBase, address: int, *, timeout: float = 0.25,
-                 char_gap: float = 0.0, bugs: Bugs | None = None) -> None:
+                 char_gap: float = 0.0, bugs: Bugs | None = None,
+                 resend_repeatable: bool = False) -> None:
         self.port = port
+        self.resend_repeatable = resend_repeatable
         self.bugs = bugs or Bugs()
         self.address = (address + 1) % 8 if self.bugs.on("wrong-address") else address
         self.timeout = None if self.bugs.on("wait-forever") else timeout
@@ -127,8 +138,9 @@ class Session:
         if self.bugs.on("no-wait") and values == 0 and body != "L0,0,0":
             self.send(data)            # and on to the next, the answer left unread
             return Answer(0, False, (), b"0")
+        again = False
         while True:
-            if self.index is None and body not in UNCOUNTED:
+            if self.index is None and body not in UNCOUNTED and not again:
                 self.sync()
             before = self.index
             if self.bugs.on("no-wait"):
@@ -142,6 +154,13 @@ class Session:
                 if answer.code == ErrorCode.WATCHDOG and body[:2] != "*E":
                     continue          # the watchdog cut it: nothing ran (spec 3)
                 return answer
+            if self.resend_repeatable and _repeatable(body) and not again:
+                print(f"gve_host: no usable answer to {data!r}; sending it again "
+                      "(it may be repeated)", file=sys.stderr)
+                self.drain()
+                self.index, again = None, True    # once or twice: asked before the next
+                continue
+            again = False
             answer = self.recover(data, before, summed)
             if answer is not None:
                 return answer
@@ -234,6 +253,13 @@ class Session:
             counted += counts(line)
             if counted >= need:
                 deadline = time.monotonic() + SETTLE_S
+
+
+def _repeatable(body: str) -> bool:
+    """Whether ``body`` may be sent again: a write of ST6 may set the axes moving."""
+    letters = _LETTERS.match(body)
+    return letters is not None and letters.group(0) in REPEATABLE \
+        and _ST6_WRITE.match(body) is None
 
 
 def _shaped(body: str, answer: Answer, values: int) -> bool:

@@ -120,20 +120,14 @@ def queries_counted(ctx: CaseContext, address: int | None = None) -> bool:
 
 
 def _read_index(ctx: CaseContext, address: int | None) -> int | None:
-    r = ctx.link.send("@", address=address)
-    if r is None or not r.ok:
-        return None
-    return r.dec()
+    return ctx.link.read_index(address)
 
 
 def index(ctx: CaseContext, address: int | None = None) -> int | None:
     """The index as ``@`` reads it (at ``address``; default the link's): on a real unit
     it is wherever the unit's use left it, so cases judge how far it moves."""
     queries_counted(ctx, address)
-    r = ctx.link.send("@", address=address)
-    if r is None or not r.ok:
-        return None
-    return r.dec()
+    return ctx.link.read_index(address)
 
 
 def index_moved(ctx: CaseContext, before: int | None, frames: int, what: str, *,

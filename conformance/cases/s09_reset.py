@@ -29,13 +29,17 @@ from gve_fixtures.protocol import ErrorCode
 def after_j(ctx: CaseContext) -> None:
     """J answers a plain 0 and restores the reset state after about 2 s."""
     link = ctx.link
+    link.read_index()             # the form the unit writes the index in, read before J
     setup(ctx, "SW2,2B")
     setup(ctx, "L" + vector(ctx, 16))
     link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5, Spent.MANUAL)
     answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
-    answers(ctx, link.send("@"), "0,1", "the index restarted at 0", rule="8.index.answer")
+    # read in the form the unit writes it (8.index.decimal is graded where @ is)
+    after = link.read_index()
+    ctx.expect(after == 1, "the index restarted at 0", observed=after, expected=1,
+               rule="8.index.answer")
     ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", rule="9.reset.state")
 
 

@@ -12,11 +12,13 @@ The reference run, on the test rig's switches and inputs. Never sent to a real u
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 
 from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    code_text,
     configured,
     measured_case,
     position,
@@ -86,7 +88,7 @@ FORMATS = {
     "I2": ("I2", HEX_ANSWER, "10.cmd.inputs"),
     "SR": ("SR0", HEX_ANSWER, "10.cmd.status-words"),
     "SW": ("SW0,00", "0", "10.cmd.status-words"), "F": ("F", HEX_ANSWER, "10.cmd.flags"),
-    "@": ("@", r"0,\d+", "8.index.answer"), "H": ("H", "8", "10.cmd.halt-answer"),
+    "@": ("@", r"0,(0|[1-9]\d*)", "8.index.decimal"), "H": ("H", "8", "10.cmd.halt-answer"),
 }
 
 
@@ -311,8 +313,15 @@ def to_switch(ctx: CaseContext) -> None:
                observed=position(ctx), expected=[0, 0, 0], rule="10.cmd.reference")
 
 
+def _begins_one_it_has(name: str, commands: Collection[str]) -> bool:
+    """Whether letters before the end of ``name`` begin a command of ``commands`` (`V`
+    of `VL`, `N` of `NX`, `X` of `XA` for `XM`): a unit may take the rest for parameters
+    of that command (1.profile.command-prefix [D])."""
+    return any(c.startswith(name[:i]) for i in range(1, len(name)) for c in commands)
+
+
 @case("10.commands.absent-refused",
-      rules=("1.profile.command-set", "5.code.unknown"))
+      rules=("1.profile.command-set", "5.code.unknown", "1.profile.command-prefix"))
 def absent(ctx: CaseContext) -> None:
     """A command the profile lacks answers 3."""
     lacking = [c for c in REFUSAL_FRAMES if c in OPTIONAL and c not in ctx.profile.commands]
@@ -324,6 +333,14 @@ def absent(ctx: CaseContext) -> None:
         if LACKING_LETTER.match(name) and r is not None and r.code == ErrorCode.RANGE:
             ctx.expect(True, f"{name} → 5: the letter a parameter the unit lacks",
                        rule="5.code.unknown")
+            continue
+        # where its manual never says where a command's name ends, the letters after
+        # one it has may be that command's parameters, which it does not take: 4
+        if r is not None and r.code == ErrorCode.SYNTAX \
+                and _begins_one_it_has(name, ctx.profile.commands):
+            ctx.expect(False, f"{name} → 3: one command the unit lacks, not a command it "
+                       "has with parameters it does not take", observed=show(r),
+                       expected=code_text(ErrorCode.UNKNOWN), rule="1.profile.command-prefix")
             continue
         code(ctx, r, ErrorCode.UNKNOWN, f"{name} → 3", rule="1.profile.command-set")
 

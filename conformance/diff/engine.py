@@ -293,6 +293,8 @@ class Pair:
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")
+        if command == "@" and self._index.in_hex(_values(rec.target), _values(rec.reference)):
+            context.add("index-hex")
         family = self.profile.family
         why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target),
                       family)

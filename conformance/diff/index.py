@@ -3,12 +3,16 @@ reading of it. A fresh emulator starts at 0, but what a unit's first `@` answers
 own (counting the `@` itself is a reading, spec 8 [D]; a real unit's index is not reset
 between sequences), so the first `@` both sides answer sets the offset and later ones
 are compared from there. A later difference that the queries sent since then account for
-exactly (one more for each `@` and `>` the unit took) is that reading, not a miscount."""
+exactly (one more for each `@` and `>` the unit took) is that reading, not a miscount.
+No manual gives the index's number format either: a target whose `@` reads as the
+reference's once its text is read as hex, from a base read as hex too, writes it in hex
+(8.index.decimal [D]), not a miscount."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from conformance.protocol import index
 from conformance.protocol.catalogue import classes
 
 #: what a query of the index is (what the index leaves out); a unit may count these
@@ -25,6 +29,8 @@ class IndexBase:
 
     offset: int | None = None
     queries: int = 0
+    #: the offset with the target's index read as hex (None: not read so, or not yet)
+    hex_offset: int | None = None
 
     def note(self, command: str, context: set[str], target: list[str],
              reference: list[str]) -> None:
@@ -36,8 +42,12 @@ class IndexBase:
             self.queries += 1
             return
         a, b = _number(target), _number(reference)
-        if command == "@" and a is not None and b is not None:
-            self.offset = (a - b) % 256
+        if command == "@" and b is not None:
+            if a is not None:
+                self.offset = (a - b) % 256
+            h = _hex(target)
+            if h is not None:
+                self.hex_offset = (h - b) % 256
 
     def counts_queries(self, target: list[str], reference: list[str]) -> bool:
         """Whether the target's `@` is off the reference's by the queries since the base
@@ -46,6 +56,19 @@ class IndexBase:
         return (self.offset is not None and a is not None and b is not None
                 and self.queries % 256 != 0
                 and (a - b - self.offset) % 256 == self.queries % 256)
+
+
+    def in_hex(self, target: list[str], reference: list[str]) -> bool:
+        """Whether the target's `@` differs from the reference's only by being written in
+        hex: read as hex, from the base read as hex (0 before any), it is the
+        reference's."""
+        a, b = _hex(target), _number(reference)
+        return (a is not None and b is not None and target != reference
+                and (a - (self.hex_offset or 0)) % 256 == b % 256)
+
+
+def _hex(values: list[str]) -> int | None:
+    return index.value(values[0], index.Form.HEX) if len(values) == 1 else None
 
 
 def _number(values: list[str]) -> int | None:

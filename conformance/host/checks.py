@@ -24,6 +24,8 @@ PATIENCE_MS = 100
 MS = 1_000_000
 #: `@` and `>`: asking, never resending (spec 8)
 ASKING = classes(asks=True)
+#: what a host may send again instead of asking: once or twice, the unit is left alike
+REPEATABLE = classes(repeatable=True)
 
 
 @dataclass(frozen=True)
@@ -93,15 +95,21 @@ def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
 def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A frame the unit refused as unknown, for syntax or for range is the host's fault
     (spec 5), unless a fault of ours made it so; so is one refused as "not while moving"
-    (7): the host did not wait for the motion to end, as `L0,0,0` lets it (spec 10.1)."""
+    (7): the host did not wait for the motion to end, as `L0,0,0` lets it (spec 10.1).
+    A frame summed after a restart turned checksum mode off is refused for that cause,
+    which its reading names (6.checksum.off-after-reset), not for its parameters."""
     rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
              ErrorCode.RANGE: "5.code.range", ErrorCode.BUSY: "10.1.queue.wait-idiom"}
     out.judged |= set(rules.values())
     for ex in rec.exchanges:
-        if ex.fault is None and ex.code in rules:
+        if ex.fault is None and ex.code in rules and not _lapsed(ex):
             answer = b"".join(ex.answer).decode("latin-1").strip()
             out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
                     f"the unit answered {answer}")
+
+
+def _lapsed(ex: Exchange) -> bool:
+    return any(p.rule == "6.checksum.off-after-reset" for p in ex.parsed.problems)
 
 
 def gaps(rec: Recording, line: LineFacts, out: Judgement) -> None:
@@ -219,7 +227,9 @@ def restarts(rec: Recording, line: LineFacts, out: Judgement) -> None:
 def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """After an answer the host did not get whole, it asks `@` (and `>`) before anything
     else and never resends a vector blindly (spec 8); in checksum mode an answer whose
-    checksum fails is not trusted (spec 6)."""
+    checksum fails is not trusted (spec 6). Sending a repeatable command again at once
+    (a setting or a read: M84 12.5.12 "Většina příkazů se dá zopakovat") trusts nothing
+    and leaves the unit as one run would: a recovery the manual names, no finding."""
     for i, ex in enumerate(rec.exchanges):
         if ex.fault is None or ex.fault in ("cut-frame", "queue-full", "interrupt",
                                             "restart"):
@@ -231,13 +241,14 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         asked = nxt.parsed.command in ASKING
         shown = f"after {ex.text} ({ex.fault})"
         out.judged |= {"8.recovery.no-blind-resend", "8.recovery.ask-index"}
+        repeated = _resends(ex, nxt) and ex.parsed.command in REPEATABLE
         if ex.fault == "corrupt-answer" and summed(ex):
             out.judged.add("6.checksum.response-sum")
-            if not asked:
+            if not asked and not repeated:
                 out.add("6.checksum.response-sum", _at(nxt.frame.start, line), nxt.text,
                         f"trusted an answer whose checksum fails {shown}")
                 continue
-        if _got_answer(ex, nxt):
+        if _got_answer(ex, nxt) or repeated:
             continue
         if _resends(ex, nxt):
             motion = ex.parsed.command in (*VECTORS, "*E")
@@ -361,7 +372,8 @@ WIRE_CHECKS: dict[str, Check] = {
         "1.profile.vector-range", "1.profile.v-b-range", "1.profile.v-b-range-gve54",
         "1.profile.dollar-range", "3.params.commas", "3.params.decimal", "3.params.hex-fields",
         "3.params.word-values-decimal", "3.params.float-syntax", "3.params.none-expected",
-        "5.code.syntax", "5.code.range", "6.checksum.sum", "10.cmd.vector", "10.cmd.modal",
+        "5.code.syntax", "5.code.range", "6.checksum.sum", "6.checksum.off-after-reset",
+        "10.cmd.vector", "10.cmd.modal",
         "10.cmd.accel-range", "10.cmd.axis-limits", "10.cmd.output", "12.spindle.speed")},
     "5.code.unknown": refusals,
     "10.1.queue.wait-idiom": refusals,

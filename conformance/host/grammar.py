@@ -99,18 +99,20 @@ class LineGrammar:
 
     def __init__(self, units: dict[int, Profile], size: int = 4096) -> None:
         self.units, self.size = units, size
-        self._seen: dict[tuple[bytes, bool], ParsedFrame] = {}
+        self._seen: dict[tuple[bytes, bool, bool], ParsedFrame] = {}
 
-    def parse(self, raw: bytes, checksums: bool) -> ParsedFrame:
-        found = self._seen.get((raw, checksums))
+    def parse(self, raw: bytes, checksums: bool, *, lapsed: bool = False) -> ParsedFrame:
+        found = self._seen.get((raw, checksums, lapsed))
         if found is None:
-            found = self._seen[raw, checksums] = _parse(raw, self.units, checksums)
+            found = self._seen[raw, checksums, lapsed] = _parse(raw, self.units, checksums,
+                                                               lapsed)
             if len(self._seen) > self.size:
                 self._seen.pop(next(iter(self._seen)))
         return found
 
 
-def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFrame:
+def _parse(raw: bytes, units: dict[int, Profile], checksums: bool,
+           lapsed: bool = False) -> ParsedFrame:
     f = ParsedFrame(raw)
     f.check(len(raw) <= MAX_FRAME, "3.frame.max-length",
             lambda: f"{len(raw)} bytes, more than {MAX_FRAME}")
@@ -136,6 +138,14 @@ def _parse(raw: bytes, units: dict[int, Profile], checksums: bool) -> ParsedFram
             expected = byte_sum(raw[: len(raw) - 2])
             f.check(int(f.checksum, 16) == expected, "6.checksum.sum",
                     lambda: f"checksum {f.checksum}, the bytes sum to {expected:02X}")
+            body = body[: m.start()]
+    elif lapsed:
+        # a frame summed as checksum mode wants, after a restart turned the mode off:
+        # that is the finding, not what the unit makes of the sum as a parameter
+        m = _SUM.search(body)
+        if m is not None and int(m.group(1), 16) == byte_sum(raw[: len(raw) - 2]):
+            f.check(False, "6.checksum.off-after-reset",
+                    "a frame with its checksum after a restart turned checksum mode off")
             body = body[: m.start()]
     f.body = body.decode("latin-1")
     _command(f, profile)

@@ -57,7 +57,8 @@ class Ledger:
                 assert ex is not None
                 view = self.view_at.get(_address(ex.frame.raw))
                 ex.reading = self.grammar.parse(ex.frame.raw, view is not None
-                                                and view.checksums)
+                                                and view.checksums,
+                                                lapsed=view is not None and view.lapsed)
                 ex.vectors_before = self._vectors()
             elif kind == ANSWERED:
                 assert ex is not None

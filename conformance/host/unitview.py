@@ -56,6 +56,9 @@ class UnitView:
     address: int
     addresses: frozenset[int] = frozenset()
     checksums: bool = False
+    #: checksum mode was on when the unit last restarted, and no `%` since: a restart
+    #: turned it off under the host (spec 6)
+    lapsed: bool = False
     packet: list[ParsedFrame] | None = None
     modal: dict[str, object] = field(default_factory=dict)
     status: list[int] = field(default_factory=lambda: [0] * 7)
@@ -71,6 +74,7 @@ class UnitView:
 
     def _reset(self) -> None:
         r = self.profile.reset
+        self.lapsed = self.checksums and not r.checksums
         self.checksums = r.checksums
         self.packet = None
         self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T,
@@ -128,7 +132,7 @@ class UnitView:
                 self.executed.append(Executed("spindle", (int(params[0]),)))
             return
         if name == "%":
-            self.checksums = params[:1] == ["+"]
+            self.checksums, self.lapsed = params[:1] == ["+"], False
         elif name in VECTORS:
             values = tuple(int(p) for p in params)
             values += (0,) * (len(self.profile.axes) - len(values))

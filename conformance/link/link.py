@@ -51,17 +51,21 @@ from conformance.link.framing import (
     HostFrame,
     HostFramer,
     Response,
+    UnitDataError,
     frame,
     parse_response,
     readable,
+    shown_bytes,
 )
 from conformance.link.interrupts import Interrupted
 from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.virtual import Rig, line_of
+from conformance.protocol import index
 from conformance.protocol.catalogue import classes
+from conformance.protocol.index import Form
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import SECOND, ErrorCode, St6
+from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
 #: processing margin on top of the bytes' own transmission time
@@ -124,6 +128,9 @@ class Link:
         self.guard = guard
         self.rig = rig
         self.checksums = False
+        #: the form `@` writes the index in, once read (protocol/index.py); the unit's
+        #: addresses share one index
+        self.index_form: Form | None = None
         #: real time: the line's round trip as the session measured it at its start
         #: (``SessionReport.line``; empty when it was not), for the timing bands
         self.round_trip: dict[str, float] = {}
@@ -240,7 +247,7 @@ class Link:
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
-                data = self.port.read(self.port.in_waiting)
+                data = self._whole_line(self.port.read(self.port.in_waiting))
             else:
                 data = self._listen(seconds, stop_early=False)
         if data:
@@ -264,7 +271,17 @@ class Link:
             data += got
             if got and stop_early:
                 end = time.monotonic() + seconds
-        return bytes(data)
+        return self._whole_line(bytes(data))
+
+    def _whole_line(self, data: bytes) -> bytes:
+        """``data`` and the rest of the line it ends inside: a unit's bytes arrive one
+        after another, so a read that ends while a line is on its way has its beginning
+        only; what the unit wrote in one go is judged whole, as it came, never its tail
+        as a second or a late answer."""
+        if not data or data.endswith(CR) or self.guard.interrupts.pending:
+            return data
+        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+        return data + self.port.read_until(CR)
 
     def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
@@ -475,6 +492,44 @@ class Link:
         frames, self._unbooked = self._unbooked, []
         self._book(frames, answer)
 
+    def read_index(self, address: int | None = None) -> int | None:
+        """The index `@` answers (None: no answer, or a refusal), read in the form the
+        unit writes it: the first read whose text does not show its form measures it
+        first (frames that count move the index: protocol/index.py), so the value
+        returned is read after them. Raises UnitDataError for text no form reads."""
+        where = self.address if address is None else address
+        r = self.send("@", address=where)
+        if r is None or not r.ok or not r.values:
+            return None
+        if self.index_form is None:
+            form = index.evident(r.values[0])
+            if form is None:
+                form = index.measure(lambda: self._index_text(where),
+                                     lambda: self._move_index(where))
+                r = self.send("@", address=where)
+                if r is None or not r.ok or not r.values:
+                    return None
+            self.index_form = form
+        return self.index_value(r)
+
+    def index_value(self, r: Response) -> int:
+        """Value 0 of ``r`` (an answer to `@`) as the index, in the form the unit writes it
+        (decimal before it is known)."""
+        text = r.values[0]
+        got = index.value(text, self.index_form or Form.DECIMAL)
+        if got is None:
+            raise UnitDataError(f"the answer {shown_bytes(r.raw)} has "
+                                f"{shown_bytes(text.encode('latin-1'), 80)} where the "
+                                f"index belongs (a number 0..255, decimal or hex)")
+        return got
+
+    def _move_index(self, address: int) -> None:
+        self.send("SR6", address=address)     # a read: it moves nothing but the index
+
+    def _index_text(self, address: int) -> str | None:
+        r = self.send("@", address=address)
+        return r.values[0] if r is not None and r.ok and r.values else None
+
     def _learn(self, body: str) -> None:
         """The host's belief about the checksum mode follows the commands that set it."""
         if body == "%+":
@@ -498,7 +553,8 @@ class Link:
         began = self._clock()
         answered_as, self._answered_as = self._answered_as, Spent.ANSWERS
         for i in range(lines):
-            chunk = self.port.read_until(CR)
+            # an answer that began in time is read to its end before it is judged
+            chunk = self._whole_line(self.port.read_until(CR))
             if i == 0 and late and not chunk.endswith(CR) \
                     and not self.guard.interrupts.pending:
                 self.port.timeout = late
@@ -581,6 +637,7 @@ class Link:
         waiting = self.port.in_waiting
         if waiting:
             data += self.port.read(waiting)
+        data = self._whole_line(data)
         if not data:
             if kept_quiet:               # the timed-out frame's answer can come no more
                 self._last = (_UNASKED, b"", b"")

@@ -50,6 +50,7 @@ class UnitMachine(RuleBasedStateMachine):
         self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0])
         # a real unit is not fresh: start the bookkeeping from where it is
         self.model.committed = self.position()
+        self.link.read_index()          # the form the unit writes the index in, measured
         self.model.index = self.index()
         # whether @ counts itself is a reading the manuals leave open [D]: measured
         again = self.index()
@@ -81,7 +82,7 @@ class UnitMachine(RuleBasedStateMachine):
     def index(self) -> int:
         r = self.send("@")
         holds(r is not None and r.ok and r.values, "8.index.answer", f"@ answered {r}")
-        return r.dec()
+        return self.link.index_value(r)
 
     def position(self) -> list[int]:
         r = self.send("PF")

@@ -85,6 +85,14 @@ class Command:
         return self.packet in ("breaker", "closes")
 
     @property
+    def repeatable(self) -> bool:
+        """Whether running it twice leaves what running it once does (M84 12.5.12:
+        "Většina příkazů se dá zopakovat (A,V,PF atd..)"): a setting or a read, not a
+        vector, a marker, a motion, a stop, a restart or a packet's end."""
+        return not (self.vector or self.motion or self.marks or self.stops or self.restart
+                    or self.empties or self.packet in ("opens", "closes"))
+
+    @property
     def switch(self) -> bool:
         """Whether it is a modal switch: modal, with no value (`VK` / `VN`)."""
         return self.modal and not self.fields

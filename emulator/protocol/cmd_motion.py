@@ -312,8 +312,7 @@ def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
 def cmd_mpg(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if p not in ("+", "&", "-"):
         raise CommandError(ErrorCode.SYNTAX, "Y takes +, & or -")
-    if p != "-" and dev.readings.active("mpg-needs-parameters") \
-            and not dev.mpg_parameters_in_range():
+    if p != "-" and not dev.mpg_parameters_in_range():
         raise CommandError(ErrorCode.RANGE, "an MPG parameter is out of range")
     dev.state.mpg = p
     return ["Y" + p]

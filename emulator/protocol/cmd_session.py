@@ -12,6 +12,8 @@ from gve_fixtures.protocol import ErrorCode
 
 
 def cmd_index(dev: Device, ses: Session, p: str, t: int) -> Reply:
+    if dev.readings.active("index-hex"):
+        return ["%02X" % ses.index]
     return [str(ses.index)]
 
 

@@ -140,22 +140,29 @@ class Device:
         value = self.eeprom.read(mpg.enable_address)[0]
         if value & 0x80 and self.mutant.active("mpg-enable-high-values-ignored"):
             return False
-        return value in mpg.enabling_values and (
-            not self.readings.active("mpg-needs-parameters") or self.mpg_parameters_in_range())
+        return value in mpg.enabling_values and self.mpg_parameters_in_range()
 
     def mpg_parameters_in_range(self) -> bool:
-        """The reading mpg-needs-parameters: M114 12.4-12.6, "Pokud je hodnota některého
+        """Whether the MPG's parameters allow it under the readings taken (always, under
+        none). mpg-needs-parameters: M114 12.4-12.6, "Pokud je hodnota některého
         parametru mimo rozsah, není možné MPG použít" (with any of them out of range the
         MPG cannot be used): the limits 0..10000, steps per mm 1..10000, the acceleration
         1..10000 and a positive maximum speed, float32 little-endian each (an erased FF
-        FF FF FF is no number)."""
-        ranges = [(0x10 + 4 * i, 0.0, 1e4) for i in range(8)] \
+        FF FF FF is no number). mpg-needs-every-parameter: that sentence read for every
+        parameter of chapter 12 with a range, the delay (12.7, 1..2000) and the default
+        spindle speed (12.8, 1..1000, uint32 each) too."""
+        every = self.readings.active("mpg-needs-every-parameter")
+        if not every and not self.readings.active("mpg-needs-parameters"):
+            return True
+        floats = [(0x10 + 4 * i, 0.0, 1e4) for i in range(8)] \
             + [(0x30 + 4 * i, 1.0, 1e4) for i in range(4)] \
             + [(0x40, 1.0, 1e4), (0x44, 1e-9, math.inf)]
-        for address, lo, hi in ranges:
-            value = struct.unpack("<f", self.eeprom.read(address, 4))[0]
-            if not lo <= value <= hi:          # NaN compares false
-                return False
+        uints = [(0x48, 1, 2000), (0x4C, 1, 1000)] if every else []
+        for fmt, ranges in (("<f", floats), ("<I", uints)):
+            for address, lo, hi in ranges:
+                value = struct.unpack(fmt, self.eeprom.read(address, 4))[0]
+                if not lo <= value <= hi:          # NaN compares false
+                    return False
         return True
 
     def st6(self, t: int) -> int:

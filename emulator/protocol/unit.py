@@ -10,7 +10,7 @@ and nothing else: the machine's state is the device's, the conversation's the se
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -54,6 +54,13 @@ LONG_FRAME = 255
 
 def _discard(data: bytes, t: int) -> None:
     pass
+
+
+def begins_one(name: str, commands: Iterable[str]) -> bool:
+    """Whether letters before the end of ``name`` begin a command of ``commands`` (`V` of
+    `VL`, `N` of `NX`, `X` of `XA` for `XM`): a unit may read the frame as that command
+    with parameters it does not take."""
+    return any(c.startswith(name[:i]) for i in range(1, len(name)) for c in commands)
 
 
 class Unit:
@@ -281,8 +288,11 @@ class Unit:
             return
         if command is None:
             lacking = self.readings.active("missing-letter-range") and _LACKING.match(name or "")
-            self._answer(raw, ErrorCode.RANGE if lacking else ErrorCode.UNKNOWN, [], t,
-                         remember=known.remembered)
+            prefixed = self.readings.active("absent-command-syntax") \
+                and begins_one(name or "", self.tables[address])
+            code = ErrorCode.RANGE if lacking else ErrorCode.SYNTAX if prefixed \
+                else ErrorCode.UNKNOWN
+            self._answer(raw, code, [], t, remember=known.remembered)
             return
         if command.packet == DISCARD:
             ses.packet = None

@@ -9,9 +9,14 @@ from gve_fixtures.profile import load_profile
 
 def test_the_hand_wheel_needs_every_parameter_its_manual_names_with_the_enable_last():
     # M114 12.4-12.9: limits, steps per mm (X, Y, Z, A), acceleration, top speed, delay,
-    # step size: "if any parameter is out of range, the MPG cannot be used"; 06 enables it
+    # default spindle speed, step size: "if any parameter is out of range, the MPG cannot
+    # be used", read for every parameter of the chapter's table with a range; 06 enables it
     params = features()["mpg"].params_for(load_profile("GVE114-500"))
-    assert [p.address for p in params] == [*range(0x10, 0x40, 4), 0x40, 0x44, 0x48, 0x60, 0x06]
+    assert [p.address for p in params] == [*range(0x10, 0x40, 4), 0x40, 0x44, 0x48, 0x4C,
+                                           0x60, 0x06]
+    spindle = params[-3]
+    assert spindle.write() == "EUW4C,500" and spindle.holds(["1000"]) \
+        and not spindle.holds(["0"]) and not spindle.holds(["4294967295"])
     assert features()["mpg"].params_for(load_profile("GVE84-100")) == ()
 
 

@@ -77,16 +77,31 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "vector-fewer-components": ([b"!0L5,3\r", b"!0PF\r"], b"4\r0,0,0,0\r",
                                 b"0\r0,5,3,0\r"),
     "commands-any-case": ([b"!0v1000\r"], b"3\r", b"0\r"),
+    # the GVE84 lacks EFR but has ER; it has no command beginning Y
+    "absent-command-syntax": ([b"!0EFR30\r", b"!0Y-\r"], b"3\r3\r", b"4\r3\r"),
+    # eleven counted frames: the index 11 in decimal, or two hex digits
+    "index-hex": ([b"!0SR6\r"] * 11 + [b"!0@\r"], b"0,00\r" * 11 + b"0,11\r",
+                  b"0,00\r" * 11 + b"0,0B\r"),
     "eeprom-erased-zero": ([b"!0ER40\r"], b"0,FF\r", b"0,00\r"),
     # 50 ms into L100 at the reset's A20 the X counter shows one step less
     "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
                             b"0\r0,23,0,0\r"),
 }
+#: the MPG's limits, steps per mm, acceleration, speed and delay, each in its range
+_MPG_SETTINGS: list[Step] = [
+    *(b"!0EFW%02X,%d\r" % (0x10 + 4 * i, 0 if i < 4 else 1000) for i in range(8)),
+    *(b"!0EFW%02X,100\r" % (0x30 + 4 * i) for i in range(4)),
+    b"!0EFW40,100\r", b"!0EFW44,10\r", b"!0EUW48,100\r"]
 #: readings of what only the GVE114 has, on a GVE114-500: EEPROM 06 enables the MPG; its
 #: parameters are erased (FF), so under the reading it does not hold RUN after J
 POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
     "mpg-needs-parameters": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r", b"!0Y+\r"],
                              b"0\r0\r0,40\r0,Y+\r", b"0\r0\r0,00\r5\r"),
+    # every MPG setting of 12.4-12.7 in range, the spindle speed (4C) still erased
+    "mpg-needs-every-parameter": ([*_MPG_SETTINGS, b"!0EW06,01\r", b"!0J\r", 2.5,
+                                   b"!0SR6\r", b"!0Y+\r"],
+                                  b"0\r" * 17 + b"0,40\r0,Y+\r",
+                                  b"0\r" * 17 + b"0,00\r5\r"),
 }
 
 

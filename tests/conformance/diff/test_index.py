@@ -34,3 +34,19 @@ def test_it_wraps_modulo_256():
     base.note("@", set(), ["1"], ["1"])       # and one query since: level again
     assert base.counts_queries(["1"], ["1"])
     assert not base.counts_queries(["0"], ["1"])
+
+
+def test_an_index_written_in_hex_is_told_from_a_miscount():
+    base = IndexBase()
+    base.note("@", set(), ["00"], ["0"])
+    assert base.in_hex(["0A"], ["10"]) and base.in_hex(["10"], ["16"])
+    # a miscount stays one, in either form; the same bytes are no difference
+    assert not base.in_hex(["0B"], ["10"]) and not base.in_hex(["10"], ["10"])
+    assert not base.in_hex(["11"], ["10"])
+
+
+def test_the_hex_base_is_the_first_index_read_as_hex():
+    base = IndexBase()
+    base.note("@", set(), ["1A"], ["3"])          # 26 read as hex: 23 ahead
+    assert base.offset is None and base.hex_offset == 23
+    assert base.in_hex(["2A"], ["19"]) and not base.in_hex(["2A"], ["20"])

@@ -65,6 +65,10 @@ def test_the_index_off_by_the_queries_is_the_counting_rule():
     assert label("@", "data", set(), {"@", "L"}, 0) == "8.index.counts"
 
 
+def test_the_index_written_in_hex_is_its_form_rule():
+    assert label("@", "data", {"index-hex"}, {"V"}, 0) == "8.index.decimal"
+
+
 def test_the_firmware_string_is_the_version_rule():
     assert label("?", "data", set(), set(), 0) == "1.profile.version"
 
@@ -264,6 +268,8 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "7.packet.open-until-end": ("7.packet.bad-checksum-member.corrupted-end",
                                 ("*E", "code", {"in-packet"}, {"*S", "C"}, 0, 2)),
     "8.index.counts": ("8.index.counts-every-frame", ("@", "data", set(), {"V"}, 0, 0)),
+    # the index written in hex, read so the reference's
+    "8.index.decimal": ("10.commands.formats", ("@", "data", {"index-hex"}, {"V"}, 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
                                   ("@", "data", {"queries-counted"}, {"@"}, 0, 0)),
     "8.repeat.answer": ("8.repeat.last-frame-and-answer", (">", "data", set(), {"T"}, 0, 0)),

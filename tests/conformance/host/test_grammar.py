@@ -127,3 +127,16 @@ def test_a_host_s_hostile_field_is_a_problem_of_its_frame_shown_escaped(raw):
     problems = parse_frame(raw, GVE84, False).problems
     assert problems and all(p.rule for p in problems)
     assert not any(ch in p.what for p in problems for ch in "\x1b\x07")
+
+
+def test_a_frame_summed_after_a_restart_turned_the_mode_off_names_that_cause():
+    from conformance.host.grammar import LineGrammar
+    grammar = LineGrammar(GVE84)
+    f = grammar.parse(b"!0@,BD", False, lapsed=True)
+    assert [p.rule for p in f.problems] == ["6.checksum.off-after-reset"]
+    assert f.command == "@" and not f.params
+    # without a restart behind it the same frame is read as the unit reads it
+    assert "3.params.none-expected" in rules(b"!0@,BD")
+    # a last field that is no sum of the frame is a parameter still
+    assert "6.checksum.off-after-reset" not in [
+        p.rule for p in grammar.parse(b"!0SW2,00", False, lapsed=True).problems]

@@ -70,3 +70,22 @@ def test_the_bug_fails(certified, bug):
     print(f"{bug}: {result['verdict']} in {scenario} by {', '.join(sorted(rules))}")
     assert status == 1
     assert result["verdict"] == "FAIL" and rule in rules
+
+
+def test_a_host_sending_a_setting_again_after_a_damaged_answer_passes(tmp_path):
+    # "Většina příkazů se dá zopakovat (A,V,PF atd..)": the resend trusts nothing, the
+    # unit is left as one run leaves it; the host that took the damaged answer still FAILs
+    # (ignore-answer-checksums above)
+    command = [sys.executable, "-m", "gve_host", "{port}", "--job", TINY, "--checksums",
+               "--resend-repeatable"]
+    status, results = certify(tmp_path, "GVE84-100", command=command,
+                              scenarios=("corrupt-answer.setting", "lost-answer.setting",
+                                         "corrupt-answer.vector"))
+    print({r["scenario"]: (r["verdict"], sorted(failing_rules(r))) for r in results})
+    assert status == 0
+    assert all(r["verdict"] == "PASS" for r in results)
+    # it did send the setting again, not `@` first
+    log = next(r for r in results if r["scenario"] == "corrupt-answer.setting")["wire_log"]
+    sent = [line.split(" ", 2)[2] for line in log if line.split(" ")[1] in (">", "=")]
+    damaged = next(i for i, line in enumerate(sent) if line.startswith("fault"))
+    assert sent[damaged + 1] == sent[damaged - 1] and "@" not in sent[damaged + 1]

@@ -64,3 +64,12 @@ def test_the_interrupt_input_the_host_enabled():
     assert booked(w).interrupt_input() == (1, 2, 0)
     w.frame(b"!0SW0,08", 20)                           # bit 3: no input behind it
     assert booked(w).interrupt_input() is None
+
+
+def test_a_restart_in_checksum_mode_leaves_the_mode_lapsed_until_the_host_sets_it():
+    view = UnitView(PROFILE, 0)
+    view.checksums = True
+    view.power_on(0)
+    assert not view.checksums and view.lapsed
+    view.power_on(0)                  # off already: nothing lapses a second time
+    assert not view.lapsed

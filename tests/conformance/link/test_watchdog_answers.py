@@ -78,3 +78,31 @@ def test_a_second_answer_to_a_complete_frame_still_fails():
     ln.settle()
     assert [(v.rule, v.always) for v in ln.violations] == [(TWICE, True)]
     assert "answered twice" in ln.violations[0].text
+
+
+def test_a_watchdog_s_answer_read_while_it_arrives_is_read_whole():
+    # the packet's watchdog writes `2,1` at 0.5 s; a wait that ends while its bytes are
+    # on their way takes the rest of the line too: never its tail as the next answer
+    for us in range(0, 1200, 20):
+        ln = _link("packet-watchdog")
+        ln.send("*S", answer=False)
+        ln.send("C10,0,0", answer=False)
+        got = ln.wait(0.5 + us / 1e6)
+        assert got in (b"", b"2,1\r"), us
+        if got:
+            r = ln.send("SR6")
+            assert r is not None and r.raw == b"0,00\r" and ln.violations == [], (us, r)
+
+
+def test_an_answer_that_began_before_its_timeout_is_read_to_its_end():
+    port = _Line([b"2", b",1,BB\r"])            # the timeout ran out after its first byte
+    ln = real_link(port)
+    r = ln.send("*E1", timeout=0.1)
+    assert r is not None and r.raw == b"2,1,BB\r" and ln.violations == [] and ln.late == []
+
+
+def test_an_answer_that_began_in_time_is_not_noted_late():
+    port = _Line([b"0,1", b"2\r"])               # the timeout ran out after three bytes
+    ln = real_link(port)
+    r = ln.send("SR6")
+    assert r is not None and r.raw == b"0,12\r" and ln.late == [] and ln.violations == []
