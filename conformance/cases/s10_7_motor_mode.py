@@ -179,3 +179,26 @@ def with_motion_commands(ctx: CaseContext) -> None:
         setup(ctx, "L" + vector(ctx, *back))
         _rest(ctx)
         setup(ctx, "N")
+
+
+@case("10.7.microstep.current-apart", requires=("M",), rules=("10.7.motor.modes",))
+def current_apart(ctx: CaseContext) -> None:
+    """The current (MU, MD) and the step division (M2..MF) are two settings: a current set
+    after a mode leaves the mode, and a step goes its factor of sixteenths."""
+    ms = ctx.profile.microstep
+    for mode, factor in ms.factors.items():
+        if mode == ms.reset_mode:
+            continue
+        for current in ms.currents:
+            start = _settled(ctx, f"M{mode}, M{current}")
+            setup(ctx, f"M{mode}")
+            setup(ctx, f"M{current}")
+            setup(ctx, "L" + vector(ctx, *MODE_MOVE))
+            got = _settled(ctx, f"M{mode}, M{current}")
+            want = [s + factor * d for s, d in zip(start, MODE_MOVE, strict=True)]
+            ctx.expect(got == want, f"M{mode} then M{current}: a step is still {factor} "
+                       "sixteenths", observed=got, expected=want, rule="10.7.motor.modes")
+            setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
+    _rest(ctx)
+    setup(ctx, f"M{ms.reset_mode}")
+    setup(ctx, f"M{ms.reset_current}")

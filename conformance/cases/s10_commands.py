@@ -20,6 +20,7 @@ from conformance.cases._kit import (
     code,
     code_text,
     configured,
+    halted_with_queue,
     measured_case,
     position,
     setup,
@@ -191,6 +192,26 @@ def output(ctx: CaseContext) -> None:
     seen = link.rig.outputs()
     ctx.expect(seen == 0xFB, "the refused frames changed nothing", observed=seen,
                expected=0xFB)
+    answers(ctx, link.send("O0,FF"), "0", "O0,FF: all off")
+
+
+@case("10.cmd.output.while-busy", rig=True, rules=("10.cmd.output",))
+def output_while_busy(ctx: CaseContext) -> None:
+    """O sets the outputs when it is answered, whatever the motion: while a vector runs
+    and while halted vectors are held (nothing in the manuals defers it)."""
+    configured(ctx, "outputs-by-host")
+    link = ctx.link
+    halted_with_queue(ctx, vectors=2, steps=200)
+    code(ctx, link.send("O0,FB"), ErrorCode.OK, "O0,FB while halted vectors are held")
+    seen = link.rig.outputs()
+    ctx.expect(seen == 0xFB, "the outputs are FB while halted vectors are held",
+               observed=seen, expected=0xFB)
+    setup(ctx, "G")
+    answers(ctx, link.send("O0,F7"), "0", "O0,F7 while the vectors run")
+    seen = link.rig.outputs()
+    ctx.expect(seen == 0xF7, "the outputs are F7 while the vectors run", observed=seen,
+               expected=0xF7)
+    link.poll("L0,0,0", lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
     answers(ctx, link.send("O0,FF"), "0", "O0,FF: all off")
 
 

@@ -32,6 +32,12 @@ def address_7(ctx: CaseContext) -> None:
     ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
     code(ctx, link.send("L1,0,0", address=7), ErrorCode.UNKNOWN, "address 7 takes no vectors",
          rule="12.spindle.commands")
+    # and serves the EEPROM's reads as address 0 does (its commands, spec 12)
+    if "ER" in ctx.profile.spindle.commands:
+        here, there = link.send("ER10"), link.send("ER10", address=7)
+        ctx.expect(there is not None and here is not None and there.ok
+                   and there.values == here.values, "!7ER10 answers as !0ER10",
+                   observed=show(there), expected=show(here), rule="12.spindle.commands")
 
 
 @case("12.spindle.measured.feed-unchanged", timing=True,

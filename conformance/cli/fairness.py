@@ -9,9 +9,9 @@ its rule; the score is fair readings / readings, and CI fails below 100 %.
 A reading alone is tried on one profile per family among those the rules it reads apply
 to (a packet's reading on the GVE84 and GVE114, which have packets): elsewhere it changes
 nothing (:func:`trial_profiles`). diff runs on those profiles (all at once too: the
-catalogue covers every profile), its budget its probes and DIFF_DRAWN drawn sequences from
-seed DIFF_SEED (:func:`diff_budget`): the same sequences on every run, a few seconds a
-profile."""
+catalogue covers every profile), its budget its written sequences (probes, the tables'
+sweep, the matrix's cells) and DIFF_DRAWN drawn ones from seed DIFF_SEED
+(:func:`diff_budget`): the same sequences on every run, a few seconds a profile."""
 
 from __future__ import annotations
 
@@ -97,16 +97,18 @@ def trial_profiles(rules: tuple[str, ...], profiles: list[str]) -> list[str]:
             if any(known[r].applies_to(p, load_profile(p).family) for r in rules)]
 
 
-def diff_budget(drawn_probes: int) -> int:
-    """Sequences diff runs on a profile: its probes and DIFF_DRAWN drawn ones."""
-    return drawn_probes + DIFF_DRAWN
+def diff_budget(written: int) -> int:
+    """Sequences diff runs on a profile: the written ones (its probes, the tables' sweep,
+    the matrix's cells) and DIFF_DRAWN drawn ones."""
+    return written + DIFF_DRAWN
 
 
 def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
     """`diff` of the emulator taking ``readings`` against the reference on ``profile``:
     the probes, then DIFF_DRAWN drawn sequences; its findings go to ``result``."""
     from conformance.diff.engine import Budget, Pair, search
-    from conformance.diff.grammar import Options, probes
+    from conformance.diff.grammar import Grammar, Options
+    from conformance.diff.matrix import cells
     from conformance.diff.sides import Side
     from conformance.link.safety import TargetNotResponding
     from conformance.targets import SessionError, parse_target
@@ -114,7 +116,10 @@ def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
                           allow_destructive=True)
     reference = parse_target(f"emu:{profile}")
     options = Options(destructive=True, rig=target.info.has_rig and reference.info.has_rig)
-    budget = Budget(examples=diff_budget(len(probes(target.profile, options))))
+    grammar = Grammar(target.profile, options)
+    written = (len(grammar.probes()) + len(grammar.sweep())
+               + sum(1 for c in cells(target.profile, options) if c.steps))
+    budget = Budget(examples=diff_budget(written))
     pair = Pair(Side(target), Side(reference), target.profile)
     where = f"diff [{profile}]"
     try:

@@ -23,14 +23,17 @@ from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options, load_grammar
 from conformance.diff.index import QUERIES, IndexBase
 from conformance.diff.labels import allowed, command_of, label, verdict_of
+from conformance.diff.matrix import Cell, cells
 from conformance.diff.reach import Reach
+from conformance.diff.rigstate import observed, response
 from conformance.diff.sides import RoundTrip, Side
-from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step, frames_in
+from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
+from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
@@ -167,8 +170,15 @@ class Pair:
                     out.records.append(StepRecord(step, place=place))
                 elif step.kind == INPUT:
                     self._input(step, place, out, earlier)
+                elif step.kind == STATE:
+                    if self._rig_state(step, place, out, earlier):
+                        break
                 elif self._frames(step, place, out, earlier):
                     break
+            else:
+                # what the rig sees at the end, whatever the sequence's last read was
+                if not out.ended:
+                    self._rig_state(Step(STATE), len(steps), out, earlier)
             if self._teller is not None:
                 self._teller.finish()
         except BaseException:
@@ -228,6 +238,31 @@ class Pair:
             earlier.add("input")
             if self.reach is not None:
                 self.reach.took(step, None)
+
+    def _rig_state(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:
+        """What the rigs see of both sides (outputs, spindle, where the axes are),
+        compared as answers are (rigstate.py); True when they disagree (the example ends
+        there). Left out where a side has no rig, or its rig does not say."""
+        if not (self.target.has_rig and self.reference.has_rig):
+            return False
+        if self._teller is not None:
+            self._teller.finish()          # the frames told ahead are all taken first
+        self.timing.align()
+        seen = self.target.rig_state()
+        known = self.reference.rig_state() if seen is not None else None
+        if known is None:
+            return False
+        for labelled, compared, a, b in observed(seen, known):
+            rec = StepRecord(step, place=place)
+            rec.target = RoundTrip(labelled.encode(), a, 0, 0, response(a))
+            rec.reference = RoundTrip(labelled.encode(), b, 0, 0, response(b))
+            kind = self._difference(compared, rec)
+            if kind is not None:
+                out.records.append(rec)
+                out.disagreement = self._disagreement(step, labelled, kind, out, earlier)
+                return True
+        out.records.append(StepRecord(step, place=place))
+        return False
 
     def _frames(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:
         """A frame (a fill: until the queue is full) to both sides; True when the example
@@ -439,12 +474,16 @@ class Pair:
         g = load_grammar()["command"]
         name = command_of(step.body)
         entry = g.get(name, g.get(name + "0", {}))
+        spindle = self.profile.spindle
+        to_spindle = spindle is not None and step.address == spindle.address
         flags = {
-            "other-address": step.address is not None,
+            "other-address": step.address is not None and not to_spindle,
+            "to-spindle": to_spindle,
             "stalled": step.stall is not None,
             "lower": _has_lower(step.body[:len(name)] if name else step.body),
             "lower-param": bool(name) and _has_lower(step.body[len(name):]),
-            "plus": name != "%" and "+" in step.body[len(name):],
+            # the parameters after the wire name (SW6's is SW: `SW+6,00` has a plus)
+            "plus": name != "%" and "+" in parse(step.body).params,
             "bad-checksum": step.checksum == "bad" and self.target.link.checksums,
             "no-checksum": step.checksum == "none" and self.target.link.checksums,
             "in-packet": in_packet,
@@ -818,15 +857,24 @@ def search(pair: Pair, options: Options, budget: Budget, *, seed: int = 0,
 def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int,
           with_probes: bool) -> list[Finding]:
     grammar = Grammar(pair.profile, options)
-    # the probes, then every table value once (the tables' sweep)
+    # the probes, then every table value once (the tables' sweep), then the matrix's cells
+    matrix = cells(pair.profile, options) if with_probes else []
+    runnable = [c for c in matrix if not c.left_out]
     written = ([steps for _, steps in grammar.probes()] + grammar.sweep()) if with_probes \
         else []
-    for steps in written:
+    ran: list[Cell] = []
+    for steps, cell in [(s, None) for s in written] + [(list(c.steps), c) for c in runnable]:
         if not hunt.more():
-            return hunt.findings
+            break
         found = hunt.trial(steps)
+        if cell is not None:
+            ran.append(cell)
         if found is not None:
             hunt.keep(found, written=True)
+    if pair.reach is not None and matrix:
+        pair.reach.matrix(matrix, ran)
+    if not hunt.more():
+        return hunt.findings
     strategy = grammar.sequences()
     rounds = 0
     while hunt.more():

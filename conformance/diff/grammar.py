@@ -13,7 +13,7 @@ from pathlib import Path
 from hypothesis import strategies as st
 
 from conformance.diff.labels import command_of
-from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from gve_fixtures.profile import Profile
 
@@ -272,7 +272,8 @@ class Grammar:
 
     def _can(self, idiom: list[str]) -> bool:
         """Whether every step of an idiom can be sent on this profile and run."""
-        allowed = set(self.names) | {"SW6"}
+        allowed = set(self.names) | {"SW6"} | {
+            n for n, c in commands().items() if c.known_as in self.names}
         for f in idiom:
             if f.startswith("input "):
                 if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
@@ -282,6 +283,9 @@ class Grammar:
                     return False
             elif f.startswith("wait "):
                 continue
+            elif f == "state":
+                if not self.options.rig:
+                    return False
             elif (command_of(_PREFIX.sub("", f)) not in allowed
                   or (f.startswith("spindle:") and self.profile.spindle is None)):
                 return False
@@ -524,7 +528,7 @@ class Grammar:
         return out + (self.reads(draw) if self.number(draw, 0, 1) else [])
 
     def idiom(self, lines: list[str] | tuple[str, ...]) -> list[Step]:
-        """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`,
+        """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`, `state`,
         `fill N BODY`, `bad:BODY` (a wrong checksum in checksum mode), `stalled:BODY` (a
         pause longer than the watchdog after its second byte), `other:BODY` (to another
         address), `spindle:BODY` (to the GVE114's spindle address), else a frame; `J` is
@@ -534,6 +538,8 @@ class Grammar:
             word, _, rest = f.partition(" ")
             if word == "wait":
                 out.append(Step(WAIT, seconds=float(rest)))
+            elif f == "state":
+                out.append(Step(STATE))
             elif word == "input":
                 port, value = rest.split()
                 out.append(Step(INPUT, port=int(port), value=int(value, 16)))

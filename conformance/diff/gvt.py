@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 
 from conformance.diff.engine import Finding, StepRecord
-from conformance.diff.steps import FILL, FRAME, INPUT, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step
 from conformance.link.framing import HostFramer, readable
 from conformance.reports.files import write_text
 from gve_fixtures.transcript import (
@@ -75,6 +75,15 @@ def _lines(rec: StepRecord, disagreeing: bool, rule: str | None, verdict: str) -
         return [Record(ACTION, f"wait {step.seconds:g}".encode())]
     if step.kind == INPUT:
         return [Record(ACTION, f"input {step.port} {step.value:02X}".encode())]
+    if step.kind == STATE:
+        note = ""
+        if rec.target is not None and rec.reference is not None:
+            what = rec.target.sent.decode("ascii", "replace").partition(":")[2]
+            note = (f"{what}: reference {readable(rec.reference.answer)}, target "
+                    f"{readable(rec.target.answer)}")
+            if disagreeing:
+                note = f"[{verdict} {rule or 'no known rule'}] {note}"
+        return [Record(ACTION, b"state", comment=note)]
     out: list[Record] = []
     sent = rec.target.sent
     if step.stall is not None:
@@ -174,7 +183,8 @@ def _fill(words: list[str]) -> Step:
 
 
 #: the actions a replay performs (the others, e.g. a log's `= fault`, are notes)
-_ACTIONS = {"wait": _wait, "input": _input, "fill": _fill}
+_ACTIONS = {"wait": _wait, "input": _input, "fill": _fill,
+            "state": lambda words: Step(STATE)}
 
 
 def _action(words: list[str]) -> Step:

@@ -71,6 +71,15 @@ class Reach:
                 self.values[v] = False
         self._state_list = [s for s in _states(g) if s.reachable(profile, names)]
         self.states = {s.name: False for s in self._state_list}
+        #: the matrix's cells that apply to the model (matrix.py), each True once it ran
+        self.cells: dict[str, bool] = {}
+
+    def matrix(self, every: list, ran: list) -> None:
+        """The matrix's cells (matrix.Cell): those the model has, and those that ran; a
+        cell left out for this run (no rig, no --allow-destructive) is one not reached."""
+        done = {c.name for c in ran}
+        self.cells = {c.name + (f" ({c.left_out})" if c.left_out else ""): c.name in done
+                      for c in every if not c.meaningless}
 
     def _profile_tables(self, options: Options) -> dict[str, list[str]]:
         """The values the profile's own tables list (not a command's range)."""
@@ -138,7 +147,9 @@ class Reach:
     def figures(self) -> dict[str, Figure]:
         out = {}
         for kind, table in (("commands", self.commands), ("table values", self.values),
-                            ("states", self.states)):
+                            ("states", self.states), ("matrix cells", self.cells)):
+            if kind == "matrix cells" and not table:
+                continue
             out[kind] = Figure(sum(table.values()), len(table),
                                [k for k, ok in table.items() if not ok])
         return out

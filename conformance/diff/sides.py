@@ -148,6 +148,15 @@ class Side:
             return False
         return True
 
+    def rig_state(self) -> dict | None:
+        """What the rig sees of the unit now (docs/rig.md `state`); None (and the rig
+        lost) when it does not say."""
+        try:
+            return self.link.rig.state()
+        except CouldNotTest as err:
+            self.rig_lost = str(err)
+            return None
+
     def close_example(self) -> None:
         """Take what is still on its way (an answer after the last frame); on a real unit
         put back the EEPROM bytes the example wrote, as after a case (the reference of the

@@ -87,7 +87,10 @@ def cmd_output(dev: Device, ses: Session, p: str, t: int) -> Reply:
     port, byte = fields(p, (2,))
     port_n, value = dec(port), hexa(byte)
     within(port_n, 0, 0)
-    dev.state.outputs = within(value, 0, 0xFF)
+    within(value, 0, 0xFF)
+    if dev.mutant.active("output-ignored-while-busy") and dev.motion.queued(t):
+        return []
+    dev.state.outputs = value
     return []
 
 

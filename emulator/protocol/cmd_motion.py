@@ -136,7 +136,10 @@ def cmd_xm(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 def positions(count: int) -> Handler:
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
-        return [str(x) for x in dev.positions(t)[:count]]
+        here = dev.positions(t)
+        if count < 3 and dev.mutant.active("short-read-ignores-microstep"):
+            here = tuple(int(x / dev.factor()) for x in here)
+        return [str(x) for x in here[:count]]
     handler.__name__ = f"cmd_positions_{count}"
     return handler
 
@@ -304,6 +307,8 @@ def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_while_moving(t)
     if p in ms.currents:
         dev.state.current = p
+        if dev.mutant.active("current-resets-mode"):
+            dev.state.microstep = ms.reset_mode
     else:
         dev.state.microstep = p
     return []

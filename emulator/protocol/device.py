@@ -324,7 +324,10 @@ class Device:
         if not (self.state.inta and self.readings.active("cause-first-only")):
             s[4] |= hit1
             s[5] |= hit2
+        inta = self.state.inta
         self.stop(t)
+        if not inta and act("input-stop-drops-queue"):
+            self.later(self.motion.halt(t), self.motion.clear)
 
     def after_clearing(self, t: int) -> None:
         """D, K, R cleared the cause bits or INTA: an input still active sets them again."""

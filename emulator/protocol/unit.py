@@ -80,6 +80,9 @@ class Unit:
         self.tables: dict[int, dict[str, Command]] = {self.address: main_table(profile)}
         if profile.spindle is not None and self.address == 0:
             self.tables[profile.spindle.address] = spindle_table(profile)
+            if self.mutant.active("spindle-refuses-eeprom"):
+                for name in ("ER", "EW"):
+                    self.tables[profile.spindle.address].pop(name, None)
         self.addresses = frozenset(self.tables)
         wd = profile.watchdog_ms if watchdog_ms is None else watchdog_ms
         if watchdog_ms is None and self.readings.active("half-second-watchdog"):

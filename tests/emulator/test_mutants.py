@@ -103,6 +103,11 @@ PROBES: dict[str, tuple[str, str]] = {
     "baud-range-ignored": ("p21-rate-read-at-power-on", "GVE114-500"),
     "baud-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-200"),
     "baud-range-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-50"),
+    "output-ignored-while-busy": ("p22-output-while-busy", "GVE84-100"),
+    "spindle-refuses-eeprom": ("p23-spindle-eeprom", "GVE114-500"),
+    "short-read-ignores-microstep": ("p24-short-read-in-sixteenths", "GVE54"),
+    "current-resets-mode": ("p25-current-apart-from-mode", "GVE54"),
+    "input-stop-drops-queue": ("p26-input-stop-holds-queue", "GVE84-100"),
 }
 
 

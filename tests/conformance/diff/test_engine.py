@@ -40,7 +40,9 @@ PROFILE = {"position-ignores-microstep": "GVE54", "microstep-rates-unscaled": "G
            "spindle-sets-feed-rate": "GVE114-500", "microstep-refused-stored": "GVE54",
            "spindle-refused-stored": "GVE114-500", "a-axis-alone-ignored": "GVE114-500",
            "microstep-continuous-unscaled": "GVE54",
-           "mpg-enable-high-values-ignored": "GVE114-500", "spindle-low-end-off": "GVE114-500"}
+           "mpg-enable-high-values-ignored": "GVE114-500", "spindle-low-end-off": "GVE114-500",
+           "spindle-refuses-eeprom": "GVE114-500", "short-read-ignores-microstep": "GVE54",
+           "current-resets-mode": "GVE54"}
 EVERYTHING = Options(destructive=True, rig=True)
 #: mutants whose deviation no frame's answer carries: diff compares what the wire carries
 #: (and sets a rig's inputs, reading nothing of it), so no probe can name them; the

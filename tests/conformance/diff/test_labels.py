@@ -284,6 +284,15 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "9.reset.mpg": ("9.reset.mpg-enabled", ("L", "code", set(), {"EW", "Y"}, 0, 7, "GVE114")),
     # RUN read right after a vector alone: the unit did not run it
     "10.cmd.vector": ("10.cmd.positions.each-axis", ("SR", "data", set(), {"L"}, 0, 0)),
+    # what the rig sees: the outputs an O set, the spindle !7V set, the axes after N
+    "10.cmd.output": ("10.cmd.output.port", ("state:outputs", "data", set(), {"O"}, 0, 0)),
+    "12.spindle.speed": ("12.spindle.range-ends",
+                         ("state:spindle", "data", set(), {"spindle"}, 0, 0)),
+    "10.cmd.zero": ("10.commands.zero-axis",
+                    ("state:physical", "position", set(), {"L", "N"}, 0, 0)),
+    # a command the spindle's address serves, refused there
+    "12.spindle.commands": ("12.spindle.address-7",
+                            ("ER", "code", {"to-spindle"}, set(), 0, 3, "GVE114")),
     # W answered before its run ended
     "10.cmd.reference": ("10.cmd.reference.answers-after-travel",
                          ("W", "timing", set(), set(), 0, 0)),

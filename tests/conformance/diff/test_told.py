@@ -150,8 +150,9 @@ def test_frames_told_ahead_take_fewer_exchanges(pairs, monkeypatch):
         pair.run(steps)
     finally:
         pair.ahead = True
-    assert sent == ["tx"] * len(steps)
-    assert told == ["batch"], told
+    # and after the sequence, in both, what the rig sees (rigstate.py)
+    assert sent == ["tx"] * len(steps) + ["state"]
+    assert told == ["batch", "state"], told
 
 
 def test_frames_told_after_a_disagreement_are_sent_and_booked(pairs):
