@@ -21,6 +21,9 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
                  "of the emulator with the catalogue until a case FAILs it."),
     "fairness": ("conformance.cli.fairness", "The fairness score: run the catalogue against "
                  "every reading of what the manuals leave open; no case may FAIL one."),
+    "corpus": ("conformance.cli.corpus", "The independent implementations gate: judge every "
+               "unit and host of corpus/ (written from one manual alone) as a user would; "
+               "every FAIL must be a documented departure."),
 }
 
 

@@ -1,0 +1,256 @@
+"""`gve-conformance corpus`: the independent implementations gate — the catalogue and
+`diff` against every unit of `corpus/` (simulators written from one manual alone by
+people who never saw this project), and host certification of every host program there,
+each run as a user runs it (the CLI, an `exec:` target, a results.json). An
+implementation is fair when every FAIL it gets is one of its documented departures from
+the manual (`corpus/corpus.toml`), and the suite keeps its power when every documented
+departure is still FAILed; CI fails otherwise.
+
+Unlike `fairness`, whose readings are the project's own, nobody here wrote these: a FAIL
+outside the documented departures is a defect of the suite (fixed in the suite, never in
+the implementation to please it)."""
+
+from __future__ import annotations
+
+import json
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from conformance.cli.pool import gate_end, workers
+from conformance.cli.progress import Progress
+from conformance.cli.usage import INTERRUPTED, Parser, UsageError, add_loudness, positive, summary
+
+PROG = "gve-conformance corpus"
+#: the corpus's manifest, from a checkout's top
+MANIFEST = Path("corpus") / "corpus.toml"
+#: how the catalogue is graded: a FAIL is a verdict no reading allows, an ERROR a crash
+UNFAIR = ("FAIL", "ERROR")
+#: the verdicts of a case that judged the target
+JUDGED = ("PASS", "FAIL", "NON-STRICT", "INFO")
+
+
+@dataclass(frozen=True)
+class Implementation:
+    """One implementation of the corpus: a unit simulator (`kind` "unit": its command
+    starts it in co-simulation) or a host program (`kind` "host": its command has
+    `{port}`), with the departures from its manual it is known to have (rule -> what it
+    does)."""
+
+    name: str
+    kind: str
+    folder: Path
+    command: str
+    profiles: tuple[str, ...]
+    departures: dict[str, str]
+    written_from: str
+    diff_seconds: float = 0.0
+
+    def argv(self) -> list[str]:
+        """The command's words, `{python}` and `{dir}` filled in."""
+        return [w.replace("{python}", sys.executable).replace("{dir}", str(self.folder))
+                for w in shlex.split(self.command)]
+
+
+@dataclass
+class Trial:
+    """What one implementation got: FAILs outside its departures, departures no longer
+    FAILed, and what each job said."""
+
+    name: str
+    unfair: list[str] = field(default_factory=list)
+    departures_missed: list[str] = field(default_factory=list)
+    said: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def fair(self) -> bool:
+        return not self.unfair and not self.departures_missed
+
+
+def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
+    """The implementations `path` lists (a TOML of `[[implementation]]` tables); raises
+    UsageError with one line for a manifest that is missing or says nonsense."""
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as err:
+        raise UsageError(f"{path}: {err}") from None
+    known = {"name", "kind", "folder", "command", "profiles", "departures", "written-from",
+             "diff-seconds"}
+    out = []
+    for table in data.get("implementation", []):
+        wrong = sorted(set(table) - known)
+        if wrong:
+            raise UsageError(f"{path}: unknown key(s) {', '.join(wrong)} in "
+                             f"{table.get('name', '?')} (known: {', '.join(sorted(known))})")
+        if table.get("kind") not in ("unit", "host"):
+            raise UsageError(f"{path}: {table.get('name', '?')}: kind is unit or host")
+        out.append(Implementation(
+            name=table["name"], kind=table["kind"], folder=path.parent / table["folder"],
+            command=table["command"], profiles=tuple(table["profiles"]),
+            departures=dict(table.get("departures", {})),
+            written_from=table.get("written-from", ""),
+            diff_seconds=float(table.get("diff-seconds", 0.0))))
+    return out
+
+
+def failed_rules(results: dict) -> list[tuple[str, str, list[str]]]:
+    """Each case of a results.json that FAILed or ERRed: (case, verdict, the rules of its
+    failed checks)."""
+    out = []
+    for r in results.get("results", []):
+        if r.get("verdict") in UNFAIR:
+            rules = sorted({c.get("rule") or "(no rule)" for c in r.get("checks", [])
+                            if not c.get("ok")})
+            out.append((f"{r.get('id')} [{r.get('profile')}]", r["verdict"], rules))
+    return out
+
+
+def _job(argv: list[str], folder: Path, timeout: float) -> tuple[dict | None, str]:
+    """Run one CLI job writing its reports under ``folder``: its results.json (None when
+    it wrote none) and the last line it printed."""
+    try:
+        done = subprocess.run(argv, capture_output=True, text=True, timeout=timeout,
+                              stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        return None, f"did not end within {timeout:.0f} s"
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    last = lines[-1] if lines else f"exit {done.returncode}, nothing printed"
+    found = sorted(folder.glob("*/results.json"))
+    if not found:
+        return None, last
+    return json.loads(found[-1].read_text(encoding="utf-8")), last
+
+
+def jobs_of(impl: Implementation, reports: Path, seed: int) -> list[tuple[str, list[str]]]:
+    """The CLI jobs that judge ``impl``: (what, argv)."""
+    cli = [sys.executable, "-m", "conformance"]
+    out = []
+    for profile in impl.profiles:
+        common = ["--profile", profile, "--report-dir", str(reports / f"{profile}-{len(out)}"),
+                  "-q"]
+        if impl.kind == "unit":
+            target = "exec:" + shlex.join(impl.argv())
+            out.append((f"catalogue {profile}",
+                        [*cli, "run", "--target", target, *common, "--yes",
+                         "--allow-destructive"]))
+            if impl.diff_seconds:
+                common = ["--profile", profile,
+                          "--report-dir", str(reports / f"{profile}-{len(out)}"), "-q"]
+                out.append((f"diff {profile}",
+                            [*cli, "diff", "--target", target, *common, "--yes",
+                             "--allow-destructive", "--seconds", str(impl.diff_seconds),
+                             "--seed", str(seed)]))
+        else:
+            out.append((f"host {profile}", [*cli, "host", *common, "--", *impl.argv()]))
+    return out
+
+
+#: what one job gave: (what it was, its results.json or None, the last line it printed)
+Outcome = tuple[str, "dict | None", str]
+
+
+def run_jobs(impl: Implementation, seed: int, timeout: float) -> list[Outcome]:
+    """Every job that judges ``impl``, run as a user runs it."""
+    out = []
+    with tempfile.TemporaryDirectory(prefix="gve-corpus-") as tmp:
+        for what, argv in jobs_of(impl, Path(tmp), seed):
+            folder = Path(argv[argv.index("--report-dir") + 1])
+            out.append((what, *_job(argv, folder, timeout)))
+    return out
+
+
+def grade(impl: Implementation, outcomes: list[Outcome]) -> Trial:
+    """``impl``'s jobs against its departures: a FAIL or ERROR naming a rule outside them
+    is unfair, a departure that no job FAILed is power lost."""
+    result = Trial(impl.name)
+    caught: set[str] = set()
+    for what, results, last in outcomes:
+        if results is None:
+            result.unfair.append(f"{what}: no results ({last})")
+            continue
+        result.said.append(f"{what}: {results.get('verdict')} — {results.get('reason')}")
+        if not any(results.get("counts", {}).get(v) for v in JUDGED):
+            result.unfair.append(f"{what}: nothing judged ({results.get('reason')})")
+        for case, verdict, rules in failed_rules(results):
+            outside = [r for r in rules if r not in impl.departures]
+            caught.update(r for r in rules if r in impl.departures)
+            if outside:
+                result.unfair.append(f"{what}: {verdict} {case}: {', '.join(outside)}")
+    result.departures_missed = [f"departure no longer FAILed: {rule} ({why})"
+                                for rule, why in impl.departures.items() if rule not in caught]
+    return result
+
+
+def trial(impl: Implementation, seed: int, timeout: float) -> Trial:
+    """Every job of ``impl``, graded against its departures."""
+    start = time.perf_counter()
+    result = grade(impl, run_jobs(impl, seed, timeout))
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _trial(args: tuple[Implementation, int, float]) -> Trial:
+    return trial(*args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = Parser(prog=PROG, description=summary(__doc__), examples=(
+        "gve-conformance corpus --jobs 2",
+        "gve-conformance corpus --implementation unit84-a -v"))
+    ap.add_argument("--implementation", action="append", default=[], metavar="NAME",
+                    help="only this implementation (repeatable; default: every one)")
+    ap.add_argument("--manifest", type=Path, default=MANIFEST,
+                    help="the corpus's manifest (default %(default)s)")
+    ap.add_argument("--jobs", "-j", type=positive, default=1,
+                    help="implementations judged in parallel")
+    ap.add_argument("--seed", type=int, default=0, help="diff's seed (default 0)")
+    ap.add_argument("--timeout", type=positive, default=900,
+                    help="seconds one job may take before it counts as unfair (default 900)")
+    add_loudness(ap, "also list what every job said")
+    try:
+        args = ap.parse_args(argv)
+        corpus = load_manifest(args.manifest)
+        names = {i.name for i in corpus}
+        wrong = [n for n in args.implementation if n not in names]
+        if wrong:
+            raise UsageError(f"unknown implementation(s) {', '.join(wrong)} "
+                             f"(known: {', '.join(sorted(names))})")
+    except UsageError as err:
+        print(f"{PROG}: {err}", file=sys.stderr)
+        return 2
+    chosen = [i for i in corpus if not args.implementation or i.name in args.implementation]
+    start = time.perf_counter()
+    trials: list[Trial] = []
+    with workers(args.jobs) as pool, Progress(len(chosen), unit="implementation",
+                                              quiet=args.quiet, verbose=args.verbose,
+                                              every_step=True) as shown:
+        for t in pool.map(_trial, [(i, args.seed, float(args.timeout)) for i in chosen]):
+            trials.append(t)
+            shown.step("\n".join(_lines(t, args.verbose)), routine=t.fair)
+    fair = sum(t.fair for t in trials)
+    unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
+    if gate_end("corpus", unfair, f"{len(trials) - fair} implementation(s)", pool.interrupted,
+                f"{len(trials)} of {len(chosen)} implementations", start):
+        return INTERRUPTED
+    verdict = "PASSED" if fair == len(trials) else "FAILED"
+    print(f"{verdict} — corpus: {fair}/{len(trials)} implementations fair (every FAIL a "
+          f"documented departure, every departure still FAILed) in "
+          f"{time.perf_counter() - start:.1f} s")
+    return 0 if fair == len(trials) else 1
+
+
+def _lines(t: Trial, verbose: bool) -> list[str]:
+    head = "fair  " if t.fair else "UNFAIR"
+    return [f"{head}  {t.name:16} in {t.seconds:.1f} s",
+            *(f"        {line}" for line in (t.said if verbose or not t.fair else [])),
+            *(f"        {line}" for line in t.unfair + t.departures_missed)]
+
+
+if __name__ == "__main__":
+    sys.exit(main())
