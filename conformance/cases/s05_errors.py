@@ -9,6 +9,7 @@ from conformance.cases._kit import (
     answers,
     code,
     fill_queue,
+    finished,
     halted_line,
     halted_with_queue,
     position,
@@ -101,7 +102,7 @@ def refused_not_executed(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 10))
     code(ctx, ctx.link.send("L" + vector(ctx, 20)), ErrorCode.QUEUE_FULL, "L while busy → 1",
          rule="10.1.queue.line-alone")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     r = ctx.link.send("PF")
     ctx.expect(r is not None and r.values[:1] == ["10"], "only the accepted L moved",
                observed=r, expected="0,10,0,0", rule="4.response.failed-not-executed")

@@ -6,7 +6,7 @@ How a vector is stepped: rates, ramps, junctions, dwell and step placement
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import measured_case, position, setup, vector
+from conformance.cases._kit import finished, measured_case, position, setup, vector
 from conformance.motion.probe import Probe
 
 #: a junction with B differing on both sides, each way round: (B before, B after)
@@ -92,7 +92,7 @@ def targets(ctx: CaseContext) -> None:
     moves = [(100, -37, 5), (-250, 40, 0), (3, 3, -3)]
     for m in moves:
         setup(ctx, "C" + vector(ctx, *m))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
+    finished(ctx, 60)
     expected = [sum(m[i] for m in moves) for i in range(3)]
     ctx.expect(position(ctx) == expected, "the sum of the vectors",
                observed=position(ctx), expected=expected, rule="10.1.queue.relative")

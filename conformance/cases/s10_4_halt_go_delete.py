@@ -8,6 +8,7 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    finished,
     halted_with_queue,
     measured_case,
     position,
@@ -77,7 +78,7 @@ def go(ctx: CaseContext) -> None:
     """G resumes the interrupted vector from the exact step: no step lost or gained."""
     halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
+    finished(ctx, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
                observed=position(ctx), expected=[990, 0, 0])
 

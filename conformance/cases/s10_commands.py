@@ -18,6 +18,7 @@ from conformance.cases._kit import (
     answers,
     code,
     configured,
+    finished,
     measured_case,
     position,
     setup,
@@ -44,7 +45,7 @@ def _reads(ctx: CaseContext, expected: list[int], what: str) -> None:
 
 
 def _settle(ctx: CaseContext) -> None:
-    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    r = finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     ctx.require(r is not None and r.ok, "the moves did not end within 30 s")
 
 

@@ -63,6 +63,10 @@ class Course:
     def __init__(self, profile: Profile) -> None:
         self.t_ns = profile.reset.T * 1_000_000
         self.vector_at: int | None = None
+        #: when the reference took an `L0,0,0`, and the longest T dwell a reader may give
+        #: it (a normal vector to a reader of "program považuje za normální vektor")
+        self.zero_at: int | None = None
+        self.longest_t_ns = profile.range("T").hi * 1_000_000
         self.top = profile.max_rate
         self.speed = profile.reset.V
         self.override = max(100, profile.reset.XM) / 100
@@ -126,6 +130,8 @@ class Course:
             self.in_packet = False
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
+        if command == "L" and _ZERO_VECTOR.fullmatch(body.upper()) and reference.code == 0:
+            self.zero_at = reference.sent_at
         if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
@@ -173,6 +179,12 @@ class Course:
     # -- what a difference reads ---------------------------------------------------------
     def within_dwell(self, t: int) -> bool:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
+
+    def after_zero_vector(self, t: int) -> bool:
+        """Whether ``t`` is within the longest T dwell after an `L0,0,0` the reference
+        took (what a unit holding RUN for that dwell does differently then is
+        10.2.motion.zero-length's [D])."""
+        return self.zero_at is not None and t - self.zero_at < self.longest_t_ns
 
     @property
     def rate(self) -> int:

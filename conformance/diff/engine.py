@@ -277,6 +277,8 @@ class Pair:
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+        if self.course.after_zero_vector(rec.reference.sent_at):
+            context.add("after-zero-vector")
         if kind == "position" and self.course.beyond_reach(_values(rec.target)):
             context.add("beyond-reach")
         if self.course.capped_elsewhere:
