@@ -163,6 +163,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # what a vector with no motion holds: RUN within the T dwell after L0,0,0
     "10.2.motion.zero-length": ("10.2.measured.zero-length-c",
                                 ("F", "data", {"after-zero-vector", "st6-run"}, {"L"}, 0, 0)),
+    # R refused as busy while halted vectors hold RUN: taken after H by the reference
+    "5.moving.after-halt": ("5.errors.n-while-run",
+                            ("R", "code", set(), {"H", "K", "L"}, 0, 7)),
     "10.2.motion.dwell": ("10.2.measured.dwell",
                           ("PF", "position", {"in-dwell"}, {"L"}, 0, 0)),
     "10.2.motion.junction": ("10.2.measured.junction",
