@@ -143,11 +143,16 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                      "GVE54: M, like N, is refused with 7 whenever RUN = 1, "
                                      "also while halted vectors hold it after H (\"Nelze "
                                      "použít za chodu\" read as RUN = 1)"),
+    "reversal-brakes-to-rest": (("10.2.motion.junction-reversal",),
+                                "a C whose next C reverses an axis brakes to rest at their "
+                                "junction, not to B (\"U pokračujícího vektoru se nesmí "
+                                "příliš změnit úhel\": a reversal is no continuation)"),
 }.items()}
 
 #: readings whose behaviour lives in the stepper core
 CORE_READINGS: dict[str, Deviation] = {
     "next-vectors-B": Deviation.NEXT_BRAKE,
+    "reversal-brakes-to-rest": Deviation.REVERSAL_STOPS,
 }
 
 

@@ -38,9 +38,13 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     "10.2.measured.no-dwell-continuous": (
         ("10.2.motion.no-dwell-continuous",), (), (),
         ["T24", "A10000", "V2000", "C100,0,0", "C100,0,0", 0.12]),
-    # the junction: a C followed by a C exits at B (10.2)
+    # the junction: a C followed by a C going on the same way exits at B (10.2)
     "10.2.measured.junction": (
         ("10.2.motion.junction",), (), (),
+        ["A5", "B500", "V2000", "C700,0,0", "C700,0,0", 1.2]),
+    # a C followed by a C reversing its axis: at B as well, our reading [D] (10.2)
+    "10.2.measured.junction-reversal": (
+        ("10.2.motion.junction-reversal",), (), (),
         ["A5", "B500", "V2000", "C700,0,0", "C-700,0,0", 1.2]),
     # the exit rate lets the next vector still stop within its length (10.2)
     "10.2.measured.junction-cap": (

@@ -72,6 +72,10 @@ class Course:
         self.override = max(100, profile.reset.XM) / 100
         self.up = 1.0
         self.queued: str | None = None
+        #: a C queued right after a C reversing an axis (a junction where braking to 0 is
+        #: a reading, 10.2.motion.junction-reversal): everything after it is timed by it
+        self.reversal = False
+        self._last_c: list[int] | None = None
         self.in_packet = False
         self.factors = dict(profile.microstep.factors) if profile.microstep else {}
         self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
@@ -145,6 +149,11 @@ class Course:
         if command in _EMPTIES:      # D and K alike, as the timing takes them
             self.queued = None
         elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
+            steps = _numbers(body[1:]) if command == "C" else None
+            if steps and self.queued in ("C", "C+C") and self._last_c and any(
+                    a * b < 0 for a, b in zip(self._last_c, steps, strict=False)):
+                self.reversal = True
+            self._last_c = steps
             self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
 
     def _ceiling(self, command: str, body: str) -> None:

@@ -279,6 +279,8 @@ class Pair:
             context.add("in-dwell")
         if self.course.after_zero_vector(rec.reference.sent_at):
             context.add("after-zero-vector")
+        if self.course.reversal:
+            context.add("reversal")
         if kind == "position" and self.course.beyond_reach(_values(rec.target)):
             context.add("beyond-reach")
         if self.course.capped_elsewhere:

@@ -84,6 +84,11 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # a halted L holds RUN: R refused, where the clean unit restores an empty save
     "restore-refused-while-run": ([b"!0L1000,0,0\r", 0.01, b"!0H\r", b"!0R\r"],
                                   b"0\r8\r0\r", b"0\r8\rF\r"),
+    # C700 then C-700 at A5, B500: 0.7 s on the reversal is passed at B500 (back at 677)
+    # or braked to rest there (still at 694)
+    "reversal-brakes-to-rest": ([b"!0A5\r", 0.001, b"!0B500\r", 0.001, b"!0V2000\r", 0.001,
+                                 b"!0C700,0,0\r", 0.001, b"!0C-700,0,0\r", 0.7, b"!0PF\r"],
+                                b"0\r" * 5 + b"0,677,0,0\r", b"0\r" * 5 + b"0,694,0,0\r"),
     # 50 ms into L100 at the reset's A20 the X counter shows one step less
     "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
                             b"0\r0,23,0,0\r"),

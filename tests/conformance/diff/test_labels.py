@@ -166,6 +166,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # R refused as busy while halted vectors hold RUN: taken after H by the reference
     "5.moving.after-halt": ("5.errors.n-while-run",
                             ("R", "code", set(), {"H", "K", "L"}, 0, 7)),
+    "10.2.motion.junction-reversal": ("10.2.measured.junction-reversal",
+                                      ("PF", "position", {"reversal"}, {"C", "junction"},
+                                       0, 0)),
     "10.2.motion.dwell": ("10.2.measured.dwell",
                           ("PF", "position", {"in-dwell"}, {"L"}, 0, 0)),
     "10.2.motion.junction": ("10.2.measured.junction",
