@@ -106,3 +106,39 @@ def test_diff_runs_its_budget_through_a_session_taking_a_reading(reading):
     assert all(verdict in (NON_STRICT, INFO) and rule in READINGS[reading].rules
                for rule, verdict in graded), graded
     assert pair.target.session.failures == []
+
+
+def test_a_known_state_not_had_on_a_cosimulator_leaves_that_sequence_untested(monkeypatch):
+    """Where the known state cannot be had before a sequence, that sequence is not tested
+    and a co-simulator is powered on through its rig: the search goes on to its budget."""
+    from conformance.targets.rig import ControlRig
+    from conformance.targets.session import RealSession, StepFailed
+    known_state, calls, powered = RealSession._known_state, [], []
+
+    def once_lost(self, link, tell=()):
+        calls.append(1)
+        if len(calls) == 3:
+            raise StepFailed("the unit is not at rest after the known state: SR6 reads "
+                             "8,D0 (RUN, INTA)")
+        return known_state(self, link, tell)
+    power_on = ControlRig.power_on
+
+    def counted(self, address=None):
+        powered.append(1)
+        return power_on(self, address)
+    monkeypatch.setattr(RealSession, "_known_state", once_lost)
+    monkeypatch.setattr(ControlRig, "power_on", counted)
+    target = cosim_target("GVE84-100", [])
+    pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                target.profile)
+    try:
+        budget = Budget(examples=12)
+        found = search(pair, Options(destructive=True, rig=True), budget, with_probes=False)
+    finally:
+        pair.target.session.finish()
+        pair.target.target.close()
+    assert budget.used == 12 and pair.lost == "" and found == []
+    assert powered == [1]
+    assert pair.untested == ["the known state could not be had: the unit is not at rest "
+                             "after the known state: SR6 reads 8,D0 (RUN, INTA)"]
+    assert pair.target.session.failures == []
