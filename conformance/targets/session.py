@@ -373,7 +373,7 @@ class RealSession(Session):
         r = link.send("SR6")
         if _hex_ok(r) and _bits(r) & (St6.RUN | St6.STOP) and not _bits(r) & St6.INTA:
             # a unit may hold RUN a while after its last vector (a T dwell): not moving
-            r = self._await_idle(link) or r
+            r = self._await_idle(link, self.profile.range("T").hi / 1000 + 2 * MARGIN) or r
         if _hex_ok(r):
             st6 = r.hex()
             self.report.found["ST6"] = "%02X" % st6
@@ -540,15 +540,15 @@ class RealSession(Session):
                 "accepted (not while moving)", f"R {_shown(restored)} at rest", "R accepted"))
         return ""
 
-    def _await_idle(self, link: Link) -> Response | None:
+    def _await_idle(self, link: Link, seconds: float | None = None) -> Response | None:
         """`SR6` until it shows RUN and STOP clear (spec 10.3 [M]: RUN = 0 is nothing
-        running), at most :meth:`_idle_seconds`: that answer, else None (RUN stayed set,
-        or `SR6` was not answered). Halted vectors (RUN with INTA) do not end by waiting:
-        None at once."""
+        running), at most ``seconds`` (:meth:`_idle_seconds` unless given): that answer,
+        else None (RUN stayed set, or `SR6` was not answered). Halted vectors (RUN with
+        INTA) do not end by waiting: None at once."""
         def done(r: Response) -> bool:
             return not _hex_ok(r) or not _bits(r) & (St6.RUN | St6.STOP) \
                 or bool(_bits(r) & St6.INTA)
-        st6 = link.poll("SR6", done, self._idle_seconds())
+        st6 = link.poll("SR6", done, self._idle_seconds() if seconds is None else seconds)
         idle = st6 is not None and _hex_ok(st6) and not _bits(st6) & (St6.RUN | St6.STOP)
         return st6 if idle else None
 
