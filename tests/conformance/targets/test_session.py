@@ -254,6 +254,17 @@ def test_a_return_move_still_running_after_its_wait_idiom_fails_that_rule_and_is
     assert ERROR not in [r.verdict for r in result.results]
 
 
+def test_an_r_refused_at_rest_with_a_k_held_is_still_a_fail_of_its_rule():
+    # R answered as an unknown command (3) once the halted vectors are deleted: at rest,
+    # with the save of a K the unit took, no reading refuses it
+    u = unit(frames={b"!0R\r": b"!0Z\r"}, allow_destructive=True)
+    result = run([u], select(["10.5.keep.single-l", "5.errors.ok"]))
+    rows = [r for r in result.results if r.id.endswith("known-state.restore")]
+    assert len(rows) == 1 and rows[0].verdict == FAIL
+    (check,) = rows[0].checks
+    assert check["rule"] == "10.5.restore.exact" and check["observed"] == "R 3 at rest"
+
+
 #: readings of what the known state sends (profile, reading): L0,0,0 holding RUN for its
 #: T dwell (N after the return move, N<axis> and EW at the end), R refused while halted
 #: vectors hold RUN (a K a case left, given back after H), M refused likewise (the GVE54's
