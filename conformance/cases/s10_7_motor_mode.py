@@ -90,7 +90,7 @@ def microstep(ctx: CaseContext) -> None:
 
 
 @case("10.7.motor.modes-while-moving", requires=("M",),
-      rules=("10.7.motor.busy", "10.7.motor.any-position"))
+      rules=("10.7.motor.busy", "10.7.motor.any-position", "5.moving.definition"))
 def motor_busy(ctx: CaseContext) -> None:
     link = ctx.link
     setup(ctx, "V5000")
@@ -107,6 +107,13 @@ def motor_busy(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [1000, 500, 400], "the manual's example: L-1,0,1",
                observed=position(ctx), expected=[1000, 500, 400], rule="10.7.motor.any-position")
     answers(ctx, link.send("M4"), "0", "then M4", rule="10.7.motor.any-position")
+    # halted, the vector's rest held (RUN = 1): nothing moves, so M is taken in our
+    # reading of "za chodu" (a unit may refuse it with 7 while RUN = 1)
+    setup(ctx, "L100,0,0")
+    setup(ctx, "H", expect="8")
+    code(ctx, link.send("MF"), ErrorCode.OK, "M after H with the vector halted", inta=True,
+         rule="5.moving.definition")
+    setup(ctx, "D")
 
 
 #: the commands acting on the motors that each micro-step mode is combined with (the
