@@ -144,11 +144,30 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                             "down: a counter shows a step one step period after the suite's "
                             "arithmetic places it (up to one step behind on each axis while "
                             "moving), and H answers one step period after the last step"),
+    "zero-vector-dwells": (("10.2.motion.zero-length",),
+                           "`L0,0,0` is a normal vector with no motion (\"program považuje za "
+                           "normální vektor\"), so the T dwell between vectors that are not "
+                           "continuous applies to it: answered 0 once everything before it "
+                           "is done, it then holds RUN = 1 (moving: N, D, K, R, M, EW "
+                           "refused with 7, L with 1) for T ms; H ends the dwell"),
+    "restore-refused-while-run": (("5.moving.after-halt",),
+                                  "R is refused with 7 whenever RUN = 1, also while halted "
+                                  "vectors hold it after H (\"Nelze použít za chodu\" read "
+                                  "as RUN = 1, as the GVE54 manual words N's)"),
+    "motor-mode-refused-while-run": (("5.moving.definition",),
+                                     "GVE54: M, like N, is refused with 7 whenever RUN = 1, "
+                                     "also while halted vectors hold it after H (\"Nelze "
+                                     "použít za chodu\" read as RUN = 1)"),
+    "reversal-brakes-to-rest": (("10.2.motion.junction-reversal",),
+                                "a C whose next C reverses an axis brakes to rest at their "
+                                "junction, not to B (\"U pokračujícího vektoru se nesmí "
+                                "příliš změnit úhel\": a reversal is no continuation)"),
 }.items()}
 
 #: readings whose behaviour lives in the stepper core
 CORE_READINGS: dict[str, Deviation] = {
     "next-vectors-B": Deviation.NEXT_BRAKE,
+    "reversal-brakes-to-rest": Deviation.REVERSAL_STOPS,
 }
 
 

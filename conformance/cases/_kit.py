@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from conformance.case import CaseContext, case
 from conformance.link.account import Spent
 from conformance.link.framing import Response
+from conformance.link.link import MARGIN
 from conformance.motion.probe import Probe
 from conformance.preconditions import feature
 from conformance.quoting import answer_text
@@ -41,6 +44,21 @@ def code(ctx: CaseContext, r: Response | None, value: ErrorCode, what: str, *,
 def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
     """The parameters of an L/C vector for the profile's axes."""
     return f"{x},{y},{z}"
+
+
+def finished(ctx: CaseContext, seconds: float,
+             until: Callable[[Response], bool] = lambda r: r.ok) -> Response | None:
+    """The manual's wait until everything queued has run: `L0,0,0` until ``until`` its
+    answer (taken only once everything before it has finished, spec 10.1 [M]), then, once
+    it is taken, `SR6` until RUN = 0 (spec 10.3 [M]) for at most the longest T dwell and
+    the line's margin: to a reader of "program považuje za normální vektor" `L0,0,0` is a
+    normal vector, whose T dwell may hold RUN after it (N, M, R, D, L refused meanwhile).
+    The answer to the last `L0,0,0` (None: none in time)."""
+    link = ctx.link
+    r = link.poll("L" + vector(ctx, 0), until, seconds)
+    if r is not None and r.ok:
+        link.wait_idle(ctx.profile.range("T").hi / 1000 + 2 * MARGIN)
+    return r
 
 
 def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | None:

@@ -6,7 +6,7 @@ What distinguishes the GVE54, the GVE84 and the GVE114 and their variants. A pro
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, position, setup, show
+from conformance.cases._kit import answers, code, finished, position, setup, show
 from conformance.protocol.catalogue import commands
 from gve_fixtures.protocol import ErrorCode
 from gve_fixtures.rules import load_rules
@@ -58,7 +58,7 @@ def axes(ctx: CaseContext) -> None:
                observed=show(r), expected="8 or C", rule=fewer)
     taken = r is not None and r.code == ErrorCode.OK
     setup(ctx, "G")
-    link.poll("L0,0,0", lambda r: r.ok, 30)
+    finished(ctx, 30)
     want = [start[0] + taken, start[1], start[2]]
     ctx.expect(position(ctx) == want, f"and X moved {int(taken)} step, Y and Z none",
                observed=position(ctx), expected=want, rule=fewer)

@@ -9,6 +9,7 @@ from conformance.cases._kit import (
     answers,
     code,
     fill_queue,
+    finished,
     halted_line,
     halted_with_queue,
     position,
@@ -58,6 +59,14 @@ def n_run(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     code(ctx, ctx.link.send("N"), ErrorCode.BUSY, "N after H with the rest queued", inta=True,
          rule="5.code.busy-run")
+    # K and D after H are the manual's own (its KEEP example, "for deleting the rest of
+    # the queue after an interruption"); R while halted vectors hold RUN is our reading
+    # of "nelze použít za chodu" (a unit may refuse it with 7 while RUN = 1)
+    setup(ctx, "K", expect="0")
+    setup(ctx, "L" + vector(ctx, 0, 0, 50))
+    setup(ctx, "H", expect="8")
+    code(ctx, ctx.link.send("R"), ErrorCode.OK, "R after H with the L after K halted",
+         inta=True, rule="5.moving.after-halt")
 
 
 @case("5.errors.ok",
@@ -101,7 +110,7 @@ def refused_not_executed(ctx: CaseContext) -> None:
     setup(ctx, "L" + vector(ctx, 10))
     code(ctx, ctx.link.send("L" + vector(ctx, 20)), ErrorCode.QUEUE_FULL, "L while busy → 1",
          rule="10.1.queue.line-alone")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     r = ctx.link.send("PF")
     ctx.expect(r is not None and r.values[:1] == ["10"], "only the accepted L moved",
                observed=r, expected="0,10,0,0", rule="4.response.failed-not-executed")

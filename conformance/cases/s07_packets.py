@@ -9,6 +9,7 @@ from conformance.cases._kit import (
     answers,
     code,
     fill_queue,
+    finished,
     index,
     index_moved,
     position,
@@ -69,7 +70,7 @@ def commits(ctx: CaseContext) -> None:
     """*E<n> commits every member in order and answers code,k."""
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
     answers(ctx, r, "0,3", "a good packet → 0,3", rule="7.packet.exchange")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     ctx.expect(position(ctx) == [10, 20, 0], "both vectors ran", observed=position(ctx),
                expected=[10, 20, 0], rule="7.packet.exchange")
 

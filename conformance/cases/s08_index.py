@@ -6,7 +6,16 @@ way to recover a lost answer."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, fresh_reset, index, index_moved, position, setup, vector
+from conformance.cases._kit import (
+    answers,
+    finished,
+    fresh_reset,
+    index,
+    index_moved,
+    position,
+    setup,
+    vector,
+)
 from conformance.link.framing import byte_sum
 
 
@@ -57,7 +66,7 @@ def lost_response(ctx: CaseContext) -> None:
     shows_index = r is not None and r.lines[:1] == [f"!{link.address}@".encode()]
     answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer",
             rule="8.repeat.remembered" if shows_index else "8.repeat.answer")
-    link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
                expected=[9, 0, 0], rule="8.index.counts")
 
@@ -93,7 +102,7 @@ def not_again(ctx: CaseContext) -> None:
     after = link.send("@")
     ctx.expect(before is not None and after is not None and before.values == after.values,
                "> added no frame to the index", observed=after, expected=before, tag="D")
-    link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     here = position(ctx)
     want = [start[0] + 7, start[1], start[2]]
     ctx.expect(here == want, "the vector ran once", observed=here, expected=want, tag="always")

@@ -9,6 +9,7 @@ from conformance.cases._kit import (
     answers,
     code,
     configured,
+    finished,
     fresh_reset,
     index,
     index_moved,
@@ -32,7 +33,7 @@ def after_j(ctx: CaseContext) -> None:
     link.read_index()             # the form the unit writes the index in, read before J
     setup(ctx, "SW2,2B")
     setup(ctx, "L" + vector(ctx, 16))
-    link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5, Spent.MANUAL)
     answers(ctx, link.send("SR2"), "0,00", "ST2 reset", rule="9.reset.state")
@@ -47,7 +48,7 @@ def after_j(ctx: CaseContext) -> None:
 def gve54_reset(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     setup(ctx, "L3,0,0")
-    ctx.link.poll("L0,0,0", lambda r: r.ok, 10)
+    finished(ctx, 10)
     ctx.expect(position(ctx) == [3, 0, 0], "after reset a step is a sixteenth (MF)",
                observed=position(ctx), expected=[3, 0, 0])
     answers(ctx, ctx.link.send("MD"), "0", "half current (MD) is a mode it takes")
@@ -86,7 +87,7 @@ def mpg_moving(ctx: CaseContext) -> None:
              rule="5.moving.definition")
     answers(ctx, link.send("Y-"), "0,Y-", "Y- turns the MPG off", rule="10.cmd.mpg")
     # an MPG that did not take effect let the vector run: it has ended by the idiom's 0
-    link.poll("L0,0,0", lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     answers(ctx, link.send("SR6"), "0,00", "and RUN clears", rule="10.cmd.mpg")
 
 
@@ -162,5 +163,5 @@ def mpg_values(ctx: CaseContext) -> None:
              f"{shown}: not a listed value, the MPG is not allowed: a vector is taken",
              rule="9.reset.mpg")
         link.poll("L" + vector(ctx, -1), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
-        link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
+        finished(ctx, 10, lambda r: r.code != ErrorCode.QUEUE_FULL)
     answers(ctx, link.send("Y-"), "0,Y-", "the MPG off at the end", rule="10.cmd.mpg")

@@ -9,6 +9,7 @@ from conformance.cases._kit import (
     answers,
     code,
     fill_queue,
+    finished,
     measured_case,
     position,
     setup,
@@ -43,7 +44,7 @@ def l_busy(ctx: CaseContext) -> None:
     setup(ctx, "C" + vector(ctx, 500))
     code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.QUEUE_FULL, "L while a C runs → 1",
          rule="10.1.queue.line-alone")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     ctx.expect(position(ctx) == [500, 0, 0], "the refused L did not move",
                observed=position(ctx), expected=[500, 0, 0], rule="10.1.queue.line-alone")
 
@@ -96,7 +97,7 @@ def refused_vector(ctx: CaseContext) -> None:
         code(ctx, r, ErrorCode.OK,
              f"{kind}{vector(ctx, *d)} sent again is taken once there is room",
              rule="5.code.queue-full")
-    r = link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    r = finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     ctx.require(r is not None and r.ok, "the queue did not run out within 30 s")
     drift = sum(1 if i % 2 == 0 else -1 for i in range(ctx.profile.buffer))
     moved = [drift, REFUSED_C[1], REFUSED_L[2]]

@@ -6,7 +6,7 @@ How a vector is stepped: rates, ramps, junctions, dwell and step placement
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import measured_case, position, setup, vector
+from conformance.cases._kit import finished, measured_case, position, setup, vector
 from conformance.motion.probe import Probe
 
 #: a junction with B differing on both sides, each way round: (B before, B after)
@@ -38,9 +38,13 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     "10.2.measured.no-dwell-continuous": (
         ("10.2.motion.no-dwell-continuous",), (), (),
         ["T24", "A10000", "V2000", "C100,0,0", "C100,0,0", 0.12]),
-    # the junction: a C followed by a C exits at B (10.2)
+    # the junction: a C followed by a C going on the same way exits at B (10.2)
     "10.2.measured.junction": (
         ("10.2.motion.junction",), (), (),
+        ["A5", "B500", "V2000", "C700,0,0", "C700,0,0", 1.2]),
+    # a C followed by a C reversing its axis: at B as well, our reading [D] (10.2)
+    "10.2.measured.junction-reversal": (
+        ("10.2.motion.junction-reversal",), (), (),
         ["A5", "B500", "V2000", "C700,0,0", "C-700,0,0", 1.2]),
     # the exit rate lets the next vector still stop within its length (10.2)
     "10.2.measured.junction-cap": (
@@ -92,7 +96,7 @@ def targets(ctx: CaseContext) -> None:
     moves = [(100, -37, 5), (-250, 40, 0), (3, 3, -3)]
     for m in moves:
         setup(ctx, "C" + vector(ctx, *m))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
+    finished(ctx, 60)
     expected = [sum(m[i] for m in moves) for i in range(3)]
     ctx.expect(position(ctx) == expected, "the sum of the vectors",
                observed=position(ctx), expected=expected, rule="10.1.queue.relative")

@@ -5,7 +5,16 @@ ST0..ST6: interrupt enables, polarities, causes, and the stepper's state."""
 from __future__ import annotations
 
 from conformance.case import CaseContext, case
-from conformance.cases._kit import answers, code, halted_line, position, setup, show, vector
+from conformance.cases._kit import (
+    answers,
+    code,
+    finished,
+    halted_line,
+    position,
+    setup,
+    show,
+    vector,
+)
 from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
@@ -172,7 +181,7 @@ def run_bit(ctx: CaseContext) -> None:
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["40"], "RUN while moving",
                observed=show(r), expected="0,40", rule="10.3.st6.bits")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     answers(ctx, ctx.link.send("SR6"), "0,00", "idle again", rule="10.3.st6.inta-run")
 
 

@@ -8,6 +8,7 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    finished,
     halted_with_queue,
     measured_case,
     position,
@@ -77,7 +78,7 @@ def go(ctx: CaseContext) -> None:
     """G resumes the interrupted vector from the exact step: no step lost or gained."""
     halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
+    finished(ctx, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
                observed=position(ctx), expected=[990, 0, 0])
 
@@ -111,6 +112,12 @@ def halt_final(ctx: CaseContext) -> None:
             rule="10.3.st6.inta-run")
 
 
+def _axes(value: object, axes: int) -> bool:
+    """Whether ``value`` (a rig's reading) gives a whole number for each of ``axes``."""
+    return isinstance(value, list) and len(value) == axes \
+        and all(type(v) is int for v in value)
+
+
 @case("10.4.halt.at-rest-on-the-rig", rig=True, timing=True, rules=("10.4.halt.ramp",))
 def halt_at_rest_on_the_rig(ctx: CaseContext) -> None:
     """H answers only when stopped, judged where the rig reads every axis (the GVE114's A
@@ -126,13 +133,21 @@ def halt_at_rest_on_the_rig(ctx: CaseContext) -> None:
     first = link.rig.state()
     link.wait(0.3)
     later = link.rig.state()
-    for key in ("physical", "position"):
-        ctx.expect(first.get(key) == later.get(key) and first.get(key) is not None,
-                   f"from H's answer on, every axis's {key} stands still",
-                   observed=f"{first.get(key)} then {later.get(key)}",
-                   expected="the same", rule="10.4.halt.ramp")
-    here = position(ctx)
-    ctx.expect(here is not None and here == (later.get("position") or [])[:3],
-               "PF reads the counters the rig reads", observed=here,
-               expected=(later.get("position") or [])[:3], rule="10.4.halt.ramp")
+    axes_read = {key: (first.get(key), later.get(key)) for key in ("physical", "position")}
+    # what the rig's state does not give is not tested (never a failure of the unit)
+    missing = [key for key, reads in axes_read.items()
+               if not all(_axes(v, axes) for v in reads)]
+    for key, (was, now) in axes_read.items():
+        if key not in missing:
+            ctx.expect(was == now, f"from H's answer on, every axis's {key} stands still",
+                       observed=f"{was} then {now}", expected="the same",
+                       rule="10.4.halt.ramp")
+    if "position" not in missing:
+        here = position(ctx)
+        ctx.expect(here is not None and here == later["position"][:3],
+                   "PF reads the counters the rig reads", observed=here,
+                   expected=later["position"][:3], rule="10.4.halt.ramp")
     setup(ctx, "D")
+    ctx.require(not missing, "the rig's state gives no "
+                + " and no ".join(repr(k) for k in missing)
+                + f" for {axes} axes: that part of H's stop is not tested")

@@ -8,6 +8,7 @@ from conformance.case import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
+    finished,
     fresh_reset,
     halted_line,
     halted_with_queue,
@@ -29,7 +30,7 @@ def gve54_full(ctx: CaseContext) -> None:
     for i in range(3):
         answers(ctx, link.send("C" + vector(ctx, 1)), "0", f"C {i + 1} after K is accepted")
     answers(ctx, link.send("F"), "0,40", "three vectors do not fill the queue")
-    link.poll("L0,0,0", lambda r: r.ok, 10)
+    finished(ctx, 10)
     answers(ctx, link.send("L" + vector(ctx, 2)), "0", "and L is accepted once idle")
 
 
@@ -55,12 +56,12 @@ def partial(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     setup(ctx, "K")
     setup(ctx, "L" + vector(ctx, 0, 0, -100))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     setup(ctx, "L" + vector(ctx, 0, 0, 100))
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 30)
+    finished(ctx, 30)
     ctx.link.send("R")
     ctx.link.send("G")
-    ctx.link.poll("L" + vector(ctx, 0), lambda r: r.ok, 60)
+    finished(ctx, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
                observed=position(ctx), expected=[990, 0, 0], rule="10.5.restore.exact")
 

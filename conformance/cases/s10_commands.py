@@ -20,6 +20,7 @@ from conformance.cases._kit import (
     code,
     code_text,
     configured,
+    finished,
     halted_with_queue,
     measured_case,
     position,
@@ -47,7 +48,7 @@ def _reads(ctx: CaseContext, expected: list[int], what: str) -> None:
 
 
 def _settle(ctx: CaseContext) -> None:
-    r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    r = finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     ctx.require(r is not None and r.ok, "the moves did not end within 30 s")
 
 
@@ -211,7 +212,7 @@ def output_while_busy(ctx: CaseContext) -> None:
     seen = link.rig.outputs()
     ctx.expect(seen == 0xF7, "the outputs are F7 while the vectors run", observed=seen,
                expected=0xF7)
-    link.poll("L0,0,0", lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
+    finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     answers(ctx, link.send("O0,FF"), "0", "O0,FF: all off")
 
 

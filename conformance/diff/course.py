@@ -63,11 +63,19 @@ class Course:
     def __init__(self, profile: Profile) -> None:
         self.t_ns = profile.reset.T * 1_000_000
         self.vector_at: int | None = None
+        #: when the reference took an `L0,0,0`, and the longest T dwell a reader may give
+        #: it (a normal vector to a reader of "program považuje za normální vektor")
+        self.zero_at: int | None = None
+        self.longest_t_ns = profile.range("T").hi * 1_000_000
         self.top = profile.max_rate
         self.speed = profile.reset.V
         self.override = max(100, profile.reset.XM) / 100
         self.up = 1.0
         self.queued: str | None = None
+        #: a C queued right after a C reversing an axis (a junction where braking to 0 is
+        #: a reading, 10.2.motion.junction-reversal): everything after it is timed by it
+        self.reversal = False
+        self._last_c: list[int] | None = None
         self.in_packet = False
         self.factors = dict(profile.microstep.factors) if profile.microstep else {}
         self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
@@ -126,6 +134,10 @@ class Course:
             self.in_packet = False
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
+        answer = reference.response
+        if command == "L" and _ZERO_VECTOR.fullmatch(body.upper()) and answer is not None \
+                and answer.code == 0 and not answer.inta:     # (with INTA it waits for G)
+            self.zero_at = reference.sent_at
         if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
         elif command in _COURSE_CHANGERS:
@@ -137,6 +149,11 @@ class Course:
         if command in _EMPTIES:      # D and K alike, as the timing takes them
             self.queued = None
         elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
+            steps = _numbers(body[1:]) if command == "C" else None
+            if steps and self.queued in ("C", "C+C") and self._last_c and any(
+                    a * b < 0 for a, b in zip(self._last_c, steps, strict=False)):
+                self.reversal = True
+            self._last_c = steps
             self.queued = "C+C" if command == "C" and self.queued in ("C", "C+C") else command
 
     def _ceiling(self, command: str, body: str) -> None:
@@ -173,6 +190,12 @@ class Course:
     # -- what a difference reads ---------------------------------------------------------
     def within_dwell(self, t: int) -> bool:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
+
+    def after_zero_vector(self, t: int) -> bool:
+        """Whether ``t`` is within the longest T dwell after an `L0,0,0` the reference
+        took (what a unit holding RUN for that dwell does differently then is
+        10.2.motion.zero-length's [D])."""
+        return self.zero_at is not None and t - self.zero_at < self.longest_t_ns
 
     @property
     def rate(self) -> int:

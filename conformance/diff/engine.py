@@ -50,6 +50,8 @@ except ImportError:
 _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: real time: how long the fresh reference stands before a sequence
 AGE_SECONDS = 1.0
+#: after a power-on through the rig, beyond the unit's restart time, before the known state
+RESTART_MARGIN_S = 0.5
 #: a unit that lives on between sequences: what both sides are sent first (the index read
 #: between two `SR0`, the same history for `>`); told ahead with the known state's last
 PRELUDE = ("SR0", "@", "SR0")
@@ -135,6 +137,10 @@ class Pair:
         #: it could); no sequence is sent to it after that
         self.lost = ""
         self._last: list[Step] = []            # the steps of the latest sequence begun
+        #: why each sequence that could not be tested was not (the known state could not
+        #: be had before it, and a power-on through the rig brought the unit back)
+        self.untested: list[str] = []
+        self._powering = False                 # powered on, no known state had since
         self.led_there: list[Step] = []        # the sequence after which it was lost
 
     @property
@@ -214,13 +220,40 @@ class Pair:
             return False
         except StepFailed as err:
             # the frames before left the unit where the manual's rules cannot bring it to
-            # rest, where the reference's were (the session names the rule its evidence
-            # broke): nothing more is sent, and the search ends there (KnownStateLost)
-            self.lost = out.ended = f"the known state could not be had: {err}"
+            # rest, where the reference's were (the session names the rule where its
+            # evidence broke one): this sequence cannot be tested; a co-simulator in
+            # virtual time is powered on through its rig (the reset state, safely) and the
+            # search goes on; anywhere else nothing more is sent, and it ends there
+            # (KnownStateLost)
+            why = f"the known state could not be had: {err}"
+            if self._powered_on(why):
+                out.ended = why + "; the unit was powered on through its rig"
+                return False
+            self.lost = out.ended = why
             self.led_there = self._last
             return False
         self.course = Course(self.profile)
+        self._powering = False
         out.begun = True
+        return True
+
+    def _powered_on(self, why: str) -> bool:
+        """A target the known state could not be had on, powered on through its test
+        rig where that is safe: a co-simulator in virtual time (its time stands still
+        between frames, the guard books the power-on as a restart that leaves the axes
+        where they are) — not twice in a row without a known state had between. Whether
+        it was; the sequences that could not be tested so are kept in :attr:`untested`."""
+        side = self.target
+        rig = None if side.link is None else side.link.rig
+        if not (side.real and side.virtual and rig is not None) or self._powering:
+            return False
+        try:
+            rig.power_on()
+        except CouldNotTest:
+            return False
+        side.wait(self.profile.restart_ms / 1000 + RESTART_MARGIN_S)
+        self._powering = True
+        self.untested.append(why)
         return True
 
     def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
@@ -312,6 +345,10 @@ class Pair:
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+        if self.course.after_zero_vector(rec.reference.sent_at):
+            context.add("after-zero-vector")
+        if self.course.reversal:
+            context.add("reversal")
         if kind == "position" and self.course.beyond_reach(_values(rec.target)):
             context.add("beyond-reach")
         if self.course.capped_elsewhere:

@@ -10,6 +10,7 @@ from hypothesis.stateful import RuleBasedStateMachine, invariant
 
 from conformance.case import CaseContext
 from conformance.link.framing import Response
+from conformance.link.link import MARGIN
 from conformance.model.unit import ModelUnit
 from conformance.protocol.parse import parse
 from conformance.quoting import as_text
@@ -75,6 +76,10 @@ class UnitMachine(RuleBasedStateMachine):
                            lambda r: r.code is not None and r.code != ErrorCode.QUEUE_FULL, 120,
                            send=self.send)
         holds(r is not None, "10.1.queue.wait-idiom", "the unit never became idle")
+        if r.ok:
+            # L0,0,0 is a normal vector to a reader of "program považuje za normální
+            # vektor": its T dwell may hold RUN after it (L refused with 1 meanwhile)
+            self.link.wait_idle(self.ctx.profile.range("T").hi / 1000 + 2 * MARGIN)
         # a poll that got no answer in time may still have counted: resynchronize with
         # what the unit says the index is
         self.model.index = self.index()

@@ -83,6 +83,11 @@ RUN_OUT_POLL_S = 1.0
 #: ST6 bits that keep a unit from being at rest for a case: moving, braking, or
 #: interrupted with vectors waiting for `G` (spec 10.3: INTA/RUN 0/0 is idle [M])
 NOT_AT_REST = St6.RUN | St6.STOP | St6.INTA
+#: the codes a frame refused only while something runs may get: 7 ("za chodu vektoru
+#: nelze") and 1 (`L` while anything is queued or running): "not yet", never a refusal
+NOT_YET = (ErrorCode.BUSY, ErrorCode.QUEUE_FULL)
+#: how often a frame answered "not yet" is sent again, each time once SR6 shows RUN = 0
+NOT_YET_TRIES = 3
 
 
 class SessionError(Exception):
@@ -366,6 +371,9 @@ class RealSession(Session):
         self.report.found = {f"ST{n}": "%02X" % v for n, v in self.status.items()}
         self.report.found["checksums"] = "on" if self.checksums else "off"
         r = link.send("SR6")
+        if _hex_ok(r) and _bits(r) & (St6.RUN | St6.STOP) and not _bits(r) & St6.INTA:
+            # a unit may hold RUN a while after its last vector (a T dwell): not moving
+            r = self._await_idle(link, self.profile.range("T").hi / 1000 + 2 * MARGIN) or r
         if _hex_ok(r):
             st6 = r.hex()
             self.report.found["ST6"] = "%02X" % st6
@@ -494,8 +502,10 @@ class RealSession(Session):
         mpg = ["Y-"] if self._has_mpg() else []
         held = self.guard.keep_held and not self.interrupts.stopped
         # R moves nothing on a unit that keeps the manual (the save holds INTA with any
-        # queue), but a unit that does not may run it: R only where the envelope takes it
-        give_back = ["R"] if held and self.guard.fits("R") else []
+        # queue), but a unit that does not may run it: R only where the envelope takes it.
+        # The halted vectors H left are deleted first: a unit may refuse R while they hold
+        # RUN ("nelze použít za chodu" read as RUN = 1); what R gives back is deleted after
+        give_back = ["D", "R"] if held and self.guard.fits("R") else []
         frames = [*mpg, *(f"SW{n},00" for n in range(6)), *give_back, "D", "SR6"]
         if not link.checksums and not self.guard.packet_open:
             link.tell(["H", *frames, *then])       # H as _halt sends it, then the rest
@@ -509,11 +519,62 @@ class RealSession(Session):
         if held and not give_back and not why:
             why = self._keep_not_given_back(link)
         if give_back and not why and not _taken(answers[-3]):
+            why = self._give_back(link, answers[-3])
+        return why, link.send_each(then)
+
+    def _give_back(self, link: Link, restored: Response | None) -> str:
+        """`R` was not taken after `D` left the unit at rest: "not yet" (7, 1) is asked
+        again once `SR6` shows RUN = 0, and what it gives back deleted; refused at rest
+        (read back before and after) it is a FAIL of `R`'s rule. Returns why the unit is
+        not at rest ("" when it is)."""
+        if _not_yet(restored):
+            restored = self._when_idle(link, "R", restored)
+            deleted, st6 = link.send_each(["D", "SR6"])
+            if not _rests(st6):
+                return ("the unit is not at rest after the known state gave back a KEEP: R "
+                        f"{_shown(restored)}, D {_shown(deleted)}, SR6 reads {_shown(st6)}"
+                        + _left(st6))
+        if not _taken(restored):
             self._step_failed(link, StepFailure(
                 "10.5.restore.exact", "restore", "R gives back the save of the K the unit "
-                "accepted (not while moving)", f"R {_shown(answers[-3])} at rest",
-                "R accepted"))
-        return why, link.send_each(then)
+                "accepted (not while moving)", f"R {_shown(restored)} at rest", "R accepted"))
+        return ""
+
+    def _await_idle(self, link: Link, seconds: float | None = None) -> Response | None:
+        """`SR6` until it shows RUN and STOP clear (spec 10.3 [M]: RUN = 0 is nothing
+        running), at most ``seconds`` (:meth:`_idle_seconds` unless given): that answer,
+        else None (RUN stayed set, or `SR6` was not answered). Halted vectors (RUN with
+        INTA) do not end by waiting: None at once."""
+        def done(r: Response) -> bool:
+            return not _hex_ok(r) or not _bits(r) & (St6.RUN | St6.STOP) \
+                or bool(_bits(r) & St6.INTA)
+        st6 = link.poll("SR6", done, self._idle_seconds() if seconds is None else seconds)
+        idle = st6 is not None and _hex_ok(st6) and not _bits(st6) & (St6.RUN | St6.STOP)
+        return st6 if idle else None
+
+    def _idle_seconds(self) -> float:
+        """The longest a unit may hold RUN once what it was asked is done: the longest
+        T dwell a reader may give a vector with no motion (`L0,0,0`), or the longest stop
+        the envelope allows, and the line's margin."""
+        return (self.profile.range("T").hi / 1000 + 2 * self.guard.stop_seconds()
+                + 2 * MARGIN)
+
+    def _when_idle(self, link: Link, body: str, first: Response | None = None
+                   ) -> Response | None:
+        """``body`` (`N`, `N<axis>`, `M`, `R`, `EW`, the return `L`: refused while a
+        vector runs) until it is answered otherwise than "not yet" (7, 1), each time
+        again once `SR6` shows RUN = 0 (:meth:`_await_idle`): a unit may hold RUN for a
+        T dwell after the `L0,0,0` the known state waits with, or read the manuals'
+        "za chodu" as RUN = 1. ``first``: its answer already had (else it is sent now).
+        The last answer."""
+        r = link.send(body) if first is None else first
+        for _ in range(NOT_YET_TRIES):
+            if not _not_yet(r):
+                return r
+            if self._await_idle(link) is None:
+                return r                # RUN stayed set, or vectors halted: not again
+            r = link.send(body)
+        return r
 
     def _halt_refused(self, halt: Response, summed: bool) -> StepFailure:
         """`H` answered otherwise than 8. `H` has no parameter: where the unit took `%+`
@@ -621,7 +682,7 @@ class RealSession(Session):
         if not self._run_out(link):
             self._halt(link)
         self._position(link)
-        st6 = link.send("SR6")
+        st6 = self._await_idle(link) or link.send("SR6")
         return st6 if _rests(st6) or not self._may_reset() else self._reset(link)
 
     def _run_out(self, link: Link) -> bool:
@@ -666,25 +727,30 @@ class RealSession(Session):
         left, _ = self._settle(link, ["PF"])       # where the axes are, for the way back
         if left:
             raise StepFailed(left)
-        returned, _ = self._go_back(link, read=False)
+        returned, there = self._go_back(link, read=False)
         link.tell(["N", "PF", *tell])
-        self._zero(link, returned)
+        self._zero(link, returned, there)
 
-    def _zero(self, link: Link, returned: str = "") -> None:
-        """`N`, read back with `PF`: every counter 0 (spec 10 [M]). Where `N` did not zero
-        them at rest, a FAIL of its rule, and `N<axis>0` where the unit has it; counters
-        still elsewhere leave the case COULD-NOT-TEST (cases judge positions from 0).
-        ``returned``: the return move just ended by `L0,0,0` (a unit still running then
-        broke the wait idiom: :meth:`_returning`)."""
+    def _zero(self, link: Link, returned: str = "", there: dict[int, int] | None = None
+              ) -> None:
+        """`N`, read back with `PF`: every counter 0 (spec 10 [M]); answered "not yet"
+        (7: a unit may hold RUN a T dwell after the `L0,0,0` that ended the return move)
+        it is sent again once `SR6` shows RUN = 0. Where `N` did not zero them at rest, a
+        FAIL of its rule, and `N<axis>0` where the unit has it; counters still elsewhere
+        leave the case COULD-NOT-TEST (cases judge positions from 0). ``returned``: the
+        return move just ended by `L0,0,0`, ``there``: `PF` right after it (axes that
+        moved on from there broke the wait idiom: :meth:`_returning`)."""
         zeroed = link.send("N")
+        if returned and _not_yet(zeroed):
+            st6 = link.send("SR6")
+            if not _rests(st6):
+                self._returning(link, returned, there, zeroed, st6)
+        zeroed = self._when_idle(link, "N", zeroed)
         with self.guard.unmoved():                 # at rest: a counter read is no motion
             here = self._position(link)
         if _taken(zeroed) and here and not any(here.values()):
             return                                 # taken: nothing runs (7 if RUN = 1)
         st6 = link.send("SR6")
-        if not _rests(st6) and returned and self._returning(link, returned, zeroed, st6):
-            self._zero(link)
-            return
         if not _rests(st6):
             raise StepFailed(f"the unit is not at rest after the known state: N answered "
                              f"{_shown(zeroed)}, SR6 reads {_shown(st6)}" + _left(st6))
@@ -694,7 +760,8 @@ class RealSession(Session):
         names = self.profile.axes
         setters = [f"N{a}0" for a in names[:3] if f"N{a}" in self.profile.commands]
         if setters:
-            link.send_each(setters)
+            for body in setters:
+                self._when_idle(link, body)
             with self.guard.unmoved():
                 here = self._position(link)
             if here and not any(here.values()):
@@ -703,20 +770,30 @@ class RealSession(Session):
                          f"{_shown(zeroed)}, PF then {_counters(here)}): the cases judge "
                          "positions from 0")
 
-    def _returning(self, link: Link, body: str, zeroed: Response | None,
-                   st6: Response | None) -> bool:
-        """The return move ``body`` still runs after `L0,0,0` was answered 0, which it is
-        only once everything before it has finished (spec 10.1 [M]): a FAIL of that rule;
-        the end of the move is then awaited by `SR6` (spec 10.3 [M]). Whether the unit
-        came to rest."""
+    def _returning(self, link: Link, body: str, there: dict[int, int] | None,
+                   zeroed: Response | None, st6: Response | None) -> bool:
+        """RUN still set after the return move ``body`` was ended by `L0,0,0`, answered
+        0 only once everything before it has finished (spec 10.1 [M]): its end is awaited
+        by `SR6` (spec 10.3 [M]). RUN alone is no evidence (a unit may hold it for a T
+        dwell after `L0,0,0`, a normal vector to a reader of "program považuje za normální
+        vektor"); axes at rest elsewhere than `PF` read them right after that answer are:
+        the move still ran, a FAIL of the wait idiom's rule. Whether the unit came to
+        rest."""
         if not _hex_ok(st6) or not _bits(st6) & St6.RUN:
             return False
-        self._step_failed(link, StepFailure(
-            "10.1.queue.wait-idiom", "return-move", "L0,0,0 after the return move answers "
-            "1 until the move has finished, then 0",
-            f"{body} 0, L0,0,0 0, then N {_shown(zeroed)}, SR6 {_shown(st6)}",
-            "L0,0,0 answered 1 while the move runs"))
-        return link.poll("SR6", _rests, self._return_seconds(body)) is not None
+        rested = link.poll("SR6", _rests, self._return_seconds(body)) is not None
+        if rested and there:
+            with self.guard.unmoved():              # at rest: a counter read is no motion
+                then = self._position(link)
+            if then and then != there:
+                self._step_failed(link, StepFailure(
+                    "10.1.queue.wait-idiom", "return-move", "L0,0,0 after the return move "
+                    "answers 1 until the move has finished, then 0: the axes no longer "
+                    "move once it is answered 0",
+                    f"{body} 0, L0,0,0 0, PF {_counters(there)}, then N {_shown(zeroed)}, "
+                    f"SR6 {_shown(st6)}, and at rest PF {_counters(then)}",
+                    "the axes where PF read them once L0,0,0 was answered 0"))
+        return rested
 
     def _return_seconds(self, body: str) -> float:
         """The longest the return move ``body`` (an `L` at the reset V) may take."""
@@ -755,7 +832,7 @@ class RealSession(Session):
             if why not in self.report.problems:
                 self.report.problems.append(why)
             return "", read_now
-        r = link.send(body)
+        r = self._when_idle(link, body)
         if r is None or not r.ok:
             self._return_refused(link, body, r)
             return "", self._position(link)
@@ -959,7 +1036,7 @@ class RealSession(Session):
         settable = {i: v for i, v in wanted.items() if f"N{names[i]}" in self.profile.commands}
         sent = [f"N{names[i]}{v}" for i, v in settable.items()]
         for body in sent:
-            link.send(body)
+            self._when_idle(link, body)
         read = self._position(link)
         found = _counters(self.counters)
         if any(read.get(i) != v for i, v in settable.items()):
@@ -1002,7 +1079,7 @@ class RealSession(Session):
             r = read[address]
             if _hex_ok(r) and r.hex() == value:
                 continue
-            link.send("EW%02X,%02X" % (address, value))
+            self._when_idle(link, "EW%02X,%02X" % (address, value))
             r = link.send("ER%02X" % address)
             if _hex_ok(r) and r.hex() == value:
                 changed.append("%02X" % address)
@@ -1125,6 +1202,11 @@ def _shown(r: Response | None) -> str:
 
 def _taken(r: Response | None) -> bool:
     return r is not None and r.ok
+
+
+def _not_yet(r: Response | None) -> bool:
+    """Whether ``r`` refuses its frame only while something runs (7, 1: not yet)."""
+    return r is not None and r.code is not None and r.code & 7 in NOT_YET
 
 
 def _counters(read: dict[int, int]) -> str:

@@ -18,6 +18,7 @@
 #define DEV_GO_AT_SPEED 32
 #define DEV_NEXT_BRAKE 64
 #define DEV_JUNCTION_UNBRAKED 128
+#define DEV_REVERSAL_STOPS 256
 
 /* ---- the exported arithmetic (tests, tools) ------------------------------------------ */
 
@@ -210,6 +211,10 @@ static i64 junction(const stepper *m, const entry_t *e, const entry_t *nxt, i64 
     if (!nxt || !(e->vec.continuous && nxt->vec.continuous) || nxt->n == 0) return 0;
     if (e->n == 0 && !(m->dev & DEV_ZERO_LENGTH_JUNCTION)) return 0;
     if (m->dev & DEV_JUNCTION_STOPS) return 0;
+    if (m->dev & DEV_REVERSAL_STOPS)
+        for (int i = 0; i < m->axes; i++)
+            if ((e->vec.steps[i] > 0 && nxt->vec.steps[i] < 0)
+                    || (e->vec.steps[i] < 0 && nxt->vec.steps[i] > 0)) return 0;
     i64 brake = (m->dev & DEV_NEXT_BRAKE) ? nxt->vec.brake : e->vec.brake;
     if (m->dev & DEV_JUNCTION_UNBRAKED) brake = vc;
     i128 v = min128(min128(brake, vc), cruise(m, nxt));

@@ -82,6 +82,7 @@ class Deviation(IntFlag):
     GO_AT_SPEED = 32           # G resumes at the cruise rate instead of from rest
     NEXT_BRAKE = 64            # a junction is passed at the next C's B (a reading)
     JUNCTION_UNBRAKED = 128    # B caps no junction: a C exits at the rate the next allows
+    REVERSAL_STOPS = 256       # a C brakes to rest where an axis reverses (a reading)
 
 
 @runtime_checkable

@@ -112,6 +112,9 @@ class PythonMotion:
             return 0
         if self.deviations & Deviation.JUNCTION_STOPS:
             return 0
+        if self.deviations & Deviation.REVERSAL_STOPS and any(
+                a * b < 0 for a, b in zip(e.vector.steps, nxt.vector.steps, strict=True)):
+            return 0
         brake = nxt.vector.brake if self.deviations & Deviation.NEXT_BRAKE else e.vector.brake
         if self.deviations & Deviation.JUNCTION_UNBRAKED:
             brake = vc

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from emulator.motion.interface import EMPTY_SAVE, KeepSave
-from emulator.protocol.device import Device
+from emulator.protocol.device import MS, Device
 from emulator.protocol.params import CommandError, dec, fields, plain, within
 from emulator.protocol.reply import Answer, Deferred, Reply
 from emulator.protocol.session import Session
@@ -41,11 +41,16 @@ def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
     dev.refuse_vectors_to_mpg()
     if dev.state.reference_until > t:
         raise CommandError(ErrorCode.QUEUE_FULL, "a reference run is in progress")
-    if dev.motion.queued(t) and not dev.mutant.active("line-while-busy"):
+    busy = dev.motion.queued(t) or dev.state.dwell_until > t
+    if busy and not dev.mutant.active("line-while-busy"):
         if dev.mutant.active("refused-line-queued"):
             dev.push(steps, False, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "L waits until nothing is queued or running")
     dev.push(steps, False, t)
+    if not any(steps) and not dev.state.inta and dev.readings.active("zero-vector-dwells"):
+        # a normal vector with no motion: the T dwell after it holds RUN (the next
+        # vector from rest waits it out in the stepper core too)
+        dev.state.dwell_until = t + dev.state.modal.T * MS
     return []
 
 
@@ -223,6 +228,7 @@ def _reference_run(dev: Device, t: int, duration: int, moves: list[tuple[int, in
 
 def cmd_halt(dev: Device, ses: Session, p: str, t: int) -> Reply:
     rest = dev.motion.halt(t)
+    dev.state.dwell_until = min(dev.state.dwell_until, t)     # a dwell ends at once
     dev.state.status[6] |= INTA | INTCOM
     if rest > t and not dev.mutant.active("halt-answers-early"):
         return Deferred(dev.seen_at_rest(rest), lambda at: (ErrorCode.OK, []))
@@ -275,7 +281,7 @@ def cmd_keep(dev: Device, ses: Session, p: str, t: int) -> Reply:
 
 
 def cmd_restore(dev: Device, ses: Session, p: str, t: int) -> Reply:
-    dev.refuse_while_moving(t)
+    dev.refuse_restore(t)
     s = dev.state
     if s.saved is None and dev.readings.active("restore-nothing-kept-refused"):
         raise CommandError(ErrorCode.SYNTAX, "nothing kept to restore")
@@ -304,6 +310,8 @@ def cmd_motor(dev: Device, ses: Session, p: str, t: int) -> Reply:
         if p[:1] in ms.factors and dev.mutant.active("microstep-refused-stored"):
             dev.state.microstep = p[:1]
         raise CommandError(ErrorCode.SYNTAX, f"unknown motor mode {p!r}")
+    if dev.readings.active("motor-mode-refused-while-run"):
+        dev.refuse_while_running(t)
     dev.refuse_while_moving(t)
     if p in ms.currents:
         dev.state.current = p

@@ -168,7 +168,8 @@ class Device:
     def st6(self, t: int) -> int:
         flags = self.motion.flags(t)
         value = self.state.status[6] & ~(RUN | STOP)
-        if flags.busy or self.mpg_active() or self.state.reference_until > t:
+        if flags.busy or self.mpg_active() or self.state.reference_until > t \
+                or self.state.dwell_until > t:
             value |= RUN
         if flags.stopping:
             value |= STOP
@@ -177,7 +178,8 @@ class Device:
     def moving(self, t: int) -> bool:
         """Executing, braking or dwelling, a reference run, or the MPG (spec 5)."""
         mpg = self.mpg_active() and not self.mutant.active("mpg-not-moving")
-        return self.motion.flags(t).moving or self.state.reference_until > t or mpg
+        return (self.motion.flags(t).moving or self.state.reference_until > t or mpg
+                or self.state.dwell_until > t)
 
     def refuse_while_moving(self, t: int) -> None:
         if self.moving(t):
@@ -186,6 +188,13 @@ class Device:
     def refuse_while_running(self, t: int) -> None:
         if self.st6(t) & RUN:
             raise CommandError(ErrorCode.BUSY, "not possible while RUN = 1")
+
+    def refuse_restore(self, t: int) -> None:
+        """R: not while moving; the reading restore-refused-while-run: whenever RUN = 1,
+        also while halted vectors hold it."""
+        if self.readings.active("restore-refused-while-run"):
+            self.refuse_while_running(t)
+        self.refuse_while_moving(t)
 
     def refuse_vectors_to_mpg(self) -> None:
         if self.mpg_active():

@@ -83,6 +83,17 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "index-hex": ([b"!0SR6\r"] * 11 + [b"!0@\r"], b"0,00\r" * 11 + b"0,11\r",
                   b"0,00\r" * 11 + b"0,0B\r"),
     "eeprom-erased-zero": ([b"!0ER40\r"], b"0,FF\r", b"0,00\r"),
+    # 1 ms after L0,0,0 its T5 dwell still holds RUN: N refused, SR6 shows RUN
+    "zero-vector-dwells": ([b"!0L0,0,0\r", 0.001, b"!0N\r", 0.001, b"!0SR6\r"],
+                           b"0\r0\r0,00\r", b"0\r7\r0,40\r"),
+    # a halted L holds RUN: R refused, where the clean unit restores an empty save
+    "restore-refused-while-run": ([b"!0L1000,0,0\r", 0.01, b"!0H\r", b"!0R\r"],
+                                  b"0\r8\r0\r", b"0\r8\rF\r"),
+    # C700 then C-700 at A5, B500: 0.7 s on the reversal is passed at B500 (back at 677)
+    # or braked to rest there (still at 694)
+    "reversal-brakes-to-rest": ([b"!0A5\r", 0.001, b"!0B500\r", 0.001, b"!0V2000\r", 0.001,
+                                 b"!0C700,0,0\r", 0.001, b"!0C-700,0,0\r", 0.7, b"!0PF\r"],
+                                b"0\r" * 5 + b"0,677,0,0\r", b"0\r" * 5 + b"0,694,0,0\r"),
     # 50 ms into L100 at the reset's A20 the X counter shows one step less
     "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
                             b"0\r0,23,0,0\r"),
@@ -102,6 +113,13 @@ POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
                                    b"!0SR6\r", b"!0Y+\r"],
                                   b"0\r" * 17 + b"0,40\r0,Y+\r",
                                   b"0\r" * 17 + b"0,00\r5\r"),
+}
+
+#: readings of what only the GVE54 has (its motor mode M)
+POINTS_54: dict[str, tuple[list[Step], bytes, bytes]] = {
+    # a halted L holds RUN: M refused (7 with INTA), where the clean unit takes it
+    "motor-mode-refused-while-run": ([b"!0L1000,0,0\r", 0.01, b"!0H\r", b"!0MF\r"],
+                                     b"0\r8\r8\r", b"0\r8\rF\r"),
 }
 
 
@@ -142,7 +160,7 @@ def answers(readings: tuple[str, ...], frames: list[Step], profile: str = "GVE84
 
 
 def test_every_reading_has_its_point_here():
-    assert set(POINTS) | set(POINTS_114) | set(RATE_POINTS) == set(READINGS)
+    assert set(POINTS) | set(POINTS_114) | set(POINTS_54) | set(RATE_POINTS) == set(READINGS)
 
 
 @pytest.mark.parametrize("name", sorted(RATE_POINTS))
@@ -164,6 +182,13 @@ def test_a_reading_of_the_gve114_answers_its_point_otherwise(name):
     frames, clean, read = POINTS_114[name]
     assert answers((), frames, "GVE114-500") == clean
     assert answers((name,), frames, "GVE114-500") == read
+
+
+@pytest.mark.parametrize("name", sorted(POINTS_54))
+def test_a_reading_of_the_gve54_answers_its_point_otherwise(name):
+    frames, clean, read = POINTS_54[name]
+    assert answers((), frames, "GVE54") == clean
+    assert answers((name,), frames, "GVE54") == read
 
 
 def test_readings_combine():

@@ -154,11 +154,13 @@ def test_a_target_whose_d_misbehaves_gets_a_fail_naming_d_and_diff_runs_on(mutan
     assert "100 sequences" in out
 
 
-def test_a_sequence_the_known_state_cannot_undo_is_named_and_ends_the_search(tmp_path, capsys):
+def test_a_sequence_the_known_state_cannot_undo_is_named_and_the_next_untested(tmp_path,
+                                                                             capsys):
     """A unit that sums checksums its own way is left by `%+` where no frame framed as
     the manual states reaches it: the disagreement is kept, the known state's H names the
-    checksum's rule with the frames that led there, and the search ends COULD-NOT-TEST,
-    never PASS, without a traceback."""
+    checksum's rule with the frames that led there, the sequence that could not begin
+    from the known state is COULD-NOT-TEST, and the co-simulator, powered on through its
+    rig, takes the rest of the search: never a PASS, never a traceback."""
     target = (f"exec:{sys.executable} -m emulator --cosim --model GVE84-100 "
               "--mutant checksum-no-comma")
     status = main(["diff", "--target", target, "--profile", "GVE84-100", "--yes",
@@ -167,12 +169,16 @@ def test_a_sequence_the_known_state_cannot_undo_is_named_and_ends_the_search(tmp
     assert status == 1 and "Traceback" not in out + err
     assert "FAIL        6.checksum.response-sum: !0%+" in out
     assert "FAIL        6.checksum.sum: the known state: H framed as the manual states" in out
-    assert "COULD-NOT-TEST: the known state could not be had" in err
+    assert "sequence(s): the known state could not be had" in out
+    assert "100 sequences" in out
     (folder,) = tmp_path.iterdir()
     results = {r["id"]: r for r in json.loads((folder / "results.json").read_text())
                ["results"]}
-    assert results["diff.search.agreement"]["verdict"] == "COULD-NOT-TEST"
-    assert any("%+" in note for note in results["diff.search.agreement"]["notes"])
+    assert "diff.search.agreement" not in results
+    untested = results["diff.search.known-state"]
+    assert untested["verdict"] == "COULD-NOT-TEST"
+    assert "sequence(s) not tested: the known state could not be had: the unit refuses the " \
+        "known state's frames" in untested["notes"][0]
     assert any("> !0%+" in line for line in results["6.known-state.halt"]["wire_log"])
 
 

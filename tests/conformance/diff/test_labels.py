@@ -93,6 +93,14 @@ def test_a_repeat_after_an_index_is_whether_the_index_is_remembered():
     assert label(">", "data", set(), {"V"}, 0, 0) == "8.repeat.answer"
 
 
+def test_what_a_unit_does_in_the_t_dwell_after_l0_0_0_is_the_zero_vectors_reading():
+    # a unit holding RUN for T after L0,0,0 (a normal vector to a reader of the manual)
+    assert label("F", "data", {"after-zero-vector", "st6-run"}, {"L"}, 0, 0) == \
+        "10.2.motion.zero-length"
+    assert label("N", "code", {"after-zero-vector"}, {"L"}, 0, 7) == "10.2.motion.zero-length"
+    assert label("F", "data", {"st6-run"}, {"L"}, 0, 0) != "10.2.motion.zero-length"
+
+
 def test_what_a_stated_rule_isolates_names_it_not_the_decision_beside_it():
     # a VL that capped only axes the motion never moved: another axis's value held it
     assert label("PF", "position", {"capped-elsewhere"}, {"VL", "L"}, 0) == \
@@ -156,6 +164,15 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                               ("PF", "position", set(), {"VL", "L"}, 0, 0)),
     "10.2.motion.dominant-rate": ("10.2.measured.cruise-at-v",
                                   ("PF", "position", set(), {"V", "L"}, 0, 0)),
+    # what a vector with no motion holds: RUN within the T dwell after L0,0,0
+    "10.2.motion.zero-length": ("10.2.measured.zero-length-c",
+                                ("F", "data", {"after-zero-vector", "st6-run"}, {"L"}, 0, 0)),
+    # R refused as busy while halted vectors hold RUN: taken after H by the reference
+    "5.moving.after-halt": ("5.errors.n-while-run",
+                            ("R", "code", set(), {"H", "K", "L"}, 0, 7)),
+    "10.2.motion.junction-reversal": ("10.2.measured.junction-reversal",
+                                      ("PF", "position", {"reversal"}, {"C", "junction"},
+                                       0, 0)),
     "10.2.motion.dwell": ("10.2.measured.dwell",
                           ("PF", "position", {"in-dwell"}, {"L"}, 0, 0)),
     "10.2.motion.junction": ("10.2.measured.junction",

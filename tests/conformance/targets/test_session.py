@@ -254,6 +254,47 @@ def test_a_return_move_still_running_after_its_wait_idiom_fails_that_rule_and_is
     assert ERROR not in [r.verdict for r in result.results]
 
 
+def test_an_r_refused_at_rest_with_a_k_held_is_still_a_fail_of_its_rule():
+    # R answered as an unknown command (3) once the halted vectors are deleted: at rest,
+    # with the save of a K the unit took, no reading refuses it
+    u = unit(frames={b"!0R\r": b"!0Z\r"}, allow_destructive=True)
+    result = run([u], select(["10.5.keep.single-l", "5.errors.ok"]))
+    rows = [r for r in result.results if r.id.endswith("known-state.restore")]
+    assert len(rows) == 1 and rows[0].verdict == FAIL
+    (check,) = rows[0].checks
+    assert check["rule"] == "10.5.restore.exact" and check["observed"] == "R 3 at rest"
+
+
+#: readings of what the known state sends (profile, reading): L0,0,0 holding RUN for its
+#: T dwell (N after the return move, N<axis> and EW at the end), R refused while halted
+#: vectors hold RUN (a K a case left, given back after H), M refused likewise (the GVE54's
+#: reset frames)
+MACHINERY_READINGS = [("GVE84-100", "zero-vector-dwells"), ("GVE54", "zero-vector-dwells"),
+                      ("GVE84-100", "restore-refused-while-run"),
+                      ("GVE54", "restore-refused-while-run"),
+                      ("GVE54", "motor-mode-refused-while-run")]
+#: cases that end moving, halted, with a K held, or right after L0,0,0
+MACHINERY_CASES = [*CASES, "10.1.*", "10.5.*", "10.7.*", "10.cmd.zero*"]
+
+
+@pytest.mark.parametrize(("profile", "reading"), MACHINERY_READINGS)
+def test_the_known_state_waits_for_run_to_clear_under_every_reading(profile, reading):
+    u = used_unit(profile, max_travel=4000, readings=(reading,), allow_destructive=True)
+    result = run([u], select(MACHINERY_CASES))
+    # nothing of the machinery FAILs, nothing is lost to a unit not brought to rest
+    steps = [(r.id, r.checks) for r in result.results if ".known-state." in r.id]
+    assert steps == []
+    lost = [(r.id, r.notes[:1]) for r in result.results if r.verdict == COULD_NOT_TEST
+            and any("known state" in n or "not at rest" in n for n in r.notes)]
+    assert lost == []
+    # the unit left at rest, as found: nothing moving, counters, EEPROM, status words back
+    assert result.problems == []
+    state = u.state()
+    assert state["status"][6] == "00" and state["queue"] == 0
+    report = result.sessions[u.info.spec]
+    assert any(line.startswith("axes back where the run began") for line in report["restored"])
+
+
 def _opened_with_work(spec: str, extensions: frozenset[str] | None = None
                       ) -> list[bool]:
     """For each run of the work given to ``open_link``: whether frames of the known
