@@ -13,11 +13,18 @@ restorations), and :class:`TargetNotResponding` after a few frames in a row got 
 answer.
 
 A unit that restarts by itself is seen in what it reads back (the envelope's
-:meth:`~conformance.link.envelope.Envelope.observe`): the case in which it is seen ends
+:meth:`~conformance.link.envelope.Envelope.observe`): the power-on counters (spec 9)
+where the frames put the axes elsewhere. The case in which it is seen ends
 (:class:`UnitRestarted`), the restart is kept in :attr:`Guard.restarts` for the
 report, and where the axes are is no longer known unless they cannot have moved since
 they last were: then no motion frame goes out (:attr:`Guard.lost`) until the session
 locates them again (:meth:`Guard.locate`).
+
+Other counters than the frames allow are no restart: the unit moved by another amount
+than the frames say (a fault a case judges), or the axes were moved by other means. The
+answer goes back to the case, which judges what it read; the guard keeps what it saw
+with the frames that led there (:attr:`Guard.untracked`) and, as after a restart, lets
+no motion frame out until the axes are located.
 
 Public interface (docs/suite.md, "The session and its guard")::
 
@@ -79,6 +86,24 @@ class Restart:
 
     def __str__(self) -> str:
         return f"{self.seen}; {self.where}: {self.then}"
+
+
+@dataclass
+class Untracked:
+    """Counters read at rest that the frames cannot explain, and no power-on counters: the
+    frames since the last read that agreed, what was read, where the axes may be, and
+    what the run did about it."""
+
+    seen: str
+    where: str
+    then: str
+
+    def __str__(self) -> str:
+        return f"{self.seen}; {self.where}: {self.then}"
+
+
+#: the frames since the last read that agreed that a disagreement names (the last ones)
+FRAMES_SHOWN = 12
 
 
 class UnitRestarted(SafetyStop):
@@ -205,6 +230,12 @@ class Guard:
         #: were), for the report
         self.restarts: list[Restart] = []
         self._told = 0                            # restarts a case has been stopped for
+        #: counters read at rest that the frames could not explain, with no restart's
+        #: power-on counters (the report's; the case that read them judges them)
+        self.untracked: list[Untracked] = []
+        #: the frames booked since a position read at rest last agreed, with their answers
+        self.since: list[str] = []
+        self._lost_by: Restart | Untracked | None = None    # what set :attr:`lost`
         #: why no motion frame may go out (the axes are not known to be anywhere exact
         #: since a restart); "" while they are
         self.lost = ""
@@ -369,15 +400,29 @@ class Guard:
                 self.packet.append(steps)
             if response is not None:      # answered: the unit did not take it as a member
                 self.envelope.vector(steps, outcome, stand_alone=False)
+            self._follow(body, response)
             return
         event = self._event(command, outcome, None if response is None else response.code)
         if event is not None:
             event(self.envelope)
+        self._follow(body, response)
         self._last = command.name
         self._summing = self._summing or command.name == "%+"
         if command.name == "J" and outcome is not Outcome.REFUSED:
             self._restarting = True          # its silence is the suite's own doing
         self._learn(command, response, outcome)
+
+    def _follow(self, body: str, response: Response | None) -> None:
+        """Keep ``body`` with its answer among the frames since the last read that agreed
+        (only the last :data:`FRAMES_SHOWN` and how many came before them are shown)."""
+        answer = "no answer" if response is None else response.text.removesuffix("\\r")
+        self.since.append(f"{body} → {answer}")
+
+    def _frames_since(self) -> str:
+        """The frames since the last read that agreed, as a disagreement names them."""
+        shown = self.since[-FRAMES_SHOWN:]
+        earlier = len(self.since) - len(shown)
+        return (f"{earlier} frame(s), then " if earlier else "") + "; ".join(shown)
 
     # -- frames told ahead ------------------------------------------------------------------
     def ahead(self) -> Guard:
@@ -421,10 +466,11 @@ class Guard:
         as a test rig's eyes see them) while the counters read ``counters``: motion may
         go out again."""
         self.envelope.locate(physical, counters)
-        if self.lost and self.restarts:
-            self.restarts[-1].then = (f"the test rig then located them at "
-                                      f"{self.whereabouts()}, and motion went on from there")
-        self.lost, self.unanswered = "", 0
+        if self.lost and self._lost_by is not None:
+            self._lost_by.then = (f"the test rig then located them at "
+                                  f"{self.whereabouts()}, and motion went on from there")
+        self.lost, self.unanswered, self._lost_by = "", 0, None
+        self.since = []
 
     def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -522,45 +568,71 @@ class Guard:
 
     def _read(self, name: str, counters: dict[int, int]) -> None:
         """A position read: when it tells the counters no longer count from where the
-        frames say, the axes are located on their trail, the event is kept for the
-        report and the case ends; motion stops unless they cannot have moved since."""
+        frames say, the axes are located on their trail and the event is kept for the
+        report; motion stops unless they cannot have moved since. The power-on counters
+        (a restart) end the case; other counters go back to the case, which judges
+        them."""
         e = self.envelope
         if self._unmoved:                  # nothing moved since: a counter, not the axes
             e.anchor(counters)
             self.unanswered = 0
+            self.since = []
             return
         expected = e.expected(sorted(counters))
         read = e.observe(counters, silence=self.unanswered > 0)
         if read in (Read.AGREES, Read.UNHELD):
             self.unanswered = 0
+            self.since = []
         if read not in (Read.RESTARTED, Read.CONTRADICTS):
             return
         shown = ",".join(str(v) for v in counters.values())
         frames = ",".join(_counts(s) for s in expected)
         silent = (f" after {self.unanswered} frame(s) went unanswered" if self.unanswered
                   else "")
+        led, unanswered = self._frames_since(), self.unanswered
+        self.unanswered = 0
+        self.since = []
+        if read is Read.CONTRADICTS and not unanswered:
+            # no power-on counters and no frame lost: no restart is said (spec 2, 9); the
+            # unit moved otherwise than the frames say, or its axes were moved by other
+            # means
+            record = Untracked(
+                f"the position counters disagree with the frames: {name} read {shown} at "
+                f"rest where the frames since the last read that agreed put them at "
+                f"{frames} (frames: {led or 'none'})", "", "")
+            self.untracked.append(record)
+            self._locate_on_trail(record)
+            return
         if read is Read.CONTRADICTS:
             what = (f"the position counters no longer tell where the axes are: {name} read "
-                    f"{shown} at rest where the frames put them at {frames}{silent} (the "
-                    "unit restarted by itself and moved on, or its axes were moved by "
-                    "other means)")
+                    f"{shown} at rest where the frames put them at {frames}{silent} (a unit "
+                    "that restarts by itself loses the frames sent meanwhile, spec 2, and "
+                    f"may have moved on since; frames: {led})")
         elif any(not s.exact or s.lo != 0 for s in expected):
             what = (f"the unit restarted by itself: {name} read {shown} at rest, the "
                     f"power-on counters (spec 9), where the frames put them at "
                     f"{frames}{silent}")
         else:
             what = (f"the unit restarted by itself, as far as the suite can tell: "
-                    f"{self.unanswered} frame(s) went unanswered, then {name} read {shown}, "
-                    "the power-on counters (spec 9), after the axes had moved")
-        self.unanswered = 0
-        if all(s.exact for s in e.start):
-            self.restarts.append(Restart(what, f"the axes stood at {self.whereabouts()} "
-                                         "(they had not moved since they were last known)",
-                                         "the run went on from there"))
+                    f"{unanswered} frame(s) went unanswered, then {name} "
+                    f"read {shown}, the power-on counters (spec 9), after the axes had "
+                    "moved")
+        self.restarts.append(Restart(what, "", ""))
+        self._locate_on_trail(self.restarts[-1])
+
+    def _locate_on_trail(self, record: Restart | Untracked) -> None:
+        """Where the axes are after a read the frames cannot explain: exact where they
+        cannot have moved since they last were known (the run goes on from there), else
+        somewhere on their trail, and no motion frame goes out until they are located."""
+        if all(s.exact for s in self.envelope.start):
+            record.where = (f"the axes stood at {self.whereabouts()} (they had not moved "
+                            "since they were last known)")
+            record.then = "the run went on from there"
             return
-        where = f"the axes stopped somewhere in {self.whereabouts()}"
-        self.lost = f"{what}; {where}, and nothing tells where exactly"
-        self.restarts.append(Restart(what, where, "no motion frame went out after it"))
+        record.where = f"the axes stopped somewhere in {self.whereabouts()}"
+        record.then = "no motion frame went out after it"
+        self.lost = f"{record.seen}; {record.where}, and nothing tells where exactly"
+        self._lost_by = record
 
     def whereabouts(self) -> str:
         """Where each axis is, in full steps from where the run began: ``X 0..1500, Y 0``."""
