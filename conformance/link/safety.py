@@ -213,8 +213,7 @@ class Guard:
             tuple(micro.factors.values()) if micro else (1,),
             micro.factors[micro.reset_mode] if micro else 1)
         self.addresses = {address} | ({profile.spindle.address} if profile.spindle else set())
-        self.packet: list[list[Span]] = []       # C members since *S
-        self.packet_open = False
+        self.packet_open = False                  # *S booked, no *E nor breaker since
         self.eeprom = EepromLedger()
         self.before_motion: Callable[[], bool | None] | None = None
         self.motion_confirmed: bool | None = None
@@ -371,8 +370,10 @@ class Guard:
                 f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
         # G and a write of ST6 resume the queue, R the save: they move only when something waits
-        waiting = {"queue": e.queue, "save": e.saved}.get(_RESUMES.get(command.name, ""))
-        if reach != e.reach() or (waiting and any(p != EMPTY for p in waiting)):
+        waiting = {"queue": any(p != EMPTY for p in e.queue),
+                   "save": e.saved is not None and e.save_moves}.get(
+                       _RESUMES.get(command.name, ""), False)
+        if reach != e.reach() or waiting:
             if self.interrupts.stopped:
                 raise SafetyStop(f"{body}: no motion after Ctrl-C")
             if self.lost:
@@ -395,11 +396,12 @@ class Guard:
         command = Body.parse(body)
         outcome = outcome_of(response)
         if command.name in _PACKET_MEMBERS and self.packet_open:
-            steps = command.fields(self.envelope.axes)
             if command.name == "C":
-                self.packet.append(steps)
-            if response is not None:      # answered: the unit did not take it as a member
-                self.envelope.vector(steps, outcome, stand_alone=False)
+                # a member (unanswered) may be committed as it arrives, or only at *E,
+                # or never (all-or-nothing is our reading [D]): maybe, from now on;
+                # answered, the unit did not take it as one
+                self.envelope.vector(command.fields(self.envelope.axes), outcome,
+                                     stand_alone=False)
             self._follow(body, response)
             return
         event = self._event(command, outcome, None if response is None else response.code)
@@ -434,7 +436,6 @@ class Guard:
         nothing here."""
         trial = copy.copy(self)
         trial.envelope, trial.eeprom = _copied(self.envelope), _copied(self.eeprom)
-        trial.packet = [list(member) for member in self.packet]
         if self.motion_confirmed is None and self.before_motion is not None:
             trial.before_motion = lambda: False
         return trial
@@ -442,16 +443,12 @@ class Guard:
     def book_any(self, body: str, address: int | None = None) -> None:
         """Book the frame ``body`` as though it got any answer at all: what it may have
         done counted whichever way reaches farther (an unclear outcome), and a `C` while
-        a packet may be open both as a member and as a vector (answered, the unit did not
-        take it as one). What only an answer tells (the unit at rest, where the axes
-        are) is not learnt."""
+        a packet may be open as a vector that may or may not have been taken (a member
+        counts so from when it is sent). What only an answer tells (the unit at rest,
+        where the axes are) is not learnt."""
         address = self.address if address is None else address
         if address not in self.addresses:
             return
-        command = Body.parse(body)
-        if command.name in _PACKET_MEMBERS and self.packet_open:
-            self.envelope.vector(command.fields(self.envelope.axes), Outcome.UNCLEAR,
-                                 stand_alone=False)
         self.accepted(body, None, address)
 
     def restarted(self) -> None:
@@ -487,16 +484,14 @@ class Guard:
 
     def _vector(self, command: Body, outcome: Outcome,
                 code: int | None) -> Callable[[Envelope], None]:
-        """`L`, `C`, and `*E` committing the packet's `C` members (a member sent while
-        the packet is open is judged with the members before it)."""
+        """`L` and `C`; a `C` member of an open packet counts as maybe taken from when it
+        is sent (a unit may commit members as they arrive), so `*E` adds nothing to
+        them, whatever its answer."""
         steps = command.fields(self.envelope.axes)
-        if command.name == "*E" or (command.name == "C" and self.packet_open):
-            members = list(self.packet) + ([steps] if command.name == "C" else [])
-            if command.name == "*E" and outcome is Outcome.REFUSED:
-                # all-or-nothing is our reading [D]: a unit may have committed the
-                # members as they arrived, so a refused *E leaves them maybe committed
-                outcome = Outcome.UNCLEAR
-            return lambda e: _commit(e, members, outcome)
+        if command.name == "*E":
+            return lambda e: None
+        if command.name == "C" and self.packet_open:
+            return lambda e: e.vector(steps, Outcome.UNCLEAR, stand_alone=False)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
     def _mode(self, command: Body, outcome: Outcome,
@@ -544,16 +539,13 @@ class Guard:
         unit shows it rests, a position is read."""
         name = command.name
         if name == "*S":
-            self._drop_packet()
-            self.packet, self.packet_open = [], True
+            self.packet_open = True
         elif name == "*E":
             self.packet_open = False
-            if outcome is not Outcome.UNCLEAR:
-                self.packet = []
         elif name in _PACKET_BREAKERS and r is not None:
             # unanswered, it may have been taken as a member: that a breaker closes the
             # packet is our reading [D], and only *E is sure to (spec 7)
-            self._drop_packet()
+            self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
@@ -641,14 +633,6 @@ class Guard:
     def where(self, axis: int) -> str:
         """Where ``axis`` may be, in full steps from where the run began: ``0..1500``."""
         return _span(self.envelope.reach()[axis], self.scale)
-
-    def _drop_packet(self) -> None:
-        """An open packet discarded without `*E` (a breaker, a second `*S`): that nothing
-        of it is committed is our reading [D]; a unit may have committed its members as
-        they arrived, so they count as maybe committed."""
-        if self.packet_open and self.packet:
-            _commit(self.envelope, self.packet, Outcome.UNCLEAR)
-        self.packet, self.packet_open = [], False
 
     def doubt_rest(self) -> None:
         """The unit showed that something may still move although an answer said
@@ -786,11 +770,6 @@ def _copied(record: object) -> object:
         if isinstance(value, (list, dict, set)):
             setattr(twin, name, copy.copy(value))
     return twin
-
-
-def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:
-    for steps in members:
-        e.vector(steps, outcome, stand_alone=False)
 
 
 def _counts(span: Span) -> str:
