@@ -436,6 +436,8 @@ class Guard:
         nothing here."""
         trial = copy.copy(self)
         trial.envelope, trial.eeprom = _copied(self.envelope), _copied(self.eeprom)
+        trial.since, trial.restarts, trial.untracked = \
+            list(self.since), list(self.restarts), list(self.untracked)
         if self.motion_confirmed is None and self.before_motion is not None:
             trial.before_motion = lambda: False
         return trial
