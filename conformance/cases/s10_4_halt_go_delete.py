@@ -16,7 +16,7 @@ from conformance.cases._kit import (
     show,
     vector,
 )
-from gve_fixtures.protocol import ErrorCode
+from gve_fixtures.protocol import ErrorCode, St6
 
 # id -> (rules (the first judges the readings), commands it requires, families, scenario)
 SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], list]] = {
@@ -75,9 +75,15 @@ def go_empty(ctx: CaseContext) -> None:
 @case("10.4.go.resumes-exactly",
       rules=("10.4.go.resume",))
 def go(ctx: CaseContext) -> None:
-    """G resumes the interrupted vector from the exact step: no step lost or gained."""
+    """G resumes the interrupted vector from the exact step: no step lost or gained; read
+    at once, ST6 shows INTA and INTCOM cleared (RUN while the rest runs)."""
     halted_with_queue(ctx)
     answers(ctx, ctx.link.send("G"), "0", "G clears INTA")
+    r = ctx.link.send("SR6")
+    st6 = r.hex() if r is not None and r.ok and r.values else None
+    ctx.expect(st6 is not None and not st6 & (St6.INTA | St6.INTCOM),
+               "G that resumes held vectors clears INTA and INTCOM", observed=show(r),
+               expected="0,40 (RUN) or 0,00: INTA and INTCOM clear")
     finished(ctx, 60)
     ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
                observed=position(ctx), expected=[990, 0, 0])

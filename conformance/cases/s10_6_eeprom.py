@@ -90,6 +90,20 @@ def kept(ctx: CaseContext) -> None:
                 rule="9.reset.eeprom-not-copied")
 
 
+@case("10.6.eeprom.kept-across-j", destructive=True, rules=("10.6.eeprom.kept",))
+def kept_across_j(ctx: CaseContext) -> None:
+    """A byte written, `J`, the byte read back once the unit is ready (spec 2: about
+    2 s); the session puts the byte back as found after the case."""
+    link = ctx.link
+    r = link.send("ER40")
+    ctx.require(r is not None and r.ok and r.values, "ER40 answered")
+    new = r.hex() ^ 0x5A
+    setup(ctx, "EW40,%02X" % new)
+    answers(ctx, link.send("ER40"), "0,%02X" % new, "ER40 reads the byte written")
+    _restart(ctx, "J")
+    answers(ctx, link.send("ER40"), "0,%02X" % new, "the byte written is kept across J")
+
+
 @case("10.6.eeprom.refused-while-moving", destructive=True, rules=("5.code.busy-eeprom",))
 def busy(ctx: CaseContext) -> None:
     link = ctx.link

@@ -5,8 +5,11 @@ Pure bookkeeping, no I/O. Every axis is a :class:`Span` (an interval: a position
 exactly is a span of one point). A vector the unit may have accepted counts with its
 whole length until the unit has shown it ended (spec 10.1, 10.4, 10.5): the queue of
 one axis is kept as its total and its extreme prefix sums (:class:`Path`), so a queue of
-back-and-forth vectors costs its widest swing, not the sum of its lengths. A halted,
-kept or restored remainder counts whole.
+back-and-forth vectors costs its widest swing, not the sum of its lengths. A halted
+remainder counts whole. A kept one (`K`) is kept as where its run may take each axis:
+the places the queue could still visit when it was kept, carried along by every move
+the axes make until `R` gives it back, so that a read which tells how far the queue had
+got before `K` never makes the remainder count from the wrong place.
 
 `N`, `N<axis>`, `J` and `W` move the counters, not the axes: they change the offset
 between a counter and the physical position, which is how a position read (`PF`, `P`)
@@ -94,12 +97,6 @@ class Path:
     def swing(self) -> Span:
         return Span(self.low, self.high)
 
-    def either(self, other: Path) -> Path:
-        """A path that covers this one and ``other`` run in any order: for a save that
-        may hold one or the other."""
-        return Path(self.swing.hull(other.swing), min(self.low, other.low),
-                    max(self.high, other.high))
-
 
 EMPTY = Path()
 
@@ -129,7 +126,9 @@ class Envelope:
         self.limit = limit                       # counter units either side of the start
         self.start = [ZERO] * axes               # where the queue begins (physical)
         self.queue = [EMPTY] * axes              # accepted, not shown ended
-        self.saved: list[Path] | None = None     # K's save, counted whole
+        #: where the run of K's save may take each axis (None: no save held)
+        self.saved: list[Span] | None = None
+        self.save_moves = False                  # the save holds a vector
         self.settled = True                      # nothing can be moving now
         self.offset = [UNKNOWN] * axes           # physical = counter + offset
         self.factor = Span(min(factors), max(factors))   # counter units per commanded step
@@ -188,9 +187,23 @@ class Envelope:
     def ended(self) -> None:
         """The unit showed that everything it accepted has ended (RUN = 0, or an `L` or
         `N` it took, which it takes only then)."""
+        self._carry([q.total for q in self.queue])
         self.start = [s + q.total for s, q in zip(self.start, self.queue, strict=True)]
         self.queue = [EMPTY] * self.axes
         self.settled = True
+
+    def _carry(self, moves: Sequence[Span]) -> None:
+        """The axes moved by ``moves`` while a save is held: its run, which starts from
+        wherever they stand at `R`, moves with them."""
+        if self.saved is not None:
+            self.saved = [s + m for s, m in zip(self.saved, moves, strict=True)]
+
+    def _cut(self) -> None:
+        """The queue stops counting (emptied, or run into the start): it may have run
+        any part of its way."""
+        self._carry([q.swing for q in self.queue])
+        self.start = self.reach()
+        self.queue = [EMPTY] * self.axes
 
     def discard(self, outcome: Outcome, *, keep: bool = False, restart: bool = False) -> None:
         """`D` (the queue emptied where the axes stand), `K` (``keep``: the queue saved
@@ -199,10 +212,16 @@ class Envelope:
             return
         sure = outcome is Outcome.ACCEPTED
         if keep:
-            self.saved = list(self.queue) if sure or self.saved is None else [
-                a.either(b) for a, b in zip(self.saved, self.queue, strict=True)]
-        self.start = self.reach()
-        self.queue = [EMPTY] * self.axes
+            # the save's run goes wherever the queue could still go from here
+            kept, moves = self.reach(), any(q != EMPTY for q in self.queue)
+            self._cut()
+            if sure or self.saved is None:
+                self.saved, self.save_moves = kept, moves
+            else:
+                self.saved = [a.hull(b) for a, b in zip(self.saved, kept, strict=True)]
+                self.save_moves = self.save_moves or moves
+        else:
+            self._cut()
         if restart:
             if sure:
                 self.saved = None
@@ -213,16 +232,18 @@ class Envelope:
         self.settled = sure
 
     def restore(self, outcome: Outcome) -> None:
-        """`R`: the saved queue, whole, runs from where the axes stand after `G`."""
+        """`R`: the saved queue replaces what is held and runs after `G` from where the
+        axes stand: they may then be anywhere its run goes, and rest there once the unit
+        shows it ended (a read at rest tells where)."""
         if outcome is Outcome.REFUSED:
             return
-        saved = self.saved or [EMPTY] * self.axes
-        self.start = self.reach()
+        self._cut()
+        moves = self.saved is not None and self.save_moves
+        if moves:
+            self.start = [a.hull(b) for a, b in zip(self.start, self.saved, strict=True)]
         if outcome is Outcome.ACCEPTED:
-            self.queue, self.saved = list(saved), None
-        else:
-            self.queue = [Path(q.swing, q.low, q.high) for q in saved]
-        self.settled = outcome is Outcome.ACCEPTED and all(q == EMPTY for q in self.queue)
+            self.saved, self.save_moves = None, False
+        self.settled = outcome is Outcome.ACCEPTED and not moves
         self._see()
 
     def counters(self, values: dict[int, int | None], outcome: Outcome) -> None:
@@ -247,8 +268,8 @@ class Envelope:
         if outcome is Outcome.ACCEPTED:
             self.ended()
         else:
-            self.start = self.reach()
-            self.queue = [EMPTY] * self.axes
+            self._cut()
+        self._carry([travel if a == axis else ZERO for a in range(self.axes)])
         self.start[axis] = self.start[axis] + travel
         if zeroed or outcome is Outcome.UNCLEAR:
             self.offset[axis] = self.start[axis] if outcome is Outcome.ACCEPTED else \

@@ -13,11 +13,18 @@ restorations), and :class:`TargetNotResponding` after a few frames in a row got 
 answer.
 
 A unit that restarts by itself is seen in what it reads back (the envelope's
-:meth:`~conformance.link.envelope.Envelope.observe`): the case in which it is seen ends
+:meth:`~conformance.link.envelope.Envelope.observe`): the power-on counters (spec 9)
+where the frames put the axes elsewhere. The case in which it is seen ends
 (:class:`UnitRestarted`), the restart is kept in :attr:`Guard.restarts` for the
 report, and where the axes are is no longer known unless they cannot have moved since
 they last were: then no motion frame goes out (:attr:`Guard.lost`) until the session
 locates them again (:meth:`Guard.locate`).
+
+Other counters than the frames allow are no restart: the unit moved by another amount
+than the frames say (a fault a case judges), or the axes were moved by other means. The
+answer goes back to the case, which judges what it read; the guard keeps what it saw
+with the frames that led there (:attr:`Guard.untracked`) and, as after a restart, lets
+no motion frame out until the axes are located.
 
 Public interface (docs/suite.md, "The session and its guard")::
 
@@ -79,6 +86,24 @@ class Restart:
 
     def __str__(self) -> str:
         return f"{self.seen}; {self.where}: {self.then}"
+
+
+@dataclass
+class Untracked:
+    """Counters read at rest that the frames cannot explain, and no power-on counters: the
+    frames since the last read that agreed, what was read, where the axes may be, and
+    what the run did about it."""
+
+    seen: str
+    where: str
+    then: str
+
+    def __str__(self) -> str:
+        return f"{self.seen}; {self.where}: {self.then}"
+
+
+#: the frames since the last read that agreed that a disagreement names (the last ones)
+FRAMES_SHOWN = 12
 
 
 class UnitRestarted(SafetyStop):
@@ -188,8 +213,7 @@ class Guard:
             tuple(micro.factors.values()) if micro else (1,),
             micro.factors[micro.reset_mode] if micro else 1)
         self.addresses = {address} | ({profile.spindle.address} if profile.spindle else set())
-        self.packet: list[list[Span]] = []       # C members since *S
-        self.packet_open = False
+        self.packet_open = False                  # *S booked, no *E nor breaker since
         self.eeprom = EepromLedger()
         self.before_motion: Callable[[], bool | None] | None = None
         self.motion_confirmed: bool | None = None
@@ -205,6 +229,12 @@ class Guard:
         #: were), for the report
         self.restarts: list[Restart] = []
         self._told = 0                            # restarts a case has been stopped for
+        #: counters read at rest that the frames could not explain, with no restart's
+        #: power-on counters (the report's; the case that read them judges them)
+        self.untracked: list[Untracked] = []
+        #: the frames booked since a position read at rest last agreed, with their answers
+        self.since: list[str] = []
+        self._lost_by: Restart | Untracked | None = None    # what set :attr:`lost`
         #: why no motion frame may go out (the axes are not known to be anywhere exact
         #: since a restart); "" while they are
         self.lost = ""
@@ -340,8 +370,10 @@ class Guard:
                 f"{_steps(span.lo, self.scale)}..{_steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
         # G and a write of ST6 resume the queue, R the save: they move only when something waits
-        waiting = {"queue": e.queue, "save": e.saved}.get(_RESUMES.get(command.name, ""))
-        if reach != e.reach() or (waiting and any(p != EMPTY for p in waiting)):
+        waiting = {"queue": any(p != EMPTY for p in e.queue),
+                   "save": e.saved is not None and e.save_moves}.get(
+                       _RESUMES.get(command.name, ""), False)
+        if reach != e.reach() or waiting:
             if self.interrupts.stopped:
                 raise SafetyStop(f"{body}: no motion after Ctrl-C")
             if self.lost:
@@ -364,20 +396,35 @@ class Guard:
         command = Body.parse(body)
         outcome = outcome_of(response)
         if command.name in _PACKET_MEMBERS and self.packet_open:
-            steps = command.fields(self.envelope.axes)
             if command.name == "C":
-                self.packet.append(steps)
-            if response is not None:      # answered: the unit did not take it as a member
-                self.envelope.vector(steps, outcome, stand_alone=False)
+                # a member (unanswered) may be committed as it arrives, or only at *E,
+                # or never (all-or-nothing is our reading [D]): maybe, from now on;
+                # answered, the unit did not take it as one
+                self.envelope.vector(command.fields(self.envelope.axes), outcome,
+                                     stand_alone=False)
+            self._follow(body, response)
             return
         event = self._event(command, outcome, None if response is None else response.code)
         if event is not None:
             event(self.envelope)
+        self._follow(body, response)
         self._last = command.name
         self._summing = self._summing or command.name == "%+"
         if command.name == "J" and outcome is not Outcome.REFUSED:
             self._restarting = True          # its silence is the suite's own doing
         self._learn(command, response, outcome)
+
+    def _follow(self, body: str, response: Response | None) -> None:
+        """Keep ``body`` with its answer among the frames since the last read that agreed
+        (only the last :data:`FRAMES_SHOWN` and how many came before them are shown)."""
+        answer = "no answer" if response is None else response.text.removesuffix("\\r")
+        self.since.append(f"{body} → {answer}")
+
+    def _frames_since(self) -> str:
+        """The frames since the last read that agreed, as a disagreement names them."""
+        shown = self.since[-FRAMES_SHOWN:]
+        earlier = len(self.since) - len(shown)
+        return (f"{earlier} frame(s), then " if earlier else "") + "; ".join(shown)
 
     # -- frames told ahead ------------------------------------------------------------------
     def ahead(self) -> Guard:
@@ -389,7 +436,8 @@ class Guard:
         nothing here."""
         trial = copy.copy(self)
         trial.envelope, trial.eeprom = _copied(self.envelope), _copied(self.eeprom)
-        trial.packet = [list(member) for member in self.packet]
+        trial.since, trial.restarts, trial.untracked = \
+            list(self.since), list(self.restarts), list(self.untracked)
         if self.motion_confirmed is None and self.before_motion is not None:
             trial.before_motion = lambda: False
         return trial
@@ -397,16 +445,12 @@ class Guard:
     def book_any(self, body: str, address: int | None = None) -> None:
         """Book the frame ``body`` as though it got any answer at all: what it may have
         done counted whichever way reaches farther (an unclear outcome), and a `C` while
-        a packet may be open both as a member and as a vector (answered, the unit did not
-        take it as one). What only an answer tells (the unit at rest, where the axes
-        are) is not learnt."""
+        a packet may be open as a vector that may or may not have been taken (a member
+        counts so from when it is sent). What only an answer tells (the unit at rest,
+        where the axes are) is not learnt."""
         address = self.address if address is None else address
         if address not in self.addresses:
             return
-        command = Body.parse(body)
-        if command.name in _PACKET_MEMBERS and self.packet_open:
-            self.envelope.vector(command.fields(self.envelope.axes), Outcome.UNCLEAR,
-                                 stand_alone=False)
         self.accepted(body, None, address)
 
     def restarted(self) -> None:
@@ -421,10 +465,11 @@ class Guard:
         as a test rig's eyes see them) while the counters read ``counters``: motion may
         go out again."""
         self.envelope.locate(physical, counters)
-        if self.lost and self.restarts:
-            self.restarts[-1].then = (f"the test rig then located them at "
-                                      f"{self.whereabouts()}, and motion went on from there")
-        self.lost, self.unanswered = "", 0
+        if self.lost and self._lost_by is not None:
+            self._lost_by.then = (f"the test rig then located them at "
+                                  f"{self.whereabouts()}, and motion went on from there")
+        self.lost, self.unanswered, self._lost_by = "", 0, None
+        self.since = []
 
     def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -441,16 +486,14 @@ class Guard:
 
     def _vector(self, command: Body, outcome: Outcome,
                 code: int | None) -> Callable[[Envelope], None]:
-        """`L`, `C`, and `*E` committing the packet's `C` members (a member sent while
-        the packet is open is judged with the members before it)."""
+        """`L` and `C`; a `C` member of an open packet counts as maybe taken from when it
+        is sent (a unit may commit members as they arrive), so `*E` adds nothing to
+        them, whatever its answer."""
         steps = command.fields(self.envelope.axes)
-        if command.name == "*E" or (command.name == "C" and self.packet_open):
-            members = list(self.packet) + ([steps] if command.name == "C" else [])
-            if command.name == "*E" and outcome is Outcome.REFUSED:
-                # all-or-nothing is our reading [D]: a unit may have committed the
-                # members as they arrived, so a refused *E leaves them maybe committed
-                outcome = Outcome.UNCLEAR
-            return lambda e: _commit(e, members, outcome)
+        if command.name == "*E":
+            return lambda e: None
+        if command.name == "C" and self.packet_open:
+            return lambda e: e.vector(steps, Outcome.UNCLEAR, stand_alone=False)
         return lambda e: e.vector(steps, outcome, stand_alone=command.name == "L")
 
     def _mode(self, command: Body, outcome: Outcome,
@@ -498,16 +541,13 @@ class Guard:
         unit shows it rests, a position is read."""
         name = command.name
         if name == "*S":
-            self._drop_packet()
-            self.packet, self.packet_open = [], True
+            self.packet_open = True
         elif name == "*E":
             self.packet_open = False
-            if outcome is not Outcome.UNCLEAR:
-                self.packet = []
         elif name in _PACKET_BREAKERS and r is not None:
             # unanswered, it may have been taken as a member: that a breaker closes the
             # packet is our reading [D], and only *E is sure to (spec 7)
-            self._drop_packet()
+            self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
@@ -522,45 +562,71 @@ class Guard:
 
     def _read(self, name: str, counters: dict[int, int]) -> None:
         """A position read: when it tells the counters no longer count from where the
-        frames say, the axes are located on their trail, the event is kept for the
-        report and the case ends; motion stops unless they cannot have moved since."""
+        frames say, the axes are located on their trail and the event is kept for the
+        report; motion stops unless they cannot have moved since. The power-on counters
+        (a restart) end the case; other counters go back to the case, which judges
+        them."""
         e = self.envelope
         if self._unmoved:                  # nothing moved since: a counter, not the axes
             e.anchor(counters)
             self.unanswered = 0
+            self.since = []
             return
         expected = e.expected(sorted(counters))
         read = e.observe(counters, silence=self.unanswered > 0)
         if read in (Read.AGREES, Read.UNHELD):
             self.unanswered = 0
+            self.since = []
         if read not in (Read.RESTARTED, Read.CONTRADICTS):
             return
         shown = ",".join(str(v) for v in counters.values())
         frames = ",".join(_counts(s) for s in expected)
         silent = (f" after {self.unanswered} frame(s) went unanswered" if self.unanswered
                   else "")
+        led, unanswered = self._frames_since(), self.unanswered
+        self.unanswered = 0
+        self.since = []
+        if read is Read.CONTRADICTS and not unanswered:
+            # no power-on counters and no frame lost: no restart is said (spec 2, 9); the
+            # unit moved otherwise than the frames say, or its axes were moved by other
+            # means
+            record = Untracked(
+                f"the position counters disagree with the frames: {name} read {shown} at "
+                f"rest where the frames since the last read that agreed put them at "
+                f"{frames} (frames: {led or 'none'})", "", "")
+            self.untracked.append(record)
+            self._locate_on_trail(record)
+            return
         if read is Read.CONTRADICTS:
             what = (f"the position counters no longer tell where the axes are: {name} read "
-                    f"{shown} at rest where the frames put them at {frames}{silent} (the "
-                    "unit restarted by itself and moved on, or its axes were moved by "
-                    "other means)")
+                    f"{shown} at rest where the frames put them at {frames}{silent} (a unit "
+                    "that restarts by itself loses the frames sent meanwhile, spec 2, and "
+                    f"may have moved on since; frames: {led})")
         elif any(not s.exact or s.lo != 0 for s in expected):
             what = (f"the unit restarted by itself: {name} read {shown} at rest, the "
                     f"power-on counters (spec 9), where the frames put them at "
                     f"{frames}{silent}")
         else:
             what = (f"the unit restarted by itself, as far as the suite can tell: "
-                    f"{self.unanswered} frame(s) went unanswered, then {name} read {shown}, "
-                    "the power-on counters (spec 9), after the axes had moved")
-        self.unanswered = 0
-        if all(s.exact for s in e.start):
-            self.restarts.append(Restart(what, f"the axes stood at {self.whereabouts()} "
-                                         "(they had not moved since they were last known)",
-                                         "the run went on from there"))
+                    f"{unanswered} frame(s) went unanswered, then {name} "
+                    f"read {shown}, the power-on counters (spec 9), after the axes had "
+                    "moved")
+        self.restarts.append(Restart(what, "", ""))
+        self._locate_on_trail(self.restarts[-1])
+
+    def _locate_on_trail(self, record: Restart | Untracked) -> None:
+        """Where the axes are after a read the frames cannot explain: exact where they
+        cannot have moved since they last were known (the run goes on from there), else
+        somewhere on their trail, and no motion frame goes out until they are located."""
+        if all(s.exact for s in self.envelope.start):
+            record.where = (f"the axes stood at {self.whereabouts()} (they had not moved "
+                            "since they were last known)")
+            record.then = "the run went on from there"
             return
-        where = f"the axes stopped somewhere in {self.whereabouts()}"
-        self.lost = f"{what}; {where}, and nothing tells where exactly"
-        self.restarts.append(Restart(what, where, "no motion frame went out after it"))
+        record.where = f"the axes stopped somewhere in {self.whereabouts()}"
+        record.then = "no motion frame went out after it"
+        self.lost = f"{record.seen}; {record.where}, and nothing tells where exactly"
+        self._lost_by = record
 
     def whereabouts(self) -> str:
         """Where each axis is, in full steps from where the run began: ``X 0..1500, Y 0``."""
@@ -569,14 +635,6 @@ class Guard:
     def where(self, axis: int) -> str:
         """Where ``axis`` may be, in full steps from where the run began: ``0..1500``."""
         return _span(self.envelope.reach()[axis], self.scale)
-
-    def _drop_packet(self) -> None:
-        """An open packet discarded without `*E` (a breaker, a second `*S`): that nothing
-        of it is committed is our reading [D]; a unit may have committed its members as
-        they arrived, so they count as maybe committed."""
-        if self.packet_open and self.packet:
-            _commit(self.envelope, self.packet, Outcome.UNCLEAR)
-        self.packet, self.packet_open = [], False
 
     def doubt_rest(self) -> None:
         """The unit showed that something may still move although an answer said
@@ -714,11 +772,6 @@ def _copied(record: object) -> object:
         if isinstance(value, (list, dict, set)):
             setattr(twin, name, copy.copy(value))
     return twin
-
-
-def _commit(e: Envelope, members: list[list[Span]], outcome: Outcome) -> None:
-    for steps in members:
-        e.vector(steps, outcome, stand_alone=False)
 
 
 def _counts(span: Span) -> str:

@@ -933,7 +933,8 @@ class RealSession(Session):
                 self._unrestored()
             self._keep_log(link)
         # what happened to the unit first: it explains what could not be put back
-        self.report.problems[:0] = [str(r) for r in self.guard.restarts]
+        self.report.problems[:0] = [str(r) for r in (*self.guard.restarts,
+                                                     *self.guard.untracked)]
         self.report.excursion = [list(e) for e in self.guard.excursion()]
 
     def _restore(self, link: Link) -> None:

@@ -66,6 +66,11 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if dev.motion.queued(t) >= room:
         if dev.mutant.active("refused-vector-queued"):
             dev.push(steps, True, t)
+        elif dev.mutant.active("refused-vector-overwrites") and dev.last_vector is not None:
+            # the last queued vector's end moves to where the refused one would end
+            last = dev.last_vector + (0,) * (len(steps) - len(dev.last_vector))
+            dev.push(tuple(s - v for s, v in zip(steps, last, strict=True)), True, t)
+            dev.last_vector = steps
         raise CommandError(ErrorCode.QUEUE_FULL, "the CONT buffer is full")
     dev.push(steps, True, t)
     return []
@@ -243,7 +248,10 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
         raise CommandError(ErrorCode.NOTHING_TO_GO, "G with INTA = 0")
     if dev.readings.active("go-nothing-queued") and not dev.motion.queued(t):
         raise CommandError(ErrorCode.NOTHING_TO_GO, "G with nothing queued")
+    held = dev.motion.queued(t)
     s.status[6] &= ~(INTA | INTCOM)
+    if held and dev.mutant.active("go-keeps-intcom"):
+        s.status[6] |= INTCOM
     s.status[4] = s.status[5] = 0
     dev.motion.resume(t)
     if dev.mutant.active("go-loses-step") and dev.motion.queued(t):

@@ -47,6 +47,11 @@ class Device:
         if readings.active("eeprom-erased-zero"):
             shipped = replace(shipped, erased=0x00)
         self.eeprom = Eeprom(shipped.image(), eeprom_path)
+        #: the mutant eeprom-forgotten-at-restart: bytes as they were before the writes
+        #: since the last restart, given back at the next
+        self._unsaved: dict[int, int] = {}
+        #: the last vector queued, in commanded steps (the mutant refused-vector-overwrites)
+        self.last_vector: tuple[int, ...] | None = None
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
                              deviations=mutant.deviations | readings.deviations)
@@ -77,6 +82,9 @@ class Device:
         self.motion.set_multiplier(self.state.xm, t)
         if self.mutant.active("restart-resets-inputs"):
             self.inputs = dict(UNCONNECTED)
+        for address, value in sorted(self._unsaved.items()):
+            self.eeprom.write(address, bytes([value]))
+        self._unsaved = {}
         self._was_active = self._active()
         self.deaf_until = t + p.restart_ms * MS
         self.due = []
@@ -265,6 +273,7 @@ class Device:
         step_f = 1 if continuous and act("microstep-continuous-unscaled") else f
         if act("a-axis-alone-ignored") and len(steps) == 4 and not any(steps[:3]):
             steps = (0, 0, 0, 0)
+        self.last_vector = steps
         self.motion.push(Vector(
             steps=tuple(s * step_f for s in steps), continuous=continuous,
             velocity=min(v, mr) * rate_f, accel=accel * 1000 * f,
@@ -395,6 +404,9 @@ class Device:
     def write_eeprom(self, address: int, data: bytes, t: int) -> None:
         if not self.readings.active("eeprom-write-while-moving"):
             self.refuse_while_moving(t)
+        if self.mutant.active("eeprom-forgotten-at-restart"):
+            for i in range(len(data)):
+                self._unsaved.setdefault(address + i, self.eeprom.read(address + i)[0])
         if not self.mutant.active("eeprom-write-lost"):
             self.eeprom.write(address, data)
 

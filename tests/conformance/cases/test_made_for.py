@@ -37,6 +37,8 @@ MADE_FOR = {
     "10.4.measured.halt-ramp": ("halt-without-ramp", "GVE84-100"),
     "10.4.measured.go-from-rest": ("go-at-speed", "GVE84-100"),
     "10.7.measured.microstep-rates": ("microstep-rates-unscaled", "GVE54"),
+    "10.4.go.resumes-exactly": ("go-keeps-intcom", "GVE54"),
+    "10.6.eeprom.kept-across-j": ("eeprom-forgotten-at-restart", "GVE114-500"),
 }
 
 

@@ -20,6 +20,8 @@ CATCHES = {
     "eeprom-7-bit-address": ("10.6.eeprom.every-address", "10.cmd.eeprom-bytes", FAMILIES),
     "refused-vector-queued": ("10.1.queue.refused-leaves-queue",
                               "4.response.failed-not-executed", FAMILIES),
+    "refused-vector-overwrites": ("10.1.queue.refused-leaves-queue",
+                                  "4.response.failed-not-executed", FAMILIES),
     "failed-packet-keeps-b": ("7.packet.failed-leaves-nothing", "7.packet.all-or-nothing",
                               ("GVE84-100", "GVE114-500")),
 }

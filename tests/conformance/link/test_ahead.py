@@ -98,12 +98,13 @@ def test_a_frame_told_ahead_is_let_through_whatever_the_answers_before_it(before
 def test_judging_ahead_changes_nothing_of_the_guard():
     g = guard()
     sent(g, "C100,0,0", "0")
-    before = (g.envelope.reach(), list(g.envelope.seen), dict(vars(g.eeprom)), g.packet_open)
+    before = (g.envelope.reach(), list(g.envelope.seen), dict(vars(g.eeprom)), g.packet_open,
+              list(g.since))
     ahead = Ahead(link(g))
     for body in ("*S", "C200,0,0", "C200,0,0", "*E", "EW05,AA"):
         ahead.admit(frame(body, 0, False), 1.0)
     assert (g.envelope.reach(), list(g.envelope.seen), dict(vars(g.eeprom)),
-            g.packet_open) == before
+            g.packet_open, list(g.since)) == before
 
 
 def test_nothing_is_told_after_a_position_read():

@@ -106,29 +106,36 @@ def test_a_halted_and_deleted_vector_leaves_the_axis_anywhere_on_it_until_read()
     sent(g, "L377,0,0")                    # to 500 exactly
 
 
-def test_a_kept_remainder_counts_whole_when_restored():
+def test_a_kept_remainder_runs_to_where_the_queue_would_have_ended_moved_as_the_axes_moved():
+    """K keeps what is left of the queue, however far it got: its run ends where the
+    queue would have, shifted by every move the axes make before R. A read after K that
+    tells how far it got (100 of 450) does not make the remainder count whole from there
+    (100..550 would leave the envelope; a unit goes to 450)."""
     g = guard()
     sent(g, "C450,0,0")
     sent(g, "H", "8")
-    sent(g, "K")                           # the remainder saved: up to 450 more
-    sent(g, "PF", "0,100,0,0")
+    sent(g, "K")                           # the save: what is left of 0..450
+    sent(g, "PF", "0,100,0,0")             # halted at 100: 350 are left
     sent(g, "L0,0,-300")
     sent(g, "L0,0,300")
     sent(g, "SR6", "0,00")
-    assert "X could reach 100..550" in refused(g, "R")
-    sent(g, "L-100,0,0")
+    g.check("R")                           # within 100..450
+    sent(g, "L-100,0,0")                   # the save's run moves with the axes: 0..350
     sent(g, "SR6", "0,00")
-    sent(g, "R", "8")                      # now from 0: up to 450
+    sent(g, "R", "8")
     sent(g, "G")
-    assert x(g) == (0, 450)
+    assert x(g) == (-100, 350)
+    sent(g, "SR6", "0,00")
+    sent(g, "PF", "0,350,0,0")             # where a unit rests: inside, and now known
+    assert x(g) == (350, 350) and not g.restarts and not g.untracked
 
 
 def test_a_packet_is_judged_whole_before_its_end_is_sent():
     g = guard()
     sent(g, "*S", None)
     for _ in range(4):
-        sent(g, "C100,0,0", None)          # members: no answer, not yet committed
-    assert x(g) == (0, 0)
+        sent(g, "C100,0,0", None)          # members: no answer, maybe committed as they come
+    assert x(g) == (0, 400)
     refused(g, "C200,0,0")                 # a member that would make the packet 600
     sent(g, "*E4", "0,4")
     assert x(g) == (0, 400)
@@ -215,3 +222,15 @@ def test_a_packet_a_breaker_discards_may_have_been_committed_as_it_arrived():
     sent(g, "C0,-50,0", None)
     sent(g, "*S", None)                    # a second *S restarts it: the same
     assert g.envelope.reach()[1] == Span(-50, 400)
+
+
+def test_a_b_answered_while_a_packet_may_be_open_moves_nothing():
+    """A unit that dropped the packet (a watchdog's reading) answers its B: a modal
+    setting, no vector."""
+    g = guard()
+    sent(g, "*S", None)
+    sent(g, "B200", "0")
+    assert x(g) == (0, 0)
+    sent(g, "L1,0,0")
+    sent(g, "L0,0,0")
+    assert g.envelope.position()[0] == 1

@@ -156,14 +156,23 @@ def test_a_checksum_mode_that_outlived_the_silence_shows_no_restart_came():
 
 
 def test_counters_the_frames_cannot_explain_leave_the_axes_anywhere_either_way():
+    """Not the power-on counters: no restart is said and the case goes on to judge what it
+    read (a unit that moved by another amount is a fault of its own rule); the frames
+    that led there are named, and nothing moves until the axes are located."""
     g = guard()
     sent(g, "L300,0,0")
     sent(g, "L0,0,0")
-    with pytest.raises(UnitRestarted) as told:
-        sent(g, "PF", "0,450,0,0")      # moved by other means, or restarted and moved on
-    assert "no longer tell where the axes are" in str(told.value)
+    sent(g, "PF", "0,450,0,0")          # moved otherwise, or by other means: no exception
+    g.check_idle()                      # the case is not stopped for it
+    assert not g.restarts and len(g.untracked) == 1
+    said = str(g.untracked[0])
+    assert "restart" not in said
+    assert ("PF read 450,0,0 at rest where the frames since the last read that agreed put "
+            "them at 300,0,0 (frames: L300,0,0 → 0; L0,0,0 → 0; PF → 0,450,0,0)") in said
     # where the counter says (450), or 450 from anywhere the axis had been (0..300)
     assert x(g) == Span(450, 750) and g.lost
+    assert "no motion: the position counters disagree" in _refused(g, "L-1,0,0")
+    sent(g, "SR6", "0,00")              # what cannot move still goes out
 
 
 def test_the_case_is_told_once_and_the_sessions_own_frames_go_on():

@@ -118,9 +118,10 @@ class VirtualUnit(PortTarget):
 
 def virtual_unit(profile: str = "GVE84-100", *, max_travel: int = 2000,
                  allow_destructive: bool = False, rig: bool = True,
-                 readings: tuple[str, ...] = ()) -> VirtualUnit:
+                 readings: tuple[str, ...] = (), mutant: str | None = None) -> VirtualUnit:
     p = load_profile(profile)
-    url = f"gve://?model={profile}" + (f"&reading={','.join(readings)}" if readings else "")
+    url = f"gve://?model={profile}" + (f"&reading={','.join(readings)}" if readings else "") \
+        + (f"&mutant={mutant}" if mutant else "")
     info = TargetInfo("serial", f"virtual:{profile}", True, rig, allow_destructive, max_travel)
     unit = VirtualUnit(info, p, p.address, p.default_baud, url)
     unit.with_rig = rig

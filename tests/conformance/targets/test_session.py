@@ -142,23 +142,46 @@ def test_the_d_mutants_through_a_session_fail_d_not_a_wall_of_could_not_test(mut
 
 @pytest.mark.parametrize("destructive", [False, True])
 def test_a_k_whose_save_the_envelope_cannot_take_back_is_cleared_by_j_or_said(destructive):
-    # single-l leaves a K holding ~740 steps of a 990-step queue; R would count it whole
-    # from where the axes then stand, beyond an envelope of 1000
+    """A K that keeps what is left of 990 steps (halted after about 250, read there),
+    then X 700 on: the save's run would end near 1690, beyond an envelope of 1000, so
+    the known state does not send R; J clears the save where destructive commands are
+    allowed, else the unit is said not to be in the known state."""
     u = used_unit("GVE84-100", max_travel=1000, allow_destructive=destructive)
     u.port = Rewritten(u.port, {})
-    result = run([u], select(["10.5.keep.single-l", "11.golden.g4f-status-read"]))
-    verdicts = {r.id: r.verdict for r in result.results}
-    assert verdicts["10.5.keep.single-l"] == PASS
+    session = u.begin()
+    link = session.open_link()
+    for body in ("V500", "C330,0,0", "C330,0,0", "C330,0,0"):
+        assert link.send(body).ok
+    link.wait(0.5)
+    assert link.send("H").inta
+    assert link.send("K").ok
+    assert link.send("PF").ok
+    assert link.send("V5000").ok and link.send("L700,0,0").ok
+    link.wait(1.0)
+    assert link.send("SR6").raw == b"0,00\r"
+    assert not session.guard.fits("R")
+    result = run([u], select(["11.golden.g4f-status-read"]))
     assert b"!0R\r" not in frames_sent(u)
+    (r,) = result.results
     if destructive:
-        assert verdicts["11.golden.g4f-status-read"] == PASS and b"!0J\r" in frames_sent(u)
-        assert result.problems == []
+        assert r.verdict == PASS and b"!0J\r" in frames_sent(u)
     else:
-        (r,) = [r for r in result.results if r.id == "11.golden.g4f-status-read"]
         assert r.verdict == COULD_NOT_TEST and "a KEEP the last case left is still held" in \
             r.notes[0]
-        # and the end of the run says the unit is left so
         assert any("KEEP" in p for p in result.problems), result.problems
+
+
+def test_a_k_whose_save_runs_where_the_axes_may_already_be_is_given_back_with_r():
+    """single-l leaves a K holding what is left of a 990-step queue and moves X 10 after
+    it: the save's run goes where the queue could still go, moved by those 10 (10..1000),
+    inside an envelope of 1000, so the known state gives it back with R."""
+    u = used_unit("GVE84-100", max_travel=1000, allow_destructive=False)
+    u.port = Rewritten(u.port, {})
+    result = run([u], select(["10.5.keep.single-l", "11.golden.g4f-status-read"]))
+    assert {r.id: r.verdict for r in result.results} == {
+        "10.5.keep.single-l": PASS, "11.golden.g4f-status-read": PASS}
+    assert b"!0R\r" in frames_sent(u) and b"!0J\r" not in frames_sent(u)
+    assert result.problems == []
 
 
 def _known_states(mutant: str, frames: list[str], seconds: float) -> tuple[list, list]:
