@@ -30,8 +30,9 @@ a worker opens a target's port at its first item of that target.
 from __future__ import annotations
 
 import re
-from collections.abc import Generator
-from contextlib import ExitStack
+import sys
+from collections.abc import Generator, Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,8 +40,10 @@ import pytest
 
 from conformance import settings as settings_profiles
 from conformance.case import Case
+from conformance.consent import Consent, NoConsent
 from conformance.explain import reason
 from conformance.link.interrupts import Interrupts
+from conformance.operator import Console
 from conformance.plugin_stop import before_item, hold, interrupted
 from conformance.quoting import quoted
 from conformance.runner import CaseResult, run_case
@@ -50,6 +53,9 @@ from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_
 
 _TARGETS = pytest.StashKey[list[Target]]()
 _INTERRUPTS = pytest.StashKey[Interrupts]()
+_MOTION = pytest.StashKey[bool]()
+#: the controller's answer to "Move this machine?", given to an xdist worker
+MOTION_ALLOWED = "gve_motion_allowed"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -63,8 +69,16 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--gve-settings", default=None,
                 help="Hypothesis settings profile (default: ci in virtual time, the "
                      "emulator's or a co-simulator's; hardware on serial/tcp/exec targets)")
-    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
-    g.addoption("--gve-allow-destructive", action="store_true")
+    g.addoption("--gve-yes", action="store_true",
+                help="real units: move without asking first (unattended benches); without "
+                     "it a unit that can move is asked about on the terminal, and with no "
+                     "terminal the run is refused before anything is sent")
+    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
+                help="real units: the motion envelope in full steps per axis either side "
+                     f"of where the run began (default {DEFAULT_MAX_TRAVEL})")
+    g.addoption("--gve-allow-destructive", action="store_true",
+                help="real units: allow J, W and EEPROM writes (EEPROM backed up and "
+                     "restored)")
     g.addoption("--gve-strict", action="store_true",
                 help="grade a serial/tcp/exec target by the project's decisions too: a "
                 "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
@@ -117,6 +131,44 @@ class CaseReport:
 
     def __str__(self) -> str:
         return "\n".join(self.lines)
+
+
+class Terminal(Console):
+    """The terminal behind pytest's capture: each line shown and each question asked
+    with the capture suspended, so that a person sees the question and answers it."""
+
+    def __init__(self, config: pytest.Config) -> None:   # no look at the terminal yet
+        self._capture = config.pluginmanager.getplugin("capturemanager")
+        self.stdin, self.stdout = sys.__stdin__, sys.__stdout__
+        self._interactive: bool | None = None
+
+    @property
+    def interactive(self) -> bool:
+        """Whether a person can answer: the terminal behind the capture, looked at only
+        when a question may be needed."""
+        if self._interactive is None:
+            with self._uncaptured():
+                self._interactive = self.stdin is not None and self.stdin.isatty()
+        return self._interactive
+
+    @contextmanager
+    def _uncaptured(self) -> Iterator[None]:
+        if self._capture is None:
+            yield
+            return
+        self._capture.suspend(in_=True)     # standard input too: the answer is typed there
+        try:
+            yield
+        finally:
+            self._capture.resume()
+
+    def say(self, text: str) -> None:
+        with self._uncaptured():
+            super().say(text)
+
+    def _answer(self, prompt: str) -> str | None:
+        with self._uncaptured():
+            return super()._answer(prompt)
 
 
 def verdict_line(r: CaseResult) -> str:
@@ -283,27 +335,54 @@ def pytest_configure(config: pytest.Config) -> None:
     if controller and config.option.dist != "loadgroup":
         config.option.dist = "loadgroup"    # only groups keep a port on one worker
     interrupts = Interrupts()
-    targets = []
+    targets, opened = [], []
+    consent = _consent(config, worker)
     try:
         for spec in specs:
             target = parse_target(spec, profile=config.getoption("--gve-profile"),
                                   allow_destructive=config.getoption("--gve-allow-destructive"),
                                   max_travel=config.getoption("--gve-max-travel"),
                                   strict=config.getoption("--gve-strict"))
+            opened.append(target)
             if not worker:
                 target.preflight()
+        if not worker:
+            consent.check(opened)        # no yes and nobody to ask: refused, nothing sent
+        if controller:      # asked once here: the workers have no terminal
+            config.stash[_MOTION] = consent.ask_once(opened, lambda t: ("", ""))
+        for target in opened:
             if controller:
                 target.close()      # it runs nothing; the worker of the port opens it
                 continue
             target.begin(interrupts)
+            consent.arm(target)
             targets.append(target)
+    except NoConsent as err:
+        for t in opened:
+            t.close()
+        raise pytest.UsageError(str(err)) from None
     except (ValueError, LookupError) as err:
-        for t in targets:
+        for t in opened:
             t.close()
         raise pytest.UsageError(str(err)) from None
     config.stash[_TARGETS] = targets
     config.stash[_INTERRUPTS] = interrupts
     hold(config, interrupts, controller=controller)
+
+
+def _consent(config: pytest.Config, worker: bool) -> Consent:
+    """The run's consent to motion (conformance/consent.py): --gve-yes, else the question
+    on the terminal; an xdist worker takes its controller's answer."""
+    if worker:
+        return Consent(bool(config.workerinput.get(MOTION_ALLOWED)),
+                       Console(interactive=False), flag="--gve-yes")
+    return Consent(config.getoption("--gve-yes"), Terminal(config), flag="--gve-yes")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node) -> None:
+    """pytest-xdist: a worker starts with its controller's answer about motion."""
+    node.workerinput[MOTION_ALLOWED] = node.config.stash.get(_MOTION, False)
 
 
 @pytest.hookimpl(tryfirst=True)

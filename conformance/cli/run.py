@@ -21,8 +21,8 @@ from conformance.cli.commands import subcommands_help
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
-    ask_before_motion,
     confirmed,
+    consent,
     record_identities,
     resolve,
     unattended,
@@ -37,6 +37,7 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
+from conformance.consent import ASKED
 from conformance.coverage import coverage, format_coverage
 from conformance.link.account import account_lines
 from conformance.metadata import RunMeta, now_iso
@@ -228,10 +229,9 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     meta = _meta(args, argv, targets, how, cases, seed, console)
     if args.jobs > 1 and len(targets) > 1:
         return _fleet(args, argv, targets, meta, console, run_id)
-    if meta.confirmed == "asked":
+    if meta.confirmed == ASKED:
         for target in targets:
-            if target.info.real:
-                target.session.before_motion = ask_before_motion(target, console, meta)
+            consent(args.yes, console, meta).arm(target)
     say = _nothing if args.quiet else _say       # -q: the last line only
     say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
     say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
@@ -267,7 +267,7 @@ def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], met
     """The targets in processes of their own (cli/fleet.py), asked about once here: the
     members have no terminal."""
     from conformance.cli.fleet import run_fleet
-    if meta.confirmed == "asked" and not confirmed(targets, meta, console):
+    if meta.confirmed == ASKED and not confirmed(targets, meta, console):
         raise UsageError("motion not confirmed, nothing that moves was sent (answer y, or "
                          "give --yes on an unattended bench)")
     for target in targets:
@@ -295,8 +295,7 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how:
     real = any(t.info.real for t in targets)
     meta.operator_steps = (real and console.interactive if args.operator is None
                            else args.operator)
-    if real:
-        meta.confirmed = "--yes" if args.yes else "asked"
+    meta.confirmed = consent(args.yes, console, meta).how(targets)
     try:
         record_identities([t for t in targets if not t.info.real], meta)
     except (OSError, SerialException, ValueError) as err:

@@ -293,7 +293,7 @@ def test_the_first_line_names_the_port(line, url):
 def test_the_plugin_runs_an_exec_target(pytester):
     result = pytester.runpytest(
         "-p", "no:cacheprovider", "--gve-target", "exec:" + shlex.join([*EMULATOR, "--pty"]),
-        "--gve-profile", "GVE84-100", "--gve-cases", "10.cmd.output.port",
+        "--gve-profile", "GVE84-100", "--gve-yes", "--gve-cases", "10.cmd.output.port",
         "--gve-cases", "5.errors.ok", "-q")
     result.assert_outcomes(passed=2)
 
