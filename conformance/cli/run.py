@@ -325,7 +325,7 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     # no --target, or emu:all: the embedded emulator on every profile (--profile is for
     # the targets named)
     specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
-             for s in (every if t.split("?")[0] == "emu:all" else [t])]
+             for s in (_with_query(every, t) if t.split("?")[0] == "emu:all" else [t])]
     try:
         chosen = [resolve(s, args.profile if named else None, args.variant, console)
                   for s, named in specs]
@@ -336,6 +336,13 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     except (ValueError, LookupError, OSError, SerialException) as err:
         raise UsageError(str(err).strip("'\"")) from None
 
+
+
+def _with_query(specs: list[str], given: str) -> list[str]:
+    """``emu:all?mutant=X``: each profile's target with the settings given (checked as
+    any ``emu:`` target's are)."""
+    query = given.partition("?")[2]
+    return [f"{s}?{query}" if query else s for s in specs]
 
 
 def _preflight(targets: list[Target]) -> None:
