@@ -49,7 +49,18 @@ from conformance.quoting import quoted
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT
+from conformance.verdict import (
+    COULD_NOT_TEST,
+    ERROR,
+    FAIL,
+    INCOMPLETE,
+    INFO,
+    MISSING,
+    NON_STRICT,
+    PASSED,
+    UNTESTED,
+    overall,
+)
 
 _TARGETS = pytest.StashKey[list[Target]]()
 _INTERRUPTS = pytest.StashKey[Interrupts]()
@@ -79,6 +90,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--gve-allow-destructive", action="store_true",
                 help="real units: allow J, W and EEPROM writes (EEPROM backed up and "
                      "restored)")
+    g.addoption("--gve-accept-incomplete", action="store_true",
+                help="pass a run that FAILed nothing yet did not test what it was asked to "
+                     "(INCOMPLETE: motion declined, no rig...); otherwise it fails")
     g.addoption("--gve-strict", action="store_true",
                 help="grade a serial/tcp/exec target by the project's decisions too: a "
                 "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
@@ -251,6 +265,8 @@ class GveItem(pytest.Item):
         self.result = result
         self.user_properties += [("verdict", result.verdict), ("tag", self.case.tag),
                                  ("section", self.case.section)]
+        if result.verdict in UNTESTED:          # why, for the run's verdict (verdict.py)
+            self.user_properties.append((NOT_TESTED, "\n".join(result.notes)))
         if result.interrupted:
             interrupted(self.session)       # its verdict reported, no item after it
         if result.verdict in (FAIL, ERROR):
@@ -367,6 +383,8 @@ def pytest_configure(config: pytest.Config) -> None:
         raise pytest.UsageError(str(err)) from None
     config.stash[_TARGETS] = targets
     config.stash[_INTERRUPTS] = interrupts
+    config.stash[_VERDICT] = verdict = RunVerdict()
+    config.pluginmanager.register(verdict, "gve-conformance-verdict")
     hold(config, interrupts, controller=controller)
 
 
@@ -440,10 +458,43 @@ def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Co
             terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
 
 
+@dataclass
+class _Seen:
+    """A case's verdict as the run's verdict reads it: the verdict and its notes (why
+    it was not tested)."""
+
+    verdict: str
+    notes: list[str]
+
+
+class RunVerdict:
+    """The suite's verdict for the whole pytest run, from every case's report (on an
+    xdist controller too: the reports carry their verdicts): PASSED, INCOMPLETE or
+    FAILED, as the command line's last line says it."""
+
+    def __init__(self) -> None:
+        self.seen: list[_Seen] = []
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        props = dict(report.user_properties)
+        if report.when == "call" and "verdict" in props:
+            self.seen.append(_Seen(props["verdict"], props.get(NOT_TESTED, "").split("\n")))
+
+    def line(self, interrupted: bool, problems: list[str]) -> tuple[str, str]:
+        return overall(self.seen, interrupted, problems)
+
+
+_VERDICT = pytest.StashKey[RunVerdict]()
+#: the user property of a case not tested: its notes, a line each
+NOT_TESTED = "not tested because"
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """The end of the pytest run (also after Ctrl-C): every session puts its unit back;
-    what could not be put back is printed and fails the run."""
+    what could not be put back is printed and fails the run. Then the suite's verdict:
+    one that is not PASSED fails the pytest run (one that FAILed nothing yet did not
+    test what it was asked to, INCOMPLETE, passes with --gve-accept-incomplete)."""
     problems, broken = [], []
     for target in session.config.stash.get(_TARGETS, []):
         report = target.session.finish()
@@ -457,6 +508,16 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     for failure in broken:
         print(f"\ngve-conformance: FAIL on {failure}")
     if (problems or broken) and session.exitstatus == pytest.ExitCode.OK:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+    verdict = session.config.stash.get(_VERDICT, None)
+    if verdict is None or _on_xdist_worker(session.config) or not verdict.seen:
+        return
+    word, tail = verdict.line(session.exitstatus == pytest.ExitCode.INTERRUPTED,
+                              problems + broken)
+    print(f"\ngve-conformance: {word} — {tail}")
+    accepted = word == PASSED or (word == INCOMPLETE and session.config.getoption(
+        "--gve-accept-incomplete"))
+    if not accepted and session.exitstatus == pytest.ExitCode.OK:
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol
 
-from conformance.untested import grouped
+from conformance.untested import NOT_IN_PROFILE, grouped
 from gve_fixtures import protocol
 
 PASS = "PASS"
@@ -61,6 +61,9 @@ def failing(verdict: str) -> bool:
 #: the run's overall verdict, the banner of its reports
 PASSED = "PASSED"
 FAILED = "FAILED"
+#: nothing failed, yet the run did not test what it was asked to (motion declined, a
+#: rig missing...): not a pass (docs/suite.md, "The last line")
+INCOMPLETE = "INCOMPLETE"
 #: verdicts that judged the target (the others say why it could not be judged)
 JUDGED = (PASS, NON_STRICT, INFO)
 #: verdicts of what was not tested (their reasons: conformance/untested.toml)
@@ -92,11 +95,14 @@ def not_tested(results: Sequence[Result]) -> str:
 
 def overall(results: Sequence[Result], interrupted: bool = False,
             problems: Sequence[str] = ()) -> tuple[str, str]:
-    """PASSED or FAILED for a run's results, with what was judged and what was not
-    tested and why: ``PASSED``, ``120 PASS, 8 NON-STRICT; not tested: 12 of 149 (9 need
-    a rig, 3 beyond the envelope)``. PASSED only when nothing FAILed or ERRed. A run that
-    judged nothing has not passed: a broken or silent target never earns a PASS; nor has
-    one that left something of a unit unrestored (``problems``) or was interrupted."""
+    """PASSED, INCOMPLETE or FAILED for a run's results, with what was judged and what
+    was not tested and why: ``INCOMPLETE``, ``120 PASS, 8 NON-STRICT; not tested: 12 of
+    149 (9 need a rig, 3 beyond the envelope)``. FAILED when something FAILed or ERRed.
+    A run that judged nothing has not passed: a broken or silent target never earns a
+    PASS; nor has one that left something of a unit unrestored (``problems``) or was
+    interrupted. INCOMPLETE when nothing failed yet a case was not tested for a reason
+    other than its rule not being in the profile (motion declined, no rig...); else
+    PASSED."""
     verdicts = [r.verdict for r in results]
     tested = counted(verdicts, LINE_ORDER) or "nothing judged"
     tail = f"{tested}; {not_tested(results)}"
@@ -109,11 +115,14 @@ def overall(results: Sequence[Result], interrupted: bool = False,
         return FAILED, f"interrupted before every case had run; {tail}"
     if not any(v in JUDGED for v in verdicts):
         return FAILED, f"no case could judge the target; {tail}"
+    if any(phrase != NOT_IN_PROFILE for phrase in grouped(results, UNTESTED)):
+        return INCOMPLETE, tail
     return PASSED, tail
 
 
 def last_line(results: Sequence[Result], interrupted: bool = False,
               problems: Sequence[str] = ()) -> str:
-    """The last line of every command: ``PASSED — ...`` or ``FAILED — ...``."""
+    """The last line of every command: ``PASSED — ...``, ``INCOMPLETE — ...`` or
+    ``FAILED — ...``."""
     verdict, reason = overall(results, interrupted, problems)
     return f"{verdict} — {reason}"

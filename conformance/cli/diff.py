@@ -273,7 +273,8 @@ def main(argv: list[str] | None = None) -> int:
     say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))
-    return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
+    return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml,
+               accept_incomplete=args.accept_incomplete)
 
 
 def _say(text: str) -> None:

@@ -194,7 +194,8 @@ def main(argv: list[str] | None = None) -> int:
         if clean is not None:
             print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the "
                   f"clean line; {result.frames} frames")
-    return end(result, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
+    return end(result, None if args.no_reports else args.report_dir, junitxml=args.junitxml,
+               accept_incomplete=args.accept_incomplete)
 
 
 if __name__ == "__main__":

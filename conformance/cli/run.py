@@ -255,7 +255,8 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     for line in _session_lines(result):
         say(line)
     return end(result, None if args.no_reports else args.report_dir,
-               junitxml=args.junitxml, colour=colour)
+               junitxml=args.junitxml, colour=colour,
+               accept_incomplete=args.accept_incomplete)
 
 
 class Stopped(Exception):

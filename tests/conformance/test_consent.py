@@ -2,7 +2,8 @@
 real time (serial, TCP, an exec: program serving a port) needs a yes, given up front or
 at the terminal; the embedded emulator and a co-simulator in virtual time need none.
 Through the CLI and the pytest plugin alike, a unit on a pty (the emulator, its wire
-logged) sees no motion frame without consent, and runs its cases with it."""
+logged) sees no motion frame without consent, and runs its cases with it; motion
+declined at the question ends the run INCOMPLETE, never PASSED."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import contextlib
 import io
 import os
 import pty
+import re
 import select
 import shlex
 import subprocess
@@ -20,6 +22,7 @@ from pathlib import Path
 
 import pytest
 
+from conformance.cli.usage import INCOMPLETE_STATUS
 from conformance.consent import Consent, NoConsent, moves
 from conformance.link.safety import MOTION
 from conformance.operator import Console
@@ -31,6 +34,7 @@ pytestmark = pytest.mark.pty
 
 EMULATOR = [sys.executable, "-m", "emulator", "--model", "GVE84-100"]
 CASE = "10.2.measured.trapezoid"
+STILL = "1.profile.version"          # judged without moving anything
 NOBODY = Console(io.StringIO(), io.StringIO(), interactive=False)
 
 
@@ -73,10 +77,10 @@ def _motion_frames(log: Path) -> list[bytes]:
 ENTRIES = {
     "cli": lambda path, yes: [sys.executable, "-m", "conformance", "--target",
                               f"serial:{path}", "--profile", "GVE84-100", "--cases", CASE,
-                              "--no-reports"] + (["--yes"] if yes else []),
+                              "--cases", STILL, "--no-reports"] + (["--yes"] if yes else []),
     "plugin": lambda path, yes: [sys.executable, "-m", "pytest", "-p", "no:cacheprovider",
                                  "--gve-target", f"serial:{path}", "--gve-profile",
-                                 "GVE84-100", "--gve-cases", CASE, "-rA"]
+                                 "GVE84-100", "--gve-cases", CASE, "--gve-cases", STILL, "-rA"]
     + (["--gve-yes"] if yes else []),
 }
 #: how each entry point refuses a run it cannot ask about: (exit status, the option)
@@ -102,7 +106,7 @@ def test_consent_up_front_runs_the_cases(entry, tmp_path):
                               capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     last = done.stdout.rstrip().splitlines()[-1]
-    assert ("1 passed" in last) if entry == "plugin" else last.startswith("PASSED — 1 PASS")
+    assert ("2 passed" in last) if entry == "plugin" else last.startswith("PASSED — 2 PASS")
     assert _motion_frames(log) != []
 
 
@@ -133,7 +137,9 @@ def on_terminal(argv: list[str], answer: bytes, cwd: Path, deadline: float = 120
     finally:
         os.close(fd)
     _, status = os.waitpid(pid, 0)
-    return os.waitstatus_to_exitcode(status), seen.decode(errors="replace")
+    # a terminal gets colour: the text without its escape sequences
+    return os.waitstatus_to_exitcode(status), re.sub(r"\x1b\[[0-9;]*m", "",
+                                                     seen.decode(errors="replace"))
 
 
 @pytest.mark.parametrize("entry", sorted(ENTRIES))
@@ -146,3 +152,7 @@ def test_the_question_on_a_terminal(entry, answer, tmp_path):
     assert (_motion_frames(log) != []) == (answer == b"y"), out
     if answer == b"y":
         assert status == 0, out
+        return
+    # declined: not PASSED but INCOMPLETE, and not a passing exit status
+    assert "INCOMPLETE — 1 PASS; not tested: 1 of 2 (1 motion not confirmed)" in out, out
+    assert status == (INCOMPLETE_STATUS if entry == "cli" else pytest.ExitCode.TESTS_FAILED)

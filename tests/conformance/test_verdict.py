@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from conformance.untested import OTHER, why
-from conformance.verdict import FAILED, PASSED, last_line, overall
+from conformance.verdict import FAILED, INCOMPLETE, PASSED, last_line, overall
 
 
 @dataclass
@@ -22,10 +22,18 @@ ENVELOPE = R("COULD-NOT-TEST", ["safety stop: L900,0,0: axis X could reach 0..90
 LACKS = R("MISSING", ["the profile lacks EFW"])
 
 
-def test_passed_says_what_was_judged_and_what_was_not_tested():
+def test_incomplete_says_what_was_judged_and_what_was_not_tested():
     results = [R("PASS")] * 120 + [R("NON-STRICT")] * 8 + [RIG] * 9 + [ENVELOPE] * 3
-    assert last_line(results) == ("PASSED — 120 PASS, 8 NON-STRICT; not tested: 12 of 140 "
-                                  "(9 need a rig, 3 beyond the envelope)")
+    assert last_line(results) == ("INCOMPLETE — 120 PASS, 8 NON-STRICT; not tested: 12 of "
+                                  "140 (9 need a rig, 3 beyond the envelope)")
+
+
+def test_only_what_the_profile_lacks_leaves_a_run_passed():
+    assert last_line([R("PASS"), LACKS]) == ("PASSED — 1 PASS; not tested: 1 of 2 (1 not in "
+                                             "the profile)")
+    assert overall([R("PASS"), LACKS, RIG])[0] == INCOMPLETE
+    declined = R("COULD-NOT-TEST", ["safety stop: L600,0,0: motion was not confirmed"])
+    assert overall([R("PASS"), declined])[0] == INCOMPLETE
 
 
 def test_everything_tested():
