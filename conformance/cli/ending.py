@@ -18,7 +18,7 @@ from conformance.reports import ReportNotWritten, write_junit, write_reports
 from conformance.reports.failures import failures
 from conformance.reports.files import RunFolderTaken, claim, new_run_id
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ORDER, last_line, overall
+from conformance.verdict import ERROR, FAIL, NON_STRICT, ORDER, last_line, overall
 
 __all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
            "written"]
@@ -63,21 +63,30 @@ def counted(result: RunResult) -> str:
     return ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
 
 
+#: the recap's lists: what failed (ERROR, FAIL), then what only departs from the
+#: project's decisions (NON-STRICT: not a failure, and not counted as one)
+RECAP = (("what failed", (ERROR, FAIL)),
+         ("what departs from the project's decisions, NON-STRICT", (NON_STRICT,)))
+
+
 def recap(result: RunResult, colour: bool = False) -> list[str]:
-    """The cases to look at, listed again at the end of a job: ERROR, FAIL, then
-    NON-STRICT, each once for every profile it failed on alike, with why (the deciding
-    check) and the sentence of the rule it judges; nothing when there are none."""
+    """The cases to look at, listed again at the end of a job: what failed (ERROR,
+    FAIL), then NON-STRICT under its own heading, each once for every profile it failed
+    on alike, with why (the deciding check) and the sentence of the rule it judges;
+    nothing when there are none."""
     found = failures(result)
-    if not found:
-        return []
-    lines = [f"what failed ({len(found)}):"]
-    for f in found:
-        why = f.why
-        lines.append(f"{paint(f.verdict, f'{f.verdict:10}', colour)} {f.id} "
-                     f"[{', '.join(r.profile for r in f.runs)}]")
-        lines.append(f"    {why.line()}")
-        if why.rule:
-            lines.append(f"    the rule: {why.cites()}")
+    lines: list[str] = []
+    for heading, verdicts in RECAP:
+        listed = [f for f in found if f.verdict in verdicts]
+        if listed:
+            lines.append(f"{heading} ({len(listed)}):")
+        for f in listed:
+            why = f.why
+            lines.append(f"{paint(f.verdict, f'{f.verdict:10}', colour)} {f.id} "
+                         f"[{', '.join(r.profile for r in f.runs)}]")
+            lines.append(f"    {why.line()}")
+            if why.rule:
+                lines.append(f"    the rule: {why.cites()}")
     return lines
 
 

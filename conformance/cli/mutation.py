@@ -202,13 +202,18 @@ def main(argv: list[str] | None = None) -> int:
     return 0 if caught == len(results) and not errors else 1
 
 
+def _runs(n: int) -> str:
+    return f"{n} run" if n == 1 else f"{n} runs"
+
+
 def _lines(h: Hunt) -> list[str]:
     """What a hunt found: caught (by what, how fast) or missed, and the ERRORs and
     clean-failing cases met on the way."""
     if h.caught:
-        line = f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s ({h.runs} runs)"
+        line = (f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s "
+                f"({_runs(h.runs)})")
     else:
-        line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {h.runs} runs "
+        line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {_runs(h.runs)} "
                 f"in {h.seconds:.1f} s")
     return [line, *(f"        ERROR on the way (a defect of the suite): {e}" for e in h.errors),
             *(f"        not counted: {e} fails the clean emulator too" for e in h.clean_fails)]

@@ -166,3 +166,19 @@ def test_a_full_tmpfs_ends_the_run_with_one_line(tmp_path):
     assert f"cannot write {reports}/full/" in done.stderr
     assert "restored: ST0..ST5 written back and read back as found" in done.stdout
     assert state["status"][:6] == ["00"] * 6
+
+
+def test_the_recap_lists_by_section_number_and_non_strict_apart():
+    from conformance.cli.ending import recap
+    from conformance.runner import RunResult
+    from tests.conformance.reports.toy import result
+    run = RunResult("toy", [result("11.golden.g1", "FAIL"), result("8.repeat.answer",
+                                                                    "NON-STRICT"),
+                            result("6.checksum.wrong", "FAIL"), result("10.10.x.y", "FAIL"),
+                            result("10.2.x.y", "FAIL")], ["emu:GVE84-100"])
+    heads = [line for line in recap(run) if not line.startswith((" ", "FAIL", "NON-"))]
+    listed = [line.split()[1] for line in recap(run) if line.startswith(("FAIL", "NON-"))]
+    assert heads == ["what failed (4):",
+                     "what departs from the project's decisions, NON-STRICT (1):"]
+    assert listed == ["6.checksum.wrong", "10.2.x.y", "10.10.x.y", "11.golden.g1",
+                      "8.repeat.answer"]
