@@ -186,6 +186,8 @@ def run_id(text: str) -> str:
 def writable_folder(folder: str | Path, what: str = "reports") -> Path:
     """``folder``, created if need be, once a file could be written in it."""
     folder = Path(folder)
+    if folder.exists() and not folder.is_dir():      # mkdir would say "File exists"
+        raise UsageError(f"cannot write {what} to {folder}: it is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):
