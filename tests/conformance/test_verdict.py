@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from conformance.untested import OTHER, why
-from conformance.verdict import FAILED, INCOMPLETE, PASSED, last_line, overall
+from conformance.verdict import FAILED, INCOMPLETE, PASSED, last_line, not_tested, overall
 
 
 @dataclass
@@ -70,6 +70,12 @@ def test_reasons_come_from_the_notes():
 
 def test_a_case_that_needs_a_reset_says_what_to_run_with():
     """A real unit is restarted with J only with --allow-destructive: the last line
-    says so rather than "other reasons"."""
+    says so rather than "for another reason"."""
     phrase = why(["could not test: needs a reset (J): run with --allow-destructive"])
     assert phrase != OTHER and "reset" in phrase and "--allow-destructive" in phrase
+
+
+def test_results_no_pattern_matches_are_counted_as_one_reason():
+    odd = R("COULD-NOT-TEST", ["something nobody foresaw"])
+    assert not_tested([R("PASS"), odd, odd]) == (
+        "not tested: 2 of 3 (2 for another reason (each case's note says which))")
