@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from conformance.cli.ending import recap, say_all, written
-from conformance.cli.progress import Progress
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import INTERRUPTED, verdict_status
 from conformance.link.interrupts import Interrupts
 from conformance.reports.files import ReportNotWritten, write_text
@@ -106,7 +106,8 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
     with Progress(len(members), unit="target", quiet=quiet,
-                  verbose=bool(getattr(args, "verbose", False)), every_step=True) as shown:
+                  verbose=bool(getattr(args, "verbose", False)), every_step=True,
+                  heartbeat=HEARTBEAT) as shown:
         interrupted = _run_members(members, folder, jobs, start, shown)
     seconds = time.perf_counter() - start
     for m in members:

@@ -23,8 +23,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import gate_end, workers
-from conformance.cli.progress import Progress
+from conformance.cli.pool import gate_end, gate_line, under_way, workers
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
@@ -179,7 +179,8 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     results = []
     with workers(args.jobs) as pool, Progress(len(jobs), unit="mutant", quiet=args.quiet,
-                                              verbose=args.verbose, every_step=True) as shown:
+                                              verbose=args.verbose, every_step=True,
+                                              heartbeat=HEARTBEAT) as shown:
         for h in pool.map(_hunt, jobs):
             results.append(h)
             shown.step("\n".join(_lines(h)), routine=h.caught and not h.errors
@@ -191,14 +192,16 @@ def main(argv: list[str] | None = None) -> int:
     if gate_end("mutation", failed,
                 f"{sum(not h.caught or bool(h.errors) for h in results)} mutant(s)",
                 pool.interrupted,
-                f"{len(results)} of {len(jobs)} mutants ({caught} caught, {errors} ERROR)",
-                start):
+                f"{len(results)} of {len(jobs)} mutants finished ({caught} caught, "
+                f"{errors} ERROR; {under_way(args.jobs, len(jobs), len(results))} under "
+                "way)", start):
         return INTERRUPTED
-    print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
-          f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-          f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
-          + (f"; {sum(h.unreached for h in results)} not run, the mutant's code unreached"
-             if args.sweep else ""))
+    print(gate_line(caught == len(results) and not errors,
+                    f"mutation score: {caught}/{len(results)} = {score:.1f} % "
+                    f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
+                    f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
+                    + (f"; {sum(h.unreached for h in results)} not run, the mutant's code "
+                       "unreached" if args.sweep else "")))
     return 0 if caught == len(results) and not errors else 1
 
 
