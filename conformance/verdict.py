@@ -82,12 +82,14 @@ def counted(verdicts: Sequence[str], among: Sequence[str] = ORDER) -> str:
     return ", ".join(f"{verdicts.count(v)} {v}" for v in among if v in verdicts)
 
 
-def not_tested(results: Sequence[Result]) -> str:
+def not_tested(results: Sequence[Result], interrupted: bool = False) -> str:
     """``not tested: 12 of 149 (9 need a rig, 3 beyond the envelope)``, or
-    ``everything tested``."""
+    ``everything tested`` (``interrupted``: the results are only what ran before it, so
+    never "everything")."""
     groups = grouped(results, UNTESTED)
     if not groups:
-        return f"everything tested ({len(results)})"
+        return (f"{len(results)} run before the interruption, nothing after it" if interrupted
+                else f"everything tested ({len(results)})")
     n = sum(groups.values())
     return (f"not tested: {n} of {len(results)} ("
             + ", ".join(f"{k} {phrase}" for phrase, k in groups.items()) + ")")
@@ -105,7 +107,7 @@ def overall(results: Sequence[Result], interrupted: bool = False,
     PASSED."""
     verdicts = [r.verdict for r in results]
     tested = counted(verdicts, LINE_ORDER) or "nothing judged"
-    tail = f"{tested}; {not_tested(results)}"
+    tail = f"{tested}; {not_tested(results, interrupted)}"
     if any(failing(v) for v in verdicts):
         return FAILED, tail
     if problems:

@@ -18,7 +18,7 @@ from conformance.reports import ReportNotWritten, write_junit, write_reports
 from conformance.reports.failures import failures
 from conformance.reports.files import RunFolderTaken, claim, new_run_id
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ERROR, FAIL, NON_STRICT, ORDER, last_line, overall
+from conformance.verdict import ERROR, FAIL, MISSING, NON_STRICT, ORDER, last_line, overall
 
 __all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
            "written"]
@@ -57,10 +57,16 @@ def progress(quiet: bool, detail: Callable[[CaseResult], str | None]
     return show
 
 
+#: what a count of a verdict means where the word alone reads like a defect
+MEANING = {MISSING: "not in the profile: nothing to test"}
+
+
 def counted(result: RunResult) -> str:
-    """``PASS 17, INFO 1``: the verdicts, worst first."""
+    """``PASS 1219, MISSING 181 (not in the profile: nothing to test)``: the verdicts,
+    worst first."""
     counts = result.counts()
-    return ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
+    return ", ".join(f"{v} {counts[v]}" + (f" ({MEANING[v]})" if v in MEANING else "")
+                     for v in ORDER if v in counts)
 
 
 #: the recap's lists: what failed (ERROR, FAIL), then what only departs from the

@@ -79,3 +79,12 @@ def test_results_no_pattern_matches_are_counted_as_one_reason():
     odd = R("COULD-NOT-TEST", ["something nobody foresaw"])
     assert not_tested([R("PASS"), odd, odd]) == (
         "not tested: 2 of 3 (2 for another reason (each case's note says which))")
+
+
+def test_an_interrupted_run_never_says_everything_was_tested():
+    verdict, reason = overall([R("FAIL")] * 3, interrupted=True)
+    assert verdict == FAILED and "everything tested" not in reason
+    assert reason == "3 FAIL; 3 run before the interruption, nothing after it"
+    assert overall([R("PASS")], interrupted=True)[1] == (
+        "interrupted before every case had run; 1 PASS; 1 run before the interruption, "
+        "nothing after it")

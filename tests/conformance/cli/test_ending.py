@@ -182,3 +182,12 @@ def test_the_recap_lists_by_section_number_and_non_strict_apart():
                      "what departs from the project's decisions, NON-STRICT (1):"]
     assert listed == ["6.checksum.wrong", "10.2.x.y", "10.10.x.y", "11.golden.g1",
                       "8.repeat.answer"]
+
+
+def test_a_count_of_missing_says_it_is_nothing_to_test():
+    from conformance.cli.ending import counted
+    from conformance.runner import RunResult
+    from tests.conformance.reports.toy import result
+    run = RunResult("toy", [result("1.a.b", "PASS"), result("3.params.float-values",
+                                                           "MISSING")], ["emu:GVE54"])
+    assert counted(run) == "MISSING 1 (not in the profile: nothing to test), PASS 1"
