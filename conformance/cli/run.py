@@ -61,7 +61,9 @@ EXAMPLES = (
     "gve-conformance --target serial:/dev/ttyUSB0?baud=115200 --profile auto",
     "gve-conformance --target tcp:127.0.0.1:5114 --profile GVE114-500 --yes",
     "gve-conformance --target 'exec:python -m emulator --model GVE84-100 --pty' "
-    "--profile GVE84-100",
+    "--profile GVE84-100 --yes",
+    "gve-conformance --target 'exec:python -m emulator --model GVE84-100 --cosim' "
+    "--profile GVE84-100   # virtual time: nothing moves, no --yes",
     "gve-conformance --cases '6.*' -v                  # some cases, every line shown",
 )
 
