@@ -76,7 +76,15 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      "tcp:..., exec:COMMAND)")
     g.addoption("--gve-profile", default=None,
                 help="the profile a serial/tcp/exec target behaves as")
-    g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
+    g.addoption("--gve-cases", action="append", default=[], metavar="GLOB",
+                help="run only cases whose ID matches (repeatable)")
+    g.addoption("--gve-exclude", action="append", default=[], metavar="GLOB",
+                help="leave out cases whose ID matches (repeatable; after --gve-cases)")
+    g.addoption("--gve-mutant", default=None, metavar="NAME",
+                help="emulator targets: plant this deliberate bug")
+    g.addoption("--gve-seed", type=int, default=None, metavar="N",
+                help="the Hypothesis machines' seed: the same N replays the same examples "
+                     "(default: the settings' own, derandomized in ci)")
     g.addoption("--gve-settings", default=None,
                 help="Hypothesis settings profile (default: ci in virtual time, the "
                      "emulator's or a co-simulator's; hardware on serial/tcp/exec targets)")
@@ -84,7 +92,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                 help="real units: move without asking first (unattended benches); without "
                      "it a unit that can move is asked about on the terminal, and with no "
                      "terminal the run is refused before anything is sent")
-    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL,
+    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL, metavar="N",
                 help="real units: the motion envelope in full steps per axis either side "
                      f"of where the run began (default {DEFAULT_MAX_TRAVEL})")
     g.addoption("--gve-allow-destructive", action="store_true",
@@ -206,7 +214,8 @@ class GveTarget(pytest.Collector):
     def collect(self) -> list[GveSection]:
         from conformance.catalogue import select
         sections: dict[str, list[Case]] = {}
-        for case in select(self.config.getoption("--gve-cases") or None):
+        for case in select(self.config.getoption("--gve-cases") or None,
+                           self.config.getoption("--gve-exclude") or None):
             sections.setdefault(case.section, []).append(case)
         return [GveSection.from_parent(self, name=f"section{s.replace('.', '_')}",
                                        nodeid=f"{self.nodeid}::{s}", cases=cases)
@@ -261,7 +270,8 @@ class GveItem(pytest.Item):
         except (ValueError, LookupError) as err:
             pytest.fail(str(err), pytrace=False)
         with interrupts.catching():
-            result = run_case(self.case, self.target, self.settings_name)
+            result = run_case(self.case, self.target, self.settings_name,
+                              seed=self.config.getoption("--gve-seed"))
         self.result = result
         self.user_properties += [("verdict", result.verdict), ("tag", self.case.tag),
                                  ("section", self.case.section)]
@@ -295,7 +305,19 @@ def _specs(config: pytest.Config) -> list[str]:
     specs = config.getoption("--gve-target")
     if not specs and config.getoption("pyargs") and "conformance" in config.args:
         specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
-    return list(dict.fromkeys(specs))       # a target named twice runs once
+    # emu:all, as on the command line: the embedded emulator on every profile, with the
+    # settings given
+    every = [spec for given in specs for spec in (_every_profile(given) or [given])]
+    return list(dict.fromkeys(every))       # a target named twice runs once
+
+
+def _every_profile(spec: str) -> list[str]:
+    """``emu:all[?settings]`` as one target per profile; [] for any other target."""
+    name, _, query = spec.partition("?")
+    if name != "emu:all":
+        return []
+    from gve_fixtures.profile import available_profiles
+    return [f"emu:{p}" + (f"?{query}" if query else "") for p in available_profiles()]
 
 
 def _on_xdist_worker(config: pytest.Config) -> bool:
@@ -338,9 +360,11 @@ def pytest_configure(config: pytest.Config) -> None:
     if settings is not None and settings not in PROFILES:
         raise pytest.UsageError(f"--gve-settings {settings!r}: one of {', '.join(PROFILES)}")
     from conformance.catalogue import select
-    globs = config.getoption("--gve-cases")
-    if globs and not select(globs):
-        raise pytest.UsageError(f"--gve-cases {' '.join(globs)}: no case matches")
+    globs, exclude = config.getoption("--gve-cases"), config.getoption("--gve-exclude")
+    if (globs or exclude) and not select(globs or None, exclude or None):
+        raise pytest.UsageError(" ".join([f"--gve-cases {g}" for g in globs]
+                                         + [f"--gve-exclude {g}" for g in exclude])
+                                + ": no case matches")
     _example_database(config)
     for marker in TAG_MARKERS.values():
         config.addinivalue_line("markers", f"{marker}: a case of the suite whose tag is "
@@ -358,6 +382,7 @@ def pytest_configure(config: pytest.Config) -> None:
             target = parse_target(spec, profile=config.getoption("--gve-profile"),
                                   allow_destructive=config.getoption("--gve-allow-destructive"),
                                   max_travel=config.getoption("--gve-max-travel"),
+                                  mutant=config.getoption("--gve-mutant"),
                                   strict=config.getoption("--gve-strict"))
             opened.append(target)
             if not worker:
@@ -444,18 +469,23 @@ def pytest_report_teststatus(report: pytest.TestReport, config: pytest.Config
 @pytest.hookimpl(wrapper=True, tryfirst=True)
 def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config
                             ) -> Generator[None, None, None]:
-    """After pytest's short summary: the NON-STRICT and INFO cases with why, wherever
-    the summary lists what did not pass (``-r`` with f, s or p: the default, -ra, -rA)."""
+    """After pytest's short summary: the FAIL and ERROR cases, then the NON-STRICT and
+    INFO ones, each with why, whole (pytest's own summary line drops the reason where the
+    node ID fills the terminal's width), wherever the summary lists what did not pass
+    (``-r`` with f, s or p: the default, -ra, -rA)."""
     yield
     chars = getattr(terminalreporter, "reportchars", "")
     if not any(c in chars for c in "fsp"):
         return
-    reports = [rep for word in ("non-strict", "info")
-               for rep in terminalreporter.stats.get(word, [])]
-    if reports:
-        terminalreporter.write_sep("=", "gve-conformance: NON-STRICT and INFO", yellow=True)
-        for rep in reports:
-            terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
+    for title, words, colour in (("FAIL and ERROR", ("failed",), {"red": True}),
+                                 ("NON-STRICT and INFO", ("non-strict", "info"),
+                                  {"yellow": True})):
+        reports = [rep for word in words for rep in terminalreporter.stats.get(word, [])
+                   if getattr(rep, "gve_why", None) and rep.when == "call"]
+        if reports:
+            terminalreporter.write_sep("=", f"gve-conformance: {title}", **colour)
+            for rep in reports:
+                terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
 
 
 @dataclass
