@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import consent, unattended
@@ -274,7 +275,8 @@ def main(argv: list[str] | None = None) -> int:
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))
     return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml,
-               accept_incomplete=args.accept_incomplete)
+               accept_incomplete=args.accept_incomplete,
+               colour=wanted(args.color, sys.stdout))
 
 
 def _say(text: str) -> None:

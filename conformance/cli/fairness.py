@@ -152,7 +152,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="only this reading (repeatable; default: every one, and all at once)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", type=positive, default=1, help="readings tried in parallel")
+    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
+                    help="readings tried in parallel")
     add_loudness(ap, "also list every difference each reading made")
     try:
         args = ap.parse_args(argv)

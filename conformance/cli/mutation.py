@@ -155,7 +155,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="only this mutant (repeatable; default: every one)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", type=positive, default=1, help="mutants hunted in parallel")
+    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
+                    help="mutants hunted in parallel")
     ap.add_argument("--sweep", action="store_true",
                     help="also run the rest of the catalogue against each mutant (one "
                          "profile per family), failing on any ERROR")

@@ -121,9 +121,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
-                    default="auto", help="colour the verdicts: auto (a terminal without "
-                    "NO_COLOR set), always or never (default auto)")
     return ap.parse_args(argv)
 
 

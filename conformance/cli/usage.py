@@ -72,12 +72,15 @@ def summary(doc: str | None) -> str:
 
 def add_loudness(ap: argparse.ArgumentParser | argparse._ArgumentGroup, verbose: str) -> None:
     """``-q`` (the recap and the verdict's line only) or ``-v`` (``verbose``: what every
-    line is), one or the other, alike on every subcommand."""
+    line is), one or the other, and ``--color``, alike on every subcommand."""
     loud = ap.add_mutually_exclusive_group()
     loud.add_argument("-q", "--quiet", action="store_true",
                       help="print only the end: what failed, where the reports are and "
                            "the verdict's line")
     loud.add_argument("-v", "--verbose", action="store_true", help=verbose)
+    ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
+                    default="auto", help="colour the verdicts: auto (a terminal without "
+                    "NO_COLOR set), always or never (default auto)")
 
 
 #: --seed's help, the same wherever a job draws at random
