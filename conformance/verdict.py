@@ -117,7 +117,8 @@ def overall(results: Sequence[Result], interrupted: bool = False,
         return FAILED, f"interrupted before every case had run; {tail}"
     if not any(v in JUDGED for v in verdicts):
         return FAILED, f"no case could judge the target; {tail}"
-    if any(phrase != NOT_IN_PROFILE for phrase in grouped(results, UNTESTED)):
+    # MISSING is what the profile lacks, whatever its note says
+    if any(phrase != NOT_IN_PROFILE for phrase in grouped(results, (COULD_NOT_TEST,))):
         return INCOMPLETE, tail
     return PASSED, tail
 

@@ -88,3 +88,7 @@ def test_an_interrupted_run_never_says_everything_was_tested():
     assert overall([R("PASS")], interrupted=True)[1] == (
         "interrupted before every case had run; 1 PASS; 1 run before the interruption, "
         "nothing after it")
+
+
+def test_missing_is_what_the_profile_lacks_whatever_its_note():
+    assert overall([R("PASS"), R("MISSING", ["no packets on the GVE54"])])[0] == PASSED
