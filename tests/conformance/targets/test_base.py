@@ -17,6 +17,8 @@ from conformance.targets.port import OURS, PYSERIAL_OPTIONS
 from gve_fixtures.transcript import load
 from tests.processes import stop
 
+pytest_plugins = ["pytester"]
+
 
 def _misspelt(key: str) -> str:
     """The key with its second letter dropped (``adress``, ``bud``, ``mutnt``...)."""
