@@ -214,7 +214,8 @@ class HandRig:
     def outputs(self, address: int | None = None) -> int:
         """The output port as the technician sees it (the outputs lit), active low."""
         words = self.words["outputs"]
-        step = HandStep("outputs", "", words["ask"], tuple(self.words["skip"]))
+        step = HandStep("outputs", words["instruction"], words["ask"],
+                        tuple(self.words["skip"]))
         while True:
             answer = self._asked(step, lambda s: self.console.observe(s))
             if answer is None or answer.lower() in step.skip:

@@ -30,8 +30,9 @@ a worker opens a target's port at its first item of that target.
 from __future__ import annotations
 
 import re
-from collections.abc import Generator
-from contextlib import ExitStack
+import sys
+from collections.abc import Generator, Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,17 +40,33 @@ import pytest
 
 from conformance import settings as settings_profiles
 from conformance.case import Case
+from conformance.consent import Consent, NoConsent
 from conformance.explain import reason
 from conformance.link.interrupts import Interrupts
+from conformance.operator import Console
 from conformance.plugin_stop import before_item, hold, interrupted
 from conformance.quoting import quoted
 from conformance.runner import CaseResult, run_case
 from conformance.settings import PROFILES
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT
+from conformance.verdict import (
+    COULD_NOT_TEST,
+    ERROR,
+    FAIL,
+    INCOMPLETE,
+    INFO,
+    MISSING,
+    NON_STRICT,
+    PASSED,
+    UNTESTED,
+    overall,
+)
 
 _TARGETS = pytest.StashKey[list[Target]]()
 _INTERRUPTS = pytest.StashKey[Interrupts]()
+_MOTION = pytest.StashKey[bool]()
+#: the controller's answer to "Move this machine?", given to an xdist worker
+MOTION_ALLOWED = "gve_motion_allowed"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -59,12 +76,31 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      "tcp:..., exec:COMMAND)")
     g.addoption("--gve-profile", default=None,
                 help="the profile a serial/tcp/exec target behaves as")
-    g.addoption("--gve-cases", action="append", default=[], help="case ID glob (repeatable)")
+    g.addoption("--gve-cases", action="append", default=[], metavar="GLOB",
+                help="run only cases whose ID matches (repeatable)")
+    g.addoption("--gve-exclude", action="append", default=[], metavar="GLOB",
+                help="leave out cases whose ID matches (repeatable; after --gve-cases)")
+    g.addoption("--gve-mutant", default=None, metavar="NAME",
+                help="emulator targets: plant this deliberate bug")
+    g.addoption("--gve-seed", type=int, default=None, metavar="N",
+                help="the Hypothesis machines' seed: the same N replays the same examples "
+                     "(default: the settings' own, derandomized in ci)")
     g.addoption("--gve-settings", default=None,
                 help="Hypothesis settings profile (default: ci in virtual time, the "
                      "emulator's or a co-simulator's; hardware on serial/tcp/exec targets)")
-    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL)
-    g.addoption("--gve-allow-destructive", action="store_true")
+    g.addoption("--gve-yes", action="store_true",
+                help="real units: move without asking first (unattended benches); without "
+                     "it a unit that can move is asked about on the terminal, and with no "
+                     "terminal the run is refused before anything is sent")
+    g.addoption("--gve-max-travel", type=int, default=DEFAULT_MAX_TRAVEL, metavar="N",
+                help="real units: the motion envelope in full steps per axis either side "
+                     f"of where the run began (default {DEFAULT_MAX_TRAVEL})")
+    g.addoption("--gve-allow-destructive", action="store_true",
+                help="real units: allow J, W and EEPROM writes (EEPROM backed up and "
+                     "restored)")
+    g.addoption("--gve-accept-incomplete", action="store_true",
+                help="pass a run that FAILed nothing yet did not test what it was asked to "
+                     "(INCOMPLETE: motion declined, no rig...); otherwise it fails")
     g.addoption("--gve-strict", action="store_true",
                 help="grade a serial/tcp/exec target by the project's decisions too: a "
                 "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
@@ -119,6 +155,44 @@ class CaseReport:
         return "\n".join(self.lines)
 
 
+class Terminal(Console):
+    """The terminal behind pytest's capture: each line shown and each question asked
+    with the capture suspended, so that a person sees the question and answers it."""
+
+    def __init__(self, config: pytest.Config) -> None:   # no look at the terminal yet
+        self._capture = config.pluginmanager.getplugin("capturemanager")
+        self.stdin, self.stdout = sys.__stdin__, sys.__stdout__
+        self._interactive: bool | None = None
+
+    @property
+    def interactive(self) -> bool:
+        """Whether a person can answer: the terminal behind the capture, looked at only
+        when a question may be needed."""
+        if self._interactive is None:
+            with self._uncaptured():
+                self._interactive = self.stdin is not None and self.stdin.isatty()
+        return self._interactive
+
+    @contextmanager
+    def _uncaptured(self) -> Iterator[None]:
+        if self._capture is None:
+            yield
+            return
+        self._capture.suspend(in_=True)     # standard input too: the answer is typed there
+        try:
+            yield
+        finally:
+            self._capture.resume()
+
+    def say(self, text: str) -> None:
+        with self._uncaptured():
+            super().say(text)
+
+    def _answer(self, prompt: str) -> str | None:
+        with self._uncaptured():
+            return super()._answer(prompt)
+
+
 def verdict_line(r: CaseResult) -> str:
     """``NON-STRICT 8.repeat.answer [emu:GVE84-100]: 8.repeat.answer [D] ...``."""
     return f"{r.verdict} {r.id} [{r.target}]: {reason(r).line()}"
@@ -140,7 +214,8 @@ class GveTarget(pytest.Collector):
     def collect(self) -> list[GveSection]:
         from conformance.catalogue import select
         sections: dict[str, list[Case]] = {}
-        for case in select(self.config.getoption("--gve-cases") or None):
+        for case in select(self.config.getoption("--gve-cases") or None,
+                           self.config.getoption("--gve-exclude") or None):
             sections.setdefault(case.section, []).append(case)
         return [GveSection.from_parent(self, name=f"section{s.replace('.', '_')}",
                                        nodeid=f"{self.nodeid}::{s}", cases=cases)
@@ -195,10 +270,13 @@ class GveItem(pytest.Item):
         except (ValueError, LookupError) as err:
             pytest.fail(str(err), pytrace=False)
         with interrupts.catching():
-            result = run_case(self.case, self.target, self.settings_name)
+            result = run_case(self.case, self.target, self.settings_name,
+                              seed=self.config.getoption("--gve-seed"))
         self.result = result
         self.user_properties += [("verdict", result.verdict), ("tag", self.case.tag),
                                  ("section", self.case.section)]
+        if result.verdict in UNTESTED:          # why, for the run's verdict (verdict.py)
+            self.user_properties.append((NOT_TESTED, "\n".join(result.notes)))
         if result.interrupted:
             interrupted(self.session)       # its verdict reported, no item after it
         if result.verdict in (FAIL, ERROR):
@@ -227,7 +305,19 @@ def _specs(config: pytest.Config) -> list[str]:
     specs = config.getoption("--gve-target")
     if not specs and config.getoption("pyargs") and "conformance" in config.args:
         specs = ["emu:GVE84-100"]      # `pytest --pyargs conformance`: the default target
-    return list(dict.fromkeys(specs))       # a target named twice runs once
+    # emu:all, as on the command line: the embedded emulator on every profile, with the
+    # settings given
+    every = [spec for given in specs for spec in (_every_profile(given) or [given])]
+    return list(dict.fromkeys(every))       # a target named twice runs once
+
+
+def _every_profile(spec: str) -> list[str]:
+    """``emu:all[?settings]`` as one target per profile; [] for any other target."""
+    name, _, query = spec.partition("?")
+    if name != "emu:all":
+        return []
+    from gve_fixtures.profile import available_profiles
+    return [f"emu:{p}" + (f"?{query}" if query else "") for p in available_profiles()]
 
 
 def _on_xdist_worker(config: pytest.Config) -> bool:
@@ -270,9 +360,11 @@ def pytest_configure(config: pytest.Config) -> None:
     if settings is not None and settings not in PROFILES:
         raise pytest.UsageError(f"--gve-settings {settings!r}: one of {', '.join(PROFILES)}")
     from conformance.catalogue import select
-    globs = config.getoption("--gve-cases")
-    if globs and not select(globs):
-        raise pytest.UsageError(f"--gve-cases {' '.join(globs)}: no case matches")
+    globs, exclude = config.getoption("--gve-cases"), config.getoption("--gve-exclude")
+    if (globs or exclude) and not select(globs or None, exclude or None):
+        raise pytest.UsageError(" ".join([f"--gve-cases {g}" for g in globs]
+                                         + [f"--gve-exclude {g}" for g in exclude])
+                                + ": no case matches")
     _example_database(config)
     for marker in TAG_MARKERS.values():
         config.addinivalue_line("markers", f"{marker}: a case of the suite whose tag is "
@@ -283,27 +375,57 @@ def pytest_configure(config: pytest.Config) -> None:
     if controller and config.option.dist != "loadgroup":
         config.option.dist = "loadgroup"    # only groups keep a port on one worker
     interrupts = Interrupts()
-    targets = []
+    targets, opened = [], []
+    consent = _consent(config, worker)
     try:
         for spec in specs:
             target = parse_target(spec, profile=config.getoption("--gve-profile"),
                                   allow_destructive=config.getoption("--gve-allow-destructive"),
                                   max_travel=config.getoption("--gve-max-travel"),
+                                  mutant=config.getoption("--gve-mutant"),
                                   strict=config.getoption("--gve-strict"))
+            opened.append(target)
             if not worker:
                 target.preflight()
+        if not worker:
+            consent.check(opened)        # no yes and nobody to ask: refused, nothing sent
+        if controller:      # asked once here: the workers have no terminal
+            config.stash[_MOTION] = consent.ask_once(opened, lambda t: ("", ""))
+        for target in opened:
             if controller:
                 target.close()      # it runs nothing; the worker of the port opens it
                 continue
             target.begin(interrupts)
+            consent.arm(target)
             targets.append(target)
+    except NoConsent as err:
+        for t in opened:
+            t.close()
+        raise pytest.UsageError(str(err)) from None
     except (ValueError, LookupError) as err:
-        for t in targets:
+        for t in opened:
             t.close()
         raise pytest.UsageError(str(err)) from None
     config.stash[_TARGETS] = targets
     config.stash[_INTERRUPTS] = interrupts
+    config.stash[_VERDICT] = verdict = RunVerdict()
+    config.pluginmanager.register(verdict, "gve-conformance-verdict")
     hold(config, interrupts, controller=controller)
+
+
+def _consent(config: pytest.Config, worker: bool) -> Consent:
+    """The run's consent to motion (conformance/consent.py): --gve-yes, else the question
+    on the terminal; an xdist worker takes its controller's answer."""
+    if worker:
+        return Consent(bool(config.workerinput.get(MOTION_ALLOWED)),
+                       Console(interactive=False), flag="--gve-yes")
+    return Consent(config.getoption("--gve-yes"), Terminal(config), flag="--gve-yes")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node) -> None:
+    """pytest-xdist: a worker starts with its controller's answer about motion."""
+    node.workerinput[MOTION_ALLOWED] = node.config.stash.get(_MOTION, False)
 
 
 @pytest.hookimpl(tryfirst=True)
@@ -347,24 +469,62 @@ def pytest_report_teststatus(report: pytest.TestReport, config: pytest.Config
 @pytest.hookimpl(wrapper=True, tryfirst=True)
 def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config
                             ) -> Generator[None, None, None]:
-    """After pytest's short summary: the NON-STRICT and INFO cases with why, wherever
-    the summary lists what did not pass (``-r`` with f, s or p: the default, -ra, -rA)."""
+    """After pytest's short summary: the FAIL and ERROR cases, then the NON-STRICT and
+    INFO ones, each with why, whole (pytest's own summary line drops the reason where the
+    node ID fills the terminal's width), wherever the summary lists what did not pass
+    (``-r`` with f, s or p: the default, -ra, -rA)."""
     yield
     chars = getattr(terminalreporter, "reportchars", "")
     if not any(c in chars for c in "fsp"):
         return
-    reports = [rep for word in ("non-strict", "info")
-               for rep in terminalreporter.stats.get(word, [])]
-    if reports:
-        terminalreporter.write_sep("=", "gve-conformance: NON-STRICT and INFO", yellow=True)
-        for rep in reports:
-            terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
+    for title, words, colour in (("FAIL and ERROR", ("failed",), {"red": True}),
+                                 ("NON-STRICT and INFO", ("non-strict", "info"),
+                                  {"yellow": True})):
+        reports = [rep for word in words for rep in terminalreporter.stats.get(word, [])
+                   if getattr(rep, "gve_why", None) and rep.when == "call"]
+        if reports:
+            terminalreporter.write_sep("=", f"gve-conformance: {title}", **colour)
+            for rep in reports:
+                terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
+
+
+@dataclass
+class _Seen:
+    """A case's verdict as the run's verdict reads it: the verdict and its notes (why
+    it was not tested)."""
+
+    verdict: str
+    notes: list[str]
+
+
+class RunVerdict:
+    """The suite's verdict for the whole pytest run, from every case's report (on an
+    xdist controller too: the reports carry their verdicts): PASSED, INCOMPLETE or
+    FAILED, as the command line's last line says it."""
+
+    def __init__(self) -> None:
+        self.seen: list[_Seen] = []
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        props = dict(report.user_properties)
+        if report.when == "call" and "verdict" in props:
+            self.seen.append(_Seen(props["verdict"], props.get(NOT_TESTED, "").split("\n")))
+
+    def line(self, interrupted: bool, problems: list[str]) -> tuple[str, str]:
+        return overall(self.seen, interrupted, problems)
+
+
+_VERDICT = pytest.StashKey[RunVerdict]()
+#: the user property of a case not tested: its notes, a line each
+NOT_TESTED = "not tested because"
 
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """The end of the pytest run (also after Ctrl-C): every session puts its unit back;
-    what could not be put back is printed and fails the run."""
+    what could not be put back is printed and fails the run. Then the suite's verdict:
+    one that is not PASSED fails the pytest run (one that FAILed nothing yet did not
+    test what it was asked to, INCOMPLETE, passes with --gve-accept-incomplete)."""
     problems, broken = [], []
     for target in session.config.stash.get(_TARGETS, []):
         report = target.session.finish()
@@ -378,6 +538,16 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     for failure in broken:
         print(f"\ngve-conformance: FAIL on {failure}")
     if (problems or broken) and session.exitstatus == pytest.ExitCode.OK:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+    verdict = session.config.stash.get(_VERDICT, None)
+    if verdict is None or _on_xdist_worker(session.config) or not verdict.seen:
+        return
+    word, tail = verdict.line(session.exitstatus == pytest.ExitCode.INTERRUPTED,
+                              problems + broken)
+    print(f"\ngve-conformance: {word} — {tail}")
+    accepted = word == PASSED or (word == INCOMPLETE and session.config.getoption(
+        "--gve-accept-incomplete"))
+    if not accepted and session.exitstatus == pytest.ExitCode.OK:
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 

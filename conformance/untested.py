@@ -12,7 +12,10 @@ from importlib import resources
 from typing import Protocol
 
 #: the phrase of a result no pattern of the table matches
-OTHER = "other reasons"
+OTHER = "for another reason (each case's note says which)"
+#: the phrase of what a profile does not have: the one reason a run that did not test
+#: it still PASSED (untested.toml says it so)
+NOT_IN_PROFILE = "not in the profile"
 
 
 class Noted(Protocol):

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol
 
-from conformance.untested import grouped
+from conformance.untested import NOT_IN_PROFILE, grouped
 from gve_fixtures import protocol
 
 PASS = "PASS"
@@ -61,6 +61,9 @@ def failing(verdict: str) -> bool:
 #: the run's overall verdict, the banner of its reports
 PASSED = "PASSED"
 FAILED = "FAILED"
+#: nothing failed, yet the run did not test what it was asked to (motion declined, a
+#: rig missing...): not a pass (docs/suite.md, "The last line")
+INCOMPLETE = "INCOMPLETE"
 #: verdicts that judged the target (the others say why it could not be judged)
 JUDGED = (PASS, NON_STRICT, INFO)
 #: verdicts of what was not tested (their reasons: conformance/untested.toml)
@@ -79,12 +82,14 @@ def counted(verdicts: Sequence[str], among: Sequence[str] = ORDER) -> str:
     return ", ".join(f"{verdicts.count(v)} {v}" for v in among if v in verdicts)
 
 
-def not_tested(results: Sequence[Result]) -> str:
+def not_tested(results: Sequence[Result], interrupted: bool = False) -> str:
     """``not tested: 12 of 149 (9 need a rig, 3 beyond the envelope)``, or
-    ``everything tested``."""
+    ``everything tested`` (``interrupted``: the results are only what ran before it, so
+    never "everything")."""
     groups = grouped(results, UNTESTED)
     if not groups:
-        return f"everything tested ({len(results)})"
+        return (f"{len(results)} run before the interruption, nothing after it" if interrupted
+                else f"everything tested ({len(results)})")
     n = sum(groups.values())
     return (f"not tested: {n} of {len(results)} ("
             + ", ".join(f"{k} {phrase}" for phrase, k in groups.items()) + ")")
@@ -92,14 +97,17 @@ def not_tested(results: Sequence[Result]) -> str:
 
 def overall(results: Sequence[Result], interrupted: bool = False,
             problems: Sequence[str] = ()) -> tuple[str, str]:
-    """PASSED or FAILED for a run's results, with what was judged and what was not
-    tested and why: ``PASSED``, ``120 PASS, 8 NON-STRICT; not tested: 12 of 149 (9 need
-    a rig, 3 beyond the envelope)``. PASSED only when nothing FAILed or ERRed. A run that
-    judged nothing has not passed: a broken or silent target never earns a PASS; nor has
-    one that left something of a unit unrestored (``problems``) or was interrupted."""
+    """PASSED, INCOMPLETE or FAILED for a run's results, with what was judged and what
+    was not tested and why: ``INCOMPLETE``, ``120 PASS, 8 NON-STRICT; not tested: 12 of
+    149 (9 need a rig, 3 beyond the envelope)``. FAILED when something FAILed or ERRed.
+    A run that judged nothing has not passed: a broken or silent target never earns a
+    PASS; nor has one that left something of a unit unrestored (``problems``) or was
+    interrupted. INCOMPLETE when nothing failed yet a case was not tested for a reason
+    other than its rule not being in the profile (motion declined, no rig...); else
+    PASSED."""
     verdicts = [r.verdict for r in results]
     tested = counted(verdicts, LINE_ORDER) or "nothing judged"
-    tail = f"{tested}; {not_tested(results)}"
+    tail = f"{tested}; {not_tested(results, interrupted)}"
     if any(failing(v) for v in verdicts):
         return FAILED, tail
     if problems:
@@ -109,11 +117,15 @@ def overall(results: Sequence[Result], interrupted: bool = False,
         return FAILED, f"interrupted before every case had run; {tail}"
     if not any(v in JUDGED for v in verdicts):
         return FAILED, f"no case could judge the target; {tail}"
+    # MISSING is what the profile lacks, whatever its note says
+    if any(phrase != NOT_IN_PROFILE for phrase in grouped(results, (COULD_NOT_TEST,))):
+        return INCOMPLETE, tail
     return PASSED, tail
 
 
 def last_line(results: Sequence[Result], interrupted: bool = False,
               problems: Sequence[str] = ()) -> str:
-    """The last line of every command: ``PASSED — ...`` or ``FAILED — ...``."""
+    """The last line of every command: ``PASSED — ...``, ``INCOMPLETE — ...`` or
+    ``FAILED — ...``."""
     verdict, reason = overall(results, interrupted, problems)
     return f"{verdict} — {reason}"

@@ -3,6 +3,11 @@ suite's subcommands, the emulator's, the reference host's and the benchmarks' (e
 parser is stopped as soon as it has read the words, so nothing runs), and the pytest
 plugin's options. A renamed option or subcommand fails here before a reader trips on it.
 
+Those that name the embedded emulator or a simulator (``emu:``, ``exec:``, with the
+emulator standing in for a clone's ``./clone-sim``), and the examples of ``--help``, are
+run too and must end as the text says; a ``$ gve-conformance`` session a document shows
+must print what it shows.
+
 docs/ci.md's recipes run whole in tests/conformance/fleet/test_ci_recipe.py; their
 lines with shell variables are left to it."""
 
@@ -10,8 +15,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -122,3 +130,115 @@ def _plugin_options_exist(words: list[str]) -> None:
     plugin.pytest_addoption(options)
     named = {w.split("=")[0] for w in words if w.startswith("--gve")}
     assert named <= options.names, named - options.names
+
+
+# -- the commands that name the emulator or a simulator, run ---------------------------------
+
+#: the clone's simulator the documents name, and the emulator standing in for it
+CLONE_SIM = "./clone-sim"
+STAND_IN = "python -m emulator --model GVE84-100"
+#: commands that read what another command wrote (a placeholder path): run elsewhere
+#: (tests/conformance/cli/test_replay.py replays diff's transcripts)
+WRITTEN_BY_ANOTHER = ("reports/X/",)
+#: a documented search runs here for a number of sequences drawn from a known seed instead
+#: of its --seconds (the same end every time): (virtual time, real time)
+SEARCH = {True: ["--examples", "300", "--seed", "1"], False: ["--examples", "40", "--seed", "1"]}
+#: the cases a run through a program runs here when it names none (the whole catalogue
+#: through a program takes minutes: tests/conformance/test_serial_target.py and the
+#: co-simulation's tests run it)
+PROGRAM_CASES = "5.errors.*"
+#: what the documents show that does not yet end as they say, and why (strict: a fix
+#: makes the test fail until the mark goes)
+NOT_YET = {
+    "gve-conformance diff --target exec:'./clone-sim --cosim' --profile GVE84-100 --seconds 60":
+        "diff draws a KEEP whose R the known state cannot undo without --allow-destructive, "
+        "and stops (the known state's and diff's grammar's to fix)",
+}
+
+
+def _running() -> list[tuple[str, str]]:
+    """The documented commands of the suite and its pytest plugin that name an ``emu:``
+    or ``exec:`` target."""
+    return [(where, line) for where, line in COMMANDS
+            if ("emu:" in line or "exec:" in line)
+            and line.split()[0] in ("gve-conformance", "python")
+            and (line.startswith("gve-conformance") or " pytest " in f" {line} ")
+            and not any(p in line for p in WRITTEN_BY_ANOTHER)]
+
+
+def _helped() -> list[tuple[str, str]]:
+    """The examples `gve-conformance --help` closes with that name a target."""
+    from conformance.cli.run import EXAMPLES
+    return [("--help", line) for line in EXAMPLES if "emu:" in line or "exec:" in line]
+
+
+RUNNING = _running() + _helped()
+
+
+def _argv(line: str) -> list[str]:
+    """The command as a test runs it: the stand-in for the clone's simulator, this
+    interpreter, a search's time capped, a real-time run narrowed to a few cases."""
+    words = shlex.split(line.replace(CLONE_SIM, STAND_IN), comments=True)
+    words = [w.replace("python -m", f"{sys.executable} -m") for w in words]
+    if words[0] == "gve-conformance":
+        words[:1] = [sys.executable, "-m", "conformance"]
+    elif words[:1] in (["python"], ["python3"]):
+        words[0] = sys.executable
+    if "--seconds" in words:
+        at = words.index("--seconds")
+        virtual = any("--cosim" in w or w.startswith("emu:") for w in words)
+        words[at:at + 2] = SEARCH[virtual]
+    program = any(w.startswith("exec:") for w in words)
+    pytest_run = "pytest" in words
+    a_run = pytest_run or words[3:4] == [] or words[3].startswith("-")   # not a subcommand
+    option = "--gve-cases" if pytest_run else "--cases"
+    if program and a_run and option not in words:
+        words += [option, PROGRAM_CASES]
+    return words
+
+
+def _expected_status(line: str) -> int:
+    """What the text says the command ends with: a planted mutant FAILs (1), anything
+    else passes (0)."""
+    return 1 if "mutant=" in line else 0
+
+
+@pytest.mark.parametrize(("where", "line"), [
+    pytest.param(w, c, marks=pytest.mark.xfail(reason=NOT_YET[c], strict=True))
+    if c in NOT_YET else (w, c) for w, c in RUNNING], ids=[f"{w}:{c[:60]}" for w, c in RUNNING])
+def test_a_documented_command_ends_as_the_text_says(where, line, tmp_path):
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    done = subprocess.run(_argv(line), cwd=tmp_path, stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    out = done.stdout + done.stderr
+    assert done.returncode == _expected_status(line), f"{where}: {line}\n{out[-3000:]}"
+    assert "Traceback" not in out
+
+
+def _sessions() -> list[tuple[str, str, list[str]]]:
+    """(document, command, the output it shows) of every ``$ gve-conformance`` in a
+    text block."""
+    found = []
+    for doc in DOCUMENTS:
+        for block in re.findall(r"```text\n(.*?)```", doc.read_text(), flags=re.S):
+            lines = block.replace("\\\n", " ").splitlines()
+            if lines and lines[0].startswith("$ gve-conformance"):
+                found.append((doc.name, lines[0][2:], lines[1:]))
+    return found
+
+
+SESSIONS = _sessions()
+
+
+def test_the_documents_show_a_session():
+    assert SESSIONS
+
+
+@pytest.mark.parametrize(("where", "line", "shown"), SESSIONS,
+                         ids=[f"{w}:{c[:60]}" for w, c, _ in SESSIONS])
+def test_a_documented_session_prints_what_the_text_shows(where, line, shown, tmp_path):
+    done = subprocess.run(_argv(line), cwd=tmp_path, stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "PYTHONPATH": str(ROOT), "NO_COLOR": "1"})
+    assert done.stdout.splitlines() == shown, done.stdout + done.stderr

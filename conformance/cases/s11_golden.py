@@ -16,6 +16,7 @@ from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
+from conformance.quoting import shown
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import TAGS
@@ -52,7 +53,7 @@ def play(ctx: CaseContext, t: Transcript, rule: str | None = None) -> None:
                 # they are this record's, not a second answer or the next one's
                 got += link.rest_of_answer()
             if setup:
-                ctx.require(ok, f"setup answered {got!r} at {what}")
+                ctx.require(ok, f"setup answered {shown(got)} at {what}")
             else:
                 ctx.expect(ok, what, observed=got, expected=rec.data, tag=tag, rule=rule)
         elif rec.direction == ACTION:

@@ -19,6 +19,7 @@ from conformance.verdict import (
     ERROR,
     FAIL,
     FAILED,
+    INCOMPLETE,
     INFO,
     MISSING,
     NON_STRICT,
@@ -30,7 +31,8 @@ CHOICES = ("auto", "always", "never")
 
 #: verdict -> SGR parameters (bold red for what failed, yellow for a difference...)
 STYLE = {ERROR: "1;31", FAIL: "1;31", FAILED: "1;31", NON_STRICT: "33", INFO: "36",
-         COULD_NOT_TEST: "35", MISSING: "2", PASS: "32", PASSED: "1;32"}
+         COULD_NOT_TEST: "35", MISSING: "2", PASS: "32", PASSED: "1;32",
+         INCOMPLETE: "1;33"}
 
 
 def wanted(choice: str, stream: TextIO, environ: Mapping[str, str] | None = None) -> bool:

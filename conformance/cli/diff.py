@@ -8,9 +8,10 @@ from __future__ import annotations
 import argparse
 import sys
 
+from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
-from conformance.cli.unit import ask_before_motion, unattended
+from conformance.cli.unit import consent, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,
@@ -111,9 +112,7 @@ def ask_first(args: argparse.Namespace, target: Target, meta: RunMeta | None = N
     """Real units: the question before the first frame that can move an axis, as the
     suite's run asks it (no terminal and no --yes: nothing moves); the answer goes to
     ``meta``."""
-    if target.info.real and not args.yes:
-        target.session.before_motion = ask_before_motion(target, Console(),
-                                                         meta or RunMeta())
+    consent(args.yes, Console(), meta or RunMeta()).arm(target)
 
 
 def meta_of(args: argparse.Namespace, argv: list[str], target: Target, reference: Target,
@@ -130,8 +129,7 @@ def meta_of(args: argparse.Namespace, argv: list[str], target: Target, reference
         else "--profile"
     t.envelope = target.info.max_travel if target.info.real else None
     t.graded = "strict" if target.info.strict else "by the tags"
-    if target.info.real:
-        meta.confirmed = "--yes" if args.yes else "asked"
+    meta.confirmed = consent(args.yes, Console(), meta).how([target])
     meta.job_flags = {
         "--against": reference.info.spec, "--seed": seed,
         "--examples": args.examples if args.examples is not None else (
@@ -280,7 +278,9 @@ def main(argv: list[str] | None = None) -> int:
     say(f"{budget.used} sequences, {budget.frames} frames in {budget.elapsed:.1f} s: "
         f"{counted(run)}" + (" (interrupted by a signal: H and D sent)" if run.interrupted
                              else ""))
-    return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
+    return end(run, None if args.no_reports else args.report_dir, junitxml=args.junitxml,
+               accept_incomplete=args.accept_incomplete,
+               colour=wanted(args.color, sys.stdout))
 
 
 def _say(text: str) -> None:

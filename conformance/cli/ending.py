@@ -4,7 +4,7 @@ recap — the cases to look at listed again (ERROR, FAIL, NON-STRICT: each with 
 rule's sentence), where the reports are (or one line saying which file could not be
 written and why: then the exit status is not 0), and the verdict line (what was judged,
 what was not tested and why) — also under ``-q``; the exit status (0 when the verdict
-line says PASSED, else 1)."""
+line says PASSED, 3 when it says INCOMPLETE, else 1)."""
 
 from __future__ import annotations
 
@@ -13,12 +13,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from conformance.cli.colour import paint
-from conformance.cli.usage import UsageError, exit_status
+from conformance.cli.usage import UsageError, verdict_status
 from conformance.reports import ReportNotWritten, write_junit, write_reports
 from conformance.reports.failures import failures
 from conformance.reports.files import RunFolderTaken, claim, new_run_id
 from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ORDER, PASSED, last_line, overall
+from conformance.verdict import ERROR, FAIL, MISSING, NON_STRICT, ORDER, last_line, overall
 
 __all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
            "written"]
@@ -57,27 +57,42 @@ def progress(quiet: bool, detail: Callable[[CaseResult], str | None]
     return show
 
 
+#: what a count of a verdict means where the word alone reads like a defect
+MEANING = {MISSING: "not in the profile: nothing to test"}
+
+
 def counted(result: RunResult) -> str:
-    """``PASS 17, INFO 1``: the verdicts, worst first."""
+    """``PASS 1219, MISSING 181 (not in the profile: nothing to test)``: the verdicts,
+    worst first."""
     counts = result.counts()
-    return ", ".join(f"{v} {counts[v]}" for v in ORDER if v in counts)
+    return ", ".join(f"{v} {counts[v]}" + (f" ({MEANING[v]})" if v in MEANING else "")
+                     for v in ORDER if v in counts)
+
+
+#: the recap's lists: what failed (ERROR, FAIL), then what only departs from the
+#: project's decisions (NON-STRICT: not a failure, and not counted as one)
+RECAP = (("what failed", (ERROR, FAIL)),
+         ("what departs from the project's decisions, NON-STRICT", (NON_STRICT,)))
 
 
 def recap(result: RunResult, colour: bool = False) -> list[str]:
-    """The cases to look at, listed again at the end of a job: ERROR, FAIL, then
-    NON-STRICT, each once for every profile it failed on alike, with why (the deciding
-    check) and the sentence of the rule it judges; nothing when there are none."""
+    """The cases to look at, listed again at the end of a job: what failed (ERROR,
+    FAIL), then NON-STRICT under its own heading, each once for every profile it failed
+    on alike, with why (the deciding check) and the sentence of the rule it judges;
+    nothing when there are none."""
     found = failures(result)
-    if not found:
-        return []
-    lines = [f"what failed ({len(found)}):"]
-    for f in found:
-        why = f.why
-        lines.append(f"{paint(f.verdict, f'{f.verdict:10}', colour)} {f.id} "
-                     f"[{', '.join(r.profile for r in f.runs)}]")
-        lines.append(f"    {why.line()}")
-        if why.rule:
-            lines.append(f"    the rule: {why.cites()}")
+    lines: list[str] = []
+    for heading, verdicts in RECAP:
+        listed = [f for f in found if f.verdict in verdicts]
+        if listed:
+            lines.append(f"{heading} ({len(listed)}):")
+        for f in listed:
+            why = f.why
+            lines.append(f"{paint(f.verdict, f'{f.verdict:10}', colour)} {f.id} "
+                         f"[{', '.join(r.profile for r in f.runs)}]")
+            lines.append(f"    {why.line()}")
+            if why.rule:
+                lines.append(f"    the rule: {why.cites()}")
     return lines
 
 
@@ -87,11 +102,12 @@ def say_all(lines: Sequence[str]) -> None:
 
 
 def end(result: RunResult, report_dir: str | Path | None, *,
-        junitxml: str | Path | None = None, colour: bool = False) -> int:
+        junitxml: str | Path | None = None, colour: bool = False,
+        accept_incomplete: bool = False) -> int:
     """The end of a job: the recap, the reports written (unless ``report_dir`` is None)
     and where, then the verdict line — the same under ``-q``, since it is what a log is
-    read for; the exit status: 0 for PASSED, 1 otherwise, 130 when a signal stopped the
-    job."""
+    read for; the exit status: 0 for PASSED, 3 for INCOMPLETE (0 when
+    ``accept_incomplete``), 1 otherwise, 130 when a signal stopped the job."""
     say_all(recap(result, colour))
     lost = False                        # a report that could not be written (a full disk)
     if report_dir is not None:
@@ -107,4 +123,5 @@ def end(result: RunResult, report_dir: str | Path | None, *,
     verdict, _ = overall(result.results, result.interrupted, result.problems)
     line = last_line(result.results, result.interrupted, result.problems)
     print(paint(verdict, verdict, colour) + line[len(verdict):], flush=True)
-    return exit_status(verdict == PASSED and not lost, result.interrupted)
+    return verdict_status(verdict, lost=lost, interrupted=result.interrupted,
+                          accept_incomplete=accept_incomplete)

@@ -19,8 +19,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import gate_end, workers
-from conformance.cli.progress import Progress
+from conformance.cli.pool import gate_end, gate_line, under_way, workers
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
@@ -157,7 +157,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="only this reading (repeatable; default: every one, and all at once)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", type=positive, default=1, help="readings tried in parallel")
+    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
+                    help="readings tried in parallel")
     add_loudness(ap, "also list every difference each reading made")
     try:
         args = ap.parse_args(argv)
@@ -179,7 +180,8 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     trials: list[Trial] = []
     with workers(args.jobs) as pool, Progress(len(jobs), unit="reading", quiet=args.quiet,
-                                              verbose=args.verbose, every_step=True) as shown:
+                                              verbose=args.verbose, every_step=True,
+                                              heartbeat=HEARTBEAT) as shown:
         for t in pool.map(_trial, jobs):
             trials.append(t)
             shown.step("\n".join(_lines(t, args.verbose)), routine=t.fair)
@@ -187,11 +189,14 @@ def main(argv: list[str] | None = None) -> int:
     score = 100.0 * fair / len(trials) if trials else 100.0
     unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
     if gate_end("fairness", unfair, f"{len(trials) - fair} reading(s)", pool.interrupted,
-                f"{len(trials)} of {len(jobs)} readings ({len(trials) - fair} unfair)", start):
+                f"{len(trials)} of {len(jobs)} readings finished ({len(trials) - fair} "
+                f"unfair; {under_way(args.jobs, len(jobs), len(trials))} under way)", start):
         return INTERRUPTED
-    print(f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
-          f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-          f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO")
+    print(gate_line(fair == len(trials),
+                    f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
+                    f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
+                    f"{sum(len(t.differences) for t in trials)} differences graded "
+                    "NON-STRICT or INFO"))
     return 0 if fair == len(trials) else 1
 
 

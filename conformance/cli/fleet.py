@@ -40,13 +40,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from conformance.cli.ending import recap, say_all, written
-from conformance.cli.progress import Progress
-from conformance.cli.usage import INTERRUPTED, exit_status
+from conformance.cli.progress import HEARTBEAT, Progress
+from conformance.cli.usage import INTERRUPTED, verdict_status
 from conformance.link.interrupts import Interrupts
 from conformance.reports.files import ReportNotWritten, write_text
 from conformance.runner import CaseResult, RunResult
 from conformance.targets import Target
-from conformance.verdict import FAILED, ORDER, PASSED
+from conformance.verdict import FAILED, INCOMPLETE, ORDER, PASSED
 
 SUMMARY_JSON = "summary.json"
 INDEX_HTML = "index.html"
@@ -106,7 +106,8 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         print(f"fleet {run_id}: {len(members)} targets, {jobs} at a time", flush=True)
     start = time.perf_counter()
     with Progress(len(members), unit="target", quiet=quiet,
-                  verbose=bool(getattr(args, "verbose", False)), every_step=True) as shown:
+                  verbose=bool(getattr(args, "verbose", False)), every_step=True,
+                  heartbeat=HEARTBEAT) as shown:
         interrupted = _run_members(members, folder, jobs, start, shown)
     seconds = time.perf_counter() - start
     for m in members:
@@ -129,9 +130,10 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         lost = lost or index is None
         if index is not None:
             print(f"reports: {index} (one folder per target), {SUMMARY_JSON}")
-    print(f"{summary['verdict']}: {summary['reason']}")
-    return exit_status(summary["verdict"] == PASSED and not lost, interrupted or any(
-        row["interrupted"] for row in summary["targets"]))
+    print(f"{summary['verdict']} — {summary['reason']}")
+    return verdict_status(summary["verdict"], lost=lost, interrupted=interrupted or any(
+        row["interrupted"] for row in summary["targets"]),
+        accept_incomplete=args.accept_incomplete)
 
 
 class _Fleet(Interrupts):
@@ -260,11 +262,14 @@ def _summary(members: list[Member], run_id: str, seconds: float, interrupted: bo
                      "interrupted": r.get("interrupted", m.status == INTERRUPTED),
                      "started": round(m.started, 3),
                      "ended": None if m.ended is None else round(m.ended, 3)})
-    failed = [row for row in rows if row["verdict"] != PASSED and not row["interrupted"]]
+    failed = [row for row in rows if row["verdict"] not in (PASSED, INCOMPLETE)
+              and not row["interrupted"]]
+    incomplete = [row for row in rows if row["verdict"] == INCOMPLETE]
     why = ([f"{len(failed)} of {len(rows)} targets failed"] if failed else []) + (
         ["interrupted before every target had run"] if interrupted else [])
     verdict, reason = (FAILED, "; ".join(why)) if why else (
-        PASSED, f"all {len(rows)} targets passed")
+        INCOMPLETE, f"{len(incomplete)} of {len(rows)} targets not tested whole") \
+        if incomplete else (PASSED, f"all {len(rows)} targets passed")
     return {"run_id": run_id, "verdict": verdict, "reason": reason,
             "seconds": round(seconds, 3), "interrupted": interrupted, "counts": counts,
             "targets": rows}

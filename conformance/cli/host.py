@@ -16,6 +16,7 @@ import argparse
 import fnmatch
 import sys
 
+from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
@@ -74,7 +75,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                     help="a host silent this long without exiting hangs (default 5)")
     ap.add_argument("--port", default="pty",
                     help="pty (default), tcp:HOST:PORT, or a serial device path")
-    ap.add_argument("--jobs", type=positive, default=4,
+    ap.add_argument("--jobs", "-j", type=positive, default=4, metavar="N",
                     help="scenarios run side by side (launched, pty or tcp port 0)")
     ap.add_argument("--strict", action="store_true",
                     help="the host claims the project's decisions: [D] rules FAIL too")
@@ -194,7 +195,9 @@ def main(argv: list[str] | None = None) -> int:
         if clean is not None:
             print(f"took {result.seconds:.1f} s; the job took {clean.seconds:.2f} s on the "
                   f"clean line; {result.frames} frames")
-    return end(result, None if args.no_reports else args.report_dir, junitxml=args.junitxml)
+    return end(result, None if args.no_reports else args.report_dir, junitxml=args.junitxml,
+               accept_incomplete=args.accept_incomplete,
+               colour=wanted(args.color, sys.stdout))
 
 
 if __name__ == "__main__":

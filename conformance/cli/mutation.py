@@ -23,8 +23,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import gate_end, workers
-from conformance.cli.progress import Progress
+from conformance.cli.pool import gate_end, gate_line, under_way, workers
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
@@ -155,7 +155,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="only this mutant (repeatable; default: every one)")
     ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
                     help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", type=positive, default=1, help="mutants hunted in parallel")
+    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
+                    help="mutants hunted in parallel")
     ap.add_argument("--sweep", action="store_true",
                     help="also run the rest of the catalogue against each mutant (one "
                          "profile per family), failing on any ERROR")
@@ -179,7 +180,8 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     results = []
     with workers(args.jobs) as pool, Progress(len(jobs), unit="mutant", quiet=args.quiet,
-                                              verbose=args.verbose, every_step=True) as shown:
+                                              verbose=args.verbose, every_step=True,
+                                              heartbeat=HEARTBEAT) as shown:
         for h in pool.map(_hunt, jobs):
             results.append(h)
             shown.step("\n".join(_lines(h)), routine=h.caught and not h.errors
@@ -191,24 +193,31 @@ def main(argv: list[str] | None = None) -> int:
     if gate_end("mutation", failed,
                 f"{sum(not h.caught or bool(h.errors) for h in results)} mutant(s)",
                 pool.interrupted,
-                f"{len(results)} of {len(jobs)} mutants ({caught} caught, {errors} ERROR)",
-                start):
+                f"{len(results)} of {len(jobs)} mutants finished ({caught} caught, "
+                f"{errors} ERROR; {under_way(args.jobs, len(jobs), len(results))} under "
+                "way)", start):
         return INTERRUPTED
-    print(f"mutation score: {caught}/{len(results)} = {score:.1f} % "
-          f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-          f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
-          + (f"; {sum(h.unreached for h in results)} not run, the mutant's code unreached"
-             if args.sweep else ""))
+    print(gate_line(caught == len(results) and not errors,
+                    f"mutation score: {caught}/{len(results)} = {score:.1f} % "
+                    f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
+                    f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
+                    + (f"; {sum(h.unreached for h in results)} not run, the mutant's code "
+                       "unreached" if args.sweep else "")))
     return 0 if caught == len(results) and not errors else 1
+
+
+def _runs(n: int) -> str:
+    return f"{n} run" if n == 1 else f"{n} runs"
 
 
 def _lines(h: Hunt) -> list[str]:
     """What a hunt found: caught (by what, how fast) or missed, and the ERRORs and
     clean-failing cases met on the way."""
     if h.caught:
-        line = f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s ({h.runs} runs)"
+        line = (f"caught  {h.mutant:32} by {h.caught_by} in {h.seconds:.2f} s "
+                f"({_runs(h.runs)})")
     else:
-        line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {h.runs} runs "
+        line = (f"MISSED  {h.mutant:32} ({h.area}: {h.description}) after {_runs(h.runs)} "
                 f"in {h.seconds:.1f} s")
     return [line, *(f"        ERROR on the way (a defect of the suite): {e}" for e in h.errors),
             *(f"        not counted: {e} fails the clean emulator too" for e in h.clean_fails)]

@@ -30,6 +30,7 @@ from typing import Any
 
 from conformance.cli.usage import INTERRUPTED
 from conformance.link.interrupts import STOPPING, Interrupts
+from conformance.verdict import FAILED, PASSED
 
 #: how long the workers may take to end once stopped, before they are killed
 ENDING_SECONDS = 10.0
@@ -268,10 +269,22 @@ def gate_end(job: str, failed: list[str], count: str, interrupted: bool, done: s
              start: float) -> bool:
     """The end of a gate run by workers: what failed listed again under ``count`` (how
     many, and of what), then, when a signal stopped it, one line saying how far it got
-    (``done``) and True: no score is given then."""
+    (``done``: what finished, and what was under way) and True: no score is given
+    then."""
     for line in [f"what failed ({count}):", *failed] if failed else []:
         print(line, flush=True)
     if interrupted:
-        print(f"{job}: interrupted by a signal after {done} in "
+        print(f"{FAILED} — {job} interrupted by a signal after {done} in "
               f"{time.perf_counter() - start:.1f} s: no score", flush=True)
     return interrupted
+
+
+def under_way(jobs: int, total: int, finished: int) -> int:
+    """How many items a pool of ``jobs`` workers had begun and not finished when it
+    was stopped."""
+    return min(jobs, total - finished)
+
+
+def gate_line(passed: bool, score: str) -> str:
+    """A gate's last line, as every job ends: ``PASSED — mutation score: ...``."""
+    return f"{PASSED if passed else FAILED} — {score}"

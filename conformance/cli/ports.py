@@ -24,10 +24,13 @@ from serial.tools import list_ports
 
 from conformance.cli.usage import Parser, UsageError, summary
 
-#: the device majors of Linux's pseudo-terminal slaves (UNIX98_PTY_SLAVE_MAJOR and up)
-_PTY_MAJORS = range(136, 144)
-#: pseudo-terminal slaves by name where majors say nothing (BSD and macOS, the old ptys)
-_PTY_NAMES = re.compile(r"/dev/(pts/\d+|ttys\d+|tty[p-zP-T][0-9a-f])\Z")
+#: the device majors of Linux's pseudo-terminal slaves: the old BSD-style ones
+#: (PTY_SLAVE_MAJOR) and UNIX98_PTY_SLAVE_MAJOR and up; a serial port (ttyS*: 4,
+#: ttyUSB*: 188, ttyACM*: 166...) has another
+_PTY_MAJORS = frozenset({3, *range(136, 144)})
+#: pseudo-terminal slaves by name where the system has no majors to tell (BSD and macOS:
+#: /dev/ttys003, the old ttyp0..ttysf); never asked on Linux, where /dev/ttyS0 is a port
+_PTY_NAMES = re.compile(r"/dev/(pts/\d+|ttys\d+|tty[p-s][0-9a-f])\Z")
 #: what a pseudo-terminal found by a glob or the system's list shows instead of a probe
 NAME_IT = ("skipped: a pseudo-terminal (an interactive terminal, or another program's "
            "line): probed only when named, gve-conformance ports --probe {device}")
@@ -70,14 +73,17 @@ def found(patterns: list[str], named: list[str] = ()) -> list[tuple[str, str, st
 
 
 def is_pseudo_terminal(device: str) -> bool:
-    """Whether ``device`` (or what its symlinks lead to) is a pseudo-terminal's slave."""
+    """Whether ``device`` (or what its symlinks lead to) is a pseudo-terminal's slave:
+    by what it is — its device major on Linux — and by its name only where there are
+    no majors to tell (``/dev/ttyS0``, a serial port, is never taken for one)."""
     path = os.path.realpath(device)
     try:
         rdev = os.stat(path).st_rdev
     except OSError:
         return False
-    return (sys.platform.startswith("linux") and os.major(rdev) in _PTY_MAJORS) or \
-        _PTY_NAMES.match(path) is not None
+    if sys.platform.startswith("linux"):
+        return os.major(rdev) in _PTY_MAJORS
+    return _PTY_NAMES.match(path) is not None
 
 
 def main(argv: list[str]) -> int:

@@ -8,6 +8,9 @@ sequences).
 - Elsewhere (a CI log, a pipe): the same lines, numbered ``[done/total]``, and no bar;
   where routine lines are not shown, a line at every tenth of the way
   (``[130/1296] 10 %, 4.1 s``), so that a log shows the job is moving.
+- A long job (``heartbeat``: the mutation and fairness scores) shows it is moving at
+  least every HEARTBEAT seconds: the bar's clock redrawn, or a line in a log
+  (``[0/31] 0 % in 5.0 s, still working``).
 - ``-q``: nothing (the job prints its recap and last line only).
 
 The verdict of each line is coloured when colour is on (colour.py). The bar is cleared
@@ -20,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import sys
+import threading
 import time
 from collections.abc import Callable
 from typing import TextIO
@@ -35,6 +39,9 @@ from conformance.verdict import MISSING, PASS, UNTESTED
 _ROUTINE = (PASS, MISSING)
 #: a log without routine lines says how far the job is at every tenth of it
 _TENTHS = 10
+#: a long job (a mutant, a reading: tens of seconds each) shows it is moving at least
+#: this often (seconds): a line in a log, the bar's clock redrawn on a terminal
+HEARTBEAT = 5.0
 
 
 def describe(r: CaseResult, colour: bool = False) -> str:
@@ -55,7 +62,8 @@ class Progress:
     def __init__(self, total: int, *, unit: str = "case", quiet: bool = False,
                  verbose: bool = False, colour: bool = False, every_step: bool = False,
                  stream: TextIO | None = None, terminal: bool | None = None,
-                 refresh: float = 0.1, status: Callable[[], str] | None = None) -> None:
+                 refresh: float = 0.1, status: Callable[[], str] | None = None,
+                 heartbeat: float | None = None) -> None:
         self.stream = stream or sys.stdout
         self.total = max(total, 1)
         self.unit = unit
@@ -72,9 +80,39 @@ class Progress:
         # the bar redraws at most every ``refresh`` seconds
         self.bar = tqdm(total=total, unit=unit, file=self.stream, dynamic_ncols=True,
                         leave=False, mininterval=refresh) if terminal and not quiet else None
+        self._lock = threading.Lock()
+        self._said = time.perf_counter()            # when the job last showed something
+        self._stop = threading.Event()
+        self._beat: threading.Thread | None = None
+        if heartbeat is not None and not quiet:
+            self._beat = threading.Thread(target=self._heartbeat, args=(heartbeat,),
+                                          daemon=True, name="progress-heartbeat")
+            self._beat.start()
+
+    def _heartbeat(self, every: float) -> None:
+        """Every ``every`` seconds without a line: the bar's clock redrawn, or in a log
+        a line saying how far the job is and that it is still working."""
+        while not self._stop.wait(every / 4):
+            if time.perf_counter() - self._said < every:
+                continue
+            with self._lock:
+                if self._stop.is_set():
+                    return
+                if self.bar is not None:
+                    self.bar.refresh()
+                    self._said = time.perf_counter()
+                else:
+                    self._print(f"[{self.done}/{self.total}] {100 * self.done // self.total}"
+                                f" % in {time.perf_counter() - self.started:.1f} s, still "
+                                f"working")
 
     def print(self, text: str) -> None:
         """A line above the bar (or a plain line)."""
+        with self._lock:
+            self._print(text)
+
+    def _print(self, text: str) -> None:
+        self._said = time.perf_counter()
         if self.bar is not None:
             self.bar.write(text, file=self.stream)
         else:
@@ -120,6 +158,10 @@ class Progress:
 
     def close(self) -> None:
         """The bar gone from the screen, the terminal's echo as it was."""
+        self._stop.set()
+        if self._beat is not None and self._beat is not threading.current_thread():
+            self._beat.join()
+            self._beat = None
         if self.bar is not None:
             self.bar.close()
             with contextlib.suppress(OSError, ValueError):

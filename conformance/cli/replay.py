@@ -1,8 +1,9 @@
 """`gve-conformance replay FILE --target ...`: replay a transcript `diff` wrote (or any
 transcript) on a target and its reference alike, frame by frame, and say whether the
 disagreement is still there: each frame with the target's answer, the reference's now
-and the one recorded, then one verdict line (PASS, FAIL..., COULD-NOT-TEST). Exit status
-0 when the sides agree on every frame, 1 while they disagree or when the transcript
+and the one recorded, then one verdict line (``PASSED — PASS: ...``, ``FAILED — FAIL
+...``, ``FAILED — COULD-NOT-TEST: ...``, as every job ends). Exit status 0 when the
+sides agree on every frame, 1 while they disagree or when the transcript
 could not be replayed whole, 2 for a usage error, 130 when a signal stopped it."""
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from conformance.diff.sides import Side
 from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
 from conformance.targets import SessionError, TargetError
-from conformance.verdict import FAIL
+from conformance.verdict import FAIL, FAILED, PASSED
 from gve_fixtures.transcript import TranscriptError, load
 
 PROG = "gve-conformance replay"
@@ -85,5 +86,6 @@ def main(argv: list[str] | None = None) -> int:
     if outcome is not None and not args.quiet:
         for line in frame_lines(outcome, steps, expected):
             print(line)
-    print(result.line, flush=True)
+    # the last line as every job's: PASSED only when the sides agreed on every frame
+    print(f"{PASSED if result.status == 0 else FAILED} — {result.line}", flush=True)
     return result.status

@@ -21,8 +21,8 @@ from conformance.cli.commands import subcommands_help
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
 from conformance.cli.unit import (
-    ask_before_motion,
     confirmed,
+    consent,
     record_identities,
     resolve,
     unattended,
@@ -37,6 +37,7 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
+from conformance.consent import ASKED
 from conformance.coverage import coverage, format_coverage
 from conformance.link.account import account_lines
 from conformance.metadata import RunMeta, now_iso
@@ -60,7 +61,9 @@ EXAMPLES = (
     "gve-conformance --target serial:/dev/ttyUSB0?baud=115200 --profile auto",
     "gve-conformance --target tcp:127.0.0.1:5114 --profile GVE114-500 --yes",
     "gve-conformance --target 'exec:python -m emulator --model GVE84-100 --pty' "
-    "--profile GVE84-100",
+    "--profile GVE84-100 --yes",
+    "gve-conformance --target 'exec:python -m emulator --model GVE84-100 --cosim' "
+    "--profile GVE84-100   # virtual time: nothing moves, no --yes",
     "gve-conformance --cases '6.*' -v                  # some cases, every line shown",
 )
 
@@ -118,9 +121,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--coverage", nargs="?", const="unit", choices=("unit", "host"),
                     help="print which rules of the spec the (selected) cases can fail, per "
                          "section and profile, and the rules without one (exit 1 if any)")
-    ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
-                    default="auto", help="colour the verdicts: auto (a terminal without "
-                    "NO_COLOR set), always or never (default auto)")
     return ap.parse_args(argv)
 
 
@@ -228,10 +228,9 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     meta = _meta(args, argv, targets, how, cases, seed, console)
     if args.jobs > 1 and len(targets) > 1:
         return _fleet(args, argv, targets, meta, console, run_id)
-    if meta.confirmed == "asked":
+    if meta.confirmed == ASKED:
         for target in targets:
-            if target.info.real:
-                target.session.before_motion = ask_before_motion(target, console, meta)
+            consent(args.yes, console, meta).arm(target)
     say = _nothing if args.quiet else _say       # -q: the last line only
     say(f"Hypothesis settings: {_settings_line(targets, args.settings)}")
     say(f"seed {seed} (the same examples again: --seed {seed})" if seed is not None else
@@ -255,7 +254,8 @@ def _run(args: argparse.Namespace, argv: list[str], cases: list) -> int:
     for line in _session_lines(result):
         say(line)
     return end(result, None if args.no_reports else args.report_dir,
-               junitxml=args.junitxml, colour=colour)
+               junitxml=args.junitxml, colour=colour,
+               accept_incomplete=args.accept_incomplete)
 
 
 class Stopped(Exception):
@@ -267,7 +267,7 @@ def _fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], met
     """The targets in processes of their own (cli/fleet.py), asked about once here: the
     members have no terminal."""
     from conformance.cli.fleet import run_fleet
-    if meta.confirmed == "asked" and not confirmed(targets, meta, console):
+    if meta.confirmed == ASKED and not confirmed(targets, meta, console):
         raise UsageError("motion not confirmed, nothing that moves was sent (answer y, or "
                          "give --yes on an unattended bench)")
     for target in targets:
@@ -295,8 +295,7 @@ def _meta(args: argparse.Namespace, argv: list[str], targets: list[Target], how:
     real = any(t.info.real for t in targets)
     meta.operator_steps = (real and console.interactive if args.operator is None
                            else args.operator)
-    if real:
-        meta.confirmed = "--yes" if args.yes else "asked"
+    meta.confirmed = consent(args.yes, console, meta).how(targets)
     try:
         record_identities([t for t in targets if not t.info.real], meta)
     except (OSError, SerialException, ValueError) as err:
@@ -326,7 +325,7 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     # no --target, or emu:all: the embedded emulator on every profile (--profile is for
     # the targets named)
     specs = [(s, t.split("?")[0] != "emu:all") for t in args.target or ["emu:all"]
-             for s in (every if t.split("?")[0] == "emu:all" else [t])]
+             for s in (_with_query(every, t) if t.split("?")[0] == "emu:all" else [t])]
     try:
         chosen = [resolve(s, args.profile if named else None, args.variant, console)
                   for s, named in specs]
@@ -337,6 +336,13 @@ def _targets(args: argparse.Namespace, console: Console) -> tuple[list[Target], 
     except (ValueError, LookupError, OSError, SerialException) as err:
         raise UsageError(str(err).strip("'\"")) from None
 
+
+
+def _with_query(specs: list[str], given: str) -> list[str]:
+    """``emu:all?mutant=X``: each profile's target with the settings given (checked as
+    any ``emu:`` target's are)."""
+    query = given.partition("?")[2]
+    return [f"{s}?{query}" if query else s for s in specs]
 
 
 def _preflight(targets: list[Target]) -> None:

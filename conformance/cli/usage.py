@@ -14,6 +14,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
+from conformance.verdict import INCOMPLETE, PASSED
+
 #: the longest --seconds / --host-timeout taken: a day (a typo of many zeros is a mistake)
 LONGEST_SECONDS = 86400.0
 _RUN_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
@@ -24,10 +26,27 @@ _RUN_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 INTERRUPTED = 130
 
 
+#: the exit status of a run that FAILed nothing yet did not test what it was asked to
+#: (INCOMPLETE: motion declined, a rig missing...), unless --accept-incomplete
+INCOMPLETE_STATUS = 3
+
+
 def exit_status(passed: bool, interrupted: bool = False) -> int:
     """0 for a job that passed, 1 for one that did not, INTERRUPTED for one a signal
     stopped (whatever it had found by then: the reports say)."""
     return INTERRUPTED if interrupted else 0 if passed else 1
+
+
+def verdict_status(verdict: str, *, lost: bool = False, interrupted: bool = False,
+                   accept_incomplete: bool = False) -> int:
+    """The exit status of a job whose last line says ``verdict``: 0 PASSED (and
+    INCOMPLETE when ``accept_incomplete``), INCOMPLETE_STATUS for INCOMPLETE, 1 FAILED
+    or a report ``lost``, INTERRUPTED for a job a signal stopped."""
+    if interrupted:
+        return INTERRUPTED
+    if lost or verdict not in (PASSED, INCOMPLETE):
+        return 1
+    return INCOMPLETE_STATUS if verdict == INCOMPLETE and not accept_incomplete else 0
 
 
 class UsageError(Exception):
@@ -53,12 +72,15 @@ def summary(doc: str | None) -> str:
 
 def add_loudness(ap: argparse.ArgumentParser | argparse._ArgumentGroup, verbose: str) -> None:
     """``-q`` (the recap and the verdict's line only) or ``-v`` (``verbose``: what every
-    line is), one or the other, alike on every subcommand."""
+    line is), one or the other, and ``--color``, alike on every subcommand."""
     loud = ap.add_mutually_exclusive_group()
     loud.add_argument("-q", "--quiet", action="store_true",
                       help="print only the end: what failed, where the reports are and "
                            "the verdict's line")
     loud.add_argument("-v", "--verbose", action="store_true", help=verbose)
+    ap.add_argument("--color", "--colour", choices=("auto", "always", "never"),
+                    default="auto", help="colour the verdicts: auto (a terminal without "
+                    "NO_COLOR set), always or never (default auto)")
 
 
 #: --seed's help, the same wherever a job draws at random
@@ -80,6 +102,10 @@ def report_options(verbose: str, seed: str | None = SEED_HELP) -> argparse.Argum
     out.add_argument("--no-reports", action="store_true",
                      help="write no report folder (--junitxml still writes its file)")
     out.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
+    out.add_argument("--accept-incomplete", action="store_true",
+                     help=f"exit 0 for a run that ends INCOMPLETE (nothing failed, yet some "
+                          f"cases were not tested: motion declined, no rig...); otherwise "
+                          f"its exit status is {INCOMPLETE_STATUS}")
     if seed is not None:
         out.add_argument("--seed", type=int, metavar="N", help=seed)
     add_loudness(out, verbose)
@@ -163,6 +189,8 @@ def run_id(text: str) -> str:
 def writable_folder(folder: str | Path, what: str = "reports") -> Path:
     """``folder``, created if need be, once a file could be written in it."""
     folder = Path(folder)
+    if folder.exists() and not folder.is_dir():      # mkdir would say "File exists"
+        raise UsageError(f"cannot write {what} to {folder}: it is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):

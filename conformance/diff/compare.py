@@ -35,6 +35,8 @@ from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import SECOND
 
 POSITION_COMMANDS = classes(position=True)
+#: the kind of a difference in when the same bytes came
+TIMING = "timing"
 #: answered when the motion has stopped (spec 2)
 DEFERRED = classes(deferred=True)
 
@@ -68,7 +70,7 @@ def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Jud
                                                          - reference.sent_at)
         if judge.exact and late and not (command in DEFERRED
                                          and abs(late) <= 2 * judge.period_ns):
-            return "timing"
+            return TIMING
         return None
     if not a or not b:
         return "silence"
@@ -107,6 +109,19 @@ def alike_because(command: str, target: RoundTrip, reference: RoundTrip, judge: 
         "read after a frame that changed the motion's course"
     line = "" if judge.line.exact else f" ({judge.line})"
     return f"within ±{limit} step(s){line}, {when}"
+
+
+def delays(target: RoundTrip, reference: RoundTrip) -> tuple[str, str]:
+    """How long after its frame each side answered, as a timing difference shows them
+    (``41.250 ms``): with as many decimals as make two different instants read
+    differently (to the nanosecond)."""
+    a = target.received_at - target.sent_at
+    b = reference.received_at - reference.sent_at
+    for decimals in range(3, 7):
+        shown = tuple(f"{ns / 1e6:.{decimals}f} ms" for ns in (a, b))
+        if shown[0] != shown[1] or a == b:
+            return shown
+    return shown
 
 
 def _repeats_position(ra, rb) -> bool:

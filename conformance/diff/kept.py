@@ -14,6 +14,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from conformance.diff.compare import delays
 from conformance.diff.engine import Finding
 from conformance.diff.gvt import transcript, write
 from conformance.diff.results import finding_result
@@ -73,6 +74,9 @@ class Kept:
                 "verdict": d.verdict, "tag": d.tag, "command": d.command,
                 "sent": readable(d.target.sent), "target": readable(d.target.answer),
                 "reference": readable(d.reference.answer), "frames": f.frames,
+                # when each answer came after its frame (what differs in a timing kind)
+                "after": dict(zip(("target", "reference"), delays(d.target, d.reference),
+                                  strict=True)),
                 "steps": [str(s) for s in f.steps],
                 "transcript": str(path) if path is not None else None}
 

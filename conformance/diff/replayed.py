@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from conformance.diff.engine import ExampleRun, StepRecord
+from conformance.diff.compare import TIMING, delays
+from conformance.diff.engine import Disagreement, ExampleRun, StepRecord
 from conformance.diff.steps import FILL, FRAME, INPUT, Step
 from conformance.link.framing import readable
 from conformance.verdict import COULD_NOT_TEST, PASS
@@ -92,7 +93,7 @@ def frame_lines(outcome: ExampleRun, steps: list[Step], expected: list[bytes]) -
             if len(recs) > 2 and (i, rec) == recs[-1]:
                 out.append(f"  ... {len(recs) - 2} more frames of the fill, each answered "
                            "alike")
-            judged = (f"DIFFERENT ({d.kind})" if d is not None and i == d.index
+            judged = (_different(d) if d is not None and i == d.index
                       else f"alike: {rec.alike}" if rec.alike else "same")
             was = expected[place] if rec.repeat == 0 and place < len(expected) else b""
             out.append(f"  > {readable(rec.target.sent):28} target "
@@ -100,6 +101,15 @@ def frame_lines(outcome: ExampleRun, steps: list[Step], expected: list[bytes]) -
                        f" recorded {_one(was):16} {judged}")
     out += [f"  not sent (the guard): {note}" for note in refused]
     return out
+
+
+def _different(d: Disagreement) -> str:
+    """``DIFFERENT (code)``; a timing difference with both sides' instants."""
+    if d.kind != TIMING:
+        return f"DIFFERENT ({d.kind})"
+    target, reference = delays(d.target, d.reference)
+    return f"DIFFERENT (timing: the target answered {target} after the frame, the " \
+        f"reference {reference})"
 
 
 def _not_run(steps: list[Step], outcome: ExampleRun) -> list[Step]:
@@ -123,9 +133,13 @@ def verdict(outcome: ExampleRun, steps: list[Step], meta: dict[str, str]) -> Ver
             still = f"a disagreement other than the recorded {recorded}"
         else:
             still = "the sides disagree"
+        target, reference = (readable(d.target.answer) or "(none)",
+                             readable(d.reference.answer) or "(none)")
+        if d.kind == TIMING:              # the same bytes: when each came
+            after = delays(d.target, d.reference)
+            target, reference = f"{target} after {after[0]}", f"{reference} after {after[1]}"
         return Verdict(d.verdict, f"{d.verdict} {rule}: {readable(d.target.sent)} target "
-                       f"{readable(d.target.answer) or '(none)'}, reference "
-                       f"{readable(d.reference.answer) or '(none)'} ({d.kind}): {still}", 1)
+                       f"{target}, reference {reference} ({d.kind}): {still}", 1)
     if outcome.refused:
         return Verdict.could_not_test(
             f"{len(outcome.refused)} step(s) not sent (the guard), so the transcript was "

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import re
 
+from conformance.diff.compare import TIMING, delays
 from conformance.diff.engine import Finding
 from conformance.link.framing import readable
-from conformance.quoting import answer_text
+from conformance.quoting import answer_text, quoted
 from conformance.runner import CaseResult
 from conformance.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures.rules import load_rules
@@ -31,10 +32,19 @@ def finding_result(f: Finding, *, profile: str, target: str, transcript: list[st
                    d.tag, rule.source if rule else "gve-conformance diff", profile, target,
                    d.verdict)
     sent = readable(d.target.sent)
-    r.checks = [{"ok": False, "what": f"{sent} answered differently ({d.kind})",
-                 "observed": answer_text(d.target.answer),
-                 "expected": answer_text(d.reference.answer),
-                 "tag": d.tag, "rule": d.rule or ""}]
+    if d.kind == TIMING:      # the same bytes: what differs is when they came
+        observed, expected = delays(d.target, d.reference)
+        answer = quoted(answer_text(d.target.answer))
+        r.checks = [{"ok": False, "what": f"{sent} answered {answer} at another instant "
+                     f"({d.kind})",
+                     "observed": f"{observed} after the frame",
+                     "expected": f"{expected} after the frame",
+                     "tag": d.tag, "rule": d.rule or ""}]
+    else:
+        r.checks = [{"ok": False, "what": f"{sent} answered differently ({d.kind})",
+                     "observed": answer_text(d.target.answer),
+                     "expected": answer_text(d.reference.answer),
+                     "tag": d.tag, "rule": d.rule or ""}]
     r.notes = [f"rule touched: {d.rule or 'none known'}",
                f"shrunk to {f.frames} frame(s): " + " | ".join(str(s) for s in f.steps)]
     if f.unreplayed:

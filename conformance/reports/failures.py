@@ -31,7 +31,8 @@ class Failure:
 
 def failures(run: RunResult, listed: tuple[str, ...] = LISTED) -> list[Failure]:
     """The cases whose verdict is one of ``listed``, worst verdict first, then in case
-    order; the same case failing the same way on several profiles once."""
+    order (section numbers in their order); the same case failing the same way on
+    several profiles once."""
     out: dict[tuple[str, Reason], Failure] = {}
     for r in run.results:
         if r.verdict not in listed:
@@ -41,4 +42,10 @@ def failures(run: RunResult, listed: tuple[str, ...] = LISTED) -> list[Failure]:
             out[r.id, why].runs.append(r)
         else:
             out[r.id, why] = Failure(r.id, why, [r])
-    return sorted(out.values(), key=lambda f: (ORDER.index(f.verdict), f.id))
+    return sorted(out.values(), key=lambda f: (ORDER.index(f.verdict), natural(f.id)))
+
+
+def natural(case_id: str) -> tuple[tuple[int, int | str], ...]:
+    """A case ID's sort key, its numbers as numbers: 6.checksum before 11.golden, 10.2
+    before 10.10."""
+    return tuple((0, int(p)) if p.isdigit() else (1, p) for p in case_id.split("."))

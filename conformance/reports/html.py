@@ -18,6 +18,7 @@ from conformance.reports.failures import failures
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import html_text as h
+from conformance.reports.text import rule_html
 from conformance.reports.units import state_section, units_table
 from conformance.runner import CaseResult, RunResult
 from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS
@@ -85,7 +86,8 @@ def _failed(run: RunResult) -> list[str]:
             seen = (f"<td>{h(quoted(why.observed))}</td><td>{h(quoted(why.expected))}</td>"
                     if why.checked else "<td></td><td></td>")
             rule = (f"<b>{h(why.head())}</b> " if why.checked else "") + (
-                f"<q>{h(why.rule)}</q>" + (f" ({h(why.source)})" if why.source else "")
+                f"<q>{rule_html(why.rule)}</q>" + (f" ({h(why.source)})" if why.source
+                                                   else "")
                 if why.rule else "")
             out.append(f"<tr class='{h(f.verdict)}'><td><a href='#{h(_anchor(f.runs[0]))}'>"
                        f"<b>{h(f.verdict)}</b> {h(f.id)}</a> [{profiles}]</td>"
@@ -193,7 +195,8 @@ def _case(r: CaseResult, full_logs: bool, also: tuple[str, ...] = ()) -> list[st
     out = [f"<details class='case {h(r.verdict)}' id='{h(_anchor(r))}' "
            f"data-verdict='{h(r.verdict)}' data-section='{h(r.section)}'"
            f"{' open' if r.verdict in _OPEN else ''}>"
-           f"<summary><b>{h(r.verdict)}</b> {h(r.id)} [{h(profiles)}] — {h(r.rule)}{why}"
+           f"<summary><b>{h(r.verdict)}</b> {h(r.id)} [{h(profiles)}] — {rule_html(r.rule)}"
+           f"{why}"
            "</summary>",
            *([f"<p class='why'>Passed on {len(also) + 1} profiles; shown: its run on "
               f"{h(r.profile)} (each run apart: --full-logs).</p>"] if also else []),

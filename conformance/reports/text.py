@@ -25,3 +25,12 @@ def clean(text: object) -> str:
 def html_text(text: object) -> str:
     """Cleaned and escaped for HTML element content and quoted attribute values."""
     return escape(clean(text), quote=True)
+
+
+def rule_html(text: object) -> str:
+    """A rule's sentence for HTML: escaped as :func:`html_text`, its Markdown code spans
+    (the spec writes commands as `` `H` ``) and bold set as HTML, no markup shown."""
+    escaped = html_text(text)
+    escaped = re.sub(r"`([^`]+)`", r"<code>\1</code>", escaped)
+    return re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", escaped)
+

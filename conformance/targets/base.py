@@ -4,6 +4,8 @@ opens its links and keeps what must hold for the whole run (docs/suite.md)."""
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import serial
@@ -19,6 +21,21 @@ DEFAULT_MAX_TRAVEL = 2000
 
 class TargetError(ValueError):
     """A target that cannot be used as given (one line for the user, before any frame)."""
+
+
+def known_settings(spec: str, given: Iterable[str], valid: Iterable[str]) -> None:
+    """Refuse a setting the target's scheme does not know (a misspelling would otherwise
+    be ignored: a run at the wrong address, a mutant not planted): TargetError naming the
+    first unknown key, the nearest valid one and every valid one."""
+    valid = sorted(set(valid))
+    unknown = [key for key in given if key not in valid]
+    if not unknown:
+        return
+    key = unknown[0]
+    nearest = difflib.get_close_matches(key, valid, n=1)
+    raise TargetError(f"{spec}: unknown setting {key!r}"
+                      + (f" (did you mean {nearest[0]!r}?)" if nearest else "")
+                      + f"; valid: {', '.join(valid) or 'none'}")
 
 
 @dataclass

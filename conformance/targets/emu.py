@@ -1,6 +1,7 @@
-"""``emu:PROFILE[?mutant=NAME]``: the embedded emulator in virtual time, a fresh unit per
-link. The only place the suite imports the emulator, and only to open its ``gve://`` URL
-(here, and for ``serial:gve://``) and to read its registries of mutants and readings."""
+"""``emu:PROFILE[?mutant=NAME&reading=A,B]``: the embedded emulator in virtual time, a
+fresh unit per link. The only place the suite imports the emulator, and only to open its
+``gve://`` URL (here, and for ``serial:gve://``) and to read its registries of mutants,
+readings and URL settings."""
 
 from __future__ import annotations
 
@@ -12,13 +13,22 @@ import serial
 
 from conformance.link.virtual import line_of
 from conformance.targetinfo import EMULATOR, TargetInfo
-from conformance.targets.base import Target, TargetError
+from conformance.targets.base import Target, TargetError, known_settings
 from gve_fixtures.profile import load_profile
+
+#: the settings an ``emu:`` target takes
+SETTINGS = ("mutant", "reading")
 
 
 def register_url_scheme() -> None:
     """Make pyserial open the emulator's ``gve://`` URLs (importing it registers them)."""
     import emulator  # noqa: F401
+
+
+def url_settings() -> tuple[str, ...]:
+    """The settings the emulator's ``gve://`` URL takes, from the emulator itself."""
+    from emulator.link.url import PARAMETERS
+    return PARAMETERS
 
 
 def mutants() -> dict[str, tuple[str, str]]:
@@ -76,7 +86,8 @@ def parse(kind: str, rest: str, *, spec: str, profile: str | None, allow_destruc
           max_travel: int, mutant: str | None, strict: bool = False) -> Target:
     parts = urlsplit("x://h/" + rest)
     name = parts.path.lstrip("/") or "GVE84-100"
-    q = parse_qs(parts.query)
+    q = parse_qs(parts.query, keep_blank_values=True)
+    known_settings(spec, q, SETTINGS)
     mutant = q.get("mutant", [mutant])[-1]
     readings = ",".join(q.get("reading", []))
     p = load_profile(name)

@@ -11,14 +11,18 @@ import serial
 
 from conformance.link.exclusive import open_serial
 from conformance.targetinfo import TargetInfo
-from conformance.targets.base import Target, TargetError
-from conformance.targets.emu import register_url_scheme
+from conformance.targets.base import Target, TargetError, known_settings
+from conformance.targets.emu import register_url_scheme, url_settings
 from conformance.targets.targetport import TargetPort
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 
 #: the suite's own query parameters on a serial/tcp target
 OURS = ("baud", "address")
+#: the options pyserial's URL handlers take, by scheme (pyserial refuses the others, yet
+#: with a message that names none of them); a scheme not here goes to pyserial as given
+PYSERIAL_OPTIONS = {"socket": ("logging",), "loop": ("logging",),
+                    "rfc2217": ("logging", "ign_set_control", "poll_modem", "timeout")}
 #: the emulator's pyserial URL scheme (README, "The emulator")
 EMULATOR_SCHEME = "gve"
 
@@ -30,15 +34,22 @@ def locate(kind: str, rest: str) -> tuple[str, dict[str, list[str]]]:
         q = parse_qs(parts.query, keep_blank_values=True)
         ours = {k: q.pop(k) for k in OURS if k in q}
         if parts.scheme == EMULATOR_SCHEME:
+            known_settings(f"{kind}:{rest}", q, url_settings())
             _emulator_url(q, ours)
+        elif parts.scheme in PYSERIAL_OPTIONS:
+            known_settings(f"{kind}:{rest}", q, OURS + PYSERIAL_OPTIONS[parts.scheme])
         query = urlencode(q, doseq=True)
         return f"{parts.scheme}://{parts.netloc}{parts.path}{'?' * bool(query)}{query}", ours
     if kind == "serial":
         parts = urlsplit("x://h" + (rest if rest.startswith("/") else "/" + rest))
+        q = parse_qs(parts.query, keep_blank_values=True)
+        known_settings(f"{kind}:{rest}", q, OURS)
         # a path as given: /dev/ttyUSB0, or COM3 on Windows
-        return parts.path if rest.startswith("/") else parts.path[1:], parse_qs(parts.query)
+        return parts.path if rest.startswith("/") else parts.path[1:], q
     where, _, q_text = rest.partition("?")
-    return f"socket://{_host_port(where)}", parse_qs(q_text)
+    q = parse_qs(q_text, keep_blank_values=True)
+    known_settings(f"{kind}:{rest}", q, OURS)
+    return f"socket://{_host_port(where)}", q
 
 
 def _emulator_url(q: dict[str, list[str]], ours: dict[str, list[str]]) -> None:

@@ -12,15 +12,14 @@ target is closed (at the end of the run, also after Ctrl-C once the session has 
 the unit), and a program that ends during the run makes the target not responding at
 once.
 
-A command that cannot be started is the user's mistake (one line, exit status 2); a
-program that started and then serves no port — it ends, says nothing, or its first line
-is neither a port it can open nor ``cosim N`` — is the target's fault: the run goes on,
-its session cannot begin, every case COULD-NOT-TEST saying why (its bytes escaped).
+A command that cannot be started, and a program that started and then serves no port —
+it ends, says nothing, or its first line is neither a port it can open nor ``cosim N`` —
+stop the run before it begins: one line saying why (its bytes escaped), exit status 2,
+as a serial port that cannot be opened does; not a COULD-NOT-TEST line per case.
 """
 
 from __future__ import annotations
 
-import contextlib
 import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
@@ -74,8 +73,12 @@ class ProcessTarget(PortTarget):
         self.unserved = ""          # why the program served no port: the target's fault
 
     def preflight(self) -> None:
-        with contextlib.suppress(SessionError):     # said by the session, case by case
+        """Start the program and open its port: one that serves none stops the run
+        before it begins, with one line (TargetError), whatever it printed."""
+        try:
             self._open()
+        except SessionError as err:
+            raise TargetError(str(err)) from None
 
     def begin(self, interrupts: Interrupts | None = None) -> Session:
         session = super().begin(interrupts)

@@ -17,6 +17,9 @@ from emulator.readings import parse_readings
 from gve_fixtures.profile import load_profile
 
 DEFAULT_MODEL = "GVE84-100"
+#: the parameters a gve:// URL takes
+PARAMETERS = ("model", "address", "unit", "baud", "watchdog_ms", "eeprom", "mutant",
+              "reading", "stepper", "log", "realtime")
 
 
 @dataclass
@@ -82,8 +85,7 @@ def parse_url(url: str) -> LineSpec:
     if parts.scheme != "gve":
         raise ValueError(f"not a gve:// URL: {url!r}")
     q = parse_qs(parts.query)
-    unknown = set(q) - {"model", "address", "unit", "baud", "watchdog_ms", "eeprom",
-                        "mutant", "reading", "stepper", "log", "realtime"}
+    unknown = set(q) - set(PARAMETERS)
     if unknown:
         raise ValueError(f"unknown gve:// parameter(s): {', '.join(sorted(unknown))}")
 

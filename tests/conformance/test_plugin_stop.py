@@ -33,7 +33,7 @@ def test_a_signal_to_the_controller_halts_every_worker_s_unit(tmp_path, sig, wor
     junit = tmp_path / "junit.xml"
     run = signal_at_frame(lambda first, other: [
         sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-n", workers, "-q",
-        "--gve-profile", "GVE84-100", "--gve-max-travel", "500",
+        "--gve-profile", "GVE84-100", "--gve-max-travel", "500", "--gve-yes",
         "--gve-target", f"serial:{first}", "--gve-target", f"serial:{other}", *CASES,
         "--junitxml", str(junit)], sig, nth, cwd=str(tmp_path))
     assert run.instant is not None, f"the {nth}th answered frame never came\n{run.out}"

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from conformance.untested import OTHER, why
-from conformance.verdict import FAILED, PASSED, last_line, overall
+from conformance.verdict import FAILED, INCOMPLETE, PASSED, last_line, not_tested, overall
 
 
 @dataclass
@@ -22,10 +22,18 @@ ENVELOPE = R("COULD-NOT-TEST", ["safety stop: L900,0,0: axis X could reach 0..90
 LACKS = R("MISSING", ["the profile lacks EFW"])
 
 
-def test_passed_says_what_was_judged_and_what_was_not_tested():
+def test_incomplete_says_what_was_judged_and_what_was_not_tested():
     results = [R("PASS")] * 120 + [R("NON-STRICT")] * 8 + [RIG] * 9 + [ENVELOPE] * 3
-    assert last_line(results) == ("PASSED — 120 PASS, 8 NON-STRICT; not tested: 12 of 140 "
-                                  "(9 need a rig, 3 beyond the envelope)")
+    assert last_line(results) == ("INCOMPLETE — 120 PASS, 8 NON-STRICT; not tested: 12 of "
+                                  "140 (9 need a rig, 3 beyond the envelope)")
+
+
+def test_only_what_the_profile_lacks_leaves_a_run_passed():
+    assert last_line([R("PASS"), LACKS]) == ("PASSED — 1 PASS; not tested: 1 of 2 (1 not in "
+                                             "the profile)")
+    assert overall([R("PASS"), LACKS, RIG])[0] == INCOMPLETE
+    declined = R("COULD-NOT-TEST", ["safety stop: L600,0,0: motion was not confirmed"])
+    assert overall([R("PASS"), declined])[0] == INCOMPLETE
 
 
 def test_everything_tested():
@@ -62,6 +70,25 @@ def test_reasons_come_from_the_notes():
 
 def test_a_case_that_needs_a_reset_says_what_to_run_with():
     """A real unit is restarted with J only with --allow-destructive: the last line
-    says so rather than "other reasons"."""
+    says so rather than "for another reason"."""
     phrase = why(["could not test: needs a reset (J): run with --allow-destructive"])
     assert phrase != OTHER and "reset" in phrase and "--allow-destructive" in phrase
+
+
+def test_results_no_pattern_matches_are_counted_as_one_reason():
+    odd = R("COULD-NOT-TEST", ["something nobody foresaw"])
+    assert not_tested([R("PASS"), odd, odd]) == (
+        "not tested: 2 of 3 (2 for another reason (each case's note says which))")
+
+
+def test_an_interrupted_run_never_says_everything_was_tested():
+    verdict, reason = overall([R("FAIL")] * 3, interrupted=True)
+    assert verdict == FAILED and "everything tested" not in reason
+    assert reason == "3 FAIL; 3 run before the interruption, nothing after it"
+    assert overall([R("PASS")], interrupted=True)[1] == (
+        "interrupted before every case had run; 1 PASS; 1 run before the interruption, "
+        "nothing after it")
+
+
+def test_missing_is_what_the_profile_lacks_whatever_its_note():
+    assert overall([R("PASS"), R("MISSING", ["no packets on the GVE54"])])[0] == PASSED

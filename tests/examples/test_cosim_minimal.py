@@ -83,10 +83,11 @@ def test_as_an_exec_target_it_runs_in_virtual_time_without_a_rig():
 
 def test_through_the_cli_it_passes_every_case_it_claims(tmp_path, capsys):
     """The README's command, as a clone author types it: the claimed goldens all PASS
-    (G9 writes the EEPROM: --allow-destructive) and the run's verdict says so."""
+    (G9 writes the EEPROM: --allow-destructive) and the run's verdict says so. In virtual
+    time nothing physical moves: no --yes, and nobody at a terminal to ask."""
     cases = [arg for name in PASSES for arg in ("--cases", f"11.golden.{name}")]
     status = main(["--target", f"exec:{sys.executable} {EXAMPLE}", "--profile", "GVE84-100",
-                   "--yes", "--allow-destructive", "--report-dir", str(tmp_path), *cases])
+                   "--allow-destructive", "--report-dir", str(tmp_path), *cases])
     out = capsys.readouterr().out
     assert status == 0, out
     (results,) = tmp_path.glob("*/results.json")

@@ -134,7 +134,8 @@ def test_reports_that_cannot_be_written_end_the_run_with_one_line(tmp_path, caps
     assert f"cannot write {tmp_path}/full/results.json: No space left on device" in captured.err
     assert "restored: ST0..ST5 written back and read back as found" in captured.out, \
         "restored before the reports"
-    assert captured.out.splitlines()[-1].startswith("PASSED"), "the verdict still said"
+    assert captured.out.splitlines()[-1].startswith(("PASSED", "INCOMPLETE")), \
+        "the verdict still said"
     assert state["status"][:6] == ["00"] * 6
     assert not (tmp_path / "full" / "results.json").exists()
     _complete(tmp_path)
@@ -165,3 +166,28 @@ def test_a_full_tmpfs_ends_the_run_with_one_line(tmp_path):
     assert f"cannot write {reports}/full/" in done.stderr
     assert "restored: ST0..ST5 written back and read back as found" in done.stdout
     assert state["status"][:6] == ["00"] * 6
+
+
+def test_the_recap_lists_by_section_number_and_non_strict_apart():
+    from conformance.cli.ending import recap
+    from conformance.runner import RunResult
+    from tests.conformance.reports.toy import result
+    run = RunResult("toy", [result("11.golden.g1", "FAIL"), result("8.repeat.answer",
+                                                                    "NON-STRICT"),
+                            result("6.checksum.wrong", "FAIL"), result("10.10.x.y", "FAIL"),
+                            result("10.2.x.y", "FAIL")], ["emu:GVE84-100"])
+    heads = [line for line in recap(run) if not line.startswith((" ", "FAIL", "NON-"))]
+    listed = [line.split()[1] for line in recap(run) if line.startswith(("FAIL", "NON-"))]
+    assert heads == ["what failed (4):",
+                     "what departs from the project's decisions, NON-STRICT (1):"]
+    assert listed == ["6.checksum.wrong", "10.2.x.y", "10.10.x.y", "11.golden.g1",
+                      "8.repeat.answer"]
+
+
+def test_a_count_of_missing_says_it_is_nothing_to_test():
+    from conformance.cli.ending import counted
+    from conformance.runner import RunResult
+    from tests.conformance.reports.toy import result
+    run = RunResult("toy", [result("1.a.b", "PASS"), result("3.params.float-values",
+                                                           "MISSING")], ["emu:GVE54"])
+    assert counted(run) == "MISSING 1 (not in the profile: nothing to test), PASS 1"

@@ -5,6 +5,7 @@ emulator FAILs the same difference; the score line."""
 from __future__ import annotations
 
 import random
+import re
 import signal
 
 import pytest
@@ -71,7 +72,10 @@ def test_a_signal_stops_every_worker_with_one_line(sig, group):
                                      ready=lambda pid: len(descendants(pid)) >= 2)
     assert status == 130, out
     assert "Traceback" not in out, out
-    assert out.splitlines()[-1].startswith("fairness: interrupted by a signal after "), out
+    last = out.splitlines()[-1]
+    assert last.startswith("FAILED — fairness interrupted by a signal after "), out
+    # the readings it was trying count too, not only those it finished
+    assert re.search(r"\d of 2 readings finished \(\d unfair; \d under way\)", last), last
     assert len(started) >= 2 and not any(alive(p) for p in started)
 
 

@@ -52,5 +52,5 @@ def test_a_signal_stops_every_worker_with_one_line(sig, group):
                                      group=group)
     assert status == 130, out
     assert "Traceback" not in out, out
-    assert out.splitlines()[-1].startswith("mutation: interrupted by a signal after "), out
+    assert out.splitlines()[-1].startswith("FAILED — mutation interrupted by a signal after "), out
     assert len(started) >= 2 and not any(alive(p) for p in started)

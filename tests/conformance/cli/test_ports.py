@@ -7,6 +7,7 @@ interactive terminal) gets no byte at all."""
 from __future__ import annotations
 
 import fcntl
+import os
 import termios
 
 import pytest
@@ -84,3 +85,28 @@ def test_a_pseudo_terminal_a_glob_found_gets_no_byte(pty, capsys):  # noqa: F811
     assert pending(master) == b""
     assert termios.tcgetattr(slave) == settings
     assert ports.is_pseudo_terminal(path) and not ports.is_pseudo_terminal("/dev/null")
+
+
+@pytest.mark.parametrize(("name", "major", "pseudo"), [
+    ("/dev/ttyS0", 4, False),          # a serial port, whose name the old pty names resemble
+    ("/dev/ttyUSB0", 188, False),
+    ("/dev/pts/7", 136, True),
+    ("/dev/ttyp0", 3, True),
+])
+def test_a_device_is_classified_by_its_major_not_its_name(monkeypatch, name, major, pseudo):
+    real_stat = os.stat
+
+    def stat(path, *args, **kw):
+        return _device(major) if path == name else real_stat(path, *args, **kw)
+    monkeypatch.setattr(ports.sys, "platform", "linux")
+    monkeypatch.setattr(ports.os.path, "realpath", lambda p: p)
+    monkeypatch.setattr(ports.os, "stat", stat)
+    assert ports.is_pseudo_terminal(name) == pseudo
+
+
+def _device(major: int):
+    """What os.stat says of a character device with ``major``."""
+    class Device:
+        st_rdev = os.makedev(major, 64)
+    return Device()
+

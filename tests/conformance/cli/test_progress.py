@@ -33,7 +33,7 @@ def test_mutation_quiet_prints_its_score_only_when_nothing_failed(capsys):
     assert main(["mutation", "--profile", "GVE84-100", "--cases", "1.*",
                  "--mutant", "range-error-code", "-q"]) == 0
     (line,) = capsys.readouterr().out.splitlines()
-    assert line.startswith("mutation score: 1/1")
+    assert line.startswith("PASSED — mutation score: 1/1")
 
 
 def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
@@ -42,7 +42,7 @@ def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
                  "--mutant", "range-error-code", "-q"]) == 1
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("what failed") and "range-error-code" in lines[1]
-    assert lines[-1].startswith("mutation score: 0/1")
+    assert lines[-1].startswith("FAILED — mutation score: 0/1")
 
 
 def test_fairness_numbers_each_reading_in_a_log(capsys):
@@ -82,3 +82,21 @@ def test_a_terminal_gets_a_bar_of_the_steps_and_the_lines_that_need_reading():
         shown.step("caught  c", routine=True)
     text = out.getvalue()
     assert "3/3" in text and "MISSED  b" in text and "caught" not in text
+
+
+
+def test_a_long_step_still_shows_the_job_is_moving():
+    """A log sees a line at least every heartbeat while a step takes long (a reading, a
+    mutant), and none once the job has ended."""
+    import io
+
+    from tests.processes import wait_for
+    log = io.StringIO()
+    with Progress(3, unit="reading", stream=log, terminal=False, heartbeat=0.05,
+                  every_step=True) as shown:
+        wait_for(lambda: "still working" in log.getvalue(), 5.0, "a heartbeat line")
+        shown.step("fair  a reading")
+    lines = log.getvalue().splitlines()
+    assert lines[0].startswith("[0/3] 0 % in ") and lines[0].endswith(" s, still working")
+    ended = log.getvalue()
+    assert shown._beat is None and log.getvalue() == ended

@@ -36,7 +36,8 @@ def test_an_agreeing_replay_ends_with_pass_and_status_0(tmp_path, capsys):
                              "(GVE84-100)")
     assert any("target 3\\r" in line and "reference 3\\r" in line and
                "recorded 3\\r" in line and line.endswith(" same") for line in lines)
-    assert lines[-1] == ("PASS: the target answers as the reference does (1 frame); the "
+    assert lines[-1] == ("PASSED — PASS: the target answers as the reference does (1 frame); "
+                         "the "
                          "recorded 3.frame.upper-case disagreement is gone")
 
 
@@ -44,7 +45,8 @@ def test_a_disagreeing_replay_ends_with_fail_and_status_1(tmp_path, capsys):
     status, lines = _replay(tmp_path, capsys, LOWER_CASE,
                             "emu:GVE84-100?mutant=lower-case-command")
     assert status == 1
-    assert lines[-1] == ("FAIL 3.frame.upper-case: !0q\\r target 0,25020304\\r, reference "
+    assert lines[-1] == ("FAILED — FAIL 3.frame.upper-case: !0q\\r target 0,25020304\\r, "
+                         "reference "
                          "3\\r (code): still there")
     assert sum(line.startswith(("PASS", "FAIL", "COULD-NOT-TEST")) for line in lines) == 1
 
@@ -53,7 +55,7 @@ def test_another_disagreement_than_the_recorded_one_says_so(tmp_path, capsys):
     text = LOWER_CASE.replace("# rules: 3.frame.upper-case", "# rules: 7.packet.count")
     status, lines = _replay(tmp_path, capsys, text, "emu:GVE84-100?mutant=lower-case-command")
     assert status == 1
-    assert lines[-1].startswith("FAIL 3.frame.upper-case: ")
+    assert lines[-1].startswith("FAILED — FAIL 3.frame.upper-case: ")
     assert lines[-1].endswith("a disagreement other than the recorded 7.packet.count")
 
 
@@ -82,4 +84,4 @@ def test_over_a_pty_answers_alike_in_the_band_say_why_and_a_refused_step_is_unte
     # the answer the transcript expects is the one recorded after each frame
     assert reads[1].split(" recorded ")[1].split()[0] == "0,300,0,0\\r"
     assert status == 1
-    assert lines[-1].startswith("COULD-NOT-TEST: 1 step(s) not sent (the guard)")
+    assert lines[-1].startswith("FAILED — COULD-NOT-TEST: 1 step(s) not sent (the guard)")

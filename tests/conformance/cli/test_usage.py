@@ -108,3 +108,21 @@ def test_the_report_s_command_keeps_its_quoting():
     row = re.search(r"<th>command</th><td>([^<]*)</td>", page).group(1)
     # a shell given the row runs the same command: the exec: target one argument
     assert shlex.split(html.unescape(row)) == ["gve-conformance", *run.meta.command]
+
+
+#: every subcommand that runs a job -> the least it needs on its command line
+JOBS = {**WRITERS, "mutation": [], "fairness": [],
+        "replay": ["fixtures/transcripts/g1-checksum-mode.gvt", "--target", "emu:GVE84-100"]}
+#: those that run several things side by side
+PARALLEL = ("run", "host", "mutation", "fairness")
+
+
+def test_every_job_takes_color_and_the_parallel_ones_j(parsed):
+    for sub, least in JOBS.items():
+        _, args = parsed([sub, *least])
+        assert args.color == "auto", sub
+        _, args = parsed([sub, "--color", "never", *least])
+        assert args.color == "never", sub
+    for sub in PARALLEL:
+        _, args = parsed([sub, "-j", "2", *JOBS[sub]])
+        assert args.jobs == 2, sub

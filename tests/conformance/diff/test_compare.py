@@ -1,7 +1,7 @@
 """Two answers compared: exact in virtual time, positions within the band in real time
 while the axes may move, exact at rest; the index from where each side began."""
 
-from conformance.diff.compare import Judge, alike_because, difference
+from conformance.diff.compare import Judge, alike_because, delays, difference
 from conformance.diff.sides import RoundTrip
 from conformance.link.framing import parse_response
 from conformance.link.line_band import LineBand
@@ -20,6 +20,13 @@ def test_alike_answers_at_the_same_instant_agree():
 
 def test_in_virtual_time_an_answer_at_another_instant_is_a_timing_difference():
     assert difference("H", ex(b"8\r", 0, MS), ex(b"8\r", 0, 5 * MS), Judge()) == "timing"
+
+
+def test_a_timing_difference_shows_two_different_instants():
+    assert delays(ex(b"8\r", 0, MS), ex(b"8\r", 0, 5 * MS)) == ("1.000 ms", "5.000 ms")
+    # as many decimals as tell them apart, to the nanosecond
+    assert delays(ex(b"8\r", 0, MS), ex(b"8\r", 0, MS + 1)) == ("1.000000 ms", "1.000001 ms")
+    assert delays(ex(b"8\r", 2, MS + 2), ex(b"8\r", 0, MS)) == ("1.000 ms", "1.000 ms")
 
 
 def test_kinds():

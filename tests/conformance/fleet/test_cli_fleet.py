@@ -43,7 +43,7 @@ def test_targets_run_in_parallel_with_a_report_each_and_a_summary(tmp_path, caps
         assert f"[{row['folder']}] " in out
     suites = ET.parse(junit).getroot().findall("testsuite")
     assert sorted(s.get("name") for s in suites) == sorted(rows)
-    assert "FAILED: 1 of 2 targets failed" in out
+    assert out.rstrip().splitlines()[-1] == "FAILED — 1 of 2 targets failed"
 
 
 def test_jobs_must_be_one_or_more(capsys):

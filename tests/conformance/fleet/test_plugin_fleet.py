@@ -22,7 +22,7 @@ CASES = ["5.errors.*"]
 def test_two_tcp_units_run_in_parallel_on_two_workers(tcp_units, tmp_path):
     ports = [tcp_units("--model", "GVE84-100"), tcp_units("--model", "GVE84-100")]
     argv = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-n", "2", "-v",
-            "--gve-profile", "GVE84-100"]
+            "--gve-profile", "GVE84-100", "--gve-yes"]
     for where in ports:
         argv += ["--gve-target", f"tcp:{where}"]
     for glob in CASES:

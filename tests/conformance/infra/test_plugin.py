@@ -18,6 +18,7 @@ from conformance.catalogue import select
 from conformance.plugin import pytest_report_teststatus
 from conformance.reports.junit import classname
 from conformance.verdict import INFO, NON_STRICT
+from gve_fixtures.profile import available_profiles
 
 pytest_plugins = ["pytester"]
 
@@ -126,3 +127,30 @@ def test_a_known_state_step_the_unit_breaks_fails_the_pytest_run(pytester):
                                 "--gve-cases", "5.errors.ok", "-q")
     assert result.ret == pytest.ExitCode.TESTS_FAILED
     result.stdout.fnmatch_lines(["*FAIL on exec:*10.4.delete: the known state: D after H*"])
+
+
+def test_the_plugin_mirrors_the_command_line_s_options(pytester):
+    """--gve-mutant plants a bug, --gve-exclude leaves cases out, emu:all is every profile,
+    and -rA's FAIL lines carry why, whole."""
+    result = pytester.runpytest("--gve-target", "emu:GVE84-100", "--gve-mutant",
+                                "range-error-code", "--gve-cases", "5.errors.*",
+                                "--gve-exclude", "5.errors.busy", "-rA")
+    kept = select(["5.errors.*"], ["5.errors.busy"])
+    result.assert_outcomes(passed=len(kept) - 1, failed=1)
+    result.stdout.fnmatch_lines([
+        "gve-conformance: FAILED — 1 FAIL,*",
+        "*gve-conformance: FAIL and ERROR*",
+        'FAIL */section5::5.errors.out-of-range[[]emu:GVE84-100[]] - 5.code.range [[]M-ex[]] '
+        'SW8,F1 → 5: observed "code 4", expected "code 5"'])
+    every = pytester.runpytest("--gve-target", "emu:all", "--gve-cases", "1.profile.version",
+                               "-q")
+    every.assert_outcomes(passed=len(available_profiles()))
+
+
+def test_every_plugin_option_has_its_help(pytester):
+    helped = pytester.runpytest("--help").stdout.str()
+    for option in ("--gve-yes", "--gve-max-travel", "--gve-allow-destructive", "--gve-mutant",
+                   "--gve-exclude", "--gve-seed", "--gve-accept-incomplete"):
+        # the option, its metavar, then words of help (not straight the next option)
+        assert re.search(rf"\n\s+{option}(?:[ =][A-Z_|:/]+)?\s+(?!-)\w", helped), option
+    assert "the Hypothesis machines' seed" in helped and "plant this deliberate bug" in helped

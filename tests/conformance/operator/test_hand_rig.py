@@ -255,6 +255,10 @@ def test_the_outputs_are_read_as_the_technician_sees_them():
     assert eyes.stdout.getvalue().count("please answer") == 2
     with pytest.raises(CouldNotTest, match="reading the outputs: skipped by the operator"):
         HandRig(lambda: unit, _Eyes("s")).outputs()
+    # nobody to ask: the step it needs is named, never an empty one
+    with pytest.raises(CouldNotTest, match=r"needs a hand: read which outputs are on \(lit\); "
+                                           "run on a terminal"):
+        HandRig(lambda: unit, None).outputs()
 
 
 def test_a_power_cycle_not_done_is_caught_by_the_index(unit):

@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import json
 import signal
+import xml.etree.ElementTree as ET
 
 import pytest
 
+from conformance.cli.usage import INCOMPLETE_STATUS
 from tests.conformance.operator.terminal import EmulatedUnit, Terminal, suite
 
 pytestmark = pytest.mark.pty
@@ -40,15 +42,31 @@ def _asked(term: Terminal) -> None:
     assert "X ±2000, Y ±2000, Z ±2000" in asked and "destructive tests" in asked
 
 
-def test_no_confirmation_moves_nothing(unit):
-    term = _start(unit, MOVING_CASE)
+def test_no_confirmation_moves_nothing_and_the_run_is_incomplete(unit, tmp_path):
+    """Motion declined at the question: nothing moves, and the run is not PASSED but
+    INCOMPLETE, with its own exit status, on the console and in every report."""
+    junit = tmp_path / "junit.xml"
+    term = Terminal(suite("--target", f"serial:{unit.path}", "--profile", "GVE84-100",
+                          "--cases", "1.profile.version", f"--cases={MOVING_CASE}",
+                          "--report-dir", str(tmp_path), "--run-id", "declined",
+                          "--junitxml", str(junit)))
     _asked(term)
     term.answer("n")
     term.expect(f"COULD-NOT-TEST  {MOVING_CASE} [GVE84-100]  -- safety stop: ")
-    term.finish()
+    assert term.finish() == INCOMPLETE_STATUS
     assert "motion was not confirmed" in term.seen
     state = json.loads(unit.rig("state"))
     assert state["excursion"] == [[0, 0], [0, 0], [0, 0]]       # not one step, any axis
+    last = term.seen.rstrip().splitlines()[-1]
+    assert last == ("INCOMPLETE — 1 PASS; not tested: 1 of 2 (1 motion not confirmed)"), last
+    folder = tmp_path / "declined"
+    data = json.loads((folder / "results.json").read_text())
+    assert data["verdict"] == "INCOMPLETE" and data["meta"]["confirmed"].startswith(
+        "asked: refused")
+    assert "class='banner INCOMPLETE'>INCOMPLETE<" in (folder / "report.html").read_text()
+    for xml in (junit, folder / "junit.xml"):
+        props = {p.get("name"): p.get("value") for p in ET.parse(xml).iter("property")}
+        assert props["run verdict"].startswith("INCOMPLETE (1 PASS; not tested"), props
 
 
 def _step(term: Terminal, step: str) -> None:
@@ -81,7 +99,7 @@ def test_a_skipped_step_is_could_not_test_with_the_reason(unit):
     term.answer("s")
     term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
                 "IN0 (the X reference input): skipped by the operator")
-    assert term.finish() == 0                        # never a FAIL
+    assert term.finish() == INCOMPLETE_STATUS        # never a FAIL, nor a PASS
 
 
 def test_a_wrong_action_is_caught_by_the_read_back(unit):
@@ -94,7 +112,7 @@ def test_a_wrong_action_is_caught_by_the_read_back(unit):
     term.answer("")
     term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: Ground input "
                 "IN0 (the X reference input): not verified, I1 reads FD (IN0 should read 0)")
-    assert term.finish() == 0
+    assert term.finish() == INCOMPLETE_STATUS
 
 
 def test_yes_skips_the_question_and_no_operator_says_why(unit):
@@ -103,7 +121,7 @@ def test_yes_skips_the_question_and_no_operator_says_why(unit):
                           "--no-reports", "--yes", "--no-operator"))
     term.expect(f"PASS            {MOVING_CASE} [GVE84-100]")
     term.expect(f"COULD-NOT-TEST  {HAND_CASE} [GVE84-100]  -- could not test: needs a hand")
-    assert term.finish() == 0 and QUESTION not in term.seen
+    assert term.finish() == INCOMPLETE_STATUS and QUESTION not in term.seen
 
 
 def test_ctrl_c_at_the_question_stops_the_run_and_moves_nothing(unit):
@@ -141,6 +159,6 @@ def test_the_rig_steps_by_hand_on_a_terminal(unit):
     term.expect("PASS            10.cmd.output.port [GVE84-100]")
     term.expect("COULD-NOT-TEST  10.cmd.reference.to-switch [GVE84-100]  -- needs a test "
                 "rig: no hand can do it: a reference switch at an exact position")
-    assert term.finish() == 0
+    assert term.finish() == INCOMPLETE_STATUS
     assert term.seen.rstrip().splitlines()[-1] == (
-        "PASSED — 2 PASS; not tested: 1 of 3 (1 need a rig no hand stands in for)")
+        "INCOMPLETE — 2 PASS; not tested: 1 of 3 (1 need a rig no hand stands in for)")

@@ -53,7 +53,7 @@ def test_what_failed_comes_before_the_first_passing_case(mutant_page):
     assert f"<a href='#case-{FAILING}-GVE84-100'><b>FAIL</b> {FAILING}</a>" in failed
     assert "H answered when the motion came to rest" in failed
     assert "answer at 512.934 ms" in failed and "at rest at 1024.793 ms" in failed
-    assert "<b>10.4.go.resume [M]</b> <q>`G` with INTA = 1" in failed
+    assert "<b>10.4.go.resume [M]</b> <q><code>G</code> with INTA = 1" in failed
     assert f"({load_rules()['10.4.go.resume'].source})" in failed
     assert PASSING not in failed
     assert f"id='case-{FAILING}-GVE84-100'" in page           # where the link goes

@@ -56,6 +56,9 @@ def test_banner_and_metadata_head_the_page(no_plots):
         assert shown in top, shown
     run = toy_run()
     run.results = [r for r in run.results if r.verdict != "FAIL"]
+    # nothing failed, yet the hand case was not tested: not a pass
+    assert re.search(r"class='banner INCOMPLETE'>INCOMPLETE<", render_html(run))
+    run.results = [r for r in run.results if r.verdict != "COULD-NOT-TEST"]
     assert re.search(r"class='banner PASSED'>PASSED<", render_html(run))
 
 
@@ -128,3 +131,14 @@ def test_without_matplotlib_the_page_says_plots_are_off(monkeypatch):
     parse(page)
     assert "<svg" not in page
     assert "Plots are off" in page and "trapezoid X: plots are off" in page
+
+
+def test_a_rule_s_markdown_is_set_as_html_not_shown():
+    from conformance.reports.text import rule_html
+    assert rule_html("`H` brakes on its **ramp**") == "<code>H</code> brakes on its <b>ramp</b>"
+    # escaped first: a code span of markup stays text
+    assert rule_html("`<script>`") == "<code>&lt;script&gt;</code>"
+    run = toy_run()
+    run.results[0].rule = "`SW6` setting INTA starts a stop ramp"
+    page = render_html(run)
+    assert "<code>SW6</code> setting INTA" in page and "`SW6`" not in page

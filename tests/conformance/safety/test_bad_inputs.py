@@ -163,7 +163,7 @@ def test_replay_of_a_fill_without_recorded_answers_runs_to_its_end(capsys, tmp_p
 
 
 def test_mutation_refuses_no_jobs_in_one_line(capsys):
-    _refused(["mutation", "--jobs", "0"], "--jobs: '0': give 1 or more", capsys,
+    _refused(["mutation", "--jobs", "0"], "--jobs/-j: '0': give 1 or more", capsys,
              "gve-conformance mutation")
 
 

@@ -120,3 +120,12 @@ def test_the_plugin_refuses_with_a_usage_error(pytester, mistake):
     assert result.ret == pytest.ExitCode.USAGE_ERROR
     text = result.stdout.str() + result.stderr.str()
     assert says in text and "INTERNALERROR" not in text and "Traceback" not in text
+
+
+def test_a_report_dir_that_is_a_file_says_so(tmp_path, capsys):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    assert main(["--report-dir", str(blocker), "--cases", "5.errors.ok"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"gve-conformance: cannot write reports to {blocker}: it is a file, not a " \
+        "folder\n"

@@ -40,7 +40,7 @@ def test_the_plugin_runs_one_session_and_puts_the_unit_back(pytester):
     with unit_behind_proxy("--model", "GVE84-100") as (emu, proxy):
         assert proxy.ask(b"!0SW0,05\r") == b"0\r"      # the machine's interrupt enables
         result = pytester.runpytest("--gve-target", f"serial:{proxy.path}", "--gve-profile",
-                                    "GVE84-100", "--gve-cases", "5.errors.ok",
+                                    "GVE84-100", "--gve-yes", "--gve-cases", "5.errors.ok",
                                     "--gve-cases", "10.3.status.all-bits-stored", "-q")
         state = emu.state()
     result.assert_outcomes(passed=2)
@@ -69,6 +69,6 @@ def test_a_problem_makes_the_exit_status_non_zero(tmp_path, capsys):
 def test_a_problem_fails_the_pytest_run_too(pytester, tmp_path):
     with unit_behind_proxy(*_mpg_unit(tmp_path)) as (_, proxy):
         result = pytester.runpytest("--gve-target", f"serial:{proxy.path}", "--gve-profile",
-                                    "GVE114-500", "--gve-cases", "5.errors.ok", "-q")
+                                    "GVE114-500", "--gve-yes", "--gve-cases", "5.errors.ok", "-q")
     assert result.ret == pytest.ExitCode.TESTS_FAILED
     result.stdout.fnmatch_lines(["*PROBLEM on serial:*the unit reports RUN*"])

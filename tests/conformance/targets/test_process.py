@@ -20,6 +20,7 @@ import pytest
 
 from conformance.case import Case
 from conformance.catalogue import select
+from conformance.cli import main as program
 from conformance.cli.run import main
 from conformance.runner import run
 from conformance.targets import TargetError, parse_target, process
@@ -241,24 +242,32 @@ def test_a_bad_exec_spec_is_one_line_and_exit_status_2(capsys, spec, says):
     ("exec:echo cosim ²", 'first line "cosim ²" is not a port'),
     ("exec:echo /no/such/port", "the program's port cannot be used"),
 ])
-def test_a_program_that_serves_no_port_is_the_targets_fault(capsys, spec, says):
-    """Not a mistake on the command line: the run ends FAILED, every case COULD-NOT-TEST
-    naming the target and what it printed."""
-    assert main(["--target", spec, "--profile", "GVE84-100", "--cases", "5.errors.ok",
-                 "--yes", "--no-reports"]) == 1
+def test_a_program_that_serves_no_port_stops_the_run_with_one_line(capsys, spec, says):
+    """The whole catalogue asked for, one line said: the target cannot start (what the
+    program printed, escaped), exit status 2, no line per case."""
+    assert main(["--target", spec, "--profile", "GVE84-100", "--yes", "--no-reports"]) == 2
     captured = capsys.readouterr()
-    assert captured.err == "" and "Traceback" not in captured.out
-    assert f"COULD-NOT-TEST  5.errors.ok [GVE84-100]  -- not run: {spec}: " in captured.out
-    assert says in captured.out
-    assert captured.out.splitlines()[-1].startswith("FAILED — no case could judge the target")
+    assert captured.err.count("\n") == 1, captured.err
+    assert captured.err.startswith(f"gve-conformance: {spec}: ") and says in captured.err
+    assert "COULD-NOT-TEST" not in captured.out and "Traceback" not in captured.out
+
+
+@pytest.mark.parametrize("job", ["diff", "replay"])
+def test_other_jobs_say_it_in_one_line_too(capsys, job):
+    transcript = Path(__file__).parents[3] / "fixtures" / "transcripts" / \
+        "g1-checksum-mode.gvt"
+    argv = {"diff": ["diff", "--no-reports"], "replay": ["replay", str(transcript)]}[job]
+    assert program([*argv, "--target", "exec:false", "--profile", "GVE84-100", "--yes"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "exec:false: the program printed no port" in err, err
 
 
 def test_a_program_that_prints_nothing_is_given_up(monkeypatch, capsys):
     monkeypatch.setattr(process, "FIRST_LINE_SECONDS", 0.3)
     monkeypatch.setattr("conformance.targets.program.QUIT_SECONDS", 0.2)
     assert main(["--target", "exec:sleep 30", "--profile", "GVE84-100", "--cases",
-                 "5.errors.ok", "--yes", "--no-reports"]) == 1
-    assert "printed no port within 0.3 s" in capsys.readouterr().out
+                 "5.errors.ok", "--yes", "--no-reports"]) == 2
+    assert "printed no port within 0.3 s" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(("argv", "says"), [
@@ -293,7 +302,7 @@ def test_the_first_line_names_the_port(line, url):
 def test_the_plugin_runs_an_exec_target(pytester):
     result = pytester.runpytest(
         "-p", "no:cacheprovider", "--gve-target", "exec:" + shlex.join([*EMULATOR, "--pty"]),
-        "--gve-profile", "GVE84-100", "--gve-cases", "10.cmd.output.port",
+        "--gve-profile", "GVE84-100", "--gve-yes", "--gve-cases", "10.cmd.output.port",
         "--gve-cases", "5.errors.ok", "-q")
     result.assert_outcomes(passed=2)
 
