@@ -62,6 +62,15 @@ def test_a_departure_no_longer_failed_is_power_lost(mutant_outcomes):
                                    "(said, never seen)"]
 
 
+def test_a_known_defect_of_the_suite_is_listed_open_not_unfair(mutant_outcomes):
+    rules = failed(mutant_outcomes) - {"10.4.halt.ramp"}
+    impl = unit({r: "planted" for r in rules})
+    impl = Implementation(**{**impl.__dict__, "open": {"10.4.halt.ramp": "not mended yet"}})
+    t = grade(impl, mutant_outcomes)
+    assert t.fair and not t.unfair
+    assert any("10.4.halt.ramp" in line and "not mended yet" in line for line in t.open)
+
+
 def test_a_job_that_judged_nothing_is_unfair():
     broken = Implementation(name="broken", kind="unit", folder=Path("."),
                             command=f"{sys.executable} -c 'raise SystemExit(3)'",
