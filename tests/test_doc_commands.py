@@ -149,11 +149,7 @@ SEARCH = {True: ["--examples", "300", "--seed", "1"], False: ["--examples", "40"
 PROGRAM_CASES = "5.errors.*"
 #: what the documents show that does not yet end as they say, and why (strict: a fix
 #: makes the test fail until the mark goes)
-NOT_YET = {
-    "gve-conformance diff --target exec:'./clone-sim --cosim' --profile GVE84-100 --seconds 60":
-        "diff draws a KEEP whose R the known state cannot undo without --allow-destructive, "
-        "and stops (the known state's and diff's grammar's to fix)",
-}
+NOT_YET: dict[str, str] = {}
 
 
 def _running() -> list[tuple[str, str]]:
