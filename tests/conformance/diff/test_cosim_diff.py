@@ -1,6 +1,7 @@
 """`gve-conformance diff` through a co-simulator: the comparison is exact (both sides in
-virtual time: positions while moving and the instants of answers too), the unit lives on
-between sequences (its known state, index and EEPROM as found); the clean emulator
+virtual time: positions while moving and the instants of answers too), each sequence
+begins at the simulator's power-on (its EEPROM as found), one that leaves the checksum
+mode on is named; the clean emulator
 agrees with itself over hundreds of sequences, a mutant is found, shrunk, written and
 replayed; every mutant is found as in process, with frames told ahead as without."""
 
@@ -17,7 +18,9 @@ from conformance.cli.replay import main as replay_main
 from conformance.diff.engine import Budget, KnownStateLost, Pair, search
 from conformance.diff.grammar import Options, probes
 from conformance.diff.sides import Side
+from conformance.diff.steps import FRAME, Step
 from conformance.targets import parse_target
+from conformance.verdict import FAIL
 from tests.conformance.diff.test_engine import (
     EVERYTHING,
     ON_THE_WIRE,
@@ -138,3 +141,25 @@ def test_through_a_co_simulator_the_probes_find_a_mutant_told_ahead_as_not(mutan
 @pytest.mark.parametrize("mutant", ON_THE_WIRE)
 def test_through_a_co_simulator_the_probes_find_every_mutant(mutant):
     _found_as_in_process(mutant)
+
+
+def test_a_power_on_that_leaves_the_checksum_mode_on_is_found_and_named():
+    """A co-simulator whose power-on leaves the checksum mode on (spec 9 [M]: off): once a
+    sequence has turned it on, the next sequences' first answers differ from the fresh
+    reference's, and diff names the reset state's rule; the clean emulator's power-on
+    turns it off and agrees."""
+    wrapper = Path(__file__).with_name("power_on_keeps_checksums.py")
+    leaves = "exec:" + shlex.join([sys.executable, str(wrapper), "--model", "GVE84-100",
+                                   "--cosim"])
+    for spec, findings in ((leaves, True), (cosim(), False)):
+        p = pair(spec)
+        try:
+            assert p.run([Step(FRAME, body="%+")]).disagreement is None
+            found = search(p, Options(destructive=True, rig=True), Budget(examples=10),
+                           with_probes=False)
+        finally:
+            p.target.session.finish()
+            p.target.target.close()
+        assert bool(found) == findings
+        assert all(f.disagreement.rule == "9.reset.state" and f.disagreement.verdict == FAIL
+                   and "summing-after-power-on" in f.disagreement.context for f in found)
