@@ -743,6 +743,11 @@ def _restarts_wait(steps: list[Step], i: int) -> bool:
             and command_of(steps[i - 1].body) in _RESTARTS)
 
 
+#: sequences in a row that sent no frame before the search ends COULD-NOT-TEST: it never
+#: goes on, or passes, on sequences that did not run
+IDLE_MOST = 20
+
+
 class _Spent(Exception):
     """The budget ran out inside Hypothesis."""
 
@@ -793,16 +798,29 @@ class _Search:
         self.findings: list[Finding] = []
         self.known: set[tuple] = set()
         self.seen = 0                  # disagreements seen so far (each one's number)
+        self.idle = 0                  # sequences in a row that sent no frame
+        self.skipped = 0               # sequences that sent no frame (not counted)
 
     def more(self) -> bool:
         return not self.pair.lost and not self.budget.spent() and (
             self.stop_after is None or len(self.findings) < self.stop_after)
 
     def trial(self, steps: list[Step]) -> Finding | None:
-        """One example run whole; a finding when it shows a disagreement not kept yet."""
-        self.budget.used += 1
+        """One example run whole; a finding when it shows a disagreement not kept yet. A
+        sequence that sent no frame (its start refused, say) is not counted in the
+        budget; :data:`IDLE_MOST` of them in a row end the search (:attr:`Pair.lost`)."""
         outcome = self.pair.run(steps)
         self.budget.frames += outcome.frames
+        if outcome.frames:
+            self.budget.used += 1
+            self.idle = 0
+        else:
+            self.idle += 1
+            self.skipped += 1
+            if self.idle >= IDLE_MOST and not self.pair.lost:
+                why = (outcome.refused or [outcome.ended or "nothing was sent"])[0]
+                self.pair.lost = (f"{IDLE_MOST} sequences in a row sent no frame: {why}")
+                self.pair.led_there = list(steps)
         d = outcome.disagreement
         if d is None or d.signature in self.known:
             return None
@@ -937,10 +955,11 @@ def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int
     strategy = grammar.sequences()
     rounds = 0
     while hunt.more():
+        skipped = hunt.skipped
         found = hunt.draw(strategy, seed + rounds)
         rounds += 1
         if found is None:
-            if budget.spent() or budget.examples is not None:
+            if budget.spent() or (budget.examples is not None and hunt.skipped == skipped):
                 break                  # (with examples left: Hypothesis found nothing new)
             continue
         hunt.keep(found)

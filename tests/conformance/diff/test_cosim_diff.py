@@ -20,6 +20,7 @@ from conformance.diff.grammar import Options, probes
 from conformance.diff.sides import Side
 from conformance.diff.steps import FRAME, Step
 from conformance.targets import parse_target
+from conformance.targets.emu import mutants
 from conformance.verdict import FAIL
 from tests.conformance.diff.test_engine import (
     EVERYTHING,
@@ -141,6 +142,36 @@ def test_through_a_co_simulator_the_probes_find_a_mutant_told_ahead_as_not(mutan
 @pytest.mark.parametrize("mutant", ON_THE_WIRE)
 def test_through_a_co_simulator_the_probes_find_every_mutant(mutant):
     _found_as_in_process(mutant)
+
+
+#: the mutants of motion (their area 10.2); a few of them in the default run
+MOTION = sorted(m for m, (area, _) in mutants().items() if area.startswith("10.2"))
+MOTION_FEW = {"velocity-ignored", "junction-stops", "short-vector-ignored"}
+
+
+@pytest.mark.parametrize("mutant", [m if m in MOTION_FEW else
+                                    pytest.param(m, marks=pytest.mark.slow) for m in MOTION])
+def test_without_allow_destructive_a_motion_mutant_is_searched_to_the_budget(mutant):
+    """Each sequence begins at the co-simulator's power-on: no held KEEP or move left by
+    the one before stops the search for want of `J` (--allow-destructive), whatever the
+    seed; every sequence counted sent frames, so the search runs its whole budget or
+    finds the mutant."""
+    target = parse_target(cosim("--mutant", mutant), profile="GVE84-100")
+    target.preflight()
+    p = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+             target.profile)
+    target.session.guard.motion_confirmed = True
+    try:
+        for seed in range(10):
+            budget = Budget(examples=12)
+            found = search(p, Options(destructive=False, rig=True), budget, seed=seed,
+                           with_probes=False, stop_after=1)
+            assert found or budget.used == 12, (seed, budget.used)
+            assert budget.frames >= budget.used
+    finally:
+        target.session.finish()
+        target.close()
+    assert target.session.failures == []
 
 
 def test_a_power_on_that_leaves_the_checksum_mode_on_is_found_and_named():

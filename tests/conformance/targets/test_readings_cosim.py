@@ -167,3 +167,4 @@ def test_a_known_state_lost_without_power_on_ends_the_search(monkeypatch):
     finally:
         pair.target.session.finish()
         pair.target.target.close()
+    assert budget.used == 2
