@@ -49,7 +49,8 @@ class Side:
         self._origin = 0
         #: why the rig stopped answering (its input steps are left out from then on)
         self.rig_lost: str | None = None
-        #: where the rig saw the axes as the example began at a power-on (None: from 0)
+        #: where the rig saw the axes at the latest power-on, where the guard's envelope
+        #: was re-centred and the known state brings them back (None: from 0)
         self._physical: list[int] | None = None
 
     @property
@@ -73,8 +74,8 @@ class Side:
         real unit the run's session's known state, ``tell`` the frames sent first on it,
         ``meanwhile`` work done while a co-simulator runs the known state's frames told
         ahead (Session.open_link)."""
-        self._physical = None
         if self.virtual and not self.target.info.real:
+            self._physical = None
             self.session = EmuSession(self.target, self.session.interrupts if self.session
                                       else None)
         elif self.session is None:
