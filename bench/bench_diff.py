@@ -2,11 +2,11 @@
 against itself), frames per second with the search's own overhead (drawing, shrinking),
 and the time 10,000 frames take as a ratio of a 10 s budget (below 1: met);
 then the same search through a co-simulator (`exec:` of `python -m emulator --cosim`,
-docs/cosim.md: virtual time over the text protocol, the unit's known state before each
-sequence), its sequences per second and their ratio to the in-process figure; and the
-same ratio per CPU second (this process's and the simulator's): on a loaded machine the
-two processes take turns and the wall-clock ratio falls towards it, on an idle one the
-simulator runs beside the suite.
+docs/cosim.md: virtual time over the text protocol, each sequence begun at the
+simulator's power-on through its rig), its sequences per second and their ratio to the
+in-process figure; and the same ratio per CPU second (this process's and the
+simulator's): on a loaded machine the two processes take turns and the wall-clock ratio
+falls towards it, on an idle one the simulator runs beside the suite.
 
     python -m bench.bench_diff [--frames N]
 """

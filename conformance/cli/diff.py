@@ -26,7 +26,7 @@ from conformance.diff.engine import Budget, KnownStateLost, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.kept import Kept
 from conformance.diff.reach import Reach
-from conformance.diff.results import agreement_result, rig_lost_result, untested_result
+from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.interrupts import Interrupts
@@ -254,10 +254,6 @@ def main(argv: list[str] | None = None) -> int:
         run.results.append(rig_lost_result(profile=target.profile.name,
                                            target=target.info.spec, why=pair.target.rig_lost))
         say(f"{COULD_NOT_TEST}: input steps: {pair.target.rig_lost}")
-    if pair.untested:
-        run.results.append(untested_result(profile=target.profile.name,
-                                           target=target.info.spec, whys=pair.untested))
-        say(f"{COULD_NOT_TEST}: {len(pair.untested)} sequence(s): {pair.untested[0]}")
     if agreed:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames,

@@ -37,7 +37,7 @@ from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
 from conformance.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode, St6
+from gve_fixtures.protocol import SECOND, ErrorCode, St6
 
 try:
     # internals of Hypothesis, used only to empty its pool of constants while a search
@@ -50,8 +50,6 @@ except ImportError:
 _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: real time: how long the fresh reference stands before a sequence
 AGE_SECONDS = 1.0
-#: after a power-on through the rig, beyond the unit's restart time, before the known state
-RESTART_MARGIN_S = 0.5
 #: a unit that lives on between sequences: what both sides are sent first (the index read
 #: between two `SR0`, the same history for `>`); told ahead with the known state's last
 PRELUDE = ("SR0", "@", "SR0")
@@ -137,10 +135,8 @@ class Pair:
         #: it could); no sequence is sent to it after that
         self.lost = ""
         self._last: list[Step] = []            # the steps of the latest sequence begun
-        #: why each sequence that could not be tested was not (the known state could not
-        #: be had before it, and a power-on through the rig brought the unit back)
-        self.untested: list[str] = []
-        self._powering = False                 # powered on, no known state had since
+        #: the latest sequence began at the target's power-on (_power_on_start)
+        self.started_at_power_on = False
         self.led_there: list[Step] = []        # the sequence after which it was lost
 
     @property
@@ -187,31 +183,49 @@ class Pair:
                     self._rig_state(Step(STATE), len(steps), out, earlier)
             if self._teller is not None:
                 self._teller.finish()
+            self._left_summing(out)
         except BaseException:
             if self._teller is not None:
                 self._teller.forget()
             raise
         return self._end(out)
 
+    def _left_summing(self, out: ExampleRun) -> None:
+        """A sequence begun at power-on whose first frame's answers differ: whether the
+        power-on left the checksum mode on is asked as a session asks a unit it finds
+        (`?` without its checksum refused 4, with it taken: spec 6); if it did, the
+        disagreement is the reset state's (context `summing-after-power-on`: checksums
+        off after power-on, 9.reset.state [M])."""
+        d = out.disagreement
+        if not (self.started_at_power_on and d is not None and not any(
+                r.step.kind in (FRAME, FILL) for r in out.records[:d.index])):
+            return
+        link = self.target.link
+        try:
+            plain = link.send("?", checksum=False)
+            summed = plain is not None and plain.code == ErrorCode.SYNTAX and \
+                link.send("?", checksum=True)
+        except (SafetyStop, TargetNotResponding):
+            return
+        if not (summed and summed.ok):
+            return
+        family = self.profile.family
+        d.context = d.context | {"summing-after-power-on"}
+        d.rule = label(d.command, d.kind, set(d.context), set(d.earlier), _code(d.reference),
+                       _code(d.target), family)
+        d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
+
     def _begin(self, out: ExampleRun) -> bool:
-        """Both sides in the known state; False when the guard refused it, or when the
-        target could not be brought there (:attr:`lost`)."""
+        """Both sides in the known state, or both from power-on where the target is a
+        co-simulator in virtual time (:meth:`_power_on_start`); False when the guard
+        refused it, or when the target could not be brought there (:attr:`lost`)."""
         if self.lost:
             out.ended = self.lost
             return False
-        real = self.target.real
-        # the reference's beginning needs nothing more of the target's (its EEPROM as
-        # found is known): done while a co-simulator runs the known state's frames
-        alone = real and self.target.session is not None and self._same_eeprom_known()
         try:
-            self.target.open(tell=PRELUDE if real else (),
-                             meanwhile=self._begin_reference if alone else None)
-            if not alone:
-                self._begin_reference()
-            self.timing.begin()
-            self._index = IndexBase()
-            if real:
-                self._prelude()
+            self.started_at_power_on = self.target.real and self._power_on_start()
+            if not self.started_at_power_on:
+                self._known_start()
         except SafetyStop as err:
             # the known state or the reads after it were refused (a minimiser's candidate
             # left the unit where the guard cannot bring it back, or the guard saw the
@@ -221,39 +235,47 @@ class Pair:
         except StepFailed as err:
             # the frames before left the unit where the manual's rules cannot bring it to
             # rest, where the reference's were (the session names the rule where its
-            # evidence broke one): this sequence cannot be tested; a co-simulator in
-            # virtual time is powered on through its rig (the reset state, safely) and the
-            # search goes on; anywhere else nothing more is sent, and it ends there
+            # evidence broke one): nothing more is sent, and the search ends there
             # (KnownStateLost)
-            why = f"the known state could not be had: {err}"
-            if self._powered_on(why):
-                out.ended = why + "; the unit was powered on through its rig"
-                return False
-            self.lost = out.ended = why
+            self.lost = out.ended = f"the known state could not be had: {err}"
             self.led_there = self._last
             return False
         self.course = Course(self.profile)
-        self._powering = False
         out.begun = True
         return True
 
-    def _powered_on(self, why: str) -> bool:
-        """A target the known state could not be had on, powered on through its test
-        rig where that is safe: a co-simulator in virtual time (its time stands still
-        between frames, the guard books the power-on as a restart that leaves the axes
-        where they are) — not twice in a row without a known state had between. Whether
-        it was; the sequences that could not be tested so are kept in :attr:`untested`."""
-        side = self.target
-        rig = None if side.link is None else side.link.rig
-        if not (side.real and side.virtual and rig is not None) or self._powering:
+    def _known_start(self) -> None:
+        """Both sides in the known state: the target's session's (its proof read back on
+        a unit that lives on), the reference a fresh unit given the target's history."""
+        real = self.target.real
+        # the reference's beginning needs nothing more of the target's (its EEPROM as
+        # found is known): done while a co-simulator runs the known state's frames
+        alone = real and self.target.session is not None and self._same_eeprom_known()
+        self.target.open(tell=PRELUDE if real else (),
+                         meanwhile=self._begin_reference if alone else None)
+        if not alone:
+            self._begin_reference()
+        self.timing.begin()
+        self._index = IndexBase()
+        if real:
+            self._prelude()
+
+    def _power_on_start(self) -> bool:
+        """Both sides from the reset state the manuals state (spec 9 [M]): a co-simulator
+        in virtual time powered on through its rig (its restart waited out on the suite's
+        clock: no wall time; RealSession.open_powered), the reference a fresh unit standing
+        as long since its start, given the target's EEPROM as found. Nothing is read back:
+        a power-on that left something behind shows in the sequence's first answers, a
+        finding of its own. False where the target is not begun so (a real unit, a
+        real-time simulator, a rig that refuses `power-on`): the known state then."""
+        if self.target.open_powered() is None:
             return False
-        try:
-            rig.power_on()
-        except CouldNotTest:
-            return False
-        side.wait(self.profile.restart_ms / 1000 + RESTART_MARGIN_S)
-        self._powering = True
-        self.untested.append(why)
+        self.reference.open()
+        self._same_eeprom()
+        self.reference.age(self.target.session.since_power_on / SECOND)
+        self.timing.begin()
+        self._index = IndexBase()
+        self.judge = replace(self.judge, index_offset=0)
         return True
 
     def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
@@ -721,6 +743,11 @@ def _restarts_wait(steps: list[Step], i: int) -> bool:
             and command_of(steps[i - 1].body) in _RESTARTS)
 
 
+#: sequences in a row that sent no frame before the search ends COULD-NOT-TEST: it never
+#: goes on, or passes, on sequences that did not run
+IDLE_MOST = 20
+
+
 class _Spent(Exception):
     """The budget ran out inside Hypothesis."""
 
@@ -771,16 +798,29 @@ class _Search:
         self.findings: list[Finding] = []
         self.known: set[tuple] = set()
         self.seen = 0                  # disagreements seen so far (each one's number)
+        self.idle = 0                  # sequences in a row that sent no frame
+        self.skipped = 0               # sequences that sent no frame (not counted)
 
     def more(self) -> bool:
         return not self.pair.lost and not self.budget.spent() and (
             self.stop_after is None or len(self.findings) < self.stop_after)
 
     def trial(self, steps: list[Step]) -> Finding | None:
-        """One example run whole; a finding when it shows a disagreement not kept yet."""
-        self.budget.used += 1
+        """One example run whole; a finding when it shows a disagreement not kept yet. A
+        sequence that sent no frame (its start refused, say) is not counted in the
+        budget; :data:`IDLE_MOST` of them in a row end the search (:attr:`Pair.lost`)."""
         outcome = self.pair.run(steps)
         self.budget.frames += outcome.frames
+        if outcome.frames:
+            self.budget.used += 1
+            self.idle = 0
+        else:
+            self.idle += 1
+            self.skipped += 1
+            if self.idle >= IDLE_MOST and not self.pair.lost:
+                why = (outcome.refused or [outcome.ended or "nothing was sent"])[0]
+                self.pair.lost = (f"{IDLE_MOST} sequences in a row sent no frame: {why}")
+                self.pair.led_there = list(steps)
         d = outcome.disagreement
         if d is None or d.signature in self.known:
             return None
@@ -915,10 +955,11 @@ def _hunt(hunt: _Search, pair: Pair, options: Options, budget: Budget, seed: int
     strategy = grammar.sequences()
     rounds = 0
     while hunt.more():
+        skipped = hunt.skipped
         found = hunt.draw(strategy, seed + rounds)
         rounds += 1
         if found is None:
-            if budget.spent() or budget.examples is not None:
+            if budget.spent() or (budget.examples is not None and hunt.skipped == skipped):
                 break                  # (with examples left: Hypothesis found nothing new)
             continue
         hunt.keep(found)

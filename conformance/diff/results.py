@@ -75,13 +75,3 @@ def rig_lost_result(*, profile: str, target: str, why: str) -> CaseResult:
                    target, COULD_NOT_TEST)
     r.notes = [f"input steps not tested: {why}"]
     return r
-
-
-def untested_result(*, profile: str, target: str, whys: list[str]) -> CaseResult:
-    """The sequences that could not be tested: the known state could not be had before
-    them (the unit was then powered on through its rig and the search went on)."""
-    r = CaseResult("diff.search.known-state", "diff", "every sequence begins from the known "
-                   "state", "M", "gve-conformance diff", profile, target, COULD_NOT_TEST)
-    r.notes = [f"{len(whys)} sequence(s) not tested: {why}" if i == 0 else why
-               for i, why in enumerate(dict.fromkeys(whys))]
-    return r

@@ -49,6 +49,9 @@ class Side:
         self._origin = 0
         #: why the rig stopped answering (its input steps are left out from then on)
         self.rig_lost: str | None = None
+        #: where the rig saw the axes at the latest power-on, where the guard's envelope
+        #: was re-centred and the known state brings them back (None: from 0)
+        self._physical: list[int] | None = None
 
     @property
     def virtual(self) -> bool:
@@ -72,6 +75,7 @@ class Side:
         ``meanwhile`` work done while a co-simulator runs the known state's frames told
         ahead (Session.open_link)."""
         if self.virtual and not self.target.info.real:
+            self._physical = None
             self.session = EmuSession(self.target, self.session.interrupts if self.session
                                       else None)
         elif self.session is None:
@@ -79,6 +83,26 @@ class Side:
         self.link = self.session.open_link(tell=tell, meanwhile=meanwhile)
         self._origin = self.link.now
         return self.link
+
+    def open_powered(self) -> Link | None:
+        """A co-simulator's link begun at its power-on through the rig in place of the
+        known state (RealSession.open_powered), and where its rig then sees the axes, from
+        which the sequence's physical positions count (a fresh reference's count from 0);
+        None where the target cannot be begun so (the known state then)."""
+        if self.session is None:
+            self.session = self.target.begin()
+        if not getattr(self.session, "powers_on", False):
+            return None
+        link = self.session.open_powered()
+        if link is None:
+            return None
+        self.link = link
+        self._origin = link.now
+        self._physical = None
+        state = self.rig_state()
+        seen = None if state is None else state.get("physical")
+        self._physical = list(seen) if _counts(seen) else None
+        return link
 
     def age(self, seconds: float) -> None:
         """Virtual time: let a fresh unit stand for ``seconds`` and begin the example
@@ -152,10 +176,15 @@ class Side:
         """What the rig sees of the unit now (docs/rig.md `state`); None (and the rig
         lost) when it does not say."""
         try:
-            return self.link.rig.state()
+            state = self.link.rig.state()
         except CouldNotTest as err:
             self.rig_lost = str(err)
             return None
+        seen = state.get("physical") if isinstance(state, dict) else None
+        if self._physical is not None and _counts(seen) and len(seen) == len(self._physical):
+            state = {**state, "physical": [a - b for a, b in zip(seen, self._physical,
+                                                                   strict=True)]}
+        return state
 
     def close_example(self) -> None:
         """Take what is still on its way (an answer after the last frame); on a real unit
@@ -179,3 +208,10 @@ def _body(data: bytes, summed: bool) -> str:
         return ""
     bodies = frames[-1].bodies(summed)
     return bodies[0] if bodies else ""
+
+
+def _counts(seen: object) -> bool:
+    """Whether a rig's `physical` is a list of counts (anything else is not subtracted
+    from: compared, or not, as it came)."""
+    return isinstance(seen, list) and all(
+        isinstance(v, int) and not isinstance(v, bool) and abs(v) < 2**62 for v in seen)

@@ -242,6 +242,8 @@ class Guard:
         self._emergency = _Depth()
         self._hands_on = _Depth()                 # a technician's hand step is open
         self._unmoved = _Depth()                  # reads with nothing moved since the last
+        #: the envelope was re-centred where a co-simulator's axes stood (recentre)
+        self.recentred = False
 
     def _limit(self, max_travel: int) -> float:
         """The envelope's reach either side, in counter units."""
@@ -459,6 +461,15 @@ class Guard:
         self.envelope.discard(Outcome.ACCEPTED, restart=True)
         self.packet_open = False
         self._restarting = True
+
+    def recentre(self) -> None:
+        """A co-simulator just powered on (counters 0): its axes are taken as standing
+        where the run began, so the envelope bounds the next frames from there. Only for
+        a unit that moves nothing physical (docs/decisions.md); :attr:`recentred` says the
+        run's origin moved."""
+        axes = range(self.envelope.axes)
+        self.locate(dict.fromkeys(axes, 0), dict.fromkeys(axes, 0))
+        self.recentred = True
 
     def locate(self, physical: dict[int, int], counters: dict[int, int]) -> None:
         """The axes stand still at ``physical`` (counter units from where the run began,

@@ -310,6 +310,8 @@ class RealSession(Session):
         self.counters: dict[int, int] = {}         # position counters as found (PF)
         #: where a test rig with eyes saw the axes as found (docs/rig.md, `physical`)
         self._rig_origin: dict[int, int] | None = None
+        self._power_on_refused = ""                # why the rig did not power the unit on
+        self.since_power_on = 0                     # ns: the restart waited out (open_powered)
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return Guard(self.profile, self.target.address, max_travel=info.max_travel,
@@ -348,6 +350,43 @@ class RealSession(Session):
         work, link.meanwhile = link.meanwhile, None
         if work is not None:
             work()
+        return link
+
+    @property
+    def powers_on(self) -> bool:
+        """Whether a link may begin at a power-on through the rig instead of the known
+        state (:meth:`open_powered`): only a co-simulator in virtual time (its first line
+        was `cosim 1`), which moves nothing physical, with a rig that has not refused
+        `power-on`."""
+        info = self.target.info
+        return info.real and info.virtual_time and self._power_on_refused == "" \
+            and getattr(self.target, "rig", None) is not None
+
+    def open_powered(self) -> Link | None:
+        """A link to the unit just powered on through its rig, in place of the known state:
+        the rig's hands off, the power cycled (the guard books it as a restart: counters
+        zeroed, the axes where they stand), the restart waited out on the suite's clock
+        (no wall time), the checksum mode off as the manuals state the reset state
+        (spec 9 [M]). The axes are then taken as standing where the run began: the guard's
+        envelope re-centred there, since a co-simulator's axes are numbers, not a machine
+        (docs/decisions.md). None where the rig refused `power-on` (the known state
+        then, from here on)."""
+        self.start()
+        self.guard.check_idle()
+        link = self._new_link()
+        rig = link.rig
+        try:
+            rig.hands_off()
+            rig.power_on()
+        except CouldNotTest as err:
+            self._power_on_refused = str(err)
+            return None
+        link.checksums = False
+        powered = link.now
+        link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
+        self.since_power_on = link.now - powered
+        self.guard.recentre()
+        link.log.clear()
         return link
 
     # -- the unit as found ----------------------------------------------------------------------
@@ -978,7 +1017,8 @@ class RealSession(Session):
         GVE114's A: PF reads X, Y, Z, M114 13.6.6) cannot be verified: said as such."""
         names = self.profile.axes
         stopped = self.interrupts.stopped
-        if not stopped and None in self.guard.envelope.position():
+        if not stopped and (None in self.guard.envelope.position() or self.guard.recentred):
+            # re-centred at a co-simulator's power-on: where the run began, by the rig's eyes
             self._relocate(link)
         body, read = "", {}
         if stopped or self.guard.lost:
@@ -998,6 +1038,10 @@ class RealSession(Session):
                             f"no motion after it: {self.guard.lost}" if self.guard.lost else
                             f"where {', '.join(unknown)} stand is not known exactly" if unknown
                             else "the way back would have left the envelope")
+            return
+        if self.guard.recentred and self._rig_origin is None:
+            self._axes_left("the envelope was re-centred at each power-on of the "
+                            "co-simulator, and its rig has no eyes to say where they are")
             return
         moved = (f"moved back with {body} at V{self.profile.reset.V}" if body else
                  "no motion after the signal" if stopped else "no move needed")

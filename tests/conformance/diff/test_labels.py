@@ -297,6 +297,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # vectors refused while the MPG holds RUN, its parameters never set
     "9.reset.mpg-parameters": ("9.reset.mpg-enabled",
                                ("L", "code", {"mpg-on"}, {"EW", "J"}, 7, 0, "GVE114")),
+    # a co-simulator's power-on that left the checksum mode on: its first answer summed
+    "9.reset.state": ("9.reset.after-j", ("SR", "data", {"summing-after-power-on"}, set(),
+                                          0, 0)),
     # a vector refused 7 after an EEPROM 06 value the manual does not list as enabling
     "9.reset.mpg": ("9.reset.mpg-enabled", ("L", "code", set(), {"EW", "Y"}, 0, 7, "GVE114")),
     # RUN read right after a vector alone: the unit did not run it

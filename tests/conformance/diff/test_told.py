@@ -25,6 +25,7 @@ from conformance.diff.sides import Side
 from conformance.diff.steps import FRAME, Step
 from conformance.link.virtual import line_of
 from conformance.targets import parse_target
+from conformance.targets.session import RealSession
 from gve_fixtures.profile import load_profile
 
 
@@ -177,10 +178,12 @@ def test_frames_told_after_a_disagreement_are_sent_and_booked(pairs):
 
 def test_a_target_drifting_from_the_frames_told_is_run_again_frame_by_frame(pairs,
                                                                              monkeypatch):
-    # the co-simulator's index is not the fresh reference's: `@` answered alike (counted
-    # from each side's start) in more digits, so the frames told after it begin later on
-    # the target than on the reference (`@` ends what is told ahead; here it does not)
+    # begun from the known state (not power-on), the co-simulator's index is not the
+    # fresh reference's: `@` answered alike (counted from each side's start) in more
+    # digits, so the frames told after it begin later on the target than on the
+    # reference (`@` ends what is told ahead; here it does not)
     monkeypatch.setattr(told_module, "ENDS", frozenset({"%", "J"}))
+    monkeypatch.setattr(RealSession, "powers_on", property(lambda self: False))
     pair = pairs["clean"]
     redone = []
     real_run = Pair._run
@@ -217,6 +220,7 @@ def test_the_reference_begins_while_the_co_simulator_runs_the_known_state(pairs,
     """The reference's known state and prelude are done while the target's known-state
     frames told ahead are on the simulator's line (their reply not read yet), and the
     sequence then runs as it does with the two done one after the other."""
+    monkeypatch.setattr(RealSession, "powers_on", property(lambda self: False))
     pair = pairs["clean"]
     steps = [Step(FRAME, body=body) for body in ("V400", "L100,0,0", "SR6", "@", "PF")]
     pair.run(steps)                        # the EEPROM as found read: nothing waits for it
