@@ -8,6 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from conformance.check import Check
 from conformance.link.link import Link
 from conformance.link.safety import SafetyStop
 from conformance.quoting import as_text
@@ -103,16 +104,6 @@ def case(id: str, *, rules: tuple[str, ...], tag: str | None = None,
                             applies, rig, destructive, timing, tuple(rules), hands)
         return func
     return register
-
-
-@dataclass
-class Check:
-    ok: bool
-    what: str
-    observed: str = ""
-    expected: str = ""
-    tag: str = ""
-    rule: str = ""           # the rule ID of fixtures/rules.toml it judges
 
 
 @dataclass

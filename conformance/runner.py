@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass, field
 
 from conformance import settings as settings_profiles
 from conformance.case import Case, CaseContext, CouldNotTest, Missing, SafetyStop
+from conformance.check import Check
 from conformance.hands import HandRig, Hands, cannot_by_hand
 from conformance.link.framing import UnitDataError
 from conformance.link.interrupts import Interrupts
@@ -44,7 +45,7 @@ class CaseResult:
     profile: str
     target: str
     verdict: str
-    checks: list[dict] = field(default_factory=list)
+    checks: list[dict] = field(default_factory=list)     # each a Check.to_dict()
     notes: list[str] = field(default_factory=list)
     wire_log: list[str] = field(default_factory=list)
     artifacts: dict[str, str] = field(default_factory=dict)
@@ -180,7 +181,7 @@ def run_case(case: Case, target: Target, settings_name: str | None = None,
         verdicts.append(ERROR)
         ctx.note("the case recorded no check: a case that cannot fail is a defect")
     result.verdict = worst(verdicts)
-    result.checks = [asdict(c) for c in ctx.checks]
+    result.checks = [c.to_dict() for c in ctx.checks]
     result.notes = ctx.notes
     result.artifacts, result.traces = ctx.artifacts, ctx.traces
     result.wire_log = [line for link in ctx.links for line in
@@ -200,8 +201,7 @@ def step_results(session: Session, target: Target) -> list[CaseResult]:
         r = CaseResult(f"{section}.known-state.{f.step}", section, rule.text,
                        rule.tag, rule.source, target.profile.name, target.info.spec,
                        grade(rule.tag, target.info.strict))
-        r.checks = [{"ok": False, "what": f.what, "observed": f.observed,
-                     "expected": f.expected, "tag": rule.tag, "rule": f.rule}]
+        r.checks = [Check(False, f.what, f.observed, f.expected, rule.tag, f.rule).to_dict()]
         r.notes = ["a step of the known state the suite sets before each case relies on "
                    "this rule of the manual and the unit broke it; the run went on where "
                    "it safely could"]
@@ -291,8 +291,7 @@ def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, setti
             stopped = str(err)
             if cases and isinstance(err, TargetNotResponding):
                 first = _result(cases[0], target, FAIL)
-                first.checks = [{"ok": False, "what": stopped, "observed": "", "expected": "",
-                                 "tag": ALWAYS, "rule": SILENT}]
+                first.checks = [Check(False, stopped, tag=ALWAYS, rule=SILENT).to_dict()]
                 first.stopped = stopped
                 add(first)
                 cases = cases[1:]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from conformance.check import Check
 from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
@@ -37,7 +38,7 @@ from conformance.reports.files import release
 from conformance.runner import RunResult, step_results
 from conformance.settings import fresh_seed
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
-from conformance.verdict import COULD_NOT_TEST, FAIL, SILENT, CouldNotTest
+from conformance.verdict import ALWAYS, COULD_NOT_TEST, FAIL, SILENT, CouldNotTest
 
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given
@@ -208,8 +209,7 @@ def main(argv: list[str] | None = None) -> int:
         r = agreement_result(profile=target.profile.name, target=target.info.spec,
                              examples=budget.used, frames=budget.frames, seconds=budget.elapsed)
         r.verdict, r.stopped = FAIL, str(err)
-        r.checks = [{"ok": False, "what": str(err), "observed": "", "expected": "",
-                     "tag": "always", "rule": SILENT}]
+        r.checks = [Check(False, str(err), tag=ALWAYS, rule=SILENT).to_dict()]
         run.results.append(r)
         print(f"{r.verdict}: {err}", file=sys.stderr)
     except (SafetyStop, SessionError, CouldNotTest) as err:

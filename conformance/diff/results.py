@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import re
 
+from conformance.check import Check
 from conformance.diff.compare import TIMING, delays
 from conformance.diff.engine import Finding
 from conformance.link.framing import readable
@@ -35,16 +36,14 @@ def finding_result(f: Finding, *, profile: str, target: str, transcript: list[st
     if d.kind == TIMING:      # the same bytes: what differs is when they came
         observed, expected = delays(d.target, d.reference)
         answer = quoted(answer_text(d.target.answer))
-        r.checks = [{"ok": False, "what": f"{sent} answered {answer} at another instant "
-                     f"({d.kind})",
-                     "observed": f"{observed} after the frame",
-                     "expected": f"{expected} after the frame",
-                     "tag": d.tag, "rule": d.rule or ""}]
+        check = Check(False, f"{sent} answered {answer} at another instant ({d.kind})",
+                      f"{observed} after the frame", f"{expected} after the frame", d.tag,
+                      d.rule or "")
     else:
-        r.checks = [{"ok": False, "what": f"{sent} answered differently ({d.kind})",
-                     "observed": answer_text(d.target.answer),
-                     "expected": answer_text(d.reference.answer),
-                     "tag": d.tag, "rule": d.rule or ""}]
+        check = Check(False, f"{sent} answered differently ({d.kind})",
+                      answer_text(d.target.answer), answer_text(d.reference.answer), d.tag,
+                      d.rule or "")
+    r.checks = [check.to_dict()]
     r.notes = [f"rule touched: {d.rule or 'none known'}",
                f"shrunk to {f.frames} frame(s): " + " | ".join(str(s) for s in f.steps)]
     if f.unreplayed:
@@ -62,8 +61,8 @@ def agreement_result(*, profile: str, target: str, examples: int, frames: int,
                      seconds: float) -> CaseResult:
     r = CaseResult("diff.search.agreement", "diff", "the target answers as the reference "
                    "does", "M", "gve-conformance diff", profile, target, PASS)
-    r.checks = [{"ok": True, "what": f"{examples} sequences, {frames} frames: every answer "
-                 "alike", "observed": "", "expected": "", "tag": "M", "rule": ""}]
+    r.checks = [Check(True, f"{examples} sequences, {frames} frames: every answer alike",
+                      tag="M").to_dict()]
     r.frames, r.seconds = frames, seconds
     return r
 

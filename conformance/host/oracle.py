@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
-from conformance.case import Check
+from conformance.check import Check
 from conformance.coverage import register_host_check
 from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
 from conformance.host.faults import Fault
@@ -282,7 +282,7 @@ def result(g: Grader, out: HostRun, profile: str, target: str) -> HostResult:
     return HostResult(
         id=sc.id, section=sc.section, rule=sc.title, tag="D-info" if sc.info else "M",
         source="spec 2, 3, 6, 7, 8, 10.1", profile=profile, target=target,
-        verdict=g.verdict(), checks=[asdict(c) for c in g.checks], notes=notes,
+        verdict=g.verdict(), checks=[c.to_dict() for c in g.checks], notes=notes,
         wire_log=rec.wire_log(), artifacts={"host output": out.output} if out.output else {},
         seconds=out.seconds, frames=len(rec.exchanges), scenario=sc.name,
         fault=out.fault.describe(), injected=out.fault.injected, exit_code=out.exit_code,

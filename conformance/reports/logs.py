@@ -5,6 +5,7 @@ them) and no trace data (the page draws its traces). ``--full-logs`` keeps every
 
 from __future__ import annotations
 
+from conformance.check import Check
 from conformance.verdict import PASS
 
 #: lines kept at each end of a passing case's wire log (its first frame, its last answer)
@@ -34,9 +35,8 @@ def compact_checks(checks: list[dict], verdict: str, full: bool = False, *,
         return list(checks)
     if not said:
         return [checks[0]]
-    return [checks[0], {"ok": True, "observed": "", "expected": "", "tag": "", "rule": "",
-                        "what": f"... and {len(checks) - 1} more passed checks (all of "
-                                "them: --full-logs) ..."}]
+    return [checks[0], Check(True, f"... and {len(checks) - 1} more passed checks (all of "
+                              "them: --full-logs) ...").to_dict()]
 
 def compact_traces(traces: list[dict], verdict: str, full: bool = False) -> list[dict]:
     """A case's traces as the JSON keeps them: whole unless the case passed (the page

@@ -1,12 +1,12 @@
-"""The units a run tested, for the top of the HTML page: one row each (profile, the
-firmware's `?` and `Q` answers, the motion envelope, the largest excursion, the verdict)
-and, for each real unit, its state as the session found it and as it left it (what was
-put back, what was set to the reset state, what could not be)."""
+"""The units a run tested, for the top of the HTML page (as data: its template lays it
+out): one row each (profile, the firmware's `?` and `Q` answers, the motion envelope, the
+largest excursion, the verdict) and, for each real unit, its state as the session found
+it and as it left it (what was put back, what was set to the reset state, what could
+not be)."""
 
 from __future__ import annotations
 
 from conformance.reports.banner import run_verdict
-from conformance.reports.text import html_text as h
 from conformance.runner import RunResult
 from conformance.targetinfo import EMULATOR
 
@@ -27,9 +27,8 @@ def excursion_text(session: dict | None, kind: str) -> str:
                      in zip(session["axes"], session["excursion"], strict=False))
 
 
-def units_table(run: RunResult) -> list[str]:
-    out = ["<h2>Units</h2><table class='units'><tr>"
-           + "".join(f"<th>{h(x)}</th>" for x in HEADERS) + "</tr>"]
+def _rows(run: RunResult) -> list[dict]:
+    out = []
     for target in run.targets:
         t = run.meta.target(target)
         v, why = run_verdict(run, target)
@@ -40,9 +39,7 @@ def units_table(run: RunResult) -> list[str]:
         cells = (target, f"{t.profile}{chosen}", t.version or "(not read)",
                  t.processor_id or "(not read)", envelope,
                  excursion_text(run.sessions.get(target), t.kind))
-        out.append("<tr>" + "".join(f"<td>{h(c)}</td>" for c in cells)
-                   + f"<td class='{h(v)}'>{h(v)}: {h(why)}</td></tr>")
-    out.append("</table>")
+        out.append({"cells": cells, "verdict": v, "why": why})
     return out
 
 
@@ -71,37 +68,12 @@ def _left(s: dict) -> list[tuple[str, str]]:
     return out
 
 
-def _items(lines: list[tuple[str, str]], empty: str) -> str:
-    if not lines:
-        return f"<p class='why'>{h(empty)}</p>"
-    return "<ul>" + "".join(f"<li class='{h(c)}'>{h(text)}</li>" if c else
-                            f"<li>{h(text)}</li>" for c, text in lines) + "</ul>"
-
-
-def state_section(run: RunResult) -> list[str]:
-    """Every unit's state as found and as left, in plain view."""
-    if not run.sessions:
-        return []
-    out = ["<h2 id='state'>The units as found and as left</h2>"]
-    emulated = [t for t, s in run.sessions.items() if not s.get("real")]
-    for target, s in run.sessions.items():
-        if not s.get("real"):
-            continue
-        out.append(f"<table class='state'><tr><th colspan='2'>{h(target)} "
-                   f"({h(s.get('profile', ''))})</th></tr>"
-                   "<tr><th>as found (before the first case)</th>"
-                   "<th>as left (after the last case)</th></tr><tr><td>"
-                   + _items([("", x) for x in _found(s)], "nothing read: the session did "
-                            "not begin")
-                   + "</td><td>" + _items(_left(s), "nothing to put back")
-                   + "</td></tr>")
-        if s.get("violations"):
-            out.append("<tr><th colspan='2'>answers between the cases</th></tr><tr>"
-                       "<td colspan='2'>" + _items([("FAIL", v) for v in s["violations"]],
-                                                   "") + "</td></tr>")
-        out.append("</table>")
-    if emulated:
-        out.append(f"<p>{h(', '.join(emulated))}: the embedded emulator — every case ran "
-                   "on a fresh unit, so there was nothing to find on it and nothing to put "
-                   "back.</p>")
-    return out
+def units_view(run: RunResult) -> dict:
+    """The units' table and every real unit's state as found and as left, as the page's
+    template (templates/units.html.j2) lays them out."""
+    states = [{"target": target, "profile": s.get("profile", ""),
+               "found": [("", x) for x in _found(s)], "left": _left(s),
+               "violations": [("FAIL", v) for v in s.get("violations", [])]}
+              for target, s in run.sessions.items() if s.get("real")]
+    return {"headers": HEADERS, "rows": _rows(run), "states": states,
+            "emulated": [t for t, s in run.sessions.items() if not s.get("real")]}

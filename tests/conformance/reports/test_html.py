@@ -142,3 +142,37 @@ def test_a_rule_s_markdown_is_set_as_html_not_shown():
     run.results[0].rule = "`SW6` setting INTA starts a stop ramp"
     page = render_html(run)
     assert "<code>SW6</code> setting INTA" in page and "`SW6`" not in page
+
+
+#: a target's answer built to break a page: markup, an ampersand, both quotes, controls
+ANSWER = "8,D0<script>alert('x')</script> & \"q\" \x00\x1b[2J\x7f"
+
+
+class _Text(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.text = ""
+
+    def handle_data(self, data):
+        self.text += data
+
+
+def test_a_hostile_answer_is_shown_escaped_and_never_raw(no_plots):
+    run = toy_run()
+    bad = result("4.toy.answer", "FAIL", notes=[ANSWER], wire_log=["# link", f"< {ANSWER}"],
+                 checks=[{"ok": False, "what": "the answer to Q", "observed": ANSWER,
+                          "expected": "8,D0", "tag": "M", "rule": "a rule"}])
+    run.results.append(bad)
+    run.meta.target("emu:GVE84-100").version = ANSWER
+    page = render_html(run)
+    tags = parse(page)
+    # raw, none of it: no markup of the target's, no quote or ampersand it sent
+    assert [t for t, _ in tags.starts].count("script") == 1        # the page's own
+    assert "<script>alert" not in page and "'x'" not in page and '"q"' not in page
+    assert "& \"" not in page and not any(c in page for c in "\x00\x1b\x7f")
+    # shown, everywhere it appears: the failed table, the check, the note, the wire
+    # log and the units' table read back as the very text, its controls spelled out
+    reader = _Text()
+    reader.feed(page)
+    shown = "8,D0<script>alert('x')</script> & \"q\" \\x00\\x1B[2J\\x7F"
+    assert reader.text.count(shown) == 5
