@@ -136,7 +136,7 @@ class Course:
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
         answer = reference.response
         if command == "L" and _ZERO_VECTOR.fullmatch(body.upper()) and answer is not None \
-                and answer.code == ErrorCode.OK and not answer.inta:     # (with INTA it waits for G)
+                and answer.code == ErrorCode.OK and not answer.inta:  # (with INTA it waits for G)
             self.zero_at = reference.sent_at
         if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
