@@ -42,10 +42,10 @@ def test_replay_quiet_prints_the_verdict_only(tmp_path, capsys):
     path = tmp_path / "t.gvt"
     path.write_text(LOWER_CASE)
     assert main(["replay", str(path), "--target", "emu:GVE84-100", "-q"]) == 0
-    assert _verdict_only(capsys.readouterr().out.splitlines()).startswith("PASS: ")
+    assert _verdict_only(capsys.readouterr().out.splitlines()).startswith("PASSED — PASS: ")
     assert main(["replay", str(path), "--target", MUTANT, "-v"]) == 1
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("replay ") and lines[-1].startswith("FAIL ")
+    assert lines[0].startswith("replay ") and lines[-1].startswith("FAILED — FAIL ")
 
 
 def test_a_quiet_fleet_prints_its_verdict_only(capsys):

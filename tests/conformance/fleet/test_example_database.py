@@ -36,6 +36,19 @@ def examples(junit: Path) -> list[list[str]]:
     return out
 
 
+def without_index_measure(frames: list[str]) -> list[str]:
+    """The frames with the index's reads folded: the first `@` of a unit whose answer does
+    not show its form is read again between `SR6` frames that move it
+    (conformance/protocol/index.py), once per unit, so only the example that first met it
+    carries them; each run of `@` reads counts as one."""
+    out: list[str] = []
+    for f in frames:
+        if f == "!0SR6\\r" or (f == "!0@\\r" and out and out[-1] == f):
+            continue
+        out.append(f)
+    return out
+
+
 def run_cli(folder: Path, run_id: str, *options: str) -> tuple[int, list[list[str]]]:
     """A run of the machine against the mutant (reports only as JUnit unless the
     options say otherwise): its status and its examples."""
@@ -53,7 +66,8 @@ def test_the_next_run_tries_the_failing_example_first(tmp_path):
     status, second = run_cli(tmp_path, "second")
     # the stored example first (it fails at once), then Hypothesis's replay of it
     assert status == 1 and len(second) == 2
-    assert second[0] == first[-1] == second[-1]
+    assert (without_index_measure(second[0]) == without_index_measure(first[-1])
+            == without_index_measure(second[-1]))
 
 
 def test_without_a_database_each_run_searches_again(tmp_path):
