@@ -959,11 +959,20 @@ class RealSession(Session):
         took (answered 0), a problem for the others."""
         frames = self._reset_frames()
         taken = [body for body in frames if _taken(answers.get(body))]
+        # M114 12: "Pokud je hodnota některého parametru mimo rozsah, není možné MPG
+        # použít": the MPG mode refused out of range where the EEPROM does not allow it
+        # is that unit's reset state, nothing left to set
+        inert = [body for body in frames if body.startswith("Y") and self._has_mpg()
+                 and _refused_range(answers.get(body))]
         refused = [f"{body} answered {_shown(answers.get(body))}" for body in frames
-                   if body not in taken]
+                   if body not in taken and body not in inert]
         if taken:
             self.report.reset.append("set to the reset state, each answered 0 (they cannot "
                                      "be read back): " + ", ".join(taken))
+        if inert:
+            self.report.reset.append("the MPG mode left as the unit's EEPROM makes it (the "
+                                     "MPG not allowed there): " + ", ".join(
+                                         f"{b} answered {_shown(answers.get(b))}" for b in inert))
         if refused:
             self.report.problems.append("not set to the reset state: " + "; ".join(refused))
         micro = self.profile.microstep
@@ -1203,6 +1212,10 @@ def _shown(r: Response | None) -> str:
 
 def _taken(r: Response | None) -> bool:
     return r is not None and r.ok
+
+
+def _refused_range(r: Response | None) -> bool:
+    return r is not None and r.code is not None and r.code & 7 == ErrorCode.RANGE
 
 
 def _not_yet(r: Response | None) -> bool:
