@@ -315,6 +315,8 @@ class Pair:
             if kind is not None:
                 out.disagreement = self._disagreement(step, command, kind, out, earlier)
                 return True
+            if (rec.reference.code or 0) & 7:
+                self._index.refused_frame(command, self._context(step, self.course.in_packet))
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
@@ -365,6 +367,9 @@ class Pair:
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")
+        if command == "@" and self._index.skips_refused(_values(rec.target),
+                                                         _values(rec.reference)):
+            context.add("refused-uncounted")
         if command == "@" and self._index.in_hex(_values(rec.target), _values(rec.reference)):
             context.add("index-hex")
         family = self.profile.family
