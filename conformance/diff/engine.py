@@ -118,7 +118,8 @@ class Pair:
         # somebody else's unit places its steps its own way, even in virtual time
         placement = 0 if target.target.info.strict else PLACEMENT_STEPS
         self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor,
-                           placement=placement)
+                           placement=placement,
+                           unused_inputs=tuple(profile.unused_inputs.items()))
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
