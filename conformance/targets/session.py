@@ -731,6 +731,11 @@ class RealSession(Session):
         left, _ = self._settle(link, ["PF"], mpg=False)   # where the axes are, for the way back
         if left:
             raise StepFailed(left)
+        spindle = self.profile.spindle
+        if spindle is not None:
+            # the spindle off, as after reset (M114 13.5 "O0,FF - Výstup vypnutý"): `O0`
+            # need not reset the setting of `!7V`, which a case or sequence may have left
+            link.send("V0", address=spindle.address)
         returned, there = self._go_back(link, read=False)
         link.tell(["N", "PF", *tell])
         self._zero(link, returned, there)
