@@ -473,15 +473,14 @@ class RealSession(Session):
             if other is not None:
                 link.checksums = not link.checksums
 
-    def _reset_frames(self, mpg: bool = True) -> list[str]:
-        """What cannot be read, set to the reset state (spec 9); not ``mpg``: the hand
-        wheel left off (see :meth:`_known_state`)."""
+    def _reset_frames(self) -> list[str]:
+        """What cannot be read, set to the reset state (spec 9)."""
         p, r = self.profile, self.profile.reset
         table = {"O0": "O0,%02X" % r.outputs, "XM": f"XM{r.XM}", "VN": "VK" if r.VK else "VN",
                  "VL": "VL" + ",".join(str(v) for v in known_axis_limits(p))}
         frames = [body for name, body in table.items() if name in p.commands]
         frames += [f"V{r.V}", f"A{r.A}", f"B{r.B}", f"${r.dollar}", f"T{r.T}"]
-        if mpg and self._has_mpg():
+        if self._has_mpg():
             frames.append(f"Y{p.mpg.reset_mode}")
         if p.microstep:
             frames += [f"M{p.microstep.reset_mode}", f"M{p.microstep.reset_current}"]
@@ -709,7 +708,7 @@ class RealSession(Session):
             link.wait(RUN_OUT_POLL_S, Spent.MOTION)
         return False
 
-    def _settle(self, link: Link, then: Sequence[str] = (), *, mpg: bool = True
+    def _settle(self, link: Link, then: Sequence[str] = ()
                 ) -> tuple[str, dict[str, Response | None]]:
         """The rig's hands off (a simulator's rig: inputs and switches as found), stopped
         (:meth:`_stop`), the reset values of what cannot be read, then the frames
@@ -717,20 +716,25 @@ class RealSession(Session):
         the frames after the stop, by frame."""
         if link.rig is not None:
             link.rig.hands_off()
-        after = [*self._reset_frames(mpg), *then]
+        after = [*self._reset_frames(), *then]
         why, answers = self._stop(link, after)
         return why, dict(zip(after, answers, strict=True))
 
     def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
         """Stopped and at rest (read back), the reset values, the axes back where the run
         began, the counters zeroed (read back); :class:`StepFailed` when the unit could
-        not be brought there. The hand wheel stays off (`Y-`): its reset mode `&` switches
-        the MPG on (M114 13.6.8), which holds the axes wherever the unit's active
+        not be brought there. The hand wheel's reset mode `&` switches the MPG on (M114
+        13.6.8), which holds the axes (RUN without INTA) wherever the unit's active
         configuration enables it — also after a case's EEPROM 06 was put back, on a unit
-        that reads its EEPROM at reset only; the restorations at the end set `&` again."""
-        left, _ = self._settle(link, ["PF"], mpg=False)   # where the axes are, for the way back
+        that reads its EEPROM at reset only: then it is turned off again (`Y-`)."""
+        left, _ = self._settle(link, ["PF"])       # where the axes are, for the way back
         if left:
             raise StepFailed(left)
+        if self._has_mpg():
+            st6 = link.send("SR6")
+            if st6 is not None and st6.ok and st6.values and is_hex_byte(st6.values[0]) \
+                    and int(st6.values[0], 16) & (St6.RUN | St6.INTA) == St6.RUN:
+                link.send("Y-")
         spindle = self.profile.spindle
         if spindle is not None:
             # the spindle off, as after reset (M114 13.5 "O0,FF - Výstup vypnutý"): `O0`
