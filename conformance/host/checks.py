@@ -16,7 +16,7 @@ from conformance.host.examples import worked_frames
 from conformance.host.grammar import UNSUMMED
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
-from conformance.protocol.catalogue import classes
+from conformance.protocol.catalogue import classes, commands
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -27,6 +27,8 @@ MS = 1_000_000
 ASKING = classes(asks=True)
 #: what a host may send again instead of asking: once or twice, the unit is left alike
 REPEATABLE = classes(repeatable=True)
+#: what only reads: sent while a host waits to ask, it trusts nothing
+QUERIES = frozenset(name for name, c in commands().items() if c.query)
 
 
 @dataclass(frozen=True)
@@ -242,6 +244,10 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         if not rest:
             continue
         nxt = rest[0]
+        if not _resends(ex, nxt):
+            # reads first (F until the motion ends, then `@`) trust nothing and change
+            # nothing: what the host does after them is what it made of the answer
+            nxt = next((e for e in rest if not _reads(e) or e.parsed.command in ASKING), nxt)
         asked = nxt.parsed.command in ASKING
         shown = f"after {ex.text} ({ex.fault})"
         out.judged |= {"8.recovery.no-blind-resend", "8.recovery.ask-index"}
@@ -262,6 +268,11 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         elif not asked:
             out.add("8.recovery.ask-index", _at(nxt.frame.start, line), nxt.text,
                     f"went on {shown} as if the answer had come")
+
+
+def _reads(ex: Exchange) -> bool:
+    """Whether the frame only reads (spec 10: a status, a port, a position, the index)."""
+    return ex.parsed.command in QUERIES
 
 
 def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
