@@ -295,7 +295,7 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # short by the frames refused since the base: what the unit took counted
     # W with a comma after the axis refused as a syntax error: the example's form only
     "10.cmd.reference-syntax": ("10.cmd.reference.to-switch",
-                                ("W", "code", set(), set(), 5, 4)),
+                                ("W", "code", set(), set(), 0, 4)),
     "8.index.refused-counted": ("8.index.counts-every-frame",
                                 ("@", "data", {"refused-uncounted"}, {"T-refused"}, 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
