@@ -78,6 +78,7 @@ def configured(ctx: CaseContext, name: str, *, required: bool = True) -> bool:
     leaves the unit as it is and the answer is False (the case grades what it then sees
     as a reading)."""
     f = feature(name)
+    wrote = False
     for p in f.params_for(ctx.profile):
         r = ctx.link.send(p.read())
         if r is not None and r.ok and p.holds(r.values):
@@ -88,9 +89,15 @@ def configured(ctx: CaseContext, name: str, *, required: bool = True) -> bool:
                     f"{f.name} needs {p.shown} ({f.source}); it reads {show(r)}, and "
                     "writing it needs --allow-destructive")
         setup(ctx, p.write())
+        wrote = True
         r = ctx.link.send(p.read())
         ctx.require(r is not None and r.ok and p.holds(r.values),
                     f"{f.name} needs {p.shown}: {p.write()} was taken, yet it reads {show(r)}")
+    if wrote and "J" in ctx.profile.commands:
+        # the manuals do not say when an EEPROM value takes effect: a reader may read its
+        # settings at reset only (as M114 10.1 says of the switches), so J applies them
+        setup(ctx, "J")
+        ctx.link.wait(ctx.profile.restart_ms / 1000 + 0.5)
     return True
 
 

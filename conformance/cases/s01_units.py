@@ -34,6 +34,16 @@ def _ranged(profile) -> list[tuple[str, str, str]]:
     return sorted(out, key=lambda r: order.index(r[0]))
 
 
+def _past_top(profile, name: str, rule: str) -> str:
+    """The rule a refusal just above a range's top breaks. M114 writes VL's range as
+    10 - 100000 in a garbled line ("v tis. pulsů/s osy Y") beside V's same range, which
+    "záleží na interpolační rychlosti konkrétní jednotky": a reader may take VL's top as
+    the variant's rate too, so above 100000 on a faster variant it is the [D] reading."""
+    if name == "VL" and profile.max_rate > profile.ranges[name].hi:
+        return "10.cmd.axis-limits-clamped"
+    return rule
+
+
 def _applies(rule: str, profile) -> bool:
     r = load_rules()[rule]
     return not r.profiles or profile.family in r.profiles or profile.name in r.profiles
@@ -101,7 +111,8 @@ def ranges(ctx: CaseContext) -> None:
         for value, want in ((lo - 1, ErrorCode.RANGE), (lo, ErrorCode.OK), (hi, ErrorCode.OK),
                             (hi + 1, ErrorCode.RANGE)):
             body = template.format(*[value] * template.count("{}"))
-            code(ctx, ctx.link.send(body), want, f"{body} → {want}", rule=rule)
+            code(ctx, ctx.link.send(body), want, f"{body} → {want}",
+                 rule=_past_top(p, name, rule) if value > hi else rule)
     if "VL" in p.commands and p.ranges["VL"].hi > p.max_rate:
         hi = p.ranges["VL"].hi
         code(ctx, ctx.link.send(f"VL{hi},{hi},{hi}"), ErrorCode.OK,

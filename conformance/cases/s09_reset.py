@@ -158,7 +158,9 @@ def mpg_values(ctx: CaseContext) -> None:
             continue
         ctx.expect(r is not None and r.values == ["00"], f"{shown}: MPG inert, ST6 = 00",
                    observed=show(r), expected="0,00", rule="9.reset.mpg-inert")
-        answers(ctx, link.send("Y&"), "0,Y&", f"{shown}: Y&", rule="10.cmd.mpg")
+        # where the MPG is not allowed (M114 12.2 "jiná: MPG nepovoleno"), what Y& answers
+        # is silent: a reader may refuse it out of range, the [D] reading's rule judges
+        answers(ctx, link.send("Y&"), "0,Y&", f"{shown}: Y&", rule="9.reset.mpg-inert")
         code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.OK,
              f"{shown}: not a listed value, the MPG is not allowed: a vector is taken",
              rule="9.reset.mpg")

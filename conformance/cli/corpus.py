@@ -25,6 +25,8 @@ from pathlib import Path
 from conformance.cli.pool import gate_end, workers
 from conformance.cli.progress import Progress
 from conformance.cli.usage import INTERRUPTED, Parser, UsageError, add_loudness, positive, summary
+from conformance.verdict import CHECK_TAGS, FAIL
+from conformance.verdict import grade as grade_of
 
 PROG = "gve-conformance corpus"
 #: the corpus's manifest, from a checkout's top
@@ -105,14 +107,22 @@ def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
     return out
 
 
+def _failing(check: dict) -> bool:
+    """Whether a failed check is one that FAILs a third party: graded by its tag as
+    every target outside --strict is (a [D] check beside an [M] one in the same case
+    is NON-STRICT, not a FAIL of its rule); a check without a known tag counts."""
+    tag = check.get("tag", "")
+    return not check.get("ok") and (tag not in CHECK_TAGS or grade_of(tag, False) == FAIL)
+
+
 def failed_rules(results: dict) -> list[tuple[str, str, list[str]]]:
     """Each case of a results.json that FAILed or ERRed: (case, verdict, the rules of its
-    failed checks)."""
+    checks that FAIL a third party)."""
     out = []
     for r in results.get("results", []):
         if r.get("verdict") in UNFAIR:
             rules = sorted({c.get("rule") or "(no rule)" for c in r.get("checks", [])
-                            if not c.get("ok")})
+                            if _failing(c)}) or ["(no rule)"]
             out.append((f"{r.get('id')} [{r.get('profile')}]", r["verdict"], rules))
     return out
 

@@ -59,6 +59,9 @@ class Judge:
     #: answer what answers once the motion is at rest (two of this step period, ns)
     placement: int = 0
     period_ns: int = 0
+    #: the bits of an input port its manual calls unused (port, mask): what they read
+    #: is silent, the rest is compared
+    unused_inputs: tuple[tuple[int, int], ...] = ()
 
 
 def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Judge,
@@ -92,7 +95,21 @@ def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Jud
         return "position"
     if command == "@" and _same_index(ra.values, rb.values, judge):
         return None
+    if _same_pins(command, ra.values, rb.values, judge):
+        return None
     return "data"
+
+
+def _same_pins(command: str, a: list[str], b: list[str], judge: Judge) -> bool:
+    """Whether two reads of an input port differ only in bits its manual calls unused."""
+    unused = dict(judge.unused_inputs).get(int(command[1:]), 0) \
+        if command[:1] == "I" and command[1:].isdigit() else 0
+    if not unused or len(a) != 1 or len(b) != 1:
+        return False
+    try:
+        return (int(a[0], 16) ^ int(b[0], 16)) & ~unused & 0xFF == 0
+    except ValueError:
+        return False
 
 
 def alike_because(command: str, target: RoundTrip, reference: RoundTrip, judge: Judge,
@@ -104,6 +121,9 @@ def alike_because(command: str, target: RoundTrip, reference: RoundTrip, judge: 
     if command == "@":
         return (f"the same index, counted from where each side began (offset "
                 f"{judge.index_offset})")
+    if command[:1] == "I" and target.response is not None and reference.response is not None \
+            and _same_pins(command, target.response.values, reference.response.values, judge):
+        return "the same in every bit with a pin (the others unused by the manual)"
     limit = band(target, reference, judge, moving)
     when = "read while the axes may have moved" if moving else \
         "read after a frame that changed the motion's course"

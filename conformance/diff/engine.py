@@ -116,7 +116,8 @@ class Pair:
         # somebody else's unit places its steps its own way, even in virtual time
         placement = 0 if target.target.info.strict else PLACEMENT_STEPS
         self.judge = Judge(exact=self.timing.exact, rate=profile.max_rate * self._factor,
-                           placement=placement)
+                           placement=placement,
+                           unused_inputs=tuple(profile.unused_inputs.items()))
         self.course = Course(profile)
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
@@ -337,6 +338,8 @@ class Pair:
             if kind is not None:
                 out.disagreement = self._disagreement(step, command, kind, out, earlier)
                 return True
+            if (rec.reference.code or 0) & 7:
+                self._index.refused_frame(command, self._context(step, self.course.in_packet))
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
@@ -387,6 +390,9 @@ class Pair:
         if command == "@" and self._index.counts_queries(_values(rec.target),
                                                          _values(rec.reference)):
             context.add("queries-counted")
+        if command == "@" and self._index.skips_refused(_values(rec.target),
+                                                         _values(rec.reference)):
+            context.add("refused-uncounted")
         if command == "@" and self._index.in_hex(_values(rec.target), _values(rec.reference)):
             context.add("index-hex")
         family = self.profile.family

@@ -31,6 +31,8 @@ class IndexBase:
     queries: int = 0
     #: the offset with the target's index read as hex (None: not read so, or not yet)
     hex_offset: int | None = None
+    #: the frames both sides refused since the base (counted by our reading [D])
+    refused: int = 0
 
     def note(self, command: str, context: set[str], target: list[str],
              reference: list[str]) -> None:
@@ -48,6 +50,21 @@ class IndexBase:
             h = _hex(target)
             if h is not None:
                 self.hex_offset = (h - b) % 256
+
+    def refused_frame(self, command: str, context: set[str]) -> None:
+        """A counted frame both sides refused (an error code), after the base was set."""
+        if self.offset is not None and command not in QUERIES and not context & UNCOUNTED:
+            self.refused += 1
+
+    def skips_refused(self, target: list[str], reference: list[str]) -> bool:
+        """Whether the target's `@` is short of the reference's by the frames refused
+        since the base exactly (the queries since counted or not): a unit that counts
+        what it took, not a miscount (8.index.refused-counted [D])."""
+        a, b = _number(target), _number(reference)
+        if self.offset is None or a is None or b is None or self.refused % 256 == 0:
+            return False
+        return (a - b - self.offset) % 256 in {(-self.refused) % 256,
+                                                (self.queries - self.refused) % 256}
 
     def counts_queries(self, target: list[str], reference: list[str]) -> bool:
         """Whether the target's `@` is off the reference's by the queries since the base

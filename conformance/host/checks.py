@@ -13,9 +13,10 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 from conformance.host.examples import worked_frames
+from conformance.host.grammar import UNSUMMED
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
-from conformance.protocol.catalogue import classes
+from conformance.protocol.catalogue import classes, commands
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -26,6 +27,8 @@ MS = 1_000_000
 ASKING = classes(asks=True)
 #: what a host may send again instead of asking: once or twice, the unit is left alike
 REPEATABLE = classes(repeatable=True)
+#: what only reads: sent while a host waits to ask, it trusts nothing
+QUERIES = frozenset(name for name, c in commands().items() if c.query)
 
 
 @dataclass(frozen=True)
@@ -109,7 +112,10 @@ def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
 
 
 def _lapsed(ex: Exchange) -> bool:
-    return any(p.rule == "6.checksum.off-after-reset" for p in ex.parsed.problems)
+    """Whether the refusal is the checksum mode's, which a reading names: a frame summed
+    after a restart turned the mode off, or a read sent unsummed in it."""
+    return any(p.rule in ("6.checksum.off-after-reset", UNSUMMED)
+               for p in ex.parsed.problems)
 
 
 def gaps(rec: Recording, line: LineFacts, out: Judgement) -> None:
@@ -238,6 +244,10 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         if not rest:
             continue
         nxt = rest[0]
+        if not _resends(ex, nxt):
+            # reads first (F until the motion ends, then `@`) trust nothing and change
+            # nothing: what the host does after them is what it made of the answer
+            nxt = next((e for e in rest if not _reads(e) or e.parsed.command in ASKING), nxt)
         asked = nxt.parsed.command in ASKING
         shown = f"after {ex.text} ({ex.fault})"
         out.judged |= {"8.recovery.no-blind-resend", "8.recovery.ask-index"}
@@ -258,6 +268,11 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         elif not asked:
             out.add("8.recovery.ask-index", _at(nxt.frame.start, line), nxt.text,
                     f"went on {shown} as if the answer had come")
+
+
+def _reads(ex: Exchange) -> bool:
+    """Whether the frame only reads (spec 10: a status, a port, a position, the index)."""
+    return ex.parsed.command in QUERIES
 
 
 def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
@@ -373,7 +388,7 @@ WIRE_CHECKS: dict[str, Check] = {
         "1.profile.dollar-range", "3.params.commas", "3.params.decimal", "3.params.hex-fields",
         "3.params.word-values-decimal", "3.params.float-syntax", "3.params.none-expected",
         "5.code.syntax", "5.code.range", "6.checksum.sum", "6.checksum.off-after-reset",
-        "10.cmd.vector", "10.cmd.modal",
+        UNSUMMED, "10.cmd.vector", "10.cmd.modal",
         "10.cmd.accel-range", "10.cmd.axis-limits", "10.cmd.output", "12.spindle.speed")},
     "5.code.unknown": refusals,
     "10.1.queue.wait-idiom": refusals,

@@ -26,6 +26,8 @@ from gve_fixtures.rules import load_rules
 _DEC = re.compile(r"-?[0-9]+\Z")
 _HEX = re.compile(r"[0-9A-Fa-f]+\Z")
 _FLOAT = re.compile(r"-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?\Z")
+#: a read sent without its sum in checksum mode (spec 6 [D])
+UNSUMMED = "6.checksum.unsummed-query"
 _SUM = re.compile(rb",(%b)\Z" % HEX_BYTE.encode(), re.IGNORECASE)
 _PRINTABLE = re.compile(rb"[\x20-\x7e]*")
 #: what a host might put between parameters instead of a comma (spec 3 [M] "commas")
@@ -149,6 +151,14 @@ def _parse(raw: bytes, units: dict[int, Profile], checksums: bool,
             body = body[: m.start()]
     f.body = body.decode("latin-1")
     _command(f, profile)
+    if checksums and f.checksum is None and f.command is not None \
+            and commands()[f.command].query:
+        # a read sent without its sum is refused and not run ("jednotka příkaz
+        # neprovede a nahlásí chybu", M114 13.3.2): a host's probe of the mode, its own
+        # choice; nothing it needed was left undone
+        f.problems = [Problem(UNSUMMED, p.what) if p.rule == "6.checksum.sum" else p
+                      for p in f.problems]
+        f.judged.add(UNSUMMED)
     return f
 
 

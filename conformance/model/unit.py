@@ -27,6 +27,9 @@ class ModelUnit:
     #: frames that do not advance the index: @ and > by our reading [D]; a unit whose @
     #: counts itself (measured by the machines) has none
     uncounted: tuple[str, ...] = UNCOUNTED
+    #: the frames booked since the index was last read that the unit refused (an error
+    #: code): counted by our reading [D], not by a reader who counts what it took
+    refused: int = 0
 
     # -- section 8 ------------------------------------------------------------------------
     def frame_arrived(self, name: str, checksum_ok: bool = True) -> None:

@@ -93,6 +93,15 @@ class Command:
                     or self.empties or self.packet in ("opens", "closes"))
 
     @property
+    def query(self) -> bool:
+        """Whether it only reads: repeatable, and it sets nothing (no modal parameter,
+        setting, EEPROM, checksum mode, speed, course, hand wheel, reaction or restart)."""
+        return self.repeatable and not (
+            self.modal or self.setting or self.eeprom or self.checksums or self.exchanges
+            or self.course or self.retimes or self.paces or self.reaction
+            or self.destructive or self.own_speed)
+
+    @property
     def switch(self) -> bool:
         """Whether it is a modal switch: modal, with no value (`VK` / `VN`)."""
         return self.modal and not self.fields

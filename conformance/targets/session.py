@@ -762,10 +762,23 @@ class RealSession(Session):
     def _known_state(self, link: Link, tell: Sequence[str] = ()) -> None:
         """Stopped and at rest (read back), the reset values, the axes back where the run
         began, the counters zeroed (read back); :class:`StepFailed` when the unit could
-        not be brought there."""
+        not be brought there. The hand wheel's reset mode `&` switches the MPG on (M114
+        13.6.8), which holds the axes (RUN without INTA) wherever the unit's active
+        configuration enables it — also after a case's EEPROM 06 was put back, on a unit
+        that reads its EEPROM at reset only: then it is turned off again (`Y-`)."""
         left, _ = self._settle(link, ["PF"])       # where the axes are, for the way back
         if left:
             raise StepFailed(left)
+        if self._has_mpg():
+            st6 = link.send("SR6")
+            if st6 is not None and st6.ok and st6.values and is_hex_byte(st6.values[0]) \
+                    and int(st6.values[0], 16) & (St6.RUN | St6.INTA) == St6.RUN:
+                link.send("Y-")
+        spindle = self.profile.spindle
+        if spindle is not None:
+            # the spindle off, as after reset (M114 13.5 "O0,FF - Výstup vypnutý"): `O0`
+            # need not reset the setting of `!7V`, which a case or sequence may have left
+            link.send("V0", address=spindle.address)
         returned, there = self._go_back(link, read=False)
         link.tell(["N", "PF", *tell])
         self._zero(link, returned, there)
@@ -998,11 +1011,20 @@ class RealSession(Session):
         took (answered 0), a problem for the others."""
         frames = self._reset_frames()
         taken = [body for body in frames if _taken(answers.get(body))]
+        # M114 12: "Pokud je hodnota některého parametru mimo rozsah, není možné MPG
+        # použít": the MPG mode refused out of range where the EEPROM does not allow it
+        # is that unit's reset state, nothing left to set
+        inert = [body for body in frames if body.startswith("Y") and self._has_mpg()
+                 and _refused_range(answers.get(body))]
         refused = [f"{body} answered {_shown(answers.get(body))}" for body in frames
-                   if body not in taken]
+                   if body not in taken and body not in inert]
         if taken:
             self.report.reset.append("set to the reset state, each answered 0 (they cannot "
                                      "be read back): " + ", ".join(taken))
+        if inert:
+            self.report.reset.append("the MPG mode left as the unit's EEPROM makes it (the "
+                                     "MPG not allowed there): " + ", ".join(
+                                         f"{b} answered {_shown(answers.get(b))}" for b in inert))
         if refused:
             self.report.problems.append("not set to the reset state: " + "; ".join(refused))
         micro = self.profile.microstep
@@ -1247,6 +1269,10 @@ def _shown(r: Response | None) -> str:
 
 def _taken(r: Response | None) -> bool:
     return r is not None and r.ok
+
+
+def _refused_range(r: Response | None) -> bool:
+    return r is not None and r.code is not None and r.code & 7 == ErrorCode.RANGE
 
 
 def _not_yet(r: Response | None) -> bool:

@@ -106,3 +106,15 @@ def test_an_unknown_implementation_is_one_line_and_exit_2(tmp_path, capsys):
                  "--implementation", "nosuch"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "unknown implementation(s) nosuch" in err
+
+
+def test_a_decided_check_beside_a_manual_one_is_not_a_fail_of_its_rule():
+    from conformance.cli.corpus import failed_rules
+    checks = [{"ok": False, "tag": "M", "rule": "10.cmd.axis-limits"},
+              {"ok": False, "tag": "D", "rule": "10.cmd.accel-range"},
+              {"ok": False, "tag": "D-info", "rule": "10.cmd.modal"},
+              {"ok": True, "tag": "M", "rule": "10.cmd.vk-vn"}]
+    results = {"results": [{"id": "c", "profile": "p", "verdict": "FAIL", "checks": checks},
+                           {"id": "e", "profile": "p", "verdict": "ERROR", "checks": []}]}
+    assert failed_rules(results) == [("c [p]", "FAIL", ["10.cmd.axis-limits"]),
+                                     ("e [p]", "ERROR", ["(no rule)"])]

@@ -120,3 +120,13 @@ def test_in_virtual_time_the_reference_s_own_kind_is_exact():
     judge = Judge()
     assert difference("PF", ex(b"0,305,0,0\r"), ex(b"0,306,0,0\r"), judge) == "position"
     assert difference("H", ex(b"8\r", 0, 2 * MS), ex(b"8\r", 0, 1 * MS), judge) == "timing"
+
+
+def test_an_input_port_is_compared_in_the_bits_with_pins_only():
+    judge = Judge(unused_inputs=((2, 0x3F),))
+    # the GVE114's I2 bits 0-5 are unused: read 1 or 0 there, the same pins
+    assert difference("I2", ex(b"0,3F\r"), ex(b"0,00\r"), judge) is None
+    assert "unused" in alike_because("I2", ex(b"0,3F\r"), ex(b"0,00\r"), judge)
+    assert difference("I2", ex(b"0,BF\r"), ex(b"0,00\r"), judge) == "data"   # bit 7 differs
+    assert difference("I1", ex(b"0,3F\r"), ex(b"0,00\r"), judge) == "data"   # every pin used
+    assert difference("I2", ex(b"0,3F\r"), ex(b"0,00\r"), Judge()) == "data"

@@ -50,3 +50,19 @@ def test_the_hex_base_is_the_first_index_read_as_hex():
     base.note("@", set(), ["1A"], ["3"])          # 26 read as hex: 23 ahead
     assert base.offset is None and base.hex_offset == 23
     assert base.in_hex(["2A"], ["19"]) and not base.in_hex(["2A"], ["20"])
+
+
+def test_an_index_short_by_the_refused_frames_since_is_the_reading_that_counts_what_it_took():
+    base = IndexBase()
+    base.refused_frame("T", set())            # before the base: not counted
+    base.note("@", set(), ["5"], ["5"])
+    base.refused_frame("T", set())
+    base.refused_frame("Z", set())
+    base.refused_frame("V", {"bad-checksum"})  # no unit counts it: not a refusal
+    assert base.refused == 2
+    assert base.skips_refused(["6"], ["8"])        # two refused frames not counted
+    assert not base.skips_refused(["7"], ["8"])    # one short: a miscount
+    assert not base.skips_refused(["8"], ["8"])    # the same: no reading at all
+    base.note("@", set(), ["6"], ["8"])            # a query since, counted by neither
+    assert base.skips_refused(["6"], ["8"])
+    assert base.skips_refused(["7"], ["8"])        # and one that counts the query

@@ -65,6 +65,11 @@ def test_the_index_off_by_the_queries_is_the_counting_rule():
     assert label("@", "data", set(), {"@", "L"}, 0) == "8.index.counts"
 
 
+def test_the_index_short_by_the_refused_frames_is_that_readings_rule():
+    assert label("@", "data", {"refused-uncounted"}, {"T-refused"}, 0) == \
+        "8.index.refused-counted"
+
+
 def test_the_index_written_in_hex_is_its_form_rule():
     assert label("@", "data", {"index-hex"}, {"V"}, 0) == "8.index.decimal"
 
@@ -287,6 +292,12 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "8.index.counts": ("8.index.counts-every-frame", ("@", "data", set(), {"V"}, 0, 0)),
     # the index written in hex, read so the reference's
     "8.index.decimal": ("10.commands.formats", ("@", "data", {"index-hex"}, {"V"}, 0, 0)),
+    # short by the frames refused since the base: what the unit took counted
+    # W with a comma after the axis refused as a syntax error: the example's form only
+    "10.cmd.reference-syntax": ("10.cmd.reference.to-switch",
+                                ("W", "code", set(), set(), 0, 4)),
+    "8.index.refused-counted": ("8.index.counts-every-frame",
+                                ("@", "data", {"refused-uncounted"}, {"T-refused"}, 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
                                   ("@", "data", {"queries-counted"}, {"@"}, 0, 0)),
     "8.repeat.answer": ("8.repeat.last-frame-and-answer", (">", "data", set(), {"T"}, 0, 0)),

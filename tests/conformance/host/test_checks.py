@@ -120,6 +120,25 @@ def test_an_answer_whose_checksum_fails_is_not_trusted():
     assert broken(w.judge())["6.checksum.response-sum"] == ["!0A100,4F", "!0L10,0,0,E2"]
 
 
+def test_reads_while_the_host_waits_to_ask_trust_nothing():
+    # a damaged answer to a vector: F until the motion ends, then PF and @, then on
+    w = Wire()
+    w.frame(b"!0L10,0,0,E2", 0, answer=b"0,5C\r", given=b"1,5C\r", fault="corrupt-answer",
+            checksums=True)
+    w.frame(b"!0F,C3", 10, answer=b"0,40,EC\r", checksums=True)
+    w.frame(b"!0PF,13", 20, answer=b"0,0,0,0,70\r", checksums=True)
+    w.frame(b"!0@,BD", 30, answer=b"0,15,EE\r", checksums=True)
+    w.frame(b"!0V1000,94", 40, answer=b"0,5C\r", checksums=True)
+    assert broken(w.judge()) == {}
+    # reads, then on without asking: still trusted
+    w = Wire()
+    w.frame(b"!0L10,0,0,E2", 0, answer=b"0,5C\r", given=b"1,5C\r",
+            fault="corrupt-answer", checksums=True)
+    w.frame(b"!0F,C3", 10, answer=b"0,40,EC\r", checksums=True)
+    w.frame(b"!0L10,0,0,E2", 20, answer=b"0,5C\r", checksums=True)
+    assert broken(w.judge())["6.checksum.response-sum"] == ["!0L10,0,0,E2"]
+
+
 def test_a_setting_sent_again_after_a_damaged_answer_trusts_nothing():
     w = Wire()
     w.frame(b"!0SW2,00,E5", 0, answer=b"0,5C\r", given=b"1,5C\r", fault="corrupt-answer",

@@ -33,6 +33,9 @@ def test_checksums_as_spec_6_sums_them():
     assert rules(b"!0A100,4F", checksums=True) == []           # spec 6, G2
     assert rules(b"!0A100,4E", checksums=True) == ["6.checksum.sum"]
     assert rules(b"!0A100", checksums=True) == ["6.checksum.sum"]   # missing
+    # a read left unsummed is refused with nothing run: a probe of the mode, a decision
+    assert rules(b"!0F", checksums=True) == ["6.checksum.unsummed-query"]
+    assert rules(b"!0V1000", checksums=True) == ["6.checksum.sum"]   # a setting
     assert rules(b"!0%-,CF", checksums=True) == []             # spec 6, G1
 
 

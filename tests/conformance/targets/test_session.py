@@ -349,3 +349,14 @@ COSIM = "exec:" + shlex.join([sys.executable, "-m", "emulator", "--cosim"])
 ])
 def test_work_given_with_a_link_is_done_once(spec, extensions, while_told):
     assert _opened_with_work(spec, extensions) == [while_told]
+
+
+def test_the_known_state_sets_the_spindle_off_as_reset_leaves_it():
+    # O0,FF need not reset the setting of !7V: a unit may keep the two apart
+    u = unit("GVE114-500")
+    result = run([u], select(["5.errors.ok", "10.3.flags.f-command"]))
+    assert {r.verdict for r in result.results} == {PASS}, [(r.id, r.notes) for r in result.results]
+    sent = frames_sent(u)
+    spindle_off = [i for i, f in enumerate(sent) if f == b"!7V0\r"]
+    assert len(spindle_off) >= 2            # before each case
+    assert result.problems == []
