@@ -1039,8 +1039,18 @@ class RealSession(Session):
         GVE114's A: PF reads X, Y, Z, M114 13.6.6) cannot be verified: said as such."""
         names = self.profile.axes
         stopped = self.interrupts.stopped
-        if not stopped and (None in self.guard.envelope.position() or self.guard.recentred):
-            # re-centred at a co-simulator's power-on: where the run began, by the rig's eyes
+        if self.guard.recentred and not stopped:
+            # a co-simulator in virtual time, its envelope re-centred at every power-on
+            # start: nothing physical moved, so nothing is brought back (nor said restored)
+            where = self._rig_physical(link)
+            self.report.reset.append(
+                "the co-simulator's axes left where its last sequence put them"
+                + (f" ({_counters(where)} counter units from where it started, by its rig)"
+                   if where else "")
+                + ": its envelope was re-centred at every power-on start, nothing physical "
+                  "moving in virtual time")
+            return
+        if not stopped and None in self.guard.envelope.position():
             self._relocate(link)
         body, read = "", {}
         if stopped or self.guard.lost:
@@ -1092,6 +1102,22 @@ class RealSession(Session):
         if not self.counters:
             self.report.problems.append("position counters not restored: PF could not be "
                                         "read before the run")
+            return
+        if self.guard.recentred and not any(self.counters.values()):
+            # a co-simulator found with its power-on counters: powered on once more, as
+            # every sequence began, they read as found (or the problem says what they read)
+            link.rig.power_on()
+            link.checksums = False
+            link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
+            self.guard.recentre()
+            read = self._position(link)
+            if read == self.counters:
+                self.report.restored.append(f"position counters as found: PF reads "
+                                            f"{_counters(read)} (the co-simulator powered on "
+                                            "as every sequence began)")
+            else:
+                self.report.problems.append(f"position counters not restored: after a "
+                                            f"power-on PF read {_counters(read)}")
             return
         here = self.guard.envelope.position()
         unknown = [names[i] for i in self.counters if here[i] is None]
