@@ -158,6 +158,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                      "GVE54: M, like N, is refused with 7 whenever RUN = 1, "
                                      "also while halted vectors hold it after H (\"Nelze "
                                      "použít za chodu\" read as RUN = 1)"),
+    "rate-jumpers-reversed": (("2.link.rate-jumper-table",),
+                              "GVE54: the jumper positions give the rates in the other "
+                              "order (115200 first): the manual names the jumpers "
+                              "\"volitelné\" and lists no rates"),
     "reversal-brakes-to-rest": (("10.2.motion.junction-reversal",),
                                 "a C whose next C reverses an axis brakes to rest at their "
                                 "junction, not to B (\"U pokračujícího vektoru se nesmí "

@@ -77,6 +77,23 @@ def test_the_reading_of_an_unlisted_range_byte_is_non_strict_and_the_unit_put_ba
     assert restored and all(k["ok"] for k in restored)
 
 
+def test_jumpers_that_select_one_rate_fail_whatever_the_table() -> None:
+    # on our emulator the table's [D] rule FAILs too; the [M] check is the one that counts
+    assert_catches(CASES[0], "2.link.rate-by-switch", "baud-jumpers-ignored", "GVE54",
+                   only=False)
+
+
+@pytest.mark.parametrize("case_id", CASES[:2])
+def test_gve54_jumpers_in_another_order_are_non_strict_and_followed(case_id: str) -> None:
+    # the manual lists no rate for its jumpers: the order is the profile's [D] table
+    result = run_case(_case(case_id), parse_target("emu:GVE54?reading=rate-jumpers-reversed"),
+                      "ci")
+    assert result.verdict == NON_STRICT
+    assert {k["rule"] for k in result.checks if not k["ok"]} == {"2.link.rate-jumper-table"}
+    restored = [k for k in result.checks if "again" in k["what"]]
+    assert restored and all(k["ok"] for k in restored)
+
+
 def test_a_line_that_carries_no_rate_could_not_test_and_changes_nothing() -> None:
     command = [sys.executable, "-m", "emulator", "--model", "GVE114-500", "--pty"]
     target = parse_target("exec:" + shlex.join(command), profile="GVE114-500",
