@@ -43,6 +43,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                        "hex fields take upper-case digits only: a-f is a syntax error (4)"),
     "queries-counted": (("8.index.queries-uncounted",),
                         "@ and > advance the index like every other command"),
+    "refused-uncounted": (("8.index.refused-counted",),
+                          "a frame answered with an error code does not advance the "
+                          "index: \"zjistit, zda ho interpolátor přijal\" read as took"),
     "restore-nothing-kept-refused": (("10.5.restore.pops",),
                                      "R with nothing saved by K (or a second R) is refused "
                                      "with 4 and changes nothing: the manual's R restores "

@@ -332,6 +332,7 @@ class Pair:
             code = (rec.reference.code or 0) & 7 if rec is not None else 0
             if code:
                 earlier.add(f"{command}-refused")
+                self._index.refused_frame(command, self._context(step, self.course.in_packet))
             if code == ErrorCode.QUEUE_FULL:
                 earlier.add(f"{command}-no-room")
         self.course.stepped(command, step)
@@ -367,6 +368,9 @@ class Pair:
             context.add("queries-counted")
         if command == "@" and self._index.in_hex(_values(rec.target), _values(rec.reference)):
             context.add("index-hex")
+        if command == "@" and self._index.skips_refused(_values(rec.target),
+                                                        _values(rec.reference)):
+            context.add("refused-uncounted")
         family = self.profile.family
         why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target),
                       family)

@@ -6,7 +6,10 @@ are compared from there. A later difference that the queries sent since then acc
 exactly (one more for each `@` and `>` the unit took) is that reading, not a miscount.
 No manual gives the index's number format either: a target whose `@` reads as the
 reference's once its text is read as hex, from a base read as hex too, writes it in hex
-(8.index.decimal [D]), not a miscount."""
+(8.index.decimal [D]), not a miscount. Nor do the manuals say whether a refused frame
+counts ("zjistit, zda ho interpolátor přijal"): a target off the reference by exactly
+the frames the reference refused since the base leaves them out (8.index.refused-counted
+[D])."""
 
 from __future__ import annotations
 
@@ -31,6 +34,8 @@ class IndexBase:
     queries: int = 0
     #: the offset with the target's index read as hex (None: not read so, or not yet)
     hex_offset: int | None = None
+    #: the frames the reference refused (an error code) since the base
+    refused: int = 0
 
     def note(self, command: str, context: set[str], target: list[str],
              reference: list[str]) -> None:
@@ -57,6 +62,23 @@ class IndexBase:
                 and self.queries % 256 != 0
                 and (a - b - self.offset) % 256 == self.queries % 256)
 
+
+    def refused_frame(self, command: str, context: set[str]) -> None:
+        """A frame the reference refused: one more a unit may leave out of the index."""
+        if self.offset is not None or self.hex_offset is not None:
+            if command not in QUERIES and not context & UNCOUNTED:
+                self.refused += 1
+
+    def skips_refused(self, target: list[str], reference: list[str]) -> bool:
+        """Whether the target's `@` is off the reference's by the frames the reference
+        refused since the base exactly, the index read in either form."""
+        b = _number(reference)
+        if b is None or self.refused % 256 == 0:
+            return False
+        return any(a is not None and base is not None
+                   and (b + base - a) % 256 == self.refused % 256
+                   for a, base in ((_number(target), self.offset),
+                                   (_hex(target), self.hex_offset)))
 
     def in_hex(self, target: list[str], reference: list[str]) -> bool:
         """Whether the target's `@` differs from the reference's only by being written in

@@ -58,12 +58,19 @@ class UnitMachine(RuleBasedStateMachine):
         if again == (self.model.index + 1) % 256:
             self.model.uncounted = ()
         self.model.index = again
+        # whether a refused frame counts is another [D]: a T out of range (refused with 5,
+        # nothing changed) tells, judged in its own case only
+        self.link.send("T%d" % (p.range("T").hi + 1))
+        after = self.index()
+        self.model.refused_counted = after != (again + (not self.model.uncounted)) % 256
+        self.model.index = after
 
     def send(self, body: str, *, checksum_ok: bool = True, **kw) -> Response | None:
         """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
         the model (``checksum_ok``: whether its sum lets it count)."""
         r = self.link.send(body, **kw)
-        self.model.frame_arrived(parse(body).name or body[:1], checksum_ok=checksum_ok)
+        self.model.frame_arrived(parse(body).name or body[:1], checksum_ok=checksum_ok,
+                                 code=None if r is None else r.code)
         return r
 
     def fits(self, body: str) -> bool:

@@ -363,7 +363,8 @@ class Unit:
     def _answer(self, raw: bytes, code: int, values: list[str], t: int, *,
                 remember: bool = True) -> None:
         ses = self.session
-        if code and remember and self.mutant.active("index-skips-refused"):
+        if code and remember and (self.mutant.active("index-skips-refused")
+                                  or self.readings.active("refused-uncounted")):
             ses.index = (ses.index - 1) & 0xFF
         data = response(
             code, values,

@@ -27,6 +27,7 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "lone-bang-answered": ([b"!"], b"", b"2\r"),
     "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
     "queries-counted": ([b"!0@\r", b"!0@\r"], b"0,0\r0,0\r", b"0,1\r0,2\r"),
+    "refused-uncounted": ([b"!0T99\r", b"!0@\r"], b"5\r0,1\r", b"5\r0,0\r"),
     "restore-nothing-kept-refused": ([b"!0R\r"], b"0\r", b"4\r"),
     # the second K finds the first one's save held
     "second-keep-refused": ([b"!0K\r", b"!0K\r"], b"0\r0\r", b"0\r4\r"),

@@ -287,6 +287,10 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "8.index.counts": ("8.index.counts-every-frame", ("@", "data", set(), {"V"}, 0, 0)),
     # the index written in hex, read so the reference's
     "8.index.decimal": ("10.commands.formats", ("@", "data", {"index-hex"}, {"V"}, 0, 0)),
+    # refused frames left out of the index: off by exactly those the reference refused
+    "8.index.refused-counted": ("8.index.counts-every-frame",
+                                ("@", "data", {"refused-uncounted"}, {"T", "T-refused"},
+                                 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
                                   ("@", "data", {"queries-counted"}, {"@"}, 0, 0)),
     "8.repeat.answer": ("8.repeat.last-frame-and-answer", (">", "data", set(), {"T"}, 0, 0)),
