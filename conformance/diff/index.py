@@ -65,9 +65,9 @@ class IndexBase:
 
     def refused_frame(self, command: str, context: set[str]) -> None:
         """A frame the reference refused: one more a unit may leave out of the index."""
-        if self.offset is not None or self.hex_offset is not None:
-            if command not in QUERIES and not context & UNCOUNTED:
-                self.refused += 1
+        based = self.offset is not None or self.hex_offset is not None
+        if based and command not in QUERIES and not context & UNCOUNTED:
+            self.refused += 1
 
     def skips_refused(self, target: list[str], reference: list[str]) -> bool:
         """Whether the target's `@` is off the reference's by the frames the reference

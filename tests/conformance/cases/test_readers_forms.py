@@ -1,6 +1,7 @@
 """A form the manuals leave open is graded once, by its own [D] rule, in its own case:
-the index written in hex, refused frames left out of the index, a lacking command read as one the unit has with parameters it
-does not take. No other case changes its verdict."""
+the index written in hex, refused frames left out of the index, a lacking command read
+as one the unit has with parameters it does not take. No other case changes its
+verdict."""
 
 from __future__ import annotations
 
