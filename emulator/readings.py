@@ -33,6 +33,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "go-nothing-queued": (("5.code.nothing-to-go", "10.4.go.without-inta"),
                           "G with INTA = 1 and nothing queued answers 6: for Go, nothing "
                           "to start (spec 5, both readings allowed)"),
+    "go-clears-then-nothing": (("5.code.nothing-to-go", "10.4.go.empty"),
+                               "G with INTA = 1 and nothing queued clears INTA, INTCOM, ST4 "
+                               "and ST5 as the manual says, then answers 6: for Go, nothing "
+                               "to start (an input still active sets INTA again)"),
     "missing-letter-range": (("5.code.unknown",),
                              "an axis, port or register letter the unit lacks (NA on a "
                              "GVE84, I2) answers 5 instead of 3 (spec 10.4, both allowed)"),

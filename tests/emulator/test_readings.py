@@ -23,6 +23,9 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
     "go-nothing-queued": ([b"!0H\r", b"!0G\r"], b"8\r0\r", b"8\rE\r"),
+    # H, G: the flags cleared either way, then 0 or 6 (with INTA clear: no 8)
+    "go-clears-then-nothing": ([b"!0H\r", b"!0G\r", b"!0SR6\r"], b"8\r0\r0,00\r",
+                               b"8\r6\r0,00\r"),
     "missing-letter-range": ([b"!0NA0\r"], b"3\r", b"5\r"),
     "lone-bang-answered": ([b"!"], b"", b"2\r"),
     "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
