@@ -26,6 +26,8 @@ CATCHES = {
                            ("GVE114-500", "GVE114-50")),
     "baud-read-at-restart": ("2.link.rate.read-at-power-on", "2.link.rate-read-at-power-on",
                              ("GVE114-125", "GVE54")),
+    "baud-jumpers-ignored": ("2.link.rate.every-listed-rate", "2.link.rate-by-switch",
+                             ("GVE54",)),
     "baud-range-read-at-restart": ("2.link.rate.read-at-power-on",
                                    "2.link.rate-range-at-restart", ("GVE114-200",)),
 }
@@ -40,7 +42,8 @@ def _case(case_id: str):
                          [(m, p) for m, (_, _, ps) in CATCHES.items() for p in ps])
 def test_the_case_catches_its_mutant(mutant: str, profile: str) -> None:
     case_id, rule, _ = CATCHES[mutant]
-    assert_catches(case_id, rule, mutant, profile)
+    # on our emulator the GVE54 table's [D] rule FAILs beside the manual's rule
+    assert_catches(case_id, rule, mutant, profile, only=mutant != "baud-jumpers-ignored")
 
 
 @pytest.mark.parametrize("case_id", CASES)
@@ -75,12 +78,6 @@ def test_the_reading_of_an_unlisted_range_byte_is_non_strict_and_the_unit_put_ba
     assert any("answers at 921600" in n for n in result.notes)
     restored = [k for k in result.checks if "again" in k["what"] or "restored" in k["what"]]
     assert restored and all(k["ok"] for k in restored)
-
-
-def test_jumpers_that_select_one_rate_fail_whatever_the_table() -> None:
-    # on our emulator the table's [D] rule FAILs too; the [M] check is the one that counts
-    assert_catches(CASES[0], "2.link.rate-by-switch", "baud-jumpers-ignored", "GVE54",
-                   only=False)
 
 
 @pytest.mark.parametrize("case_id", CASES[:2])
