@@ -37,13 +37,21 @@ class IndexBase:
     #: the frames the reference refused (an error code) since the base
     refused: int = 0
 
+    @classmethod
+    def read(cls, target: list[str], reference: int) -> IndexBase:
+        """The base from the index each side read before the sequence: the target's as it
+        wrote it, in either form it may be read in (neither: no base yet)."""
+        a, h = _number(target), _hex(target)
+        return cls(offset=None if a is None else (a - reference) % 256,
+                   hex_offset=None if h is None else (h - reference) % 256)
+
     def note(self, command: str, context: set[str], target: list[str],
              reference: list[str]) -> None:
         """Before a frame's answers are compared: a query taken counts from the base on;
         the first `@` both sides answer with a number sets the base."""
         if command not in QUERIES or context & UNCOUNTED:
             return
-        if self.offset is not None:
+        if self.offset is not None or self.hex_offset is not None:
             self.queries += 1
             return
         a, b = _number(target), _number(reference)
