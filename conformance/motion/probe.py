@@ -360,12 +360,12 @@ class Probe:
             ok = all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True))
             expected = [b0 + tol.steps if b0 + tol.steps == b1 - tol.steps else f"{b0}..{b1}"
                         for b0, b1 in band]
+            placed = not ok and self._placed(model, variants, w, tol, got, period)
             ok_all &= self.ctx.expect(
                 ok, f"{self.name}: PF at {(w.lo + line.ns - t0) / 1e6:.3f} ms"
                 f"{' ' + reading.label if reading.label else ''}{_within(tol)}",
                 observed=got, expected=expected,
-                rule=self.rule if ok or not self._placed(model, variants, w, tol, got, period)
-                else PLACEMENT_RULE)
+                rule=PLACEMENT_RULE if placed else self.rule, machinery=placed)
             if not ok:
                 t = ((w.lo + w.hi) / 2 - t0) / SECOND
                 faults += [{"kind": "position", "t": t, "axis": i, "observed": g,
