@@ -50,3 +50,24 @@ def test_the_hex_base_is_the_first_index_read_as_hex():
     base.note("@", set(), ["1A"], ["3"])          # 26 read as hex: 23 ahead
     assert base.offset is None and base.hex_offset == 23
     assert base.in_hex(["2A"], ["19"]) and not base.in_hex(["2A"], ["20"])
+
+
+def test_a_hex_index_read_before_the_sequence_is_based_in_both_forms():
+    # a co-simulator's index, read before the sequence, written in two hex digits
+    base = IndexBase.read(["C0"], 2)
+    assert base.offset is None and base.hex_offset == 0xC0 - 2
+    assert base.in_hex(["C3"], ["5"])
+    base.note("@", set(), ["C3"], ["5"])
+    assert base.queries == 1               # based already: the query counts from there
+
+
+def test_an_index_off_by_the_refused_frames_since_leaves_them_out():
+    base = IndexBase.read(["10"], 0)      # decimal 10, or hex 16
+    for _ in range(2):
+        base.refused_frame("T", set())
+    base.refused_frame("V", {"bad-checksum"})   # no unit counts it: not one more
+    base.refused_frame("@", set())              # a query: not one more
+    assert base.refused == 2
+    assert base.skips_refused(["13"], ["5"])    # 10 + 5 - 2
+    assert base.skips_refused(["1A"], ["12"])   # hex 0x1A = 26 = 16 + 12 - 2
+    assert not base.skips_refused(["15"], ["5"])
