@@ -33,6 +33,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
     "go-nothing-queued": (("5.code.nothing-to-go", "10.4.go.without-inta"),
                           "G with INTA = 1 and nothing queued answers 6: for Go, nothing "
                           "to start (spec 5, both readings allowed)"),
+    "go-clears-then-nothing": (("5.code.nothing-to-go", "10.4.go.empty"),
+                               "G with INTA = 1 and nothing queued clears INTA, INTCOM, ST4 "
+                               "and ST5 as the manual says, then answers 6: for Go, nothing "
+                               "to start (an input still active sets INTA again)"),
     "missing-letter-range": (("5.code.unknown",),
                              "an axis, port or register letter the unit lacks (NA on a "
                              "GVE84, I2) answers 5 instead of 3 (spec 10.4, both allowed)"),
@@ -161,6 +165,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                      "GVE54: M, like N, is refused with 7 whenever RUN = 1, "
                                      "also while halted vectors hold it after H (\"Nelze "
                                      "použít za chodu\" read as RUN = 1)"),
+    "rate-jumpers-reversed": (("2.link.rate-jumper-table",),
+                              "GVE54: the jumper positions give the rates in the other "
+                              "order (115200 first): the manual names the jumpers "
+                              "\"volitelné\" and lists no rates"),
     "reversal-brakes-to-rest": (("10.2.motion.junction-reversal",),
                                 "a C whose next C reverses an axis brakes to rest at their "
                                 "junction, not to B (\"U pokračujícího vektoru se nesmí "

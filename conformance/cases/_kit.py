@@ -221,7 +221,10 @@ def measured_case(id: str, rules: tuple[str, ...], requires: tuple[str, ...],
 
     A scenario is a list: a frame to send, seconds to sample ``PF`` for (every 50 ms, or a
     pair: seconds and how often), or a position (in commanded steps) to poll ``PF`` until."""
-    @case(id, rules=rules, requires=requires, timing=True,
+    placement = "10.2.motion.step-placement"     # the probe's grade of another placement
+    every = rules if placement in rules else (*rules, placement)
+
+    @case(id, rules=every, requires=requires, timing=True,
           applies=(lambda p: p.family in families) if families else None)
     def measured(ctx: CaseContext) -> None:
         steps = (fill_scenario(s, ctx) for s in scenario)

@@ -120,15 +120,23 @@ def _as_found(ctx: CaseContext) -> Iterator[int | None]:
                     f"EEPROM {choice.range_address:02X} restored", rule="10.cmd.eeprom-bytes")
 
 
-def _power_at(ctx: CaseContext, position: int, baud: int, what: str, rule: str) -> bool:
-    """The switch to ``position``, a power cycle: the unit answers at ``baud``."""
+def _power_at(ctx: CaseContext, position: int, baud: int, what: str,
+              rule: str) -> int | None:
+    """The switch to ``position``, a power cycle: the unit answers at ``baud``. Where the
+    profile's table of positions is ours, not the manual's, a unit found at another rate
+    of the list is graded by the table's own [D] rule and followed there. Gives the rate
+    the unit answers at (None: not found)."""
     ctx.link.rig.set_rate_switch(position)
     _restart(ctx, "power-on")
+    table_rule = ctx.profile.baud.table_rule
     ok = _answers_at(ctx, baud)
+    here = baud if ok else (_find(ctx, baud) if table_rule else None)
     ctx.expect(ok, f"{what}: after power-on the unit answers at {baud}",
-               observed="it answers" if ok else "no answer at that rate",
-               expected=f"? answered at {baud}", rule=rule)
-    return ok
+               observed="it answers" if ok else
+               "no answer at that rate" if here is None else f"it answers at {here}",
+               expected=f"? answered at {baud}",
+               rule=rule if ok or here is None else table_rule)
+    return here
 
 
 def _write_range(ctx: CaseContext, code: int) -> None:
@@ -144,7 +152,7 @@ def _shown(choice: BaudChoice, position: int, code: int | None) -> str:
 
 
 @case("2.link.rate.every-listed-rate", rig=True, destructive=True, applies=_switchable,
-      rules=("2.link.rate-by-switch", "10.cmd.eeprom-bytes"))
+      rules=("2.link.rate-by-switch", "10.cmd.eeprom-bytes", "2.link.rate-jumper-table"))
 def every_rate(ctx: CaseContext) -> None:
     """Every range the range byte lists, every position of the switch: the unit, power
     cycled, answers at the rate the manual's table gives (each rate the profile lists is
@@ -154,17 +162,26 @@ def every_rate(ctx: CaseContext) -> None:
         for code in sorted(choice.ranges, key=lambda c: -1 if c is None else c):
             if code is not None:
                 _write_range(ctx, code)
+            reached = set()
             for position in range(len(choice.positions)):
                 baud = choice.rate(position, code)
-                if not _power_at(ctx, position, baud, _shown(choice, position, code),
-                                 "2.link.rate-by-switch"):
+                here = _power_at(ctx, position, baud, _shown(choice, position, code),
+                                 "2.link.rate-by-switch")
+                if here is None:
                     ctx.require(_find(ctx, baud) is not None,
                                 "the unit answers at none of the profile's rates")
+                reached.add(here)
+            if choice.table_rule and None not in reached:
+                # whatever the table, the jumpers select the rate: not one rate for all
+                ctx.expect(len(reached) > 1, "the positions select more than one rate",
+                           observed=f"{len(reached)} rate(s): "
+                                    f"{', '.join(map(str, sorted(reached)))}",
+                           expected="different rates", rule="2.link.rate-by-switch")
 
 
 @case("2.link.rate.read-at-power-on", rig=True, destructive=True, applies=_switchable,
       rules=("2.link.rate-read-at-power-on", "2.link.rate-range-at-restart",
-             "2.link.rate-by-switch", "10.cmd.eeprom-bytes"))
+             "2.link.rate-by-switch", "10.cmd.eeprom-bytes", "2.link.rate-jumper-table"))
 def read_at_power_on(ctx: CaseContext) -> None:
     """The switch moved after power-on does not change the rate at `J`; on the GVE114
     neither does EEPROM 0D written before `J` [D]: only the next power-on reads them."""
@@ -174,10 +191,10 @@ def read_at_power_on(ctx: CaseContext) -> None:
     with _as_found(ctx):
         if default is not None:
             _write_range(ctx, default)
-        baud = choice.rate(first, default)
-        ctx.require(_power_at(ctx, first, baud, _shown(choice, first, default),
-                              "2.link.rate-by-switch"),
-                    f"the unit does not answer at {baud} after power-on")
+        expected = choice.rate(first, default)
+        baud = _power_at(ctx, first, expected, _shown(choice, first, default),
+                         "2.link.rate-by-switch")
+        ctx.require(baud is not None, f"the unit does not answer at {expected} after power-on")
         ctx.link.rig.set_rate_switch(last)
         _restart(ctx, "J")
         ok = _answers_at(ctx, baud)
@@ -220,8 +237,8 @@ def unlisted_range(ctx: CaseContext) -> None:
         for code in _unlisted(choice):
             _write_range(ctx, code)
             baud = choice.rate(0, code)
-            if not _power_at(ctx, 0, baud, _shown(choice, 0, code),
-                             "2.link.rate-range-unlisted"):
+            if _power_at(ctx, 0, baud, _shown(choice, 0, code),
+                         "2.link.rate-range-unlisted") is None:
                 here = _find(ctx, baud)
                 ctx.require(here is not None, "the unit answers at none of the profile's rates")
                 ctx.note(f"EEPROM {choice.range_address:02X} = {code:02X}: the unit answers "

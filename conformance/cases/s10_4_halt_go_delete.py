@@ -103,17 +103,28 @@ def halt(ctx: CaseContext) -> None:
                observed=show(r), expected="8,D0", rule="10.3.st6.inta-run")
 
 
-@case("10.4.halt.in-final-deceleration", rules=("10.4.halt.ramp", "10.3.st6.inta-run"),
+@case("10.4.halt.in-final-deceleration",
+      rules=("10.4.halt.ramp", "10.3.st6.inta-run", "10.2.motion.step-placement"),
       timing=True)
 def halt_final(ctx: CaseContext) -> None:
+    """H while the vector already decelerates at A to its end: the stop ramp at the same A
+    ends there too. One step short is another placement of that ramp's steps (where a
+    unit's own arithmetic lays the stop, the manuals do not say) [D], the step left held
+    (RUN = 1); farther from the target, the ramp was not A's [M]."""
     link = ctx.link
     link.wait(0.03)
     setup(ctx, "V1500")
     setup(ctx, "L" + vector(ctx, 0, 0, 245))
     link.wait(0.20)
     answers(ctx, link.send("H"), "8", "H during the final deceleration", rule="10.4.halt.ramp")
-    answers(ctx, link.send("PF"), "8,0,0,245", "the vector ended on its target",
-            rule="10.4.halt.ramp")
+    r = link.send("PF")
+    short = r is not None and r.raw == b"8,0,0,244\r"
+    answers(ctx, r, "8,0,0,245", "the vector ended on its target",
+            rule="10.2.motion.step-placement" if short else "10.4.halt.ramp")
+    if short:
+        answers(ctx, link.send("SR6"), "8,D0", "INTA and INTCOM; RUN = 1: the step left is "
+                "held", rule="10.3.st6.inta-run")
+        return
     answers(ctx, link.send("SR6"), "8,90", "INTA and INTCOM; RUN = 0: nothing is left",
             rule="10.3.st6.inta-run")
 

@@ -196,6 +196,9 @@ def grade(impl: Implementation, outcomes: list[Outcome]) -> Trial:
         for case, verdict, rules in failed_rules(results):
             outside = [r for r in rules if r not in impl.departures]
             caught.update(r for r in rules if r in impl.departures)
+            if verdict == "ERROR" and not outside:
+                # a crash of the suite is never a departure of the implementation
+                outside = ["a defect of the suite"]
             known = [r for r in outside if r in impl.open]
             if known:
                 result.open.append(f"{what}: {verdict} {case}: {', '.join(known)} (open: "

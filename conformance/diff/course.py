@@ -72,6 +72,8 @@ class Course:
         self.override = max(100, profile.reset.XM) / 100
         self.up = 1.0
         self.queued: str | None = None
+        #: the vector the dwell is measured from is a C that starts from rest
+        self.c_from_rest = False
         #: a C queued right after a C reversing an axis (a junction where braking to 0 is
         #: a reading, 10.2.motion.junction-reversal): everything after it is timed by it
         self.reversal = False
@@ -140,6 +142,9 @@ class Course:
             self.zero_at = reference.sent_at
         if command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             self.vector_at = reference.sent_at
+            # a C with no C before it to join starts from rest: whether it waits the
+            # dwell is a reading (10.2.motion.dwell-before-c [D])
+            self.c_from_rest = command == "C" and self.queued in (None, "L")
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
         elif command == "T" and (ms := decimal(body[1:])) is not None:

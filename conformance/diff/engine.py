@@ -48,6 +48,8 @@ except ImportError:
     _providers = _Constants = None
 
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: the frames that change a running motion's course (H, G, XA...)
+_COURSE = classes(retimes=True)
 #: real time: how long the fresh reference stands before a sequence
 AGE_SECONDS = 1.0
 #: a unit that lives on between sequences: what both sides are sent first (the index read
@@ -119,6 +121,9 @@ class Pair:
                            placement=placement,
                            unused_inputs=tuple(profile.unused_inputs.items()))
         self.course = Course(profile)
+        #: the frames of the example that changed a motion's course (H, G, XA...): a unit
+        #: of somebody else's may take each at its own next step
+        self._course_changes = 0
         self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
         self._index = IndexBase()
         self._reference_index = 0          # the reference's index read in the prelude
@@ -224,6 +229,7 @@ class Pair:
             out.ended = self.lost
             return False
         try:
+            self._course_changes = 0
             self.started_at_power_on = self.target.real and self._power_on_start()
             if not self.started_at_power_on:
                 self._known_start()
@@ -354,6 +360,8 @@ class Pair:
             spindle = self.profile.spindle
             to_spindle = spindle is not None and step.address == spindle.address
             earlier.add("spindle" if to_spindle else command)
+            if command in _COURSE:
+                self._course_changes += 1
             code = (rec.reference.code or 0) & 7 if rec is not None else 0
             if code:
                 earlier.add(f"{command}-refused")
@@ -370,12 +378,16 @@ class Pair:
         context = self._context(step, self.course.in_packet)
         if self.course.within_dwell(rec.reference.sent_at):
             context.add("in-dwell")
+            if self.course.c_from_rest:
+                context.add("c-from-rest")
         if self.course.after_zero_vector(rec.reference.sent_at):
             context.add("after-zero-vector")
         if self.course.reversal:
             context.add("reversal")
         if kind == "position" and self.course.beyond_reach(_values(rec.target)):
             context.add("beyond-reach")
+        if kind == "position" and self._placed(rec):
+            context.add("placement")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
         context.add("kept" if self.course.kept else "nothing-kept")
@@ -433,10 +445,22 @@ class Pair:
         so the sequence begins once the longest dwell T after that has passed (waited
         after the reads, which the known state told a co-simulator ahead with its last).
         The reference's part is done as it begins (:meth:`_begin_reference`)."""
-        index = _index_read(self.target)
+        self._index = IndexBase.read(_index_values(self.target), self._reference_index)
         self.target.wait(self.profile.range("T").hi / 1000)
-        self._index = IndexBase((index - self._reference_index) % 256)
-        self.judge = replace(self.judge, index_offset=self._index.offset)
+        self.judge = replace(self.judge, index_offset=self._index.offset or 0)
+
+    def _placed(self, rec: StepRecord) -> bool:
+        """Whether a target of somebody else's reads within another placement of the same
+        steps: one step of placement, and one more for each frame of the example that
+        changed the motion's course, which it may take at its own next step."""
+        if not self.judge.placement:
+            return False
+        a, b = _values(rec.target), _values(rec.reference)
+        try:
+            apart = [abs(int(x) - int(y)) for x, y in zip(a, b, strict=True)]
+        except ValueError:
+            return False
+        return max(apart, default=0) <= self.judge.placement * (1 + self._course_changes)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""
@@ -592,12 +616,18 @@ def _has_lower(text: str) -> bool:
     return any("a" <= ch <= "z" for ch in text)
 
 
-def _index_read(side: Side) -> int:
-    """The index a side reads in the prelude (its second frame, `@`; 0 when unread)."""
+def _index_values(side: Side) -> list[str]:
+    """What a side's `@` answers in the prelude (its second frame), as written."""
     r = side.link.send_each(PRELUDE)[1]
+    return [] if r is None else list(r.values)
+
+
+def _index_read(side: Side) -> int:
+    """The index a side reads in the prelude (0 when unread or not a decimal number)."""
+    values = _index_values(side)
     try:
-        return r.dec(0) if r is not None else 0
-    except AssertionError:
+        return int(values[0]) if len(values) == 1 else 0
+    except ValueError:
         return 0
 
 

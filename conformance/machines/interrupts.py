@@ -221,11 +221,19 @@ class InterruptMachine(UnitMachine):
             self.look("G with INTA = 0")
             return
         # nothing is queued: 0, or 6 (both allowed, spec 5); a G refused with 6 may have
-        # cleared the flags first or done nothing, as ST6 then shows
+        # cleared the flags first or done nothing, as ST6 then shows: INTA or INTCOM
+        # cleared tell; INTA set again with no INTCOM to tell by may be an input still
+        # active that set it again after the clear, or nothing done
         holds(r.code & 7 in (ErrorCode.OK, ErrorCode.NOTHING_TO_GO), "10.4.go.resume",
               f"G with INTA = 1 answered {r.text}")
-        if r.code & 7 == ErrorCode.OK or not self.read(6)[1] & INTA:
+        if r.code & 7 == ErrorCode.OK:
             self.cleared()
+        else:
+            st6 = self.read(6)[1]
+            if not st6 & INTA or (f.intcom and not st6 & INTCOM):
+                self.cleared()
+            elif not f.intcom:
+                self.maybe_cleared()
         self.look("G")
 
     @rule()
@@ -255,6 +263,17 @@ class InterruptMachine(UnitMachine):
         for word, b in enumerate(f.words):
             b.may |= self.hot(word)
             f.inta_may = f.inta_may or bool(self.hot(word))
+        self.level_triggered()
+
+    def maybe_cleared(self) -> None:
+        """G refused with 6 and ST6 cannot tell whether it cleared first: no cause bit
+        must stay, those set may, and what is active may set its own again."""
+        f = self.flags
+        for b in f.words:
+            b.must = 0
+        f.inta_must = False
+        for word, b in enumerate(f.words):
+            b.may |= self.hot(word)
         self.level_triggered()
 
     # -- the reading after every step --------------------------------------------------------------

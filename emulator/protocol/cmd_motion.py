@@ -257,6 +257,8 @@ def cmd_go(dev: Device, ses: Session, p: str, t: int) -> Reply:
     if dev.mutant.active("go-loses-step") and dev.motion.queued(t):
         dev.motion.set_position(0, dev.motion.position(t)[0] + 1, t)
     dev.check_inputs(t)
+    if not held and dev.readings.active("go-clears-then-nothing"):
+        raise CommandError(ErrorCode.NOTHING_TO_GO, "G with nothing queued, flags cleared")
     return []
 
 

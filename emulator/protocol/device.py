@@ -106,6 +106,10 @@ class Device:
         if choice is None or position is None:
             self.rate = None
             return
+        if choice.table_rule and self.mutant.active("baud-jumpers-ignored"):
+            position = len(choice.positions) - 1
+        if choice.table_rule and self.readings.active("rate-jumpers-reversed"):
+            position = len(choice.positions) - 1 - position
         code = None
         if choice.range_address is not None:
             code = self.eeprom.read(choice.range_address)[0]

@@ -106,6 +106,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "baud-range-ignored": ("p21-rate-read-at-power-on", "GVE114-500"),
     "baud-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-200"),
     "baud-range-read-at-restart": ("p21-rate-read-at-power-on", "GVE114-50"),
+    "baud-jumpers-ignored": ("p27-gve54-jumpers-select", "GVE54"),
     "output-ignored-while-busy": ("p22-output-while-busy", "GVE84-100"),
     "spindle-refuses-eeprom": ("p23-spindle-eeprom", "GVE114-500"),
     "short-read-ignores-microstep": ("p24-short-read-in-sixteenths", "GVE54"),

@@ -23,6 +23,9 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
     "go-nothing-queued": ([b"!0H\r", b"!0G\r"], b"8\r0\r", b"8\rE\r"),
+    # H, G: the flags cleared either way, then 0 or 6 (with INTA clear: no 8)
+    "go-clears-then-nothing": ([b"!0H\r", b"!0G\r", b"!0SR6\r"], b"8\r0\r0,00\r",
+                               b"8\r6\r0,00\r"),
     "missing-letter-range": ([b"!0NA0\r"], b"3\r", b"5\r"),
     "lone-bang-answered": ([b"!"], b"", b"2\r"),
     "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
@@ -125,15 +128,17 @@ POINTS_54: dict[str, tuple[list[Step], bytes, bytes]] = {
 }
 
 
-#: readings of the GVE114's line rate: EEPROM 0D written (a byte the manual does not
-#: list), the rate switch at sw1 OFF sw2 OFF, power-on: the rate read (clean, reading)
-RATE_POINTS: dict[str, tuple[bytes, int, int]] = {
-    "baud-unlisted-high": (b"!0EW0D,00\r", 19200, 921600),
+#: readings of the line rate: a frame (on the GVE114 EEPROM 0D written, a byte the manual
+#: does not list), the rate switch at its first position (sw1 OFF sw2 OFF), power-on: the
+#: rate read (profile, frame, clean, reading)
+RATE_POINTS: dict[str, tuple[str, bytes, int, int]] = {
+    "baud-unlisted-high": ("GVE114-500", b"!0EW0D,00\r", 19200, 921600),
+    "rate-jumpers-reversed": ("GVE54", b"!0?\r", 9600, 115200),
 }
 
 
-def rate_after_power_on(readings: tuple[str, ...], frame: bytes) -> int | None:
-    unit = Unit("GVE114-500", readings=readings)
+def rate_after_power_on(readings: tuple[str, ...], profile: str, frame: bytes) -> int | None:
+    unit = Unit(profile, readings=readings)
     unit.receive(frame, 10**9, 1000)
     unit.set_rate_switch(0)
     unit.power_on(2 * 10**9)
@@ -167,9 +172,9 @@ def test_every_reading_has_its_point_here():
 
 @pytest.mark.parametrize("name", sorted(RATE_POINTS))
 def test_a_reading_of_the_rate_picks_another_rate(name):
-    frame, clean, read = RATE_POINTS[name]
-    assert rate_after_power_on((), frame) == clean
-    assert rate_after_power_on((name,), frame) == read
+    profile, frame, clean, read = RATE_POINTS[name]
+    assert rate_after_power_on((), profile, frame) == clean
+    assert rate_after_power_on((name,), profile, frame) == read
 
 
 @pytest.mark.parametrize("name", sorted(POINTS))

@@ -1,6 +1,7 @@
 """A form the manuals leave open is graded once, by its own [D] rule, in its own case:
-the index written in hex, a lacking command read as one the unit has with parameters it
-does not take. No other case changes its verdict."""
+the index written in hex, refused frames left out of the index, a lacking command read
+as one the unit has with parameters it does not take. No other case changes its
+verdict."""
 
 from __future__ import annotations
 
@@ -15,10 +16,12 @@ from conformance.verdict import NON_STRICT
 GRADED = {
     "index-hex": ("10.commands.formats", "8.index.decimal"),
     "absent-command-syntax": ("10.commands.absent-refused", "1.profile.command-prefix"),
+    "refused-uncounted": ("8.index.counts-every-frame", "8.index.refused-counted"),
 }
 #: the cases that read the index, or send commands the GVE54 lacks, besides
 NEIGHBOURS = ["8.*", "9.reset.after-j", "6.checksum.*", "7.packet.breakers",
-              "3.frame.*", "10.commands.*"]
+              "3.frame.*", "10.commands.*", "5.machine.error-codes",
+              "10.machine.queue-status-eeprom"]
 
 
 @pytest.mark.parametrize("reading", sorted(GRADED))

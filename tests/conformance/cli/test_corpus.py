@@ -70,6 +70,16 @@ def test_a_known_defect_of_the_suite_is_listed_open_not_unfair(mutant_outcomes):
     assert t.fair and not t.unfair
     assert any("10.4.halt.ramp" in line and "not mended yet" in line for line in t.open)
 
+def test_an_error_is_unfair_even_with_no_failed_check():
+    # a case that crashed records no failed check: its ERROR is the suite's, never a
+    # departure of the implementation
+    results = {"verdict": "FAILED", "reason": "", "counts": {"PASS": 1, "ERROR": 1},
+               "results": [{"id": "x.case", "profile": "GVE84-100", "verdict": "ERROR",
+                            "checks": []}]}
+    t = grade(unit({}), [("catalogue GVE84-100", results, "FAILED")])
+    assert t.unfair == ["catalogue GVE84-100: ERROR x.case [GVE84-100]: "
+                        "a defect of the suite"]
+
 
 def test_a_job_that_judged_nothing_is_unfair():
     broken = Implementation(name="broken", kind="unit", folder=Path("."),

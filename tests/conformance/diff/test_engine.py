@@ -55,6 +55,7 @@ OFF_THE_WIRE = {
     "baud-range-ignored": "the rate EEPROM 0D's range gives after power-on",
     "baud-read-at-restart": "the rate after J with the rate switch moved",
     "baud-range-read-at-restart": "the rate after J with EEPROM 0D written",
+    "baud-jumpers-ignored": "the rate after power-on at each GVE54 jumper position",
 }
 #: the mutants the probes must name
 ON_THE_WIRE = sorted(set(mutants()) - set(OFF_THE_WIRE))

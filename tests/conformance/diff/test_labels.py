@@ -289,6 +289,11 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # a packet a watchdog closed by time: *E answered 2,k on its own
     "7.packet.open-until-end": ("7.packet.bad-checksum-member.corrupted-end",
                                 ("*E", "code", {"in-packet"}, {"*S", "C"}, 0, 2)),
+    # a third party's own placement of the same steps, H and G taken at its next step
+    "10.2.motion.step-placement": ("10.4.measured.go-from-rest",
+                                   ("PF", "position", {"placement"}, {"L", "H", "G"}, 0, 0)),
+    # an A the reference takes, refused as out of range
+    "10.cmd.accel-range": ("1.profile.parameter-ranges", ("A", "code", set(), set(), 0, 5)),
     "8.index.counts": ("8.index.counts-every-frame", ("@", "data", set(), {"V"}, 0, 0)),
     # the index written in hex, read so the reference's
     "8.index.decimal": ("10.commands.formats", ("@", "data", {"index-hex"}, {"V"}, 0, 0)),
