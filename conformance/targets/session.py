@@ -66,6 +66,10 @@ class Reachable(Protocol):
 
 #: the `*E` that closes a packet left open: -1 is no count of members, so it is refused
 PACKET_CLOSER = "*E-1"
+#: the `*E` that closes it on a unit that refused the first as a malformed frame and kept
+#: the packet open: a count every reading takes, and one no member is committed by (none
+#: taken: nothing to commit; some: their count differs)
+SURE_CLOSER = "*E0"
 #: status words restored at the end, polarity before causes before enables (an enable
 #: written last finds its polarity and cause already in place)
 RESTORE_ORDER = (2, 3, 4, 5, 0, 1)
@@ -484,11 +488,15 @@ class RealSession(Session):
         believes, it is sent in the other. A packet that may be open is closed first;
         ``urgent`` (Ctrl-C, a unit gone quiet) sends `H` first all the same, and closes
         the packet and sends `H` again only when that `H` went unanswered."""
-        if not urgent:
-            self._close_packet(link, timeout)
+        closed = not urgent and self._close_packet(link, timeout)
         r = link.send("H", timeout=timeout)
         if r is None and urgent and self.guard.packet_open:
-            self._close_packet(link, timeout)
+            closed = self._close_packet(link, timeout)
+            r = link.send("H", timeout=timeout)
+        if r is None and closed:
+            # H taken as a member: the closer was refused as a malformed frame and the
+            # packet kept open (a reading of spec 7); a count every reading takes ends it
+            self._close_packet(link, timeout, SURE_CLOSER)
             r = link.send("H", timeout=timeout)
         if r is None or r.code == ErrorCode.SYNTAX:
             other = link.send("H", checksum=not link.checksums, timeout=timeout)
@@ -497,20 +505,25 @@ class RealSession(Session):
                 return other
         return r
 
-    def _close_packet(self, link: Link, timeout: float | None = None) -> None:
+    def _close_packet(self, link: Link, timeout: float | None = None,
+                      closer: str = PACKET_CLOSER) -> bool:
         """Close a packet a case may have left open, in a way every reading ends one:
         that `H`, `@`, `>` and `J` close it is our reading [D]; only `*E` is sure to
         (spec 7). Its count is no count, so every unit refuses it and the packet's members
         are not committed by it (a unit that committed them as they arrived already has:
         the guard books them as maybe committed). Unanswered in the mode the link believes
-        (a failing member), it is sent in the other."""
-        if not self.guard.packet_open or "*E" not in self.profile.commands:
-            return
-        r = link.send(PACKET_CLOSER, timeout=timeout)
+        (a failing member), it is sent in the other. ``closer``: the `*E` sent
+        (:data:`SURE_CLOSER` whether or not the guard believes a packet open); returns
+        whether one was."""
+        if "*E" not in self.profile.commands or not (
+                self.guard.packet_open or closer == SURE_CLOSER):
+            return False
+        r = link.send(closer, timeout=timeout)
         if r is None:
-            other = link.send(PACKET_CLOSER, checksum=not link.checksums, timeout=timeout)
+            other = link.send(closer, checksum=not link.checksums, timeout=timeout)
             if other is not None:
                 link.checksums = not link.checksums
+        return True
 
     def _reset_frames(self) -> list[str]:
         """What cannot be read, set to the reset state (spec 9)."""
