@@ -100,12 +100,17 @@ def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
     (spec 5), unless a fault of ours made it so; so is one refused as "not while moving"
     (7): the host did not wait for the motion to end, as `L0,0,0` lets it (spec 10.1).
     A frame summed after a restart turned checksum mode off is refused for that cause,
-    which its reading names (6.checksum.off-after-reset), not for its parameters."""
+    which its reading names (6.checksum.off-after-reset), not for its parameters. A `*E`
+    refused after a packet was opened closes one the host could not know closed (spec 7:
+    only `*E` is sure to), as its answer or a fault left it unsure: no fault of the host's."""
     rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
              ErrorCode.RANGE: "5.code.range", ErrorCode.BUSY: "10.1.queue.wait-idiom"}
     out.judged |= set(rules.values())
+    opened = False
     for ex in rec.exchanges:
-        if ex.fault is None and ex.code in rules and not _lapsed(ex):
+        closer = opened and ex.parsed.command == "*E"
+        opened = opened or ex.parsed.command == "*S"
+        if ex.fault is None and ex.code in rules and not _lapsed(ex) and not closer:
             answer = b"".join(ex.answer).decode("latin-1").strip()
             out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
                     f"the unit answered {answer}")
@@ -174,8 +179,11 @@ def _relay_late(t: int, rec: Recording) -> bool:
 
 def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """`*E n` gives the members sent since `*S`, and only `C` and `B` are members
-    (spec 7)."""
+    (spec 7). A `*E` with no packet open right after one whose answer the host did not
+    get intact, or that was no `0,n`, closes a packet the host could not know closed
+    (only `*E` is sure to): no fault of the host's."""
     members: dict[int, int | None] = {}
+    unsure: set[int] = set()        # addresses whose last packet may still be open
     for ex in rec.exchanges:
         f = ex.parsed
         if f.address is None or f.command is None:
@@ -186,12 +194,16 @@ def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
             members[f.address] = 0
         elif f.command == "*E":
             out.judged.add("7.packet.exchange")
-            if n is None:
+            if n is None and f.address not in unsure:
                 out.add("7.packet.exchange", _at(ex.frame.start, line), ex.text,
                         "`*E` with no packet open")
-            elif f.params[:1] != [str(n)]:
+            elif n is not None and f.params[:1] != [str(n)]:
                 out.add("7.packet.count", _at(ex.frame.start, line), ex.text,
                         f"{n} member(s) sent since `*S`")
+            if n is not None and (ex.fault is not None or not ex.intact or ex.code != 0):
+                unsure.add(f.address)
+            else:
+                unsure.discard(f.address)
             members[f.address] = None
         elif n is not None:
             if f.command in classes(packet="breaker"):
@@ -240,7 +252,9 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         if ex.fault is None or ex.fault in ("cut-frame", "queue-full", "interrupt",
                                             "restart"):
             continue
-        rest = rec.exchanges[i + 1:]
+        # a `*E0` first closes a packet that may be open and commits no member (a count
+        # no packet that had members gives): what the host does next is judged
+        rest = [e for e in rec.exchanges[i + 1:] if not _closer(e)]
         if not rest:
             continue
         nxt = rest[0]
@@ -280,6 +294,10 @@ def _got_answer(ex: Exchange, nxt: Exchange) -> bool:
     before an answer leaves the answer whole)."""
     whole = ex.fault in ("late-answer", "noise") and ex.delivered is not None
     return whole and ex.delivered_at is not None and ex.delivered_at <= nxt.frame.start
+
+
+def _closer(ex: Exchange) -> bool:
+    return ex.parsed.command == "*E" and ex.parsed.params[:1] == ["0"]
 
 
 def _resends(ex: Exchange, nxt: Exchange) -> bool:

@@ -68,6 +68,24 @@ def test_packet_counts_and_members():
     assert found["7.packet.count"] == ["!0*E1"]
 
 
+def test_a_star_e0_closing_a_packet_the_host_is_unsure_of_is_no_fault():
+    w = Wire()
+    w.frame(b"!0*S", 0, answer=None)
+    w.frame(b"!0C1,0,0", 1, answer=None)
+    w.frame(b"!0*E1", 2, answer=b"1,0\r")        # refused: the packet may still be open
+    w.frame(b"!0*E0", 5, answer=b"4,0\r")        # the only sure way to end one
+    found = broken(w.judge())
+    assert "7.packet.exchange" not in found and "5.code.syntax" not in found
+    w = Wire()
+    w.frame(b"!0*E0", 0, answer=b"4,0\r")        # no packet was ever opened
+    w.frame(b"!0*S", 3, answer=None)
+    w.frame(b"!0C1,0,0", 4, answer=None)
+    w.frame(b"!0*E1", 5, answer=b"0,1\r")
+    w.frame(b"!0*E0", 8, answer=b"4,0\r")        # after a packet that ended well
+    found = broken(w.judge())
+    assert found["7.packet.exchange"] == ["!0*E0", "!0*E0"]
+
+
 def test_gaps_below_the_watchdog():
     w = Wire()
     w.frame(b"!0V1000", 0, gap_ms=20)            # a COM_SEND host: 20 ms a byte
