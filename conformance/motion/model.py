@@ -24,6 +24,8 @@ from conformance.motion.plan import (
 
 #: XU and XD scale the captured V by these fractions (spec 10 XA/XU/XD)
 EXCHANGE = {"XU": (17, 16), "XD": (15, 16)}
+#: ns: the unit the manuals give T in (milliseconds), the tick a unit may dwell on
+DWELL_TICK = 1_000_000
 
 
 @dataclass
@@ -69,10 +71,15 @@ class Vector:
 
 
 class MotionModel:
-    def __init__(self, origin: list[int], xm: int = 100, *, next_brake: bool = False) -> None:
+    def __init__(self, origin: list[int], xm: int = 100, *, next_brake: bool = False,
+                 start_delay: int = 0) -> None:
         self.origin = list(origin)
         self.xm = xm
         self.next_brake = next_brake       # a junction at the next C's B: another reading
+        #: ns every start from rest waits from the instant it became possible (a dwell
+        #: before every such start, on the unit's own tick): another reading of "prodleva
+        #: mezi nenavazujícími vektory" (10.2.motion.dwell bounds a start from below only)
+        self.start_delay = start_delay
         self.queue: list[Vector] = []
         self.history: list[Vector] = []
         self.halted = False
@@ -125,7 +132,12 @@ class MotionModel:
                 self.queue.pop(0)
                 vin = 0
                 continue
-            if vin or self.last_rest is None:
+            if vin:
+                head.start = t
+            elif self.start_delay:
+                head.start = max(t + self.start_delay,
+                                 t if self.last_rest is None else self.last_rest + head.p.T)
+            elif self.last_rest is None:
                 head.start = t
             else:
                 head.start = max(t, self.last_rest + head.p.T)

@@ -101,6 +101,18 @@ def test_a_line_from_rest_runs_at_v_and_ends_on_target():
     assert m.position(SECOND) == [300, -100, 0]
 
 
+def test_a_unit_that_dwells_before_every_start_from_rest_starts_later_not_at_junctions():
+    p = params(A=10_000_000, V=1000, T=20 * MS)
+    m = MotionModel([0, 0, 0], start_delay=2 * MS)
+    m.push(0, (100, 0, 0), "C", p)                # long at rest: starts at 2 ms, not 0
+    m.push(1 * MS, (100, 0, 0), "C", p)           # continuous: no delay at the junction
+    m.advance(SECOND)
+    assert m.position(12 * MS)[0] == 10 and m.position(152 * MS)[0] == 150
+    m.push(300 * MS, (100, 0, 0), "L", p)         # from rest: T after the rest at 202 ms
+    m.advance(SECOND)
+    assert m.position(322 * MS)[0] == 220         # started at max(302, 222) ms
+
+
 def test_t_separates_vectors_from_rest_but_not_continuous_ones():
     p = params(A=10_000_000, V=1000, T=20 * MS)
     m = _model((0, (100, 0, 0), "L", p))
