@@ -303,6 +303,8 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                                 ("W", "code", set(), set(), 0, 4)),
     "8.index.refused-counted": ("8.index.counts-every-frame",
                                 ("@", "data", {"refused-uncounted"}, {"T-refused"}, 0, 0)),
+    # J answered with the INTA bit H left, before its reset
+    "10.cmd.restart": ("2.link.restart", ("J", "inta", set(), {"H"}, 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
                                   ("@", "data", {"queries-counted"}, {"@"}, 0, 0)),
     "8.repeat.answer": ("8.repeat.last-frame-and-answer", (">", "data", set(), {"T"}, 0, 0)),
