@@ -34,6 +34,10 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
     "10.2.measured.dwell": (
         ("10.2.motion.dwell", "10.cmd.modal"), (), (),
         ["T24", "A10000", "V5000", "L100,0,0", [100, 0, 0], "L100,0,0", (0.06, 0.005)]),
+    # a C from rest, after an L has ended: it waits T as an L does, our reading [D] (10.2)
+    "10.2.measured.dwell-before-c": (
+        ("10.2.motion.dwell-before-c",), (), (),
+        ["T24", "A10000", "V5000", "L100,0,0", [100, 0, 0], "C100,0,0", (0.06, 0.005)]),
     # no dwell between continuous vectors (10.2; M84 12.5.2)
     "10.2.measured.no-dwell-continuous": (
         ("10.2.motion.no-dwell-continuous",), (), (),

@@ -445,9 +445,10 @@ class Pair:
         so the sequence begins once the longest dwell T after that has passed (waited
         after the reads, which the known state told a co-simulator ahead with its last).
         The reference's part is done as it begins (:meth:`_begin_reference`)."""
-        self._index = IndexBase.read(_index_values(self.target), self._reference_index)
+        index = _index_read(self.target)
         self.target.wait(self.profile.range("T").hi / 1000)
-        self.judge = replace(self.judge, index_offset=self._index.offset or 0)
+        self._index = IndexBase((index - self._reference_index) % 256)
+        self.judge = replace(self.judge, index_offset=self._index.offset)
 
     def _placed(self, rec: StepRecord) -> bool:
         """Whether a target of somebody else's reads within another placement of the same

@@ -27,13 +27,17 @@ class ModelUnit:
     #: frames that do not advance the index: @ and > by our reading [D]; a unit whose @
     #: counts itself (measured by the machines) has none
     uncounted: tuple[str, ...] = UNCOUNTED
-    #: the frames booked since the index was last read that the unit refused (an error
-    #: code): counted by our reading [D], not by a reader who counts what it took
-    refused: int = 0
+    #: whether a refused frame advances the index, as we read it [D]; a unit that counts
+    #: only what it takes (measured by the machines) does not
+    refused_counted: bool = True
 
     # -- section 8 ------------------------------------------------------------------------
-    def frame_arrived(self, name: str, checksum_ok: bool = True) -> None:
-        """A complete frame for the unit arrived (spec 8: counted unless @/> or a bad sum)."""
+    def frame_arrived(self, name: str, checksum_ok: bool = True,
+                      code: int | None = None) -> None:
+        """A complete frame for the unit arrived (spec 8: counted unless @/> or a bad sum);
+        ``code``: the error code it was answered with (None: no answer read)."""
+        if code and not self.refused_counted:
+            return
         if checksum_ok and name not in self.uncounted:
             self.index = (self.index + 1) % 256
 

@@ -86,6 +86,8 @@ ALSO = (
      "GVE114-500"),
 )
 
+#: the rule a third party's own placement of the same steps is graded by
+PLACEMENT = "10.2.motion.step-placement"
 #: reading -> (the case that measures its point, the rule it reads, the profiles)
 READ = {
     "next-vectors-B": ("10.2.measured.junction-brake-sides", "10.2.motion.junction-own-b",
@@ -109,7 +111,9 @@ def test_the_reading_grades_non_strict(reading: str, profile: str) -> None:
     (c,) = select([case_id])
     read = run_case(c, parse_target(f"emu:{profile}?reading={reading}"), "mutation")
     assert read.verdict == NON_STRICT
-    assert {k["rule"] for k in read.checks if not k["ok"]} == {rule}
+    # (a reading the model with another step placement also explains is graded by that
+    # placement's [D] rule beside its own: both NON-STRICT, neither a FAIL)
+    assert {k["rule"] for k in read.checks if not k["ok"]} - {PLACEMENT} == {rule}
 
 
 def test_the_spindle_case_reads_the_spindle_after_each_feed_rate() -> None:

@@ -77,8 +77,8 @@ def test_an_error_is_unfair_even_with_no_failed_check():
                "results": [{"id": "x.case", "profile": "GVE84-100", "verdict": "ERROR",
                             "checks": []}]}
     t = grade(unit({}), [("catalogue GVE84-100", results, "FAILED")])
-    assert t.unfair == ["catalogue GVE84-100: ERROR x.case [GVE84-100]: "
-                        "a defect of the suite"]
+    assert len(t.unfair) == 1 and t.unfair[0].startswith(
+        "catalogue GVE84-100: ERROR x.case [GVE84-100]: "), t.unfair
 
 
 def test_a_job_that_judged_nothing_is_unfair():
