@@ -55,7 +55,7 @@ class Implementation:
     #: the suite gets wrong): listed at every run as open, not counted unfair, so that a new
     #: defect still fails the gate while a known one is being fixed
     open: dict[str, str] = field(default_factory=dict)
-    diff_seconds: float = 0.0
+    diff_examples: int = 0
 
     def argv(self) -> list[str]:
         """The command's words, `{python}` and `{dir}` filled in."""
@@ -88,7 +88,7 @@ def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
     except (OSError, tomllib.TOMLDecodeError) as err:
         raise UsageError(f"{path}: {err}") from None
     known = {"name", "kind", "folder", "command", "profiles", "departures", "written-from",
-             "diff-seconds", "open"}
+             "diff-examples", "open"}
     out = []
     for table in data.get("implementation", []):
         wrong = sorted(set(table) - known)
@@ -103,7 +103,7 @@ def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
             departures=dict(table.get("departures", {})),
             open=dict(table.get("open", {})),
             written_from=table.get("written-from", ""),
-            diff_seconds=float(table.get("diff-seconds", 0.0))))
+            diff_examples=int(table.get("diff-examples", 0))))
     return out
 
 
@@ -155,12 +155,12 @@ def jobs_of(impl: Implementation, reports: Path, seed: int) -> list[tuple[str, l
             out.append((f"catalogue {profile}",
                         [*cli, "run", "--target", target, *common, "--yes",
                          "--allow-destructive"]))
-            if impl.diff_seconds:
+            if impl.diff_examples:
                 common = ["--profile", profile,
                           "--report-dir", str(reports / f"{profile}-{len(out)}"), "-q"]
                 out.append((f"diff {profile}",
                             [*cli, "diff", "--target", target, *common, "--yes",
-                             "--allow-destructive", "--seconds", str(impl.diff_seconds),
+                             "--allow-destructive", "--examples", str(impl.diff_examples),
                              "--seed", str(seed)]))
         else:
             out.append((f"host {profile}", [*cli, "host", *common, "--", *impl.argv()]))
