@@ -200,7 +200,7 @@ def packets(rec: Recording, line: LineFacts, out: Judgement) -> None:
             elif n is not None and f.params[:1] != [str(n)]:
                 out.add("7.packet.count", _at(ex.frame.start, line), ex.text,
                         f"{n} member(s) sent since `*S`")
-            if n is not None and (ex.fault is not None or not ex.intact or ex.code != 0):
+            if n is not None and (ex.fault is not None or not ex.intact or ex.code != ErrorCode.OK):
                 unsure.add(f.address)
             else:
                 unsure.discard(f.address)

@@ -15,8 +15,9 @@ from conformance.cli.progress import Progress
 from conformance.verdict import COULD_NOT_TEST, MISSING, PASS
 from tests.conformance.reports.toy import result
 
-#: the default run's three reports together stay under this
-LIMIT = 2 * 1024 * 1024
+#: the default run's three reports together stay under this (about 1,450 case runs:
+#: some 1.5 KB each, whatever the run finds)
+LIMIT = 5 * 1024 * 1024 // 2
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +33,7 @@ def default_run(tmp_path_factory):
     return status, out.getvalue(), run_dir, junit
 
 
-def test_the_default_run_writes_at_most_2_mb(default_run):
+def test_the_default_run_writes_at_most_2_5_mb(default_run):
     status, _, run_dir, _ = default_run
     sizes = {p.name: p.stat().st_size for p in run_dir.iterdir()}
     assert status == 0 and set(sizes) == {"report.html", "results.json", "junit.xml"}

@@ -303,6 +303,10 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                                 ("W", "code", set(), set(), 0, 4)),
     "8.index.refused-counted": ("8.index.counts-every-frame",
                                 ("@", "data", {"refused-uncounted"}, {"T-refused"}, 0, 0)),
+    # a C from rest, read within the T after the vector before it ended
+    "10.2.motion.dwell-before-c": ("10.2.measured.dwell-before-c",
+                                   ("PF", "position", {"in-dwell", "c-from-rest"}, {"C"},
+                                    0, 0)),
     # J answered with the INTA bit H left, before its reset
     "10.cmd.restart": ("2.link.restart", ("J", "inta", set(), {"H"}, 0, 0)),
     "8.index.queries-uncounted": ("8.index.queries-not-counted",
