@@ -36,7 +36,7 @@ class ModelUnit:
                       code: int | None = None) -> None:
         """A complete frame for the unit arrived (spec 8: counted unless @/> or a bad sum);
         ``code``: the error code it was answered with (None: no answer read)."""
-        if code and not self.refused_counted:
+        if code is not None and code & 7 and not self.refused_counted:   # (8: INTA, taken)
             return
         if checksum_ok and name not in self.uncounted:
             self.index = (self.index + 1) % 256

@@ -363,8 +363,12 @@ class Unit:
     def _answer(self, raw: bytes, code: int, values: list[str], t: int, *,
                 remember: bool = True) -> None:
         ses = self.session
-        if code and remember and (self.mutant.active("index-skips-refused")
-                                  or self.readings.active("refused-uncounted")):
+        # a refused frame the index counted is taken back; a query (@, >) counts only
+        # where a reading or a mutant makes it count
+        counted = remember or self.readings.active("queries-counted") \
+            or self.mutant.active("index-counts-queries")
+        if code and counted and (self.mutant.active("index-skips-refused")
+                                 or self.readings.active("refused-uncounted")):
             ses.index = (ses.index - 1) & 0xFF
         data = response(
             code, values,

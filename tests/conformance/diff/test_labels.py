@@ -303,6 +303,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                                 ("W", "code", set(), set(), 0, 4)),
     "8.index.refused-counted": ("8.index.counts-every-frame",
                                 ("@", "data", {"refused-uncounted"}, {"T-refused"}, 0, 0)),
+    # a command the spindle's address lacks whose letters begin one it has: 4, not 3
+    "1.profile.command-prefix": ("10.commands.absent-refused",
+                                 ("VL", "code", {"to-spindle"}, set(), 3, 4, "GVE114")),
     # a C from rest, read within the T after the vector before it ended
     "10.2.motion.dwell-before-c": ("10.2.measured.dwell-before-c",
                                    ("PF", "position", {"in-dwell", "c-from-rest"}, {"C"},
