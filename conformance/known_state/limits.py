@@ -1,5 +1,5 @@
 """The known state a case starts from on a real unit, as far as a case must know it to
-predict answers (the session sets it, the motion probe models from it)."""
+predict answers (the known state sets it, the motion probe models from it)."""
 
 from __future__ import annotations
 
