@@ -166,6 +166,15 @@ class CaseContext:
                                  graded, rule))
         return bool(ok)
 
+    def expect_equal(self, observed: Any, expected: Any, what: str, *,
+                     tag: str | None = None, rule: str | None = None,
+                     machinery: bool = False) -> bool:
+        """Record one check that ``observed`` equals ``expected``, as :meth:`expect` does:
+        the value judged is the value reported, read once by the caller (a second read,
+        e.g. a second `PF` of a moving unit, may differ from the one judged)."""
+        return self.expect(observed == expected, what, observed=observed, expected=expected,
+                           tag=tag, rule=rule, machinery=machinery)
+
     def require(self, ok: bool, why: str) -> None:
         if not ok:
             raise CouldNotTest(why)

@@ -102,8 +102,7 @@ def targets(ctx: CaseContext) -> None:
         setup(ctx, "C" + vector(ctx, *m))
     finished(ctx, 60)
     expected = [sum(m[i] for m in moves) for i in range(3)]
-    ctx.expect(position(ctx) == expected, "the sum of the vectors",
-               observed=position(ctx), expected=expected, rule="10.1.queue.relative")
+    ctx.expect_equal(position(ctx), expected, "the sum of the vectors", rule="10.1.queue.relative")
     ctx.step_train("the step train of the three vectors")
 
 

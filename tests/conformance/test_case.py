@@ -185,3 +185,15 @@ def test_a_watchdog_s_answer_is_graded_by_the_watchdog_s_rule(target):
     r = run_case(_toy(ended), target)
     assert r.verdict == NON_STRICT
     assert [c["rule"] for c in r.checks if not c["ok"]] == ["3.frame.watchdog-lone-bang"]
+
+
+@pytest.mark.parametrize(("reads", "verdict"), [([7, 8], PASS), ([8, 7], FAIL)])
+def test_an_equality_check_reports_the_reading_it_judged(target, reads, verdict):
+    # a reading that changes between two reads (a moving unit's PF): read once, judged
+    # and reported alike
+    left = iter(reads)
+    r = run_case(_toy(lambda ctx: ctx.expect_equal(next(left), 7, "x", rule="5.code.ok")),
+                 target)
+    assert r.verdict == verdict
+    assert (r.checks[0]["observed"], r.checks[0]["expected"]) == (str(reads[0]), "7")
+    assert next(left) == reads[1]                      # the value was read once
