@@ -18,7 +18,6 @@ OVER: dict[tuple[str, str], int] = {
     ("link/link.py", "Link"): 608,
     ("link/safety.py", "Guard"): 541,
     ("diff/engine.py", "Pair"): 485,
-    ("targets/cosim.py", "CosimLine"): 423,
 }
 
 
