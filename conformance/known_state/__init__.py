@@ -2,7 +2,7 @@
 limits between cases (:mod:`.limits`), and the procedure that brings a unit there by the
 manuals' rules only (:mod:`.procedure`: the stop in :mod:`.stop`, the way back and the
 counters zeroed in :mod:`.way_back`, what the unit answered read in :mod:`.answers`, a
-step that failed booked in :mod:`.failures`). The run's session
+step that failed booked in :mod:`.failed_steps`). The run's session
 (conformance/targets/session.py) sets it before each case and uses its stop and its way
 back for Ctrl-C and the restorations.
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from conformance.known_state.failures import Failures, StepFailed
+from conformance.known_state.failed_steps import Failures, StepFailed
 from conformance.known_state.rest import ToRest
 from conformance.known_state.way_back import WayBack
 from conformance.link.framing import Response

@@ -18,7 +18,7 @@ from conformance.known_state.answers import (
     shown_counters,
     taken,
 )
-from conformance.known_state.failures import Failures, StepFailure
+from conformance.known_state.failed_steps import Failures, StepFailure
 from conformance.known_state.limits import known_axis_limits
 from conformance.link.account import Spent
 from conformance.link.framing import Response

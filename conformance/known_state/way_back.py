@@ -14,7 +14,7 @@ from conformance.known_state.answers import (
     shown_counters,
     taken,
 )
-from conformance.known_state.failures import Failures, StepFailed, StepFailure
+from conformance.known_state.failed_steps import Failures, StepFailed, StepFailure
 from conformance.known_state.rest import ToRest
 from conformance.link.account import Spent
 from conformance.link.framing import Response

@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol
 
 from conformance.known_state.answers import bits, hex_ok
-from conformance.known_state.failures import Failures, StepFailed, StepFailure
+from conformance.known_state.failed_steps import Failures, StepFailed, StepFailure
 from conformance.known_state.procedure import KnownState
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response

@@ -146,7 +146,7 @@ def test_a_known_state_lost_without_power_on_ends_the_search(monkeypatch):
     had as on any unit, and a sequence after which it cannot be had ends the search
     COULD-NOT-TEST (KnownStateLost), never a PASS."""
     from conformance.diff.engine import KnownStateLost
-    from conformance.known_state.failures import StepFailed
+    from conformance.known_state.failed_steps import StepFailed
     from conformance.known_state.procedure import KnownState
     from conformance.targets.session import RealSession
     known_state, calls = KnownState.bring, []
