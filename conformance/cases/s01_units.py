@@ -5,7 +5,7 @@ What distinguishes the GVE54, the GVE84 and the GVE114 and their variants. A pro
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, finished, position, setup, show
 from conformance.protocol.catalogue import commands
 from gve_fixtures.protocol import ErrorCode

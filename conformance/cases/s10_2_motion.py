@@ -5,7 +5,7 @@ How a vector is stepped: rates, ramps, junctions, dwell and step placement
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import finished, measured_case, position, setup, vector
 from conformance.motion.probe import Probe
 

@@ -4,7 +4,7 @@ ST0..ST6: interrupt enables, polarities, causes, and the stepper's state."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,

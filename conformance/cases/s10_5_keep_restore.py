@@ -4,7 +4,7 @@ Saving the queue to lift the tool mid-job and restoring it afterwards."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,

@@ -4,7 +4,7 @@ The spindle speed the GVE114 takes at address 7."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, show
 from conformance.motion.probe import Probe
 from gve_fixtures.protocol import ErrorCode

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from conformance.link.link import Link
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 
 
 @dataclass(frozen=True)

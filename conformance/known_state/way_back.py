@@ -20,7 +20,7 @@ from conformance.link.account import Spent
 from conformance.link.framing import Response
 from conformance.link.link import Link
 from conformance.link.safety import Guard
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, St6
 

@@ -19,7 +19,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
-from conformance.case import CaseContext, CouldNotTest
+from conformance.case.context import CaseContext, CouldNotTest
 from conformance.known_state.limits import known_axis_limits
 from conformance.link.account import Spent
 from conformance.link.framing import Response, frame

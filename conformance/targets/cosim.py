@@ -27,7 +27,7 @@ from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
 from conformance.protocol.bounded import decimal
-from conformance.quoting import shown
+from conformance.verdicts.quoting import shown
 from gve_fixtures.protocol import SECOND
 
 VERSION = 1

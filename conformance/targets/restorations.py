@@ -14,7 +14,7 @@ from conformance.link.link import MARGIN, Link
 from conformance.link.safety import Guard, TargetNotResponding
 from conformance.targets.as_found import AsFound, read_eeprom
 from conformance.targets.session_report import SessionReport
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 

@@ -35,14 +35,14 @@ from conformance.known_state.failed_steps import Failures, StepFailed, StepFailu
 from conformance.known_state.procedure import KnownState
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response
-from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
-from conformance.targetinfo import TargetInfo
+from conformance.link.signals import Interrupted, Interrupts
 from conformance.targets.as_found import AsFound, read_eeprom, round_trip
+from conformance.targets.info import TargetInfo
 from conformance.targets.restorations import Restorations
 from conformance.targets.session_report import SessionReport
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode, St6
 

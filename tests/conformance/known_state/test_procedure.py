@@ -13,11 +13,11 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.known_state.way_back import WayBack
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 from tests.conformance.cases.used import UsedUnit, used_unit
 from tests.conformance.safety.units import Recorder
 

@@ -11,13 +11,13 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.sides import Side
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
+from conformance.verdicts.verdict import ERROR, FAIL, INFO, NON_STRICT
 from emulator.readings import READINGS
 from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
