@@ -16,8 +16,8 @@ from setuptools import find_namespace_packages, find_packages, setup
 from setuptools.command.build_ext import build_ext
 
 # fixtures/ installs as gve_fixtures; its data folders (profiles/, transcripts/) and the
-# reference host's jobs/ and the report's templates/ are named as packages too, as setuptools asks of every folder
-# that carries package data
+# reference host's jobs/ and the report's templates/ are named as packages too, as
+# setuptools asks of every folder that carries package data
 packages = [*find_packages(include=["emulator*", "conformance*", "gve_host*"]), "gve_host.jobs",
             "conformance.reports.templates",
             "gve_fixtures", *(f"gve_fixtures.{name}" for name in

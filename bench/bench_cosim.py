@@ -14,8 +14,8 @@ import shlex
 import sys
 import time
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import Target, parse_target
 
 GOAL = 3.0

@@ -13,9 +13,9 @@ import argparse
 import subprocess
 import sys
 
-from conformance.catalogue import select
 from conformance.link.account import Spent, suite_share
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
 
 GOAL = 0.25

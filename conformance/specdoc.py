@@ -17,7 +17,7 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from conformance.case import Case
+from conformance.case.context import Case
 from gve_fixtures.rules import Rule, Spec, load_spec
 
 #: where the document lives in a checkout (an installed copy has no docs/: --document)
@@ -74,8 +74,8 @@ def render(spec: Spec, by: dict[str, list[str]]) -> str:
 def current() -> str:
     """The document as the rules file and the registered cases make it now."""
     import conformance.host.oracle  # noqa: F401  (registers the host checks)
-    from conformance.catalogue import select
-    from conformance.coverage import HOST_CHECKS
+    from conformance.run.coverage import HOST_CHECKS
+    from conformance.run.selection import select
     return render(load_spec(), judges(select(), HOST_CHECKS))
 
 

@@ -111,7 +111,7 @@ def test_a_documented_command_parses(where, line, monkeypatch, capsys):
 
 def _plugin_options_exist(words: list[str]) -> None:
     """The plugin's options named in a `python -m pytest` line are the plugin's."""
-    from conformance import plugin
+    from conformance.pytest_plugin import plugin
 
     class Options:
         def __init__(self) -> None:

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
+from conformance.case.preconditions import feature
 from conformance.link.account import Spent
 from conformance.link.framing import Response
 from conformance.link.link import MARGIN
 from conformance.motion.probe import Probe
-from conformance.preconditions import feature
-from conformance.quoting import answer_text
+from conformance.verdicts.quoting import answer_text
 from gve_fixtures.protocol import ErrorCode
 
 
@@ -71,7 +71,7 @@ def setup(ctx: CaseContext, body: str, expect: str = "0", **kw) -> Response | No
 
 def configured(ctx: CaseContext, name: str, *, required: bool = True) -> bool:
     """Setup: the feature ``name`` configured as its manual requires before a case relies
-    on it (conformance/preconditions.toml): every parameter it names read, and one the
+    on it (conformance/case/preconditions.toml): every parameter it names read, and one the
     manual does not allow written and read back (EEPROM: needs --allow-destructive; the
     session puts the bytes back after the case). COULD-NOT-TEST where a write is needed
     and not allowed, or does not take; not ``required``, a write that is not allowed

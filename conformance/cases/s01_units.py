@@ -5,7 +5,7 @@ What distinguishes the GVE54, the GVE84 and the GVE114 and their variants. A pro
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, finished, position, setup, show
 from conformance.protocol.catalogue import commands
 from gve_fixtures.protocol import ErrorCode
@@ -70,8 +70,8 @@ def axes(ctx: CaseContext) -> None:
     setup(ctx, "G")
     finished(ctx, 30)
     want = [start[0] + taken, start[1], start[2]]
-    ctx.expect(position(ctx) == want, f"and X moved {int(taken)} step, Y and Z none",
-               observed=position(ctx), expected=want, rule=fewer)
+    ctx.expect_equal(position(ctx), want, f"and X moved {int(taken)} step, Y and Z none",
+                     rule=fewer)
 
 
 @case("1.profile.interrupt-inputs.wired", rig=True,

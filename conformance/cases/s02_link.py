@@ -4,7 +4,7 @@ The serial line: its format, the addresses on it and who may speak when."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, index, index_moved, setup
 from conformance.link.account import Spent
 from conformance.link.framing import frame

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, setup, show
 from conformance.link.account import Spent
 from gve_fixtures.profile import BaudChoice

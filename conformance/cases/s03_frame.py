@@ -5,7 +5,7 @@ and reads its parameters (syntax is checked before range)."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, setup, show
 from conformance.link.framing import Response
 from gve_fixtures.protocol import ErrorCode

@@ -4,7 +4,7 @@ A code (bit 3 is ST6.INTA), values, an optional checksum, CR."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, halted_with_queue, show
 from gve_fixtures.protocol import ErrorCode
 

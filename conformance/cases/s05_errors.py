@@ -4,7 +4,7 @@ The eight codes of the response and which condition raises which."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,

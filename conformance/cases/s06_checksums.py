@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, setup, show
 from conformance.link.framing import byte_sum
 from gve_fixtures.protocol import ErrorCode

@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -59,8 +59,8 @@ def corrupted_end(ctx: CaseContext) -> None:
     index_moved(ctx, before, 3, "*S, the member and *E counted; the corrupted frame not",
                 rule="8.index.uncounted")
     ctx.link.wait(0.5)
-    ctx.expect(position(ctx) == [0, 0, 0], "nothing was committed", observed=position(ctx),
-               expected=[0, 0, 0], rule="7.packet.bad-checksum-member")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "nothing was committed",
+                     rule="7.packet.bad-checksum-member")
 
 
 @case("7.packet.commits-all",
@@ -71,8 +71,7 @@ def commits(ctx: CaseContext) -> None:
     r = _packet(ctx, ["B500", "C" + vector(ctx, 10), "C" + vector(ctx, 0, 20)], 3)
     answers(ctx, r, "0,3", "a good packet → 0,3", rule="7.packet.exchange")
     finished(ctx, 30)
-    ctx.expect(position(ctx) == [10, 20, 0], "both vectors ran", observed=position(ctx),
-               expected=[10, 20, 0], rule="7.packet.exchange")
+    ctx.expect_equal(position(ctx), [10, 20, 0], "both vectors ran", rule="7.packet.exchange")
 
 
 @case("7.packet.count-mismatch",
@@ -110,8 +109,7 @@ def failed_packet(ctx: CaseContext) -> None:
         answers(ctx, link.send(f"*E{n}"), want, f"{', '.join(members)}, *E{n} → {want}",
                 rule="7.packet.codes")
     link.wait(0.3)
-    ctx.expect(position(ctx) == start, "no C member moved", observed=position(ctx),
-               expected=start, rule="7.packet.all-or-nothing")
+    ctx.expect_equal(position(ctx), start, "no C member moved", rule="7.packet.all-or-nothing")
     code(ctx, link.send("L" + vector(ctx, 0)), ErrorCode.OK,
          "nothing was queued: L0,0,0 → 0 at once",
          rule="7.packet.all-or-nothing")
@@ -152,8 +150,8 @@ def invalid(ctx: CaseContext) -> None:
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
     answers(ctx, r, "4,3", "V inside a packet → 4,3", rule="7.packet.codes")
     ctx.link.wait(1.0)
-    ctx.expect(position(ctx) == [0, 0, 0], "no member was committed", observed=position(ctx),
-               expected=[0, 0, 0], rule="7.packet.all-or-nothing")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "no member was committed",
+                     rule="7.packet.all-or-nothing")
 
 
 @case("7.packet.no-room",

@@ -5,7 +5,7 @@ way to recover a lost answer."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     finished,
@@ -70,8 +70,7 @@ def lost_response(ctx: CaseContext) -> None:
     answers(ctx, r, f"!{link.address}L{vector(ctx, 9)}\r0", "> shows the lost answer",
             rule="8.repeat.remembered" if shows_index else "8.repeat.answer")
     finished(ctx, 30)
-    ctx.expect(position(ctx) == [9, 0, 0], "executed exactly once", observed=position(ctx),
-               expected=[9, 0, 0], rule="8.index.counts")
+    ctx.expect_equal(position(ctx), [9, 0, 0], "executed exactly once", rule="8.index.counts")
 
 
 @case("8.repeat.last-frame-and-answer",

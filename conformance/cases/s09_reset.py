@@ -4,7 +4,7 @@ What power-on and `J` leave."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -49,8 +49,7 @@ def gve54_reset(ctx: CaseContext) -> None:
     fresh_reset(ctx)
     setup(ctx, "L3,0,0")
     finished(ctx, 10)
-    ctx.expect(position(ctx) == [3, 0, 0], "after reset a step is a sixteenth (MF)",
-               observed=position(ctx), expected=[3, 0, 0])
+    ctx.expect_equal(position(ctx), [3, 0, 0], "after reset a step is a sixteenth (MF)")
     answers(ctx, ctx.link.send("MD"), "0", "half current (MD) is a mode it takes")
 
 

@@ -4,7 +4,7 @@ The CONT buffer, stand-alone and continuous vectors."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -45,8 +45,8 @@ def l_busy(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("L" + vector(ctx, 10)), ErrorCode.QUEUE_FULL, "L while a C runs → 1",
          rule="10.1.queue.line-alone")
     finished(ctx, 30)
-    ctx.expect(position(ctx) == [500, 0, 0], "the refused L did not move",
-               observed=position(ctx), expected=[500, 0, 0], rule="10.1.queue.line-alone")
+    ctx.expect_equal(position(ctx), [500, 0, 0], "the refused L did not move",
+                     rule="10.1.queue.line-alone")
 
 
 @case("10.1.line.wait-idiom",
@@ -56,8 +56,7 @@ def idiom(ctx: CaseContext) -> None:
     code(ctx, ctx.link.send("L" + vector(ctx, 0)), ErrorCode.QUEUE_FULL, "L0,0,0 while moving → 1")
     r = ctx.link.poll("L" + vector(ctx, 0), lambda r: r.code != ErrorCode.QUEUE_FULL, 30)
     code(ctx, r, ErrorCode.OK, "L0,0,0 once idle → 0")
-    ctx.expect(position(ctx) == [300, 0, 0], "the first L completed",
-               observed=position(ctx), expected=[300, 0, 0])
+    ctx.expect_equal(position(ctx), [300, 0, 0], "the first L completed")
 
 
 @case("10.1.queue.executing-counts",
@@ -103,7 +102,6 @@ def refused_vector(ctx: CaseContext) -> None:
     moved = [drift, REFUSED_C[1], REFUSED_L[2]]
     expected = None if start is None else [s + m * step_factor(ctx)
                                            for s, m in zip(start, moved, strict=True)]
-    ctx.expect(position(ctx) == expected,
-               "every queued vector ran once, and each refused one only once taken",
-               observed=position(ctx), expected=expected,
-               rule="4.response.failed-not-executed")
+    ctx.expect_equal(position(ctx), expected,
+                     "every queued vector ran once, and each refused one only once taken",
+                     rule="4.response.failed-not-executed")

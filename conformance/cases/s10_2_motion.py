@@ -5,7 +5,7 @@ How a vector is stepped: rates, ramps, junctions, dwell and step placement
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import finished, measured_case, position, setup, vector
 from conformance.motion.probe import Probe
 
@@ -102,8 +102,7 @@ def targets(ctx: CaseContext) -> None:
         setup(ctx, "C" + vector(ctx, *m))
     finished(ctx, 60)
     expected = [sum(m[i] for m in moves) for i in range(3)]
-    ctx.expect(position(ctx) == expected, "the sum of the vectors",
-               observed=position(ctx), expected=expected, rule="10.1.queue.relative")
+    ctx.expect_equal(position(ctx), expected, "the sum of the vectors", rule="10.1.queue.relative")
     ctx.step_train("the step train of the three vectors")
 
 

@@ -4,7 +4,7 @@ ST0..ST6: interrupt enables, polarities, causes, and the stepper's state."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -123,8 +123,7 @@ def interrupt(ctx: CaseContext) -> None:
     link.wait(1.0)
     here = position(ctx)
     link.wait(0.5)
-    ctx.expect(position(ctx) == here, "stopped", observed=position(ctx), expected=here,
-               rule="10.3.inputs.interrupt")
+    ctx.expect_equal(position(ctx), here, "stopped", rule="10.3.inputs.interrupt")
     _in0_was_the_cause(ctx, "ST4 bit 0, INTA", rule="10.3.status.meaning")
 
 
@@ -193,8 +192,7 @@ def sw6(ctx: CaseContext) -> None:
     code(ctx, link.send("L" + vector(ctx, 100)), ErrorCode.OK,
          "L is accepted while INTA = 1", inta=True, rule="10.3.sw6.acts")
     link.wait(0.5)
-    ctx.expect(position(ctx) == [0, 0, 0], "the vector waits for G", observed=position(ctx),
-               expected=[0, 0, 0], rule="10.3.sw6.acts")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "the vector waits for G", rule="10.3.sw6.acts")
     link = ctx.fresh_link()
     halted_line(ctx, 300, 0.1)
     code(ctx, link.send("SW6,00"), ErrorCode.OK,
@@ -202,8 +200,8 @@ def sw6(ctx: CaseContext) -> None:
     r = link.poll("SR6", lambda r: r.values == ["00"], 10)
     ctx.expect(r is not None, "RUN clears when the resumed vector ends", observed=show(r),
                expected="0,00", rule="10.3.sw6.live-bits")
-    ctx.expect(position(ctx) == [300, 0, 0], "the vector resumed to its target",
-               observed=position(ctx), expected=[300, 0, 0], rule="10.3.sw6.acts")
+    ctx.expect_equal(position(ctx), [300, 0, 0], "the vector resumed to its target",
+                     rule="10.3.sw6.acts")
     code(ctx, link.send("L" + vector(ctx, 0)), ErrorCode.OK, "idle again: L0,0,0 → 0",
          rule="10.3.sw6.live-bits")
 

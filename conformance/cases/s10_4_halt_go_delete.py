@@ -4,7 +4,7 @@ Stopping, resuming and discarding motion."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -47,8 +47,7 @@ def delete(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("D"), "0", "D after H")
     answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared")
     ctx.link.wait(1.0)
-    ctx.expect(position(ctx) == here, "position unchanged", observed=position(ctx),
-               expected=here)
+    ctx.expect_equal(position(ctx), here, "position unchanged")
 
 
 @case("10.4.delete.refused-while-moving",
@@ -68,8 +67,7 @@ def go_empty(ctx: CaseContext) -> None:
     answers(ctx, link.send("G"), "0", "G with an empty queue clears INTA")
     answers(ctx, link.send("SR6"), "0,00", "INTA and INTCOM cleared")
     code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "and there is nothing more to resume")
-    ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", observed=position(ctx),
-               expected=[0, 0, 0])
+    ctx.expect_equal(position(ctx), [0, 0, 0], "nothing moved")
 
 
 @case("10.4.go.resumes-exactly",
@@ -85,8 +83,7 @@ def go(ctx: CaseContext) -> None:
                "G that resumes held vectors clears INTA and INTCOM", observed=show(r),
                expected="0,40 (RUN) or 0,00: INTA and INTCOM clear")
     finished(ctx, 60)
-    ctx.expect(position(ctx) == [990, 0, 0], "all three vectors completed",
-               observed=position(ctx), expected=[990, 0, 0])
+    ctx.expect_equal(position(ctx), [990, 0, 0], "all three vectors completed")
 
 
 @case("10.4.halt.answers-when-stopped",
@@ -96,8 +93,7 @@ def halt(ctx: CaseContext) -> None:
     halted_with_queue(ctx)
     first = position(ctx)
     ctx.link.wait(0.5)
-    ctx.expect(position(ctx) == first, "no motion after H's answer",
-               observed=position(ctx), expected=first, rule="10.4.halt.ramp")
+    ctx.expect_equal(position(ctx), first, "no motion after H's answer", rule="10.4.halt.ramp")
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 = INTA+RUN+INTCOM, STOP clear",
                observed=show(r), expected="8,D0", rule="10.3.st6.inta-run")

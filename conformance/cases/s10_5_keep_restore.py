@@ -4,7 +4,7 @@ Saving the queue to lift the tool mid-job and restoring it afterwards."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -62,8 +62,8 @@ def partial(ctx: CaseContext) -> None:
     ctx.link.send("R")
     ctx.link.send("G")
     finished(ctx, 60)
-    ctx.expect(position(ctx) == [990, 0, 0], "the job finished exactly",
-               observed=position(ctx), expected=[990, 0, 0], rule="10.5.restore.exact")
+    ctx.expect_equal(position(ctx), [990, 0, 0], "the job finished exactly",
+                     rule="10.5.restore.exact")
 
 
 @case("10.5.keep.refused-while-moving",
@@ -129,5 +129,4 @@ def save_emptied(ctx: CaseContext) -> None:
     answers(ctx, link.send("R"), "0", "a second R restores the empty save")
     code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "nothing to resume: G → 6")
     link.wait(1.0)
-    ctx.expect(position(ctx) == [1000, 0, 0], "the remainder ran once",
-               observed=position(ctx), expected=[1000, 0, 0])
+    ctx.expect_equal(position(ctx), [1000, 0, 0], "the remainder ran once")

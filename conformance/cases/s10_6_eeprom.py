@@ -4,7 +4,7 @@ The 256 bytes that outlive restarts."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, setup, show, vector
 from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode

@@ -4,7 +4,7 @@ Micro-stepping and current of the GVE54."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -54,9 +54,8 @@ def each_mode(ctx: CaseContext) -> None:
         setup(ctx, "L" + vector(ctx, *MODE_MOVE))
         _rest(ctx)
         want = [s + factor * d for s, d in zip(start, MODE_MOVE, strict=True)]
-        ctx.expect(position(ctx) == want, f"M{mode}: L{vector(ctx, *MODE_MOVE)} ends "
-                   f"{factor} sixteenths a step on", observed=position(ctx), expected=want,
-                   rule="10.7.motor.modes")
+        ctx.expect_equal(position(ctx), want, f"M{mode}: L{vector(ctx, *MODE_MOVE)} ends "
+                         f"{factor} sixteenths a step on", rule="10.7.motor.modes")
         setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
         _rest(ctx)
     setup(ctx, f"M{ms.reset_mode}")
@@ -66,8 +65,8 @@ def each_mode(ctx: CaseContext) -> None:
         setup(ctx, "L" + vector(ctx, *(-d for d in MODE_MOVE)))
         _rest(ctx)
         setup(ctx, f"M{ms.reset_mode}")
-    ctx.expect(position(ctx) == start, "the axes are back where the case found them",
-               observed=position(ctx), expected=start, rule="10.7.motor.modes")
+    ctx.expect_equal(position(ctx), start, "the axes are back where the case found them",
+                     rule="10.7.motor.modes")
 
 
 @case("10.7.microstep.positions-in-sixteenths",
@@ -97,15 +96,15 @@ def motor_busy(ctx: CaseContext) -> None:
     setup(ctx, "L1001,500,399")
     code(ctx, link.send("M4"), ErrorCode.BUSY, "M while moving → 7", rule="10.7.motor.busy")
     finished(ctx, 10)
-    ctx.expect(position(ctx) == [1001, 500, 399], "in MF the counters count the steps",
-               observed=position(ctx), expected=[1001, 500, 399], rule="10.7.motor.any-position")
+    ctx.expect_equal(position(ctx), [1001, 500, 399], "in MF the counters count the steps",
+                     rule="10.7.motor.any-position")
     answers(ctx, link.send("M2"), "0", "a coarser mode at a position not divisible by 8",
             rule="10.7.motor.any-position")
     setup(ctx, "MF")
     setup(ctx, "L-1,0,1")
     finished(ctx, 10)
-    ctx.expect(position(ctx) == [1000, 500, 400], "the manual's example: L-1,0,1",
-               observed=position(ctx), expected=[1000, 500, 400], rule="10.7.motor.any-position")
+    ctx.expect_equal(position(ctx), [1000, 500, 400], "the manual's example: L-1,0,1",
+                     rule="10.7.motor.any-position")
     answers(ctx, link.send("M4"), "0", "then M4", rule="10.7.motor.any-position")
     # halted, the vector's rest held (RUN = 1): nothing moves, so M is taken in our
     # reading of "za chodu" (a unit may refuse it with 7 while RUN = 1)
@@ -178,8 +177,8 @@ def with_motion_commands(ctx: CaseContext) -> None:
         setup(ctx, "H", expect="8")
         stopped = position(ctx)
         setup(ctx, "D")
-        ctx.expect(position(ctx) == stopped, f"M{mode}: D after H leaves the position",
-                   observed=position(ctx), expected=stopped, rule="10.4.delete")
+        ctx.expect_equal(position(ctx), stopped, f"M{mode}: D after H leaves the position",
+                         rule="10.4.delete")
         setup(ctx, "N")
         setup(ctx, "V1000")
         setup(ctx, "L" + vector(ctx, *MODE_MOVE))

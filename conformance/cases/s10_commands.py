@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 from collections.abc import Collection
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import (
     answers,
     code,
@@ -269,8 +269,8 @@ def _answered_after_the_run(ctx: CaseContext, r, body: str, steps: int, rate: in
                expected="RUN (bit 6) clear", rule=rule)
     here = position(ctx)
     ctx.link.wait(0.2)
-    ctx.expect(position(ctx) == here, f"{body}: the counters stand still from its answer on",
-               observed=position(ctx), expected=here, rule=rule)
+    ctx.expect_equal(position(ctx), here, f"{body}: the counters stand still from its answer on",
+                     rule=rule)
 
 
 def _reference(ctx: CaseContext, axis: str, *numbers: int) -> tuple[str, Response | None]:
@@ -303,9 +303,9 @@ def answers_after_travel(ctx: CaseContext) -> None:
         _answered_after_the_run(ctx, r, body, ran, 1000)
         if r is not None and r.code == ErrorCode.RANGE:
             want = [s - 100 * (j == i) for j, s in enumerate(start)]
-            ctx.expect(position(ctx) == want, f"{body}: not found, the axis where the travel "
-                       "ended", observed=position(ctx), expected=want,
-                       rule="10.cmd.reference-fails")
+            ctx.expect_equal(position(ctx), want,
+                             f"{body}: not found, the axis where the travel ended",
+                             rule="10.cmd.reference-fails")
             setup(ctx, "L" + vector(ctx, *[100 * (j == i) for j in range(3)]))
             _settle(ctx)
 
@@ -320,14 +320,15 @@ def inputs(ctx: CaseContext) -> None:
     answers(ctx, r, "5", "X watches IN0, which is not active: not found within 100 steps",
             rule="10.cmd.reference-fails")
     _answered_after_the_run(ctx, r, body, 100, 1000)
-    ctx.expect(position(ctx) == [-100, 0, 0], "X stayed where the travel ended",
-               observed=position(ctx), expected=[-100, 0, 0], rule="10.cmd.reference-fails")
+    ctx.expect_equal(position(ctx), [-100, 0, 0], "X stayed where the travel ended",
+                     rule="10.cmd.reference-fails")
     body, r = _reference(ctx, "Y", -100, 1000, 50, 1000)
     answers(ctx, r, "5", "Y watches IN1, active all the way back: still active after 50 "
             "steps back", rule="10.cmd.reference-switch")
     _answered_after_the_run(ctx, r, body, 50, 1000)
-    ctx.expect(position(ctx) == [-100, 50, 0], "Y stayed 50 steps back from where it found it",
-               observed=position(ctx), expected=[-100, 50, 0], rule="10.cmd.reference-fails")
+    ctx.expect_equal(position(ctx), [-100, 50, 0],
+                     "Y stayed 50 steps back from where it found it",
+                     rule="10.cmd.reference-fails")
     link = ctx.fresh_link()
     link.rig.set_input(1, 0xFF)
     setup(ctx, "SW2,04")                     # Z's input IN2 active at log. 1: it is
@@ -335,8 +336,8 @@ def inputs(ctx: CaseContext) -> None:
     answers(ctx, r, "5", "Z watches IN2 under the polarity rule (active at 1, reads 1)",
             rule="10.cmd.reference-switch")
     _answered_after_the_run(ctx, r, body, 30, 1000)
-    ctx.expect(position(ctx) == [0, 0, 30], "Z found it at once and backed off 30 steps",
-               observed=position(ctx), expected=[0, 0, 30], rule="10.cmd.reference-switch")
+    ctx.expect_equal(position(ctx), [0, 0, 30], "Z found it at once and backed off 30 steps",
+                     rule="10.cmd.reference-switch")
 
 
 @case("10.cmd.reference.to-switch", rig=True, destructive=True, requires=("W",),
@@ -351,15 +352,15 @@ def to_switch(ctx: CaseContext) -> None:
                observed=f"{took} s", expected="at least the 75 ms to the switch",
                rule="2.link.answer-promptly")
     _answered_after_the_run(ctx, r, body, 150, 2000)
-    ctx.expect(position(ctx) == [0, 0, 0], "the counter is 0 where the switch releases",
-               observed=position(ctx), expected=[0, 0, 0], rule="10.cmd.reference")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "the counter is 0 where the switch releases",
+                     rule="10.cmd.reference")
     link.rig.set_switch("X", None)
     link.rig.set_switch("Y", -100)
     answers(ctx, link.send("WY-1000,2000,200,1000"), "0",
             "WY-1000,... (no comma after the axis) is accepted too",
             rule="10.cmd.reference-syntax")
-    ctx.expect(position(ctx) == [0, 0, 0], "Y's counter is 0 where its switch releases",
-               observed=position(ctx), expected=[0, 0, 0], rule="10.cmd.reference")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "Y's counter is 0 where its switch releases",
+                     rule="10.cmd.reference")
 
 
 def _begins_one_it_has(name: str, commands: Collection[str]) -> bool:
@@ -460,11 +461,9 @@ def formats(ctx: CaseContext) -> None:
 def set_axis(ctx: CaseContext) -> None:
     """!0NX100 sets the X counter; !0N zeroes every axis."""
     answers(ctx, ctx.link.send("NX100"), "0", "NX100", rule="10.cmd.set-axis")
-    ctx.expect(position(ctx) == [100, 0, 0], "X = 100", observed=position(ctx),
-               rule="10.cmd.set-axis")
+    ctx.expect_equal(position(ctx), [100, 0, 0], "X = 100", rule="10.cmd.set-axis")
     answers(ctx, ctx.link.send("N"), "0", "N", rule="10.cmd.zero")
-    ctx.expect(position(ctx) == [0, 0, 0], "all zero", observed=position(ctx),
-               rule="10.cmd.zero")
+    ctx.expect_equal(position(ctx), [0, 0, 0], "all zero", rule="10.cmd.zero")
 
 
 #: each axis's own count in the read-back moves (commanded steps): different sizes and
@@ -516,15 +515,15 @@ def each_axis(ctx: CaseContext) -> None:
             counts = _move(ctx, kind, axes, 1)
             want = [s + scale * c for s, c in zip(start, counts, strict=False)]
             names = "".join(ctx.profile.axes[i] for i in axes)
-            ctx.expect(position(ctx) == want, f"{kind} moving {names}: PF", observed=position(ctx),
-                       expected=want, rule="10.cmd.positions")
+            ctx.expect_equal(position(ctx), want, f"{kind} moving {names}: PF",
+                             rule="10.cmd.positions")
             r = ctx.link.send("P")
             ctx.expect(r is not None and r.ok and r.values == [str(v) for v in want[:2]],
                        f"{kind} moving {names}: P", observed=show(r),
                        expected="0,%d,%d" % tuple(want[:2]), rule="10.cmd.positions")
             _move(ctx, kind, axes, -1)
-            ctx.expect(position(ctx) == start, f"{kind} moving {names} back",
-                       observed=position(ctx), expected=start, rule="10.cmd.vector")
+            ctx.expect_equal(position(ctx), start, f"{kind} moving {names} back",
+                             rule="10.cmd.vector")
 
 
 def _rig_axes(ctx: CaseContext, key: str) -> list[int]:

@@ -9,14 +9,14 @@ import math
 import re
 from pathlib import Path
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import configured
 from conformance.link.account import Spent
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import BeyondEnvelope, Guard
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
-from conformance.quoting import shown
+from conformance.verdicts.quoting import shown
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import TAGS

@@ -4,7 +4,7 @@ The spindle speed the GVE114 takes at address 7."""
 
 from __future__ import annotations
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, show
 from conformance.motion.probe import Probe
 from gve_fixtures.protocol import ErrorCode
@@ -25,11 +25,12 @@ def address_7(ctx: CaseContext) -> None:
     link = ctx.link
     speed = "12.spindle.speed"
     answers(ctx, link.send("V300", address=7), "0", "!7V300", rule=speed)
-    ctx.expect(link.rig.spindle() == 300, "spindle 300", observed=link.rig.spindle(),
-               rule=speed)
-    ctx.expect(link.rig.outputs() & 1 == 0, "OUT0 on", observed=link.rig.outputs(), rule=speed)
+    ctx.expect_equal(link.rig.spindle(), 300, "spindle 300", rule=speed)
+    outputs = link.rig.outputs()
+    ctx.expect(outputs & 1 == 0, "OUT0 on", observed=outputs, rule=speed)
     answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)
-    ctx.expect(link.rig.outputs() & 1 == 1, "OUT0 off", observed=link.rig.outputs(), rule=speed)
+    outputs = link.rig.outputs()
+    ctx.expect(outputs & 1 == 1, "OUT0 off", observed=outputs, rule=speed)
     code(ctx, link.send("L1,0,0", address=7), ErrorCode.UNKNOWN, "address 7 takes no vectors",
          rule="12.spindle.commands")
     # and serves the EEPROM's reads as address 0 does (its commands, spec 12)
@@ -59,8 +60,8 @@ def spindle_unchanged(ctx: CaseContext) -> None:
     answers(ctx, link.send("V300", address=7), "0", "!7V300", rule="12.spindle.speed")
     for feed in ("V40", "V2000", "V1000"):
         answers(ctx, link.send(feed), "0", f"!0{feed}", rule=rule)
-        ctx.expect(link.rig.spindle() == 300, f"the spindle still at 300 after !0{feed}",
-                   observed=link.rig.spindle(), expected=300, rule=rule)
+        ctx.expect_equal(link.rig.spindle(), 300, f"the spindle still at 300 after !0{feed}",
+                         rule=rule)
     answers(ctx, link.send("V0", address=7), "0", "!7V0", rule="12.spindle.speed")
 
 
@@ -74,20 +75,22 @@ def range_ends(ctx: CaseContext) -> None:
     speed = "12.spindle.speed"
     for value in (r.lo + 1, r.hi, r.lo, r.hi, r.lo + 1, r.lo):
         answers(ctx, link.send(f"V{value}", address=7), "0", f"!7V{value}", rule=speed)
-        ctx.expect(link.rig.spindle() == value, f"!7V{value}: the spindle at {value}",
-                   observed=link.rig.spindle(), expected=value, rule=speed)
+        ctx.expect_equal(link.rig.spindle(), value, f"!7V{value}: the spindle at {value}",
+                         rule=speed)
         on = value > 0
-        ctx.expect(link.rig.outputs() & 1 == (0 if on else 1),
+        outputs = link.rig.outputs()
+        ctx.expect(outputs & 1 == (0 if on else 1),
                    f"!7V{value}: OUT0 {'on' if on else 'off'}",
-                   observed="%02X" % link.rig.outputs(),
+                   observed="%02X" % outputs,
                    expected=f"OUT0 {'on (bit 0 = 0)' if on else 'off (bit 0 = 1)'}",
                    rule=speed)
     answers(ctx, link.send(f"V{r.hi}", address=7), "0", f"!7V{r.hi}", rule=speed)
     for beyond in (r.hi + 1, r.lo - 1):
         code(ctx, link.send(f"V{beyond}", address=7), ErrorCode.RANGE, f"!7V{beyond} → 5",
              rule="5.code.range")
-        ctx.expect(link.rig.spindle() == r.hi and link.rig.outputs() & 1 == 0,
+        spindle, outputs = link.rig.spindle(), link.rig.outputs()
+        ctx.expect(spindle == r.hi and outputs & 1 == 0,
                    f"the refused !7V{beyond} left the spindle at {r.hi}, OUT0 on",
-                   observed=f"{link.rig.spindle()}, outputs {link.rig.outputs():02X}",
+                   observed=f"{spindle}, outputs {outputs:02X}",
                    expected=f"{r.hi}, bit 0 clear", rule=speed)
     answers(ctx, link.send("V0", address=7), "0", "!7V0", rule=speed)

@@ -16,7 +16,7 @@ import sys
 
 from conformance.cli.commands import SUBCOMMANDS
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.interrupts import Interrupts
+from conformance.link.signals import Interrupts
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -14,7 +14,7 @@ import os
 from collections.abc import Mapping
 from typing import TextIO
 
-from conformance.verdict import (
+from conformance.verdicts.verdict import (
     COULD_NOT_TEST,
     ERROR,
     FAIL,

@@ -25,8 +25,8 @@ from pathlib import Path
 from conformance.cli.pool import gate_end, workers
 from conformance.cli.progress import Progress
 from conformance.cli.usage import INTERRUPTED, Parser, UsageError, add_loudness, positive, summary
-from conformance.verdict import CHECK_TAGS, FAIL
-from conformance.verdict import grade as grade_of
+from conformance.verdicts.verdict import CHECK_TAGS, FAIL
+from conformance.verdicts.verdict import grade as grade_of
 
 PROG = "gve-conformance corpus"
 #: the corpus's manifest, from a checkout's top

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from conformance.check import Check
+from conformance.case.settings import fresh_seed
 from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
 from conformance.cli.progress import Progress
@@ -30,15 +30,15 @@ from conformance.diff.reach import Reach
 from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
-from conformance.link.interrupts import Interrupts
 from conformance.link.safety import SafetyStop, TargetNotResponding
-from conformance.metadata import RunMeta, now_iso
-from conformance.operator import Console
+from conformance.link.signals import Interrupts
+from conformance.operator.console import Console
 from conformance.reports.files import release
-from conformance.runner import RunResult, step_results
-from conformance.settings import fresh_seed
+from conformance.run.metadata import RunMeta, now_iso
+from conformance.run.runner import RunResult, step_results
 from conformance.targets import DEFAULT_MAX_TRAVEL, SessionError, Target, TargetError, parse_target
-from conformance.verdict import ALWAYS, COULD_NOT_TEST, FAIL, SILENT, CouldNotTest
+from conformance.verdicts.check import Check
+from conformance.verdicts.verdict import ALWAYS, COULD_NOT_TEST, FAIL, SILENT, CouldNotTest
 
 PROG = "gve-conformance diff"
 #: sequences tried when neither --examples nor --seconds is given

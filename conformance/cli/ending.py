@@ -17,8 +17,8 @@ from conformance.cli.usage import UsageError, verdict_status
 from conformance.reports import ReportNotWritten, write_junit, write_reports
 from conformance.reports.failures import failures
 from conformance.reports.files import RunFolderTaken, claim, new_run_id
-from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ERROR, FAIL, MISSING, NON_STRICT, ORDER, last_line, overall
+from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.verdict import ERROR, FAIL, MISSING, NON_STRICT, ORDER, last_line, overall
 
 __all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
            "written"]

@@ -30,7 +30,7 @@ from conformance.cli.usage import (
     summary,
 )
 from conformance.link.framing import readable
-from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
+from conformance.verdicts.verdict import ERROR, FAIL, INFO, NON_STRICT
 
 PROG = "gve-conformance fairness"
 #: one profile per family for the readings one at a time
@@ -62,10 +62,10 @@ class Trial:
 def trial(reading: str, readings: list[str], profiles: list[str],
           include: list[str] | None) -> Trial:
     """Run the catalogue on ``profiles`` with the emulator taking ``readings``."""
-    from conformance.catalogue import select
-    from conformance.explain import reason
-    from conformance.runner import run_case
+    from conformance.run.runner import run_case
+    from conformance.run.selection import select
     from conformance.targets import parse_target
+    from conformance.verdicts.explain import reason
     result = Trial(reading, profiles)
     start = time.perf_counter()
     for p in profiles:

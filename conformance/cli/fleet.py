@@ -42,11 +42,11 @@ from pathlib import Path
 from conformance.cli.ending import recap, say_all, written
 from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import INTERRUPTED, verdict_status
-from conformance.link.interrupts import Interrupts
+from conformance.link.signals import Interrupts
 from conformance.reports.files import ReportNotWritten, write_text
-from conformance.runner import CaseResult, RunResult
+from conformance.run.runner import CaseResult, RunResult
 from conformance.targets import Target
-from conformance.verdict import FAILED, INCOMPLETE, ORDER, PASSED
+from conformance.verdicts.verdict import FAILED, INCOMPLETE, ORDER, PASSED
 
 SUMMARY_JSON = "summary.json"
 INDEX_HTML = "index.html"

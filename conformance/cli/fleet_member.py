@@ -19,7 +19,7 @@ import threading
 from pathlib import Path
 
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.interrupts import Interrupts
+from conformance.link.signals import Interrupts
 
 
 def _fleet_gone() -> None:

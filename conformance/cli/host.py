@@ -27,15 +27,15 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.explain import reason
 from conformance.host.certify import HostStartError, Plan, certify
 from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.host.units import load_units
-from conformance.operator import Console
+from conformance.operator.console import Console
 from conformance.reports.files import release
-from conformance.runner import CaseResult
-from conformance.verdict import PASS
+from conformance.run.runner import CaseResult
+from conformance.verdicts.explain import reason
+from conformance.verdicts.verdict import PASS
 from gve_fixtures.profile import Profile, ProfileError
 
 #: where the played unit is served to the host (--port), for --help

@@ -33,7 +33,7 @@ from conformance.cli.usage import (
     positive,
     summary,
 )
-from conformance.verdict import ERROR, FAIL
+from conformance.verdicts.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
 #: profiles tried first, one per family; the others follow
@@ -79,8 +79,8 @@ def hunt(mutant: str, profiles: list[str] | None = None,
          include: list[str] | None = None, sweep: bool = False) -> Hunt:
     """Run cases against ``mutant`` until one FAILs (see the module's text); with
     ``sweep`` go on through the catalogue on one profile per family, noting ERRORs."""
-    from conformance.catalogue import select
-    from conformance.runner import run_case
+    from conformance.run.runner import run_case
+    from conformance.run.selection import select
     from conformance.targets import emu, parse_target
     area, description = emu.mutants()[mutant]
     result = Hunt(mutant, area, description)
@@ -130,7 +130,7 @@ _CLEAN: dict[tuple[str, str], tuple[str, frozenset[str]]] = {}
 def clean_run(case, clean) -> tuple[str, frozenset[str]]:
     """The verdict of ``case`` on the clean emulator ``clean`` and the mutants whose code
     it reached (run once per process: the runs are exact)."""
-    from conformance.runner import run_case
+    from conformance.run.runner import run_case
     from conformance.targets.emu import mutants_reached
     key = (case.id, clean.info.spec)
     if key not in _CLEAN:

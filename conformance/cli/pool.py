@@ -29,8 +29,8 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.interrupts import STOPPING, Interrupts
-from conformance.verdict import FAILED, PASSED
+from conformance.link.signals import STOPPING, Interrupts
+from conformance.verdicts.verdict import FAILED, PASSED
 
 #: how long the workers may take to end once stopped, before they are killed
 ENDING_SECONDS = 10.0

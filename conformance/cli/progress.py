@@ -31,9 +31,9 @@ from typing import TextIO
 from tqdm import tqdm
 
 from conformance.cli.colour import paint
-from conformance.explain import reason
-from conformance.runner import CaseResult
-from conformance.verdict import MISSING, PASS, UNTESTED
+from conformance.run.runner import CaseResult
+from conformance.verdicts.explain import reason
+from conformance.verdicts.verdict import MISSING, PASS, UNTESTED
 
 #: verdicts a terminal does not show a line for (the bar counts them)
 _ROUTINE = (PASS, MISSING)
@@ -46,7 +46,7 @@ HEARTBEAT = 5.0
 
 def describe(r: CaseResult, colour: bool = False) -> str:
     """One console line for a result: its verdict, ID, profile and why it is not a PASS
-    (the deciding check's rule, tag, what was seen and wanted: conformance/explain.py)."""
+    (the deciding check's rule, tag, what was seen and wanted: conformance/verdicts/explain.py)."""
     line = f"{paint(r.verdict, f'{r.verdict:15}', colour)} {r.id} [{r.profile}]"
     if r.verdict != PASS and (r.verdict not in UNTESTED or r.notes):
         line += f"  -- {reason(r).line()}"

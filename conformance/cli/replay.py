@@ -24,10 +24,10 @@ from conformance.diff.engine import Pair
 from conformance.diff.gvt import expected_of, steps_of
 from conformance.diff.replayed import Verdict, frame_lines, header, verdict
 from conformance.diff.sides import Side
-from conformance.link.interrupts import Interrupts
 from conformance.link.safety import TargetNotResponding
+from conformance.link.signals import Interrupts
 from conformance.targets import SessionError, TargetError
-from conformance.verdict import FAIL, FAILED, PASSED
+from conformance.verdicts.verdict import FAIL, FAILED, PASSED
 from gve_fixtures.transcript import TranscriptError, load
 
 PROG = "gve-conformance replay"

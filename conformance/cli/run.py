@@ -15,7 +15,7 @@ from pathlib import Path
 
 from serial import SerialException
 
-from conformance.catalogue import select
+from conformance.case.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
 from conformance.cli.colour import wanted
 from conformance.cli.commands import subcommands_help
 from conformance.cli.ending import claimed, counted, end, new_run_id
@@ -37,16 +37,16 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.consent import ASKED
-from conformance.coverage import coverage, format_coverage
 from conformance.link.account import account_lines
-from conformance.metadata import RunMeta, now_iso
-from conformance.operator import Console
-from conformance.quoting import escaped
+from conformance.operator.consent import ASKED
+from conformance.operator.console import Console
 from conformance.reports.files import release
-from conformance.runner import RunResult, run, settings_for
-from conformance.settings import DEFAULT_DATABASE, PROFILES, example_database, run_seed
+from conformance.run.coverage import coverage, format_coverage
+from conformance.run.metadata import RunMeta, now_iso
+from conformance.run.runner import RunResult, run, settings_for
+from conformance.run.selection import select
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
+from conformance.verdicts.quoting import escaped
 from gve_fixtures.profile import ProfileError, available_profiles
 
 PROG = "gve-conformance"

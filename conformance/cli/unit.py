@@ -5,14 +5,14 @@ move on a real unit."""
 from __future__ import annotations
 
 from conformance.cli.usage import UsageError
-from conformance.consent import Consent, NoConsent
-from conformance.metadata import RunMeta
-from conformance.operator import Console
-from conformance.quoting import shown
-from conformance.targetinfo import EMULATOR
+from conformance.operator.consent import Consent, NoConsent
+from conformance.operator.console import Console
+from conformance.run.metadata import RunMeta
 from conformance.targets import Target
 from conformance.targets.identify import ask, bauds, choose, of_target, variant_of
+from conformance.targets.info import EMULATOR
 from conformance.targets.port import locate
+from conformance.verdicts.quoting import shown
 from gve_fixtures.profile import Profile
 
 AUTO = "auto"
@@ -62,7 +62,7 @@ def record_identities(targets: list[Target], meta: RunMeta) -> None:
 
 
 def consent(yes: bool, console: Console, meta: RunMeta) -> Consent:
-    """The run's consent to motion (conformance/consent.py), its answer into ``meta``."""
+    """The run's consent to motion (conformance/operator/consent.py), its answer into ``meta``."""
     return Consent(yes, console, answered=lambda how: setattr(meta, "confirmed", how))
 
 

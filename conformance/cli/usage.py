@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from conformance.verdict import INCOMPLETE, PASSED
+from conformance.verdicts.verdict import INCOMPLETE, PASSED
 
 #: the longest --seconds / --host-timeout taken: a day (a typo of many zeros is a mistake)
 LONGEST_SECONDS = 86400.0

@@ -35,7 +35,7 @@ from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, ErrorCode, St6
 

@@ -21,7 +21,7 @@ from conformance.diff.results import finding_result
 from conformance.link.framing import readable
 from conformance.reports import write_reports
 from conformance.reports.files import ReportNotWritten
-from conformance.runner import RunResult
+from conformance.run.runner import RunResult
 
 #: the file of events, one JSON object a line
 EVENTS = "findings.jsonl"

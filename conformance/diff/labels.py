@@ -13,7 +13,7 @@ from functools import cache
 from pathlib import Path
 
 from conformance.protocol.parse import parse
-from conformance.verdict import INFO, grade
+from conformance.verdicts.verdict import INFO, grade
 from gve_fixtures.rules import load_rules
 
 LABELS_FILE = Path(__file__).with_name("labels.toml")

@@ -12,7 +12,7 @@ from conformance.diff.compare import TIMING, delays
 from conformance.diff.engine import Disagreement, ExampleRun, StepRecord
 from conformance.diff.steps import FILL, FRAME, INPUT, Step
 from conformance.link.framing import readable
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 
 #: the sides agree on every answer: what the last line says, and the exit status
 AGREE = "the target answers as the reference does"

@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import re
 
-from conformance.check import Check
 from conformance.diff.compare import TIMING, delays
 from conformance.diff.engine import Finding
 from conformance.link.framing import readable
-from conformance.quoting import answer_text, quoted
-from conformance.runner import CaseResult
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.run.runner import CaseResult
+from conformance.verdicts.check import Check
+from conformance.verdicts.quoting import answer_text, quoted
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures.rules import load_rules
 
 

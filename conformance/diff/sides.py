@@ -19,7 +19,7 @@ from conformance.link.link import Link
 from conformance.link.virtual import line_of
 from conformance.targets import Session, Target
 from conformance.targets.session import EmuSession
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 
 
 @dataclass

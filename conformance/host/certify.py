@@ -32,10 +32,10 @@ from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.units import open_line
 from conformance.host.unitview import line_views, profiles_by_address
-from conformance.link.interrupts import STOPPING, Interrupts
-from conformance.metadata import now_iso
-from conformance.runner import RunResult
-from conformance.verdict import COULD_NOT_TEST, MISSING
+from conformance.link.signals import STOPPING, Interrupts
+from conformance.run.metadata import now_iso
+from conformance.run.runner import RunResult
+from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING
 from gve_fixtures.profile import Profile
 
 #: the longest a clean run may take, and the slack a fault run gets over the clean one

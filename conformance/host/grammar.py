@@ -18,7 +18,7 @@ from conformance.protocol.bounded import decimal, hexadecimal
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from conformance.protocol.parse import parse
 from conformance.protocol.wire import HEX_BYTE, byte_sum
-from conformance.quoting import escaped
+from conformance.verdicts.quoting import escaped
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import MAX_FRAME
 from gve_fixtures.rules import load_rules

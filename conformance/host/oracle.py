@@ -21,8 +21,6 @@ import difflib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from conformance.check import Check
-from conformance.coverage import register_host_check
 from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
 from conformance.host.faults import Fault
 from conformance.host.probe import Final
@@ -30,8 +28,10 @@ from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.unitview import VECTORS, Executed, UnitView
 from conformance.protocol.catalogue import classes
-from conformance.runner import CaseResult
-from conformance.verdict import COULD_NOT_TEST, PASS, grade, worst
+from conformance.run.coverage import register_host_check
+from conformance.run.runner import CaseResult
+from conformance.verdicts.check import Check
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS, grade, worst
 from gve_fixtures.rules import load_rules
 
 NS = 1e9

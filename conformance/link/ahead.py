@@ -14,9 +14,9 @@ judged and booked by the run's guard as it is sent.
 
 from __future__ import annotations
 
-from conformance.link.interrupts import Interrupted
 from conformance.link.link import Link
 from conformance.link.safety import Body, SafetyStop, TargetNotResponding
+from conformance.link.signals import Interrupted
 from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
 

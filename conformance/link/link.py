@@ -57,8 +57,8 @@ from conformance.link.framing import (
     readable,
     shown_bytes,
 )
-from conformance.link.interrupts import Interrupted
 from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding
+from conformance.link.signals import Interrupted
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol import index
 from conformance.protocol.catalogue import classes

@@ -7,7 +7,7 @@ ends COULD-NOT-TEST) a frame that could take an axis beyond ``max_travel`` full 
 from where the run began (the :class:`~conformance.link.envelope.Envelope` keeps that for
 the whole run), `J`, `W` and EEPROM writes without ``allow_destructive``, an EEPROM write
 to a byte the session did not back up, and motion or destructive frames for an address
-that is not the unit's. It raises :class:`~conformance.link.interrupts.Interrupted`
+that is not the unit's. It raises :class:`~conformance.link.signals.Interrupted`
 before any frame once Ctrl-C was pressed (except the session's `H`, `D` and
 restorations), and :class:`TargetNotResponding` after a few frames in a row got no
 answer.
@@ -53,8 +53,8 @@ from conformance.link.envelope import (
     point,
 )
 from conformance.link.framing import HostFrame, Response
-from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.ledger import EepromLedger
+from conformance.link.signals import Interrupted, Interrupts
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.parse import parse

@@ -8,12 +8,12 @@ from collections.abc import Callable
 
 from hypothesis.stateful import RuleBasedStateMachine, invariant
 
-from conformance.case import CaseContext
+from conformance.case.context import CaseContext
 from conformance.link.framing import Response
 from conformance.link.link import MARGIN
 from conformance.model.unit import ModelUnit
 from conformance.protocol.parse import parse
-from conformance.quoting import as_text
+from conformance.verdicts.quoting import as_text
 from gve_fixtures.protocol import ErrorCode
 
 #: a frame every unit refuses and none can store (no command of spec 10 begins with Z)
@@ -24,7 +24,7 @@ class Broken(AssertionError):
     """A machine's invariant that failed, with the rule it checks: graded by that
     rule's tag, as a directed case's check is; what the unit did and what the rule
     wants where the machine knows them (written as a directed case's check writes them:
-    conformance/quoting.py)."""
+    conformance/verdicts/quoting.py)."""
 
     def __init__(self, rule: str, message: str, observed: object = None,
                  expected: object = None) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import strategies as st
 from hypothesis.stateful import rule
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.link.framing import byte_sum
 from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
 from conformance.machines.base import UnitMachine, holds
 from conformance.machines.runner import run_machine

@@ -20,7 +20,7 @@ from typing import NamedTuple
 from hypothesis import strategies as st
 from hypothesis.stateful import precondition, rule
 
-from conformance.case import CaseContext, case
+from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
 from conformance.link.line_band import line_band
 from conformance.link.link import idle_st6

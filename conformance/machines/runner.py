@@ -8,11 +8,11 @@ from hypothesis import seed
 from hypothesis.errors import Flaky, FlakyFailure
 from hypothesis.stateful import run_state_machine_as_test
 
-from conformance import settings as settings_profiles
-from conformance.case import CaseContext, CouldNotTest
+from conformance.case import settings as settings_profiles
+from conformance.case.context import CaseContext, CouldNotTest
 from conformance.link.framing import UnitDataError
 from conformance.machines.base import UnitMachine
-from conformance.verdict import ALWAYS, UNREADABLE
+from conformance.verdicts.verdict import ALWAYS, UNREADABLE
 
 
 class Factory:

@@ -19,8 +19,8 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
-from conformance.case import CaseContext, CouldNotTest
-from conformance.known_state import known_axis_limits
+from conformance.case.context import CaseContext, CouldNotTest
+from conformance.known_state.limits import known_axis_limits
 from conformance.link.account import Spent
 from conformance.link.framing import Response, frame
 from conformance.link.line_band import EXACT, LineBand, acted_within, line_band

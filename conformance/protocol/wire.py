@@ -35,14 +35,14 @@ def is_hex_byte(text: str, either_case: bool = False) -> bool:
 def readable(data: bytes) -> str:
     """Bytes as text for people: printable ASCII as itself, the rest escaped as in
     transcripts (``\\r``, ``\\x00``), so no raw control byte reaches a report (the one
-    way every room shows them: conformance/quoting.py)."""
+    way every room shows them: conformance/verdicts/quoting.py)."""
     return "".join(chr(b) if 0x20 <= b <= 0x7E and b != 0x5C else escape(bytes([b]))
                    for b in data)
 
 
 def shown_bytes(data: bytes, limit: int = 200) -> str:
     """A unit's bytes in a message: their first ``limit`` escaped, in double quotes,
-    ``...`` when there were more (what conformance/quoting.py's ``shown`` gives bytes)."""
+    ``...`` when there were more (what conformance/verdicts/quoting.py's ``shown`` gives bytes)."""
     return f'"{readable(data[:limit])}{"..." if len(data) > limit else ""}"'
 
 

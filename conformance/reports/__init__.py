@@ -15,7 +15,7 @@ from conformance.reports.html import render_html
 from conformance.reports.junit import render_junit, write_junit
 from conformance.reports.logs import compact, compact_checks, compact_traces
 from conformance.reports.sections import section_key, section_name
-from conformance.runner import RunResult
+from conformance.run.runner import RunResult
 
 __all__ = ["ReportNotWritten", "render_html", "render_junit", "to_json", "write_junit",
            "write_reports"]

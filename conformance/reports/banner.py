@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from conformance.runner import RunResult
-from conformance.verdict import overall
+from conformance.run.runner import RunResult
+from conformance.verdicts.verdict import overall
 
 
 def run_verdict(run: RunResult, target: str | None = None) -> tuple[str, str]:

@@ -1,6 +1,6 @@
 """What failed, first: per case that did not pass (FAIL, ERROR, NON-STRICT) why — the
 check that decided its verdict, what the unit did, what the rule wants, the rule and the
-sentence it cites (conformance/explain.py) — for the list at the top of the HTML page
+sentence it cites (conformance/verdicts/explain.py) — for the list at the top of the HTML page
 and the recap at the end of a run. A case failing the same way on several profiles is
 one entry naming each of them."""
 
@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from conformance.explain import Reason, reason
-from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ERROR, FAIL, NON_STRICT, ORDER
+from conformance.verdicts.explain import Reason, reason
+from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.verdict import ERROR, FAIL, NON_STRICT, ORDER
 
 #: the verdicts the list shows, worst first
 LISTED = (ERROR, FAIL, NON_STRICT)

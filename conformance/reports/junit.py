@@ -14,7 +14,7 @@ spec section. CI tools know only pass, fail, error and skip (docs/ci.md):
   the one state a dashboard shows that is neither a pass nor a failure, with its text;
 - COULD-NOT-TEST and MISSING are ``skipped`` with their reason.
 
-Every message is the verdict and why (conformance/explain.py: the deciding check's rule,
+Every message is the verdict and why (conformance/verdicts/explain.py: the deciding check's rule,
 tag, what was seen and wanted); the ``system-out`` of a case that did not PASS adds the
 rule's sentence and its source, then the wire log. Every text goes through
 :func:`clean`, so any bytes from a unit leave the file well-formed."""
@@ -25,14 +25,14 @@ import datetime
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from conformance.explain import reason
+from conformance.verdicts.explain import reason
 from conformance.reports.banner import run_verdict
 from conformance.reports.files import write_text
 from conformance.reports.logs import compact
 from conformance.reports.sections import section_title
 from conformance.reports.text import clean
-from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, ORDER, PASS
+from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, ORDER, PASS
 
 #: verdicts a CI sees as skipped (unless --strict makes NON-STRICT a failure)
 SKIPPED = (NON_STRICT, INFO, COULD_NOT_TEST, MISSING)

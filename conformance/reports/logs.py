@@ -5,8 +5,8 @@ them) and no trace data (the page draws its traces). ``--full-logs`` keeps every
 
 from __future__ import annotations
 
-from conformance.check import Check
-from conformance.verdict import PASS
+from conformance.verdicts.check import Check
+from conformance.verdicts.verdict import PASS
 
 #: lines kept at each end of a passing case's wire log (its first frame, its last answer)
 LOG_ENDS = 1

@@ -7,8 +7,8 @@ not be)."""
 from __future__ import annotations
 
 from conformance.reports.banner import run_verdict
-from conformance.runner import RunResult
-from conformance.targetinfo import EMULATOR
+from conformance.run.runner import RunResult
+from conformance.targets.info import EMULATOR
 
 HEADERS = ("target", "profile", "firmware (`?`)", "processor id (`Q`)",
            "motion envelope (full steps per axis)", "largest excursion (full steps)",

@@ -7,9 +7,9 @@ run-wide session (session.py) opens links and keeps the unit safe."""
 
 from __future__ import annotations
 
-from conformance.targetinfo import EMULATOR
 from conformance.targets import emu, port, process
 from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
+from conformance.targets.info import EMULATOR
 from conformance.targets.session import Session, SessionError, SessionReport
 from gve_fixtures.profile import Profile
 

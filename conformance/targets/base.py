@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import serial
 
-from conformance.link.interrupts import Interrupts
 from conformance.link.link import Link
-from conformance.targetinfo import TargetInfo
+from conformance.link.signals import Interrupts
+from conformance.targets.info import TargetInfo
 from conformance.targets.session import Session, open_session
 from gve_fixtures.profile import Profile
 

@@ -27,7 +27,7 @@ from typing import NoReturn, Protocol
 
 from conformance.link.safety import TargetNotResponding
 from conformance.protocol.bounded import decimal
-from conformance.quoting import shown
+from conformance.verdicts.quoting import shown
 from gve_fixtures.protocol import SECOND
 
 VERSION = 1
@@ -90,12 +90,68 @@ def byte_ns(baud: int) -> int:
     return round(10 * SECOND / baud)
 
 
+class Conversation:
+    """One command and its reply at a time with the simulator's program: the line is
+    broken for good from the first reply that breaks the protocol (or a reply cut off),
+    saying why."""
+
+    def __init__(self, program: Channel) -> None:
+        self.program = program
+        self.broken = ""
+
+    def fail(self, why: str) -> NoReturn:
+        self.broken = self.broken or f"the co-simulator broke the protocol: {why}"
+        raise ProtocolBroken(self.broken)
+
+    def usable(self) -> None:
+        if self.broken:
+            raise ProtocolBroken(self.broken)
+
+    def send(self, command: str) -> None:
+        if not self.program.send(command):
+            self.ended(command)
+
+    @contextlib.contextmanager
+    def exchange(self, command: str) -> Iterator[None]:
+        """One command and its whole reply; a reply left half read (a third Ctrl-C,
+        an error of the suite) would be taken for the next command's: the line is broken
+        from then on, saying so."""
+        self.usable()
+        done = False
+        try:
+            self.send(command)
+            yield
+            done = True
+        finally:
+            if not done and not self.broken:
+                self.broken = (f"the exchange {command!r} was cut off before its reply was "
+                               "read: the co-simulation cannot go on")
+
+    def ended(self, command: str) -> NoReturn:
+        self.program.wait(1.0)
+        ended = self.program.ended()
+        self.broken = (f"the target's program ended: {ended}" if ended else
+                       f"the co-simulator stopped reading its input at {command!r}")
+        raise ProtocolBroken(self.broken)
+
+    def reply(self, command: str, deadline: float, said: str) -> str:
+        text = self.program.line(max(0.0, deadline - time.monotonic()))
+        if text is None:
+            if not self.program.alive or self.program.wait(0.2):
+                self.ended(command)
+            self.fail(f"no reply to {command!r} within {REPLY_SECONDS:g} s" if not said
+                        else f"after {command!r} it sent {shown(said, 120)} and then nothing "
+                        f"within {REPLY_SECONDS:g} s (no `now`)")
+        return text
+
+
 class CosimLine:
     """The simulator's line, driven in virtual time (see the module's docstring)."""
 
     def __init__(self, program: Channel, baud: int, extensions: frozenset[str] = frozenset()
                  ) -> None:
         self.program = program
+        self.talk = Conversation(program)
         self.extensions = extensions
         self.baud = baud
         self.byte_ns = byte_ns(baud)
@@ -108,70 +164,28 @@ class CosimLine:
         self._inflight: tuple[str, int, int, int] | None = None
         #: frames told ahead whose reply is not read yet (tell): the command, its plan
         self._told: tuple[str, list[tuple[bytes, int]]] | None = None
-        self.broken = ""
 
-    # -- the channel -------------------------------------------------------------------------
-    def _break(self, why: str) -> NoReturn:
-        self.broken = self.broken or f"the co-simulator broke the protocol: {why}"
-        raise ProtocolBroken(self.broken)
-
-    def _usable(self) -> None:
-        if self.broken:
-            raise ProtocolBroken(self.broken)
-
-    def _send(self, command: str) -> None:
-        if not self.program.send(command):
-            self._ended(command)
-
-    @contextlib.contextmanager
-    def _exchange(self, command: str) -> Iterator[None]:
-        """One command and its whole reply; a reply left half read (a third Ctrl-C,
-        an error of the suite) would be taken for the next command's: the line is broken
-        from then on, saying so."""
-        self._usable()
-        done = False
-        try:
-            self._send(command)
-            yield
-            done = True
-        finally:
-            if not done and not self.broken:
-                self.broken = (f"the exchange {command!r} was cut off before its reply was "
-                               "read: the co-simulation cannot go on")
-
-    def _ended(self, command: str) -> NoReturn:
-        self.program.wait(1.0)
-        ended = self.program.ended()
-        self.broken = (f"the target's program ended: {ended}" if ended else
-                       f"the co-simulator stopped reading its input at {command!r}")
-        raise ProtocolBroken(self.broken)
-
-    def _reply(self, command: str, deadline: float, said: str) -> str:
-        text = self.program.line(max(0.0, deadline - time.monotonic()))
-        if text is None:
-            if not self.program.alive or self.program.wait(0.2):
-                self._ended(command)
-            self._break(f"no reply to {command!r} within {REPLY_SECONDS:g} s" if not said
-                        else f"after {command!r} it sent {shown(said, 120)} and then nothing "
-                        f"within {REPLY_SECONDS:g} s (no `now`)")
-        return text
+    @property
+    def broken(self) -> str:
+        """Why the line is broken for good ("" while it is not)."""
+        return self.talk.broken
 
     def start(self) -> str:
         """The line at the target's rate (`baud N`), then the reply to `state`: the
         rig's state, or an ``error:`` line when it has none."""
         command = f"baud {self.baud}"
-        with self._exchange(command):
-            reply = self._reply(command, time.monotonic() + REPLY_SECONDS, "")
+        with self.talk.exchange(command):
+            reply = self.talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
         if reply.strip() != "ok":
-            self._break(f"it answered 'baud {self.baud}' with {shown(reply, 120)}, not ok")
+            self.talk.fail(f"it answered 'baud {self.baud}' with {shown(reply, 120)}, not ok")
         return self.ask("state")
 
     def ask(self, command: str) -> str:
         """A rig command (docs/rig.md) at the current instant: its one reply line."""
         self._flush()
         self._catch_up()
-        with self._exchange(command):
-            return self._reply(command, time.monotonic() + REPLY_SECONDS, "")
+        with self.talk.exchange(command):
+            return self.talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
 
     def next_event(self) -> int | None:
         """The instant the simulator says something next happens (None: nothing is
@@ -186,7 +200,7 @@ class CosimLine:
         due = decimal(words[1]) if len(words) == 2 and words[0] == "next" else None
         if due is not None:
             return due
-        self._break(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
+        self.talk.fail(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -194,7 +208,7 @@ class CosimLine:
         the host's bytes to ``end``, then on to ``goal`` unless a CR reached the host by
         ``end``, stopping at the first CR after ``end``. Takes the reply's bytes; True
         when a CR ended it (or came during the bytes)."""
-        with self._exchange(command):
+        with self.talk.exchange(command):
             return self._moved(command, start, end, goal)
 
     def _moved(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -205,23 +219,23 @@ class CosimLine:
         stop: int | None = None               # the CR after `end` where the clock stops
         said = ""
         while True:
-            said = self._reply(command, deadline, said)
+            said = self.talk.reply(command, deadline, said)
             words = said.split()
             if len(words) == 3 and words[0] == "rx":
                 t, data = _rx(words)
                 if t is None or not data:
-                    self._break(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX")
+                    self.talk.fail(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX")
                 if t <= start:
-                    self._break(f"after {command!r} it sent {shown(said, 120)}: a byte stamped "
+                    self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: a byte stamped "
                                 f"{t}, not after the instant {start} the command began "
                                 "(a byte in the past)")
                 if t < last:
-                    self._break(f"after {command!r} it sent {shown(said, 120)}: stamped {t}, "
+                    self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: stamped {t}, "
                                 f"before the byte it sent before ({last})")
                 for i, value in enumerate(data):
                     at = t + i * b
                     if stop is not None or (cr_sent and at > end):
-                        self._break(f"after {command!r} it sent {shown(said, 120)}: a byte at "
+                        self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: a byte at "
                                     f"{at}, after the CR at "
                                     f"{stop if stop is not None else end} where the clock "
                                     "was to stop")
@@ -233,35 +247,35 @@ class CosimLine:
                 last = t + (len(data) - 1) * b
                 got += len(data)
                 if got > REPLY_BYTES:
-                    self._break(f"it answered {command!r} with more than {REPLY_BYTES} bytes")
+                    self.talk.fail(f"it answered {command!r} with more than {REPLY_BYTES} bytes")
                 self._rx += data
             elif len(words) == 2 and words[0] == "now":
                 now = decimal(words[1])
                 if now is None:
-                    self._break(f"it answered {command!r} with {shown(said, 120)}: not now T")
+                    self.talk.fail(f"it answered {command!r} with {shown(said, 120)}: not now T")
                 self._arrived(command, said, now, start, end, goal, last,
                               end if cr_sent else stop if stop is not None else goal)
                 return cr_sent or stop is not None
             elif said.startswith("error"):
-                self._break(f"it refused {command!r}: {shown(said)}")
+                self.talk.fail(f"it refused {command!r}: {shown(said)}")
             else:
-                self._break(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX "
+                self.talk.fail(f"it answered {command!r} with {shown(said, 120)}: not rx T HEX "
                             "or now T")
 
     def _arrived(self, command: str, said: str, now: int, start: int, end: int, goal: int,
                  last: int, expected: int) -> None:
         """``now`` must be where the command was to take the clock."""
         if now < start:
-            self._break(f"after {command!r} it sent {shown(said)}: time went backwards "
+            self.talk.fail(f"after {command!r} it sent {shown(said)}: time went backwards "
                         f"(it was {start})")
         if now < last:
-            self._break(f"after {command!r} it sent {shown(said)}: before the last byte it sent "
+            self.talk.fail(f"after {command!r} it sent {shown(said)}: before the last byte it sent "
                         f"({last}), a byte in the future")
         if now > goal:
-            self._break(f"after {command!r} it sent {shown(said)}: past the instant {goal} "
+            self.talk.fail(f"after {command!r} it sent {shown(said)}: past the instant {goal} "
                         "it was asked for")
         if now != expected:
-            self._break(f"after {command!r} it sent {shown(said)}, where the clock had to stop "
+            self.talk.fail(f"after {command!r} it sent {shown(said)}, where the clock had to stop "
                         f"at {expected}" + (" (the end of the host's bytes)" if expected ==
                                             end and end > start else ""))
         self.now = now
@@ -272,7 +286,7 @@ class CosimLine:
         self._land_told()
         if self._inflight is not None:
             return self._land()
-        self._usable()
+        self.talk.usable()
         if self._tx is not None:
             data, start = self._tx
             self._tx = None
@@ -308,7 +322,7 @@ class CosimLine:
         it: nothing waits to be read (bytes received already, say during an injected
         pause, may be the answer the read takes, and the write then waits)."""
         self._land_told()
-        if self._tx is None or self._ahead or self._rx or self.broken:
+        if self._tx is None or self._ahead or self._rx or self.talk.broken:
             return
         data, start = self._tx
         end = self.now
@@ -316,7 +330,7 @@ class CosimLine:
         goal = min(max(deadline, end), end + STEP_NS)
         command = f"tx {data.hex().upper()}" + (f" {goal}" if goal > end else "")
         self._tx = None
-        self._send(command)
+        self.talk.send(command)
         self._inflight = (command, start, end, goal)
 
     def _land(self) -> bool:
@@ -324,12 +338,12 @@ class CosimLine:
         assert self._inflight is not None
         command, start, end, goal = self._inflight
         self._inflight = None
-        self._usable()
+        self.talk.usable()
         try:
             return self._moved(command, start, end, goal)
         except BaseException:
-            if not self.broken:
-                self.broken = (f"the exchange {command!r} was cut off before its reply was "
+            if not self.talk.broken:
+                self.talk.broken = (f"the exchange {command!r} was cut off before its reply was "
                                "read: the co-simulation cannot go on")
             raise
 
@@ -356,7 +370,7 @@ class CosimLine:
         simulator runs the frames. Whether they were told."""
         if not self.tells:
             return False
-        self._usable()
+        self.talk.usable()
         stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
         for data, timeout, *due in frames:
@@ -369,7 +383,7 @@ class CosimLine:
         if len(plan) < 2:
             return False
         command = "batch " + " ".join(f"{wait} {data.hex().upper()}" for data, wait in plan)
-        self._send(command)
+        self.talk.send(command)
         self._told = (command, plan)
         return True
 
@@ -387,7 +401,7 @@ class CosimLine:
             return 0
         command, plan = self._told
         self._told = None
-        self._usable()
+        self.talk.usable()
         stops = "batch-stops" in self.extensions
         here, ahead = self.now, []
         try:
@@ -401,8 +415,8 @@ class CosimLine:
                 if stops and not cr:
                     break                         # the simulator ran none after it
         except BaseException:
-            if not self.broken:
-                self.broken = (f"the exchange {command[:60]!r}... was cut off before its "
+            if not self.talk.broken:
+                self.talk.broken = (f"the exchange {command[:60]!r}... was cut off before its "
                                "reply was read: the co-simulation cannot go on")
             raise
         self.now = here
@@ -457,7 +471,7 @@ class CosimLine:
         """The host's bytes, one byte time each from now: the clock moves to their end
         (sent with the next operation)."""
         self._flush()
-        self._usable()
+        self.talk.usable()
         if self._ahead and (self._ahead[0].data, self._ahead[0].start) != (data, self.now):
             self._catch_up()
         if data:
@@ -511,7 +525,7 @@ class CosimLine:
     def set_baud(self, baud: int) -> None:
         reply = self.ask(f"baud {baud}")
         if reply.strip() != "ok":
-            self._break(f"it answered 'baud {baud}' with {shown(reply, 120)}, not ok")
+            self.talk.fail(f"it answered 'baud {baud}' with {shown(reply, 120)}, not ok")
         self.baud, self.byte_ns = baud, byte_ns(baud)
 
 

@@ -24,10 +24,8 @@ import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
 
-from conformance.link.interrupts import Interrupts
+from conformance.link.signals import Interrupts
 from conformance.protocol.bounded import decimal
-from conformance.quoting import shown
-from conformance.targetinfo import TargetInfo
 from conformance.targets.base import Target, TargetError
 from conformance.targets.cosim import (
     VERSION,
@@ -37,11 +35,13 @@ from conformance.targets.cosim import (
     announced,
     offered,
 )
+from conformance.targets.info import TargetInfo
 from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
 from conformance.targets.session import Session, SessionError
 from conformance.targets.targetport import ENDING_SECONDS, TargetPort
+from conformance.verdicts.quoting import shown
 from gve_fixtures.profile import available_profiles
 
 #: how long the program may take to print its port

@@ -25,8 +25,8 @@ import tempfile
 import threading
 import time
 
-from conformance.link.interrupts import Interrupts
-from conformance.quoting import shown
+from conformance.link.signals import Interrupts
+from conformance.verdicts.quoting import shown
 
 #: how long the program may take to end after ``quit``, then after SIGTERM
 QUIT_SECONDS = 2.0

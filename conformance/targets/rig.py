@@ -18,9 +18,9 @@ from collections.abc import Callable
 
 from conformance.link.safety import TargetNotResponding
 from conformance.protocol.bounded import decimal, hexadecimal, json_object
-from conformance.quoting import shown
 from conformance.targets.program import Program
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.quoting import shown
+from conformance.verdicts.verdict import CouldNotTest
 
 #: asks one command and gives its reply line (raising when there is none)
 Ask = Callable[[str], str]

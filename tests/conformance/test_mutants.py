@@ -9,12 +9,12 @@ import re
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.cli import mutation
 from conformance.cli.mutation import Hunt, hunt, main
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import emu, parse_target
-from conformance.verdict import ERROR, FAIL
+from conformance.verdicts.verdict import ERROR, FAIL
 from gve_fixtures.profile import available_profiles, load_profile
 
 MUTANTS = emu.mutants()

@@ -5,7 +5,7 @@ import dataclasses
 from pathlib import Path
 
 from conformance import specdoc
-from conformance.case import REGISTRY
+from conformance.case.context import REGISTRY
 from gve_fixtures.rules import load_spec
 
 #: the checkout's document (the tests also run against an installed copy, which has none)

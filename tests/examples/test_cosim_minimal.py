@@ -15,13 +15,13 @@ import pytest
 import serial
 
 import emulator  # noqa: F401  (registers gve://)
-from conformance.catalogue import select
 from conformance.cli import main
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from conformance.targets.cosim import CosimLine, CosimPort
 from conformance.targets.program import Program
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures import golden_transcripts
 from gve_fixtures.transcript import load
 from tests.emulator.replay import play

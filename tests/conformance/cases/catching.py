@@ -3,10 +3,10 @@ mutant breaks, and PASSes the clean emulator on the same profile."""
 
 from __future__ import annotations
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import FAIL, PASS
+from conformance.verdicts.verdict import FAIL, PASS
 
 
 def assert_catches(case_id: str, rule: str, mutant: str, profile: str, *,

@@ -9,7 +9,7 @@ import pkgutil
 import re
 
 import conformance.cases
-from conformance.catalogue import select
+from conformance.run.selection import select
 from gve_fixtures.rules import load_spec
 
 NUMBERS = {s.number for s in load_spec().sections}

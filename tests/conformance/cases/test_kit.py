@@ -5,10 +5,10 @@ every parameter its manual names read, only those out of range written (with
 
 from __future__ import annotations
 
-from conformance.catalogue import select
 from conformance.link.framing import frame
-from conformance.runner import run
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from tests.conformance.cases.used import used_unit
 
 CASES = ["10.cmd.mpg.modes", "9.reset.mpg-enabled"]

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import FAIL, PASS
+from conformance.verdicts.verdict import FAIL, PASS
 
 # case -> (the mutant made for it, the profile it shows on)
 MADE_FOR = {

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import FAIL, NON_STRICT, PASS
+from conformance.verdicts.verdict import FAIL, NON_STRICT, PASS
 from tests.conformance.cases.catching import assert_catches
 
 #: mutant -> (the case made to catch it, the rule of its failing check, the profiles)

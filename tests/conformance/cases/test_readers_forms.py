@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import NON_STRICT
+from conformance.verdicts.verdict import NON_STRICT
 
 #: reading -> the case that grades it, the rule
 GRADED = {

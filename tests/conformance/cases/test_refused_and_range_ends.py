@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from tests.conformance.cases.catching import assert_catches
 

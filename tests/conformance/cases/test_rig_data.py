@@ -4,10 +4,10 @@ so, and the checks that read what it does give still judge."""
 
 from __future__ import annotations
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from emulator.link.line import Line
 
 CASE = "10.4.halt.at-rest-on-the-rig"

@@ -11,10 +11,10 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST, MISSING, NON_STRICT, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING, NON_STRICT, PASS
 from tests.conformance.cases.catching import assert_catches
 
 CASES = ("2.link.rate.every-listed-rate", "2.link.rate.read-at-power-on",

@@ -7,9 +7,9 @@ from __future__ import annotations
 import pytest
 
 from conformance.cases.s11_golden import envelope_needed
-from conformance.catalogue import select
-from conformance.runner import run_case
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.run.runner import run_case
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import available_profiles, load_profile
 from gve_fixtures.transcript import load
@@ -51,7 +51,7 @@ def test_a_d_record_takes_the_extra_lines_of_a_unit_reading_it_otherwise():
     # a unit that remembers @ answers > after @ with two lines where g7 expects one (a
     # [D] record): the second line is that record's, not a second answer nor SR0's
     from conformance.targets import parse_target
-    from conformance.verdict import NON_STRICT
+    from conformance.verdicts.verdict import NON_STRICT
     (c,) = select(["11.golden.g7-reset-state"])
     r = run_case(c, parse_target("emu:GVE84-100?reading=index-remembered"))
     assert r.verdict == NON_STRICT, r.notes

@@ -10,9 +10,9 @@ from fnmatch import fnmatch
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
-from conformance.verdict import COULD_NOT_TEST, MISSING, PASS
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING, PASS
 from tests.conformance.cases.used import used_unit
 
 #: cases that assumed a fresh unit: each must judge a used one

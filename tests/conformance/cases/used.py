@@ -10,7 +10,7 @@ from __future__ import annotations
 import serial
 
 import emulator  # noqa: F401  (registers gve://)
-from conformance.case import TargetInfo
+from conformance.case.context import TargetInfo
 from conformance.targets.base import DEFAULT_MAX_TRAVEL
 from conformance.targets.port import PortTarget
 from gve_fixtures.profile import load_profile

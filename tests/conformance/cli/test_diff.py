@@ -15,7 +15,7 @@ from conformance.cli import main
 from conformance.diff.grammar import Options, probes
 from conformance.diff.sides import Side
 from conformance.targets.emu import emulator_readings
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
 from tests.conformance.diff.test_engine import ON_THE_WIRE, PROFILE, in_area

@@ -170,7 +170,7 @@ def test_a_full_tmpfs_ends_the_run_with_one_line(tmp_path):
 
 def test_the_recap_lists_by_section_number_and_non_strict_apart():
     from conformance.cli.ending import recap
-    from conformance.runner import RunResult
+    from conformance.run.runner import RunResult
     from tests.conformance.reports.toy import result
     run = RunResult("toy", [result("11.golden.g1", "FAIL"), result("8.repeat.answer",
                                                                     "NON-STRICT"),
@@ -186,7 +186,7 @@ def test_the_recap_lists_by_section_number_and_non_strict_apart():
 
 def test_a_count_of_missing_says_it_is_nothing_to_test():
     from conformance.cli.ending import counted
-    from conformance.runner import RunResult
+    from conformance.run.runner import RunResult
     from tests.conformance.reports.toy import result
     run = RunResult("toy", [result("1.a.b", "PASS"), result("3.params.float-values",
                                                            "MISSING")], ["emu:GVE54"])

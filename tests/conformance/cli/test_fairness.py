@@ -10,12 +10,12 @@ import signal
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.cli import main
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from conformance.targets.emu import emulator_readings
-from conformance.verdict import FAIL, NON_STRICT
+from conformance.verdicts.verdict import FAIL, NON_STRICT
 from tests.processes import alive, descendants, signalled
 
 
@@ -88,14 +88,14 @@ def test_a_reading_alone_is_tried_where_the_rules_it_reads_apply():
 
 def test_a_check_that_names_no_rule_makes_a_reading_unfair(monkeypatch):
     from conformance.cli import fairness
-    from conformance.runner import CaseResult
+    from conformance.run.runner import CaseResult
 
     def unnamed(case, target, settings=None):
         return CaseResult(case.id, case.section, case.rule, case.tag, case.source,
                           target.profile.name, target.info.spec, "PASS",
                           checks=[{"ok": True, "what": "x", "observed": "", "expected": "",
                                    "tag": "M", "rule": ""}])
-    monkeypatch.setattr("conformance.runner.run_case", unnamed)
+    monkeypatch.setattr("conformance.run.runner.run_case", unnamed)
     monkeypatch.setattr(fairness, "diff_trial", lambda *a: None)
     t = fairness.trial("plus-sign", ["plus-sign"], ["GVE84-100"], ["1.profile.version"])
     assert not t.fair and "names no rule" in t.unfair[0]

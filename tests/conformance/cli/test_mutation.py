@@ -13,8 +13,8 @@ import signal
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.cli.mutation import clean_run, hunt, main
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from tests.processes import alive, descendants, signalled
 

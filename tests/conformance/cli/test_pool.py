@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from conformance.cli.pool import WorkerFailed, workers
-from conformance.link.interrupts import STOPPING
+from conformance.link.signals import STOPPING
 
 #: seconds a job "works" when it is not the first: long enough to be stopped in
 LONG = 60.0

@@ -12,7 +12,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.cli.progress import Progress
-from conformance.verdict import COULD_NOT_TEST, MISSING, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING, PASS
 from tests.conformance.reports.toy import result
 
 #: the default run's three reports together stay under this (about 1,450 case runs:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import io
 
 from conformance.cli.unit import confirmed
-from conformance.metadata import RunMeta
-from conformance.operator import Console
+from conformance.operator.console import Console
+from conformance.run.metadata import RunMeta
 from conformance.targets import parse_target
 
 

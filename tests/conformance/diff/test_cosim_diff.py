@@ -21,7 +21,7 @@ from conformance.diff.sides import Side
 from conformance.diff.steps import FRAME, Step
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
-from conformance.verdict import FAIL
+from conformance.verdicts.verdict import FAIL
 from tests.conformance.diff.test_engine import (
     EVERYTHING,
     ON_THE_WIRE,

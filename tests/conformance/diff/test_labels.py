@@ -3,7 +3,7 @@
 import pytest
 
 from conformance.diff.labels import allowed, command_of, label, load_labels, verdict_of
-from conformance.verdict import FAIL, INFO, NON_STRICT
+from conformance.verdicts.verdict import FAIL, INFO, NON_STRICT
 from gve_fixtures.rules import load_rules
 
 
@@ -348,7 +348,7 @@ PAIRS: dict[str, tuple[str, tuple]] = {
 
 
 def _shared_rules() -> set[str]:
-    from conformance.catalogue import select
+    from conformance.run.selection import select
     graded = {r for c in select() for r in c.rules}
     return {entry.rule for entry in load_labels()} & graded
 
@@ -359,8 +359,8 @@ def test_every_rule_both_use_has_its_behaviour_here():
 
 @pytest.mark.parametrize("rule", sorted(PAIRS))
 def test_diff_names_the_rule_the_catalogue_grades_the_behaviour_by(rule):
-    import conformance.catalogue  # noqa: F401  (registers the cases)
-    from conformance.case import REGISTRY
+    import conformance.run.selection  # noqa: F401  (registers the cases)
+    from conformance.case.context import REGISTRY
     case_id, facts = PAIRS[rule]
     assert rule in REGISTRY[case_id].rules
     command, kind, context, earlier, reference, target, *family = facts

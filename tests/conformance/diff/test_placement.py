@@ -11,7 +11,7 @@ from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options, probes
 from conformance.diff.sides import Side
 from conformance.targets import parse_target
-from conformance.verdict import FAIL
+from conformance.verdicts.verdict import FAIL
 
 READING = "steps-a-period-late"
 

@@ -1,7 +1,7 @@
 """A real unit as a side: its EEPROM holds its own bytes (the reference is given them
 before every sequence) and what a sequence wrote is put back before the next."""
 
-from conformance.case import CouldNotTest
+from conformance.case.context import CouldNotTest
 from conformance.diff.engine import Pair
 from conformance.diff.sides import Side
 from conformance.diff.steps import FRAME, INPUT, Step

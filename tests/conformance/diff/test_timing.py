@@ -8,7 +8,7 @@ from conformance.diff.grammar import Grammar, Options
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.timing import RealTime, Timing
 from conformance.link.framing import frame
-from conformance.link.interrupts import Interrupts
+from conformance.link.signals import Interrupts
 from conformance.targets import parse_target
 from tests.emulator.process import Emulator
 from tests.usb_relay import UsbRelay

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from conformance.case.settings import DEFAULT_DATABASE, database_for, example_database
 from conformance.cli import main
-from conformance.settings import DEFAULT_DATABASE, database_for, example_database
 from tests.conformance.fleet.services import free_port
 
 # a machine and a mutant it catches: every checksummed answer shows the mutant

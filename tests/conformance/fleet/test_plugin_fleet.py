@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from conformance.plugin import worker_group
+from conformance.pytest_plugin.plugin import worker_group
 from conformance.targets import parse_target
 
 pytest.importorskip("xdist", reason="pytest-xdist (the dev extra) runs the fleets")

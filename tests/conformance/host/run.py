@@ -9,7 +9,7 @@ from pathlib import Path
 
 import gve_host
 from conformance.cli.host import main
-from conformance.verdict import FAIL, grade
+from conformance.verdicts.verdict import FAIL, grade
 
 JOB = Path(gve_host.__file__).parent / "jobs" / "square.job"
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.host.scenarios import SCENARIOS
-from conformance.verdict import INFO, MISSING, PASS
+from conformance.verdicts.verdict import INFO, MISSING, PASS
 from gve_fixtures.profile import available_profiles, load_profile
 from tests.conformance.host.run import certify, verdicts
 

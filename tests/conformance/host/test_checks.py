@@ -209,7 +209,7 @@ def test_port_settings():
 
 
 def test_coverage_counts_the_host_checks():
-    from conformance.coverage import coverage
+    from conformance.run.coverage import coverage
 
     (pc,) = coverage(["GVE84-100"], role="host", cases=[])
     assert "8.recovery.exactly-once" in next(s for s in pc.sections if s.section == "8").covered

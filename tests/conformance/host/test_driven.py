@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from conformance.cli.host import main
-from conformance.verdict import FAIL, PASS
+from conformance.verdicts.verdict import FAIL, PASS
 from tests.conformance.host.run import certify, failing_rules
 
 pytestmark = pytest.mark.pty

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from junitparser import Failure, JUnitXml, Properties, Skipped
 
-from conformance.verdict import FAIL, NON_STRICT, PASS
+from conformance.verdicts.verdict import FAIL, NON_STRICT, PASS
 from tests.conformance.host.run import certify, failing_rules, verdicts
 
 pytestmark = [pytest.mark.pty,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.link.faults import FrameFault
-from conformance.verdict import FAIL, INFO, NON_STRICT, PASS, grade, worst
+from conformance.verdicts.verdict import FAIL, INFO, NON_STRICT, PASS, grade, worst
 
 FRAME = b"!0V1000\r"
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import json
 
-from conformance.case import Case
+from conformance.case.context import Case
 from conformance.reports import write_reports
-from conformance.runner import run
+from conformance.run.runner import run
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 
 
 def _ok(ctx) -> None:

@@ -6,8 +6,8 @@ import json
 import xml.etree.ElementTree as ET
 
 from conformance.reports import write_reports
-from conformance.runner import CaseResult, RunResult
-from conformance.verdict import ERROR, FAIL
+from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.verdict import ERROR, FAIL
 
 HOSTILE = "<script>alert(1)</script> & \"quoted\" ]]></pre>"
 #: what no XML document may hold and no HTML page should: NUL and control characters

@@ -6,10 +6,18 @@ import dataclasses
 
 import pytest
 
-from conformance.case import Case, CouldNotTest, Missing
-from conformance.runner import run_case
+from conformance.case.context import Case, CouldNotTest, Missing
+from conformance.run.runner import run_case
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, PASS
+from conformance.verdicts.verdict import (
+    COULD_NOT_TEST,
+    ERROR,
+    FAIL,
+    INFO,
+    MISSING,
+    NON_STRICT,
+    PASS,
+)
 
 #: a rule of each tag: every check names its rule, and is graded by its tag
 RULE_OF = {"M": "5.code.ok", "M-ex": "5.code.range", "D": "3.frame.upper-case",
@@ -104,7 +112,7 @@ def test_destructive_cases_wait_for_permission_on_real_units():
 
 
 def test_one_id_for_two_different_cases_is_refused():
-    from conformance.case import REGISTRY, case
+    from conformance.case.context import REGISTRY, case
     try:
         case("99.toy.twice", rules=("5.code.ok",))(_fails)
         with pytest.raises(ValueError, match="registered twice"):

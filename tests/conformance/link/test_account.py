@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.link.account import SUITE, Spent, TimeAccount, account_lines, suite_share
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from tests.emulator.process import Emulator
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import FAIL, PASS
+from conformance.verdicts.verdict import FAIL, PASS
 from tests.conformance.safety.proxy import HOSTILE, unit_behind_proxy
 from tests.emulator.process import Emulator
 from tests.usb_relay import UsbRelay

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.case import REGISTRY
-from conformance.catalogue import select
+from conformance.case.context import REGISTRY
 from conformance.link.link import OPEN_FRAME, TWICE, WATCHDOG_RULES
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import ERROR, FAIL, NON_STRICT
+from conformance.verdicts.verdict import ERROR, FAIL, NON_STRICT
 from tests.conformance.link.test_link import _Line, real_link
 
 WATCHDOGS = ["lone-bang-answered,half-second-watchdog,packet-watchdog",

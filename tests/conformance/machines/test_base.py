@@ -9,15 +9,15 @@ from typing import ClassVar
 import pytest
 from hypothesis.stateful import rule
 
-from conformance import settings as settings_profiles
-from conformance.case import CaseContext, CouldNotTest
-from conformance.catalogue import select
+from conformance.case import settings as settings_profiles
+from conformance.case.context import CaseContext, CouldNotTest
+from conformance.case.settings import example_database
 from conformance.machines.base import UnitMachine, index_invariant
 from conformance.machines.checksum import ChecksumMachine
 from conformance.machines.index import RecoveryMachine
 from conformance.machines.keep import KeepMachine
 from conformance.machines.runner import Factory, run_machine
-from conformance.settings import example_database
+from conformance.run.selection import select
 from conformance.targets import parse_target
 
 #: a case whose rules name the index's

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import re
 
-from conformance.catalogue import select
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from conformance.targets.emu import EmuTarget
-from conformance.verdict import ALWAYS, FAIL, UNREADABLE
+from conformance.verdicts.verdict import ALWAYS, FAIL, UNREADABLE
 
 #: a number in an answer, spoiled with digits of another script
 _NUMBER = re.compile(rb"^0,(-?[0-9]+)")

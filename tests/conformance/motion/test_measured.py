@@ -10,10 +10,10 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import MISSING, PASS
+from conformance.verdicts.verdict import MISSING, PASS
 
 MEASURED = ["*measured*"]
 #: the band a real-time check prints: the line's, and the steps either side it allowed

@@ -9,11 +9,11 @@ import time
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.link.framing import frame
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import FAIL
+from conformance.verdicts.verdict import FAIL
 from tests.emulator.process import Emulator
 from tests.usb_relay import UsbRelay
 

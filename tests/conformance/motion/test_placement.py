@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.case import REGISTRY
-from conformance.catalogue import select
+from conformance.case.context import REGISTRY
 from conformance.cli.mutation import FIRST
-from conformance.runner import run_case
+from conformance.run.runner import run_case
+from conformance.run.selection import select
 from conformance.targets import emu, parse_target
-from conformance.verdict import ERROR, FAIL, NON_STRICT, PASS
+from conformance.verdicts.verdict import ERROR, FAIL, NON_STRICT, PASS
 from emulator.mutants import CORE_DEVIATIONS
 
 READING = "steps-a-period-late"

@@ -12,16 +12,16 @@ import json
 import pytest
 
 import conformance.cases  # noqa: F401  (registers the cases)
-from conformance.case import REGISTRY, Case
-from conformance.hands import HandRig, cannot_by_hand, wording
+from conformance.case.context import REGISTRY, Case
 from conformance.link.framing import parse_response
 from conformance.link.safety import Guard, SafetyStop
 from conformance.link.virtual import Rig
-from conformance.operator import Console, HandStep
-from conformance.runner import CaseResult, run
+from conformance.operator.console import Console, HandStep
+from conformance.operator.hands import HandRig, cannot_by_hand, wording
+from conformance.run.runner import CaseResult, run
 from conformance.targets import parse_target
 from conformance.targets.rig import ControlRig
-from conformance.verdict import COULD_NOT_TEST, PASS, CouldNotTest
+from conformance.verdicts.verdict import COULD_NOT_TEST, PASS, CouldNotTest
 from gve_fixtures.profile import load_profile
 from tests.conformance.operator.terminal import EmulatedUnit
 

@@ -8,7 +8,7 @@ import pytest
 
 from conformance.cli import main, ports
 from conformance.cli.unit import resolve
-from conformance.operator import Console
+from conformance.operator.console import Console
 from conformance.targets.identify import candidates, variant_of
 from gve_fixtures.profile import available_profiles, load_profile
 from tests.conformance.operator.terminal import EmulatedUnit, Terminal, suite

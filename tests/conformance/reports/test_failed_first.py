@@ -12,7 +12,7 @@ import pytest
 from conformance.cli import main
 from conformance.reports import plots
 from conformance.reports.html import render_html
-from conformance.verdict import ERROR, FAIL, NON_STRICT
+from conformance.verdicts.verdict import ERROR, FAIL, NON_STRICT
 from gve_fixtures.rules import load_rules
 from tests.conformance.reports.test_html import parse
 from tests.conformance.reports.toy import TRACE, result, toy_run

@@ -9,7 +9,7 @@ from html.parser import HTMLParser
 
 from conformance.reports import plots
 from conformance.reports.html import render_html
-from conformance.verdict import ERROR
+from conformance.verdicts.verdict import ERROR
 from tests.conformance.reports.toy import HOSTILE, result, toy_run
 
 

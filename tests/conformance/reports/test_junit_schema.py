@@ -27,7 +27,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.reports import render_junit
-from conformance.verdict import NON_STRICT
+from conformance.verdicts.verdict import NON_STRICT
 from tests.conformance.reports.toy import toy_run
 
 _TIMESTAMP = re.compile(r"\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}")

@@ -3,9 +3,9 @@ unit bytes, a long passing wire log, many checks and a motion trace."""
 
 from __future__ import annotations
 
-from conformance.metadata import RunMeta
-from conformance.runner import CaseResult, RunResult
-from conformance.verdict import COULD_NOT_TEST, FAIL, INFO, NON_STRICT, PASS
+from conformance.run.metadata import RunMeta
+from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.verdict import COULD_NOT_TEST, FAIL, INFO, NON_STRICT, PASS
 
 #: what a hostile or broken unit may send back: NUL, controls, markup, CDATA's end
 HOSTILE = "\x00\x07\x1b[31m</pre><script>alert(1)</script> & \"q\" ]]> \x7f\ud800"

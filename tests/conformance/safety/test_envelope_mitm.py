@@ -12,10 +12,10 @@ from pathlib import Path
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import ERROR, FAIL
+from conformance.verdicts.verdict import ERROR, FAIL
 from gve_fixtures.profile import available_profiles, load_profile
 from tests.conformance.safety.proxy import unit_behind_proxy
 

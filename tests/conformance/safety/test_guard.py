@@ -7,8 +7,8 @@ import pytest
 
 from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
-from conformance.link.interrupts import Interrupted, Interrupts
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.link.signals import Interrupted, Interrupts
 from gve_fixtures.profile import load_profile
 
 

@@ -12,11 +12,11 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.reports import write_reports
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import ERROR, FAIL, PASS, failing
+from conformance.verdicts.verdict import ERROR, FAIL, PASS, failing
 from tests.conformance.safety.proxy import HOSTILE, unit_behind_proxy
 
 pytestmark = pytest.mark.pty

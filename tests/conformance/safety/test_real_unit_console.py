@@ -9,7 +9,7 @@ import json
 import pytest
 
 from conformance.cli import main
-from conformance.targets.session import ROUND_TRIPS
+from conformance.targets.as_found import ROUND_TRIPS
 from tests.conformance.safety.proxy import unit_behind_proxy
 
 pytestmark = pytest.mark.pty

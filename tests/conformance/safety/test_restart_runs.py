@@ -17,11 +17,11 @@ from pathlib import Path
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.cli import main
 from conformance.link import safety
-from conformance.runner import run
-from conformance.verdict import FAILED, overall
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.verdicts.verdict import FAILED, overall
 from emulator.readings import READINGS
 from tests.conformance.safety.restarting_unit import arm, condition
 from tests.conformance.safety.units import virtual_unit

@@ -5,7 +5,7 @@ judged as a real unit; its `state` tells the truth."""
 
 from __future__ import annotations
 
-from conformance.targets.session import RealSession
+from conformance.known_state.rest import ToRest
 from tests.conformance.safety.units import virtual_unit
 
 
@@ -50,8 +50,8 @@ def test_axes_brought_back_and_counters_as_found_say_the_frames_and_the_reads():
 
 
 def test_a_reset_frame_the_unit_refuses_is_a_problem_not_a_reset_line(monkeypatch):
-    frames = RealSession._reset_frames
-    monkeypatch.setattr(RealSession, "_reset_frames", lambda s: [*frames(s), "T99999"])
+    frames = ToRest.reset_frames
+    monkeypatch.setattr(ToRest, "reset_frames", lambda s: [*frames(s), "T99999"])
     unit = virtual_unit(max_travel=500)
     session = unit.begin()
     session.open_link()

@@ -9,9 +9,9 @@ import random
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL
 from tests.conformance.safety.units import in_process_unit
 
 #: frames that can start motion (R only gives back a K a case left: the physical check

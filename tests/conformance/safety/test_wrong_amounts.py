@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, FAILED, overall
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, FAILED, overall
 from tests.conformance.safety.units import virtual_unit
 
 #: mutant -> (profile, the cases run, the case (or the first of its area) that must FAIL

@@ -11,10 +11,10 @@ from collections.abc import Callable
 import serial
 
 import emulator  # noqa: F401  (registers gve://)
-from conformance.case import TargetInfo
+from conformance.case.context import TargetInfo
 from conformance.targets.port import PortTarget
 from conformance.targets.rig import ControlRig
-from conformance.verdict import CouldNotTest
+from conformance.verdicts.verdict import CouldNotTest
 from emulator.link.control import handle
 from gve_fixtures.profile import load_profile
 

@@ -15,11 +15,11 @@ import time
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import TargetError, parse_target
 from conformance.targets import cosim as cosim_module
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 
 EMULATOR = [sys.executable, "-m", "emulator", "--cosim"]
 

@@ -12,10 +12,10 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import COULD_NOT_TEST
+from conformance.verdicts.verdict import COULD_NOT_TEST
 from gve_fixtures.profile import available_profiles, load_profile
 
 #: why a case may be COULD-NOT-TEST through the co-simulator and not on emu:

@@ -9,7 +9,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conformance.case import CouldNotTest
+from conformance.case.context import CouldNotTest
 from conformance.link.safety import TargetNotResponding
 from conformance.targets.cosim import CosimLine, announced
 from conformance.targets.process import port_url

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.catalogue import select
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import TargetError, parse_target
 from conformance.targets.port import locate
-from conformance.verdict import PASS
+from conformance.verdicts.verdict import PASS
 
 
 @pytest.mark.parametrize(("rest", "url", "ours"), [

@@ -18,13 +18,13 @@ from pathlib import Path
 
 import pytest
 
-from conformance.case import Case
-from conformance.catalogue import select
+from conformance.case.context import Case
 from conformance.cli import main as program
 from conformance.cli.run import main
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import TargetError, parse_target, process
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 from gve_fixtures.transcript import HOST, load
 from tests.processes import stop
 

@@ -11,13 +11,13 @@ import sys
 
 import pytest
 
-from conformance.catalogue import select
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.sides import Side
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
-from conformance.verdict import ERROR, FAIL, INFO, NON_STRICT
+from conformance.verdicts.verdict import ERROR, FAIL, INFO, NON_STRICT
 from emulator.readings import READINGS
 from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
@@ -113,10 +113,10 @@ def test_each_sequence_on_a_cosimulator_begins_at_its_power_on(monkeypatch):
     """A co-simulator in virtual time is powered on through its rig before every sequence
     instead of being brought to the known state: the known state is never sent, and the
     search runs its budget."""
+    from conformance.known_state.procedure import KnownState
     from conformance.targets.rig import ControlRig
-    from conformance.targets.session import RealSession
     known, powered = [], []
-    known_state, power_on = RealSession._known_state, ControlRig.power_on
+    known_state, power_on = KnownState.bring, ControlRig.power_on
 
     def counted_known(self, link, tell=()):
         known.append(1)
@@ -125,7 +125,7 @@ def test_each_sequence_on_a_cosimulator_begins_at_its_power_on(monkeypatch):
     def counted(self, address=None):
         powered.append(1)
         return power_on(self, address)
-    monkeypatch.setattr(RealSession, "_known_state", counted_known)
+    monkeypatch.setattr(KnownState, "bring", counted_known)
     monkeypatch.setattr(ControlRig, "power_on", counted)
     target = cosim_target("GVE84-100", [])
     pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
@@ -146,8 +146,10 @@ def test_a_known_state_lost_without_power_on_ends_the_search(monkeypatch):
     had as on any unit, and a sequence after which it cannot be had ends the search
     COULD-NOT-TEST (KnownStateLost), never a PASS."""
     from conformance.diff.engine import KnownStateLost
-    from conformance.targets.session import RealSession, StepFailed
-    known_state, calls = RealSession._known_state, []
+    from conformance.known_state.failed_steps import StepFailed
+    from conformance.known_state.procedure import KnownState
+    from conformance.targets.session import RealSession
+    known_state, calls = KnownState.bring, []
 
     def once_lost(self, link, tell=()):
         calls.append(1)
@@ -155,7 +157,7 @@ def test_a_known_state_lost_without_power_on_ends_the_search(monkeypatch):
             raise StepFailed("the unit is not at rest after the known state: SR6 reads "
                              "8,D0 (RUN, INTA)")
         return known_state(self, link, tell)
-    monkeypatch.setattr(RealSession, "_known_state", once_lost)
+    monkeypatch.setattr(KnownState, "bring", once_lost)
     monkeypatch.setattr(RealSession, "powers_on", property(lambda self: False))
     target = cosim_target("GVE84-100", [])
     pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),

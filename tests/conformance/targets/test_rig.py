@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from conformance.case import CouldNotTest
+from conformance.case.context import CouldNotTest
 from conformance.link.safety import TargetNotResponding
 from conformance.targets import rig as rig_module
 from conformance.targets.program import Program

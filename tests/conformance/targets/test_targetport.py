@@ -11,14 +11,14 @@ import time
 import pytest
 import serial
 
-from conformance.catalogue import select
 from conformance.link.exclusive import open_serial
 from conformance.link.link import Link
 from conformance.link.safety import EmulatorGuard, TargetNotResponding
-from conformance.runner import run
+from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
 from conformance.targets.targetport import TargetPort
-from conformance.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
 from gve_fixtures.profile import load_profile
 from tests.emulator.process import Emulator
 

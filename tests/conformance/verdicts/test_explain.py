@@ -1,0 +1,58 @@
+"""Why a case got its verdict: the check that decided it (a broken manual's rule before
+a decision, on a target graded strictly too), its rule, tag and the rule's sentence; the
+note for a verdict no check made."""
+
+from __future__ import annotations
+
+from conformance.verdicts.explain import deciding_check, reason
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, NON_STRICT
+from gve_fixtures.rules import load_rules
+from tests.conformance.reports.toy import result
+
+
+def _check(tag: str, rule: str, what: str) -> dict:
+    return {"ok": False, "what": what, "observed": "code 4", "expected": "code 5", "tag": tag,
+            "rule": rule}
+
+
+def _rules(tag: str) -> list[str]:
+    return [r.id for r in load_rules().values() if r.tag == tag]
+
+
+def test_a_broken_manual_rule_decides_a_fail_before_a_decision_that_failed_first():
+    d, m = _rules("D")[0], _rules("M")[0]
+    checks = [{"ok": True, "what": "fine", "tag": "M", "rule": m},
+              _check("D", d, "our reading"), _check("M", m, "the manual's rule")]
+    assert deciding_check(checks, FAIL)["rule"] == m
+    why = reason(result("1.toy.mixed", FAIL, checks=checks))
+    rule = load_rules()[m]
+    assert (why.rule_id, why.tag, why.rule, why.source) == (m, "M", rule.text, rule.source)
+    assert why.line().startswith(f"{m} [M] the manual's rule: ")
+    assert why.cites() == f"{rule.text} ({rule.source})"
+
+
+def test_non_strict_and_info_are_decided_by_their_own_checks():
+    d, info = _rules("D")[0], _rules("D-info")[0]
+    checks = [_check("D-info", info, "worth knowing"), _check("D", d, "our reading")]
+    assert deciding_check(checks, NON_STRICT)["rule"] == d
+    assert deciding_check(checks[:1], INFO)["rule"] == info
+
+
+def test_a_verdict_no_check_made_says_why_from_its_note():
+    crashed = result("5.toy.broken", ERROR, checks=[_check("M", _rules("M")[0], "x")],
+                     notes=["defect of the suite:\nTraceback\n  ...\nValueError: boom"])
+    why = reason(crashed)
+    assert not why.checked and why.what == "defect of the suite: … ValueError: boom"
+    assert why.line() == why.what
+    untested = reason(result("9.toy.rig", COULD_NOT_TEST, checks=[],
+                             notes=["needs a test rig"]))
+    assert untested.line() == "needs a test rig" and untested.cites() == ""
+
+
+def test_one_format_for_what_was_seen_and_wanted():
+    why = reason(result("1.toy.x", FAIL, checks=[_check("M", _rules("M")[0], "V0 → 5")]))
+    assert why.seen() == 'observed "code 4", expected "code 5"'
+    nothing = reason(result("1.toy.y", FAIL, checks=[
+        {"ok": False, "what": "an invariant", "observed": "", "expected": "", "tag": "M",
+         "rule": ""}]))
+    assert nothing.seen() == "" and nothing.line() == "[M] an invariant"
