@@ -84,6 +84,14 @@ class Course:
         #: the smallest acceleration it took (commanded steps/s²): the longest last step
         #: of a ramp to rest
         self.accel = profile.reset.A * 1000
+        #: the vectors that may have started from rest (every L, a C with no C to join),
+        #: the highest V they may have cruised at, and whether VK was taken: what another
+        #: profile of the same motion reads (Pair's reading_ns)
+        self.starts = 0
+        self.cruise = profile.reset.V
+        self.path = False
+        #: each axis's direction in the last vector that moved it (0: none did)
+        self.heading = [0] * len(profile.axes)
         self.reach: list[int] | None = [0] * len(profile.axes)
         self.caps: list[int] | None = None
         self.moved: set[int] = set()
@@ -145,6 +153,7 @@ class Course:
             # a C with no C before it to join starts from rest: whether it waits the
             # dwell is a reading (10.2.motion.dwell-before-c [D])
             self.c_from_rest = command == "C" and self.queued in (None, "L")
+            self.starts += command == "L" or self.c_from_rest
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
         elif command == "T" and (ms := decimal(body[1:])) is not None:
@@ -165,6 +174,9 @@ class Course:
         value = _first_number(body[len(command):])
         if command == "V" and value is not None:
             self.speed = max(self.speed, value)
+            self.cruise = max(self.cruise, value)
+        elif command == "VK":
+            self.path = True
         elif command == "XM" and value is not None:
             self.override = max(self.override, value / 100)
         elif command == "A" and value is not None and value > 0:
@@ -181,6 +193,9 @@ class Course:
             if d is None or self.reach is None:
                 self.reach = None
                 return
+            for i, n in enumerate(d[:len(self.heading)]):
+                if n:
+                    self.heading[i] = 1 if n > 0 else -1
             for i, n in enumerate(d[:len(self.reach)]):
                 self.reach[i] += abs(n) * self.factor
                 if n:
@@ -205,6 +220,13 @@ class Course:
     @property
     def rate(self) -> int:
         return min(self.top, math.ceil(self.speed * self.override * self.up))
+
+    @property
+    def ramp_ns(self) -> int:
+        """The longest a vector's ramp from rest to its cruise can take (ns): the highest V
+        (raised by XM and XU) at the smallest A."""
+        cruise = min(self.top, self.cruise * self.override * self.up)
+        return math.ceil(cruise * 1_000_000_000 / self.accel)
 
     def beyond_reach(self, position: list[str]) -> bool:
         """Whether ``position`` (a `P`/`PF` answer's values) has an axis farther from

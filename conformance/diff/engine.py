@@ -31,7 +31,7 @@ from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step, frames
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
-from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
+from conformance.motion.tolerance import PLACEMENT_STEPS, profile_reach, step_period
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
@@ -121,6 +121,7 @@ class Pair:
                            placement=placement,
                            unused_inputs=tuple(profile.unused_inputs.items()))
         self.course = Course(profile)
+        self.timing.reach = self._reading_ns
         #: the frames of the example that changed a motion's course (H, G, XA...): a unit
         #: of somebody else's may take each at its own next step
         self._course_changes = 0
@@ -394,6 +395,10 @@ class Pair:
             context.add("beyond-reach")
         if kind == "position" and self._placed(rec):
             context.add("placement")
+        elif "beyond-reach" not in context and self.timing.within(
+                command, step.body, kind, rec.target, rec.reference,
+                self.course.rate * self.course.factor, self.course.heading):
+            context.add("profile")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
         context.add("kept" if self.course.kept else "nothing-kept")
@@ -468,6 +473,14 @@ class Pair:
         except ValueError:
             return False
         return max(apart, default=0) <= self.judge.placement * (1 + self._course_changes)
+
+    def _reading_ns(self) -> tuple[int, int]:
+        """How much earlier and later a unit of somebody else's may place the example's
+        motion than the reference (tolerance.py's profile_reach)."""
+        c = self.course
+        return profile_reach(starts=c.starts, changes=self._course_changes,
+                             dwell_ns=c.t_ns, longest_dwell_ns=c.longest_t_ns,
+                             ramp_ns=c.ramp_ns if c.path else 0)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""

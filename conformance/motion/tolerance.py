@@ -52,6 +52,9 @@ from gve_fixtures.protocol import SECOND
 BITS_PER_BYTE = 10
 #: steps a real target may differ by from the model at a known instant (step placement)
 PLACEMENT_STEPS = 1
+#: the tick a unit of somebody else's may step, ramp and start on: the manuals time the
+#: motion in whole milliseconds (the dwell `T` 1..24 ms) and fix no finer clock
+TICK_NS = 1_000_000
 
 
 def byte_ns(baud: int) -> int:
@@ -178,3 +181,21 @@ def reading_band(a: Window, b: Window, rate: int, *,
     itself)."""
     apart = max(a.hi - b.lo, b.hi - a.lo, 0)
     return math.ceil(rate * apart / SECOND) + placement
+
+
+
+def profile_reach(*, starts: int, changes: int, dwell_ns: int, longest_dwell_ns: int,
+                  ramp_ns: int) -> tuple[int, int]:
+    """How much earlier and how much later (ns) a unit of somebody else's may place a
+    motion's events than the reference and still read the manuals: each event (the first,
+    each start from rest, each frame that changed the course) a tick of its own either
+    way; each start from rest up to the reference's dwell `T` earlier (the dwell placed
+    after the end before it, or none before a first start) and up to the longest `T`
+    later (a dwell before every start, its value after reset a reader's: spec 9 [D]); and
+    under `VK` a whole ramp either way (along which length `A` accelerates is not fixed).
+    A position read while the motion runs, or near its end, may be ahead or behind by the
+    rate times these; the instant the motion ends (an `H`'s or `W`'s answer, RUN or STOP
+    read) by the larger."""
+    ticks = TICK_NS * (1 + starts + changes)
+    return (ticks + starts * (dwell_ns + ramp_ns),
+            ticks + starts * (longest_dwell_ns + ramp_ns))

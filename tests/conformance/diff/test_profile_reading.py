@@ -1,0 +1,90 @@
+"""diff against somebody else's unit in virtual time grades a difference that another
+profile of the same motion explains (a tick of its own, the dwell T placed elsewhere, A
+along the path under VK) by the motion's own [D] rule, and one beyond every such profile
+by the rule it touches: a third party's reading of the ramp is NON-STRICT, the same reading
+graded exactly (--strict) FAILs, and a unit that ignores V FAILs through it all the same."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from pathlib import Path
+
+from conformance.diff.engine import Pair
+from conformance.diff.labels import label
+from conformance.diff.sides import Side
+from conformance.diff.steps import FRAME, WAIT, Step
+from conformance.motion.tolerance import TICK_NS, profile_reach
+from conformance.targets import parse_target
+from conformance.verdict import FAIL, NON_STRICT
+
+CORPUS = Path(__file__).resolve().parents[3] / "corpus"
+#: a simulator written from M84 alone that starts each motion on a 1 ms tick of its own
+#: and accelerates along the path under VK
+TICKED = "exec:" + shlex.join([sys.executable, str(CORPUS / "gve84-a" / "sim.py"), "--cosim",
+                               "--model", "GVE84-100"])
+EMULATOR = [sys.executable, "-m", "emulator", "--model", "GVE84-100", "--cosim"]
+
+
+def _run(spec: str, steps: list[Step], *, strict: bool = False):
+    target = parse_target(spec, profile="GVE84-100", allow_destructive=True, strict=strict)
+    target.preflight()
+    try:
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+                    target.profile)
+        return pair.run(steps).disagreement
+    finally:
+        target.session.finish()
+        target.close()
+
+
+def _frames(*bodies: str, wait: float) -> list[Step]:
+    return [*(Step(FRAME, body=b) for b in bodies), Step(WAIT, seconds=wait),
+            Step(FRAME, body="PF")]
+
+
+def test_a_ramp_along_the_path_read_while_moving_is_the_profile_s_reading():
+    d = _run(TICKED, _frames("VK", "L300,300,0", wait=0.4))
+    assert d is not None and d.kind == "position"
+    assert "profile" in d.context
+    assert (d.rule, d.verdict) == ("10.2.motion.trapezoid", NON_STRICT)
+
+
+def test_the_same_reading_graded_exactly_fails():
+    d = _run(TICKED, _frames("VK", "L300,300,0", wait=0.4), strict=True)
+    assert d is not None and d.kind == "position"
+    assert "profile" not in d.context and d.verdict == FAIL
+
+
+def test_where_the_motion_ends_at_rest_is_exact_for_every_reading():
+    # long after the vector's end both read its target: the tick's reading differs in
+    # nothing there
+    assert _run(TICKED, _frames("VK", "L300,300,0", wait=2.0)) is None
+
+
+def test_a_rate_no_reading_allows_fails_through_another_profile():
+    ignores_v = "exec:" + shlex.join([*EMULATOR, "--mutant", "velocity-ignored"])
+    d = _run(ignores_v, _frames("V200", "L300,0,0", wait=1.0))
+    assert d is not None and d.kind == "position"
+    assert "profile" not in d.context
+    assert d.verdict == FAIL and d.tag in ("M", "M-ex")
+
+
+def test_the_reach_is_a_tick_an_event_and_the_dwell_later_than_earlier():
+    ahead, behind = profile_reach(starts=1, changes=1, dwell_ns=5_000_000,
+                                  longest_dwell_ns=24_000_000, ramp_ns=0)
+    assert ahead == 3 * TICK_NS + 5_000_000
+    assert behind == 3 * TICK_NS + 24_000_000
+    # under VK a whole ramp either way, each start
+    ahead_vk, behind_vk = profile_reach(starts=2, changes=0, dwell_ns=5_000_000,
+                                        longest_dwell_ns=24_000_000, ramp_ns=50_000_000)
+    assert (ahead_vk, behind_vk) == (3 * TICK_NS + 2 * 55_000_000,
+                                     3 * TICK_NS + 2 * 74_000_000)
+
+
+def test_a_w_refused_as_a_syntax_error_is_the_reading_of_its_fields():
+    # the reference ran it and found no switch (5), or took it: a reader of the other
+    # form refuses it before its values (10.cmd.reference-syntax [D])
+    for reference in (0, 5):
+        assert label("W", "code", set(), set(), reference, 4) == "10.cmd.reference-syntax"
+    assert label("W", "code", set(), set(), 5, 0) != "10.cmd.reference-syntax"
