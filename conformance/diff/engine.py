@@ -31,7 +31,13 @@ from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step, frames
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
-from conformance.motion.tolerance import PLACEMENT_STEPS, profile_reach, step_period
+from conformance.motion.tolerance import (
+    PLACEMENT_STEPS,
+    TICK_NS,
+    byte_ns,
+    profile_reach,
+    step_period,
+)
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
@@ -401,6 +407,8 @@ class Pair:
             context.add("profile")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
+        if _ran(rec.reference, self.reference.link.baud):
+            context.add("after-run")
         context.add("kept" if self.course.kept else "nothing-kept")
         shipped = self.course.unwritten(command, step.body)
         if shipped:
@@ -606,6 +614,15 @@ class Pair:
 
 #: the frames whose answer's value is ST6 (F's with its queue bit)
 _ST6_READS = ("SR6", "F")
+
+
+def _ran(reference: RoundTrip, baud: int) -> bool:
+    """Whether the reference answered a tick or more later than the bytes take: after a
+    run of its own (a W that met no switch), not at once (a value out of range)."""
+    if not reference.answer:
+        return False
+    lasted = reference.received_at - reference.sent_at
+    return lasted > (len(reference.sent) + len(reference.answer)) * byte_ns(baud) + TICK_NS
 
 
 def _st6_differs(body: str, rec: StepRecord) -> set[str]:

@@ -83,8 +83,10 @@ def test_the_reach_is_a_tick_an_event_and_the_dwell_later_than_earlier():
 
 
 def test_a_w_refused_as_a_syntax_error_is_the_reading_of_its_fields():
-    # the reference ran it and found no switch (5), or took it: a reader of the other
+    # the reference took it, or ran it and found no switch (5): a reader of the other
     # form refuses it before its values (10.cmd.reference-syntax [D])
-    for reference in (0, 5):
-        assert label("W", "code", set(), set(), reference, 4) == "10.cmd.reference-syntax"
-    assert label("W", "code", set(), set(), 5, 0) != "10.cmd.reference-syntax"
+    syntax = "10.cmd.reference-syntax"
+    assert label("W", "code", set(), set(), 0, 4) == syntax
+    assert label("W", "code", {"after-run"}, set(), 5, 4) == syntax
+    # refused at once for a value out of range: 4 there is the range's code missed
+    assert label("W", "code", set(), set(), 5, 4) == "5.code.range"
