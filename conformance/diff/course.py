@@ -92,6 +92,8 @@ class Course:
         self.path = False
         #: each axis's direction in the last vector that moved it (0: none did)
         self.heading = [0] * len(profile.axes)
+        #: the ramps at A to and from the speeds of the runs at a speed of their own (W)
+        self.run_ramps_ns = 0
         self.reach: list[int] | None = [0] * len(profile.axes)
         self.caps: list[int] | None = None
         self.moved: set[int] = set()
@@ -185,6 +187,9 @@ class Course:
             self.up *= 17 / 16
         elif command in _OWN_SPEED:
             self.speed = self.top
+            moves, ramps = self.own_run(command, body)
+            self.starts += moves
+            self.run_ramps_ns += ramps
 
     def _where(self, command: str, body: str) -> None:
         params = body[len(command):]
@@ -227,6 +232,16 @@ class Course:
         (raised by XM and XU) at the smallest A."""
         cruise = min(self.top, self.cruise * self.override * self.up)
         return math.ceil(cruise * 1_000_000_000 / self.accel)
+
+    def own_run(self, command: str, body: str) -> tuple[int, int]:
+        """A run at a speed of its own (`W<axis>,n2,n3,n4,n5`): its moves from rest (to
+        the switch and back) and how long ramps at the smallest A to and from its speeds
+        n3 and n5 take (ns); (0, 0) for anything else."""
+        fields = [int(n) for n in re.findall(r"-?\d+", body[len(command) + 1:])]
+        if command not in _OWN_SPEED or len(fields) != 4:
+            return 0, 0
+        speeds = abs(fields[1]) + abs(fields[3])
+        return 2, 2 * math.ceil(speeds * 1_000_000_000 / self.accel)
 
     def beyond_reach(self, position: list[str]) -> bool:
         """Whether ``position`` (a `P`/`PF` answer's values) has an axis farther from

@@ -403,7 +403,8 @@ class Pair:
             context.add("placement")
         elif "beyond-reach" not in context and self.timing.within(
                 command, step.body, kind, rec.target, rec.reference,
-                self.course.rate * self.course.factor, self.course.heading):
+                self.course.rate * self.course.factor, self.course.heading,
+                self._reading_ns(command, step.body)):
             context.add("profile")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
@@ -482,13 +483,16 @@ class Pair:
             return False
         return max(apart, default=0) <= self.judge.placement * (1 + self._course_changes)
 
-    def _reading_ns(self) -> tuple[int, int]:
+    def _reading_ns(self, command: str = "", body: str = "") -> tuple[int, int]:
         """How much earlier and later a unit of somebody else's may place the example's
-        motion than the reference (tolerance.py's profile_reach)."""
+        motion than the reference (tolerance.py's profile_reach), the run of the frame
+        ``body`` (a W's, answered when it ends) included."""
         c = self.course
-        return profile_reach(starts=c.starts, changes=self._course_changes,
+        moves, ramps = c.own_run(command, body)
+        return profile_reach(starts=c.starts + moves, changes=self._course_changes,
                              dwell_ns=c.t_ns, longest_dwell_ns=c.longest_t_ns,
-                             ramp_ns=c.ramp_ns if c.path else 0)
+                             ramp_ns=c.ramp_ns if c.path else 0,
+                             run_ramps_ns=c.run_ramps_ns + ramps)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""

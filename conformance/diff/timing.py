@@ -98,11 +98,13 @@ class Timing:
     reach: Callable[[], tuple[int, int]] = staticmethod(lambda: (0, 0))
 
     def within(self, command: str, body: str, kind: str, target: RoundTrip,
-               reference: RoundTrip, rate: int, heading: list[int]) -> bool:
+               reference: RoundTrip, rate: int, heading: list[int],
+               reach: tuple[int, int]) -> bool:
         """Whether a difference of ``kind`` (to ``body``, of ``command``) lies within what
         another profile of the same motion reads (:class:`Readings`); never where the
         comparison is the reference's own. ``heading``: each axis's direction in the last
-        vector that moved it."""
+        vector that moved it; ``reach``: how much earlier and later the target may place
+        the motion's events, this frame's run included (the pair's ``reach``)."""
         return False
 
     def _follow(self, instant: int) -> None:
@@ -255,11 +257,12 @@ class Readings(Timing):
             self.cut = False               # every vector ran to its end after all
 
     def within(self, command: str, body: str, kind: str, target: RoundTrip,
-               reference: RoundTrip, rate: int, heading: list[int]) -> bool:
+               reference: RoundTrip, rate: int, heading: list[int],
+               reach: tuple[int, int]) -> bool:
         self._watch()
-        ahead, behind = self.reach()
-        reach = max(ahead, behind)
-        ended = self.edge_at is not None and self.reference.now - self.edge_at <= reach
+        ahead, behind = reach
+        longest = max(reach)
+        ended = self.edge_at is not None and self.reference.now - self.edge_at <= longest
         if kind == "position":
             if not (ended or self.cut or self.st6 & St6.RUN):
                 return False               # at rest, where every reading ends alike
@@ -269,7 +272,7 @@ class Readings(Timing):
         if kind == "timing":
             late = (target.received_at - target.sent_at) - (reference.received_at
                                                              - reference.sent_at)
-            return command in _AT_REST and abs(late) <= reach
+            return command in _AT_REST and abs(late) <= longest
         if kind == "data":
             # RUN or STOP read as the motion ends: near an end seen, or in a stop ramp
             # (another tick ends it sooner)

@@ -90,3 +90,14 @@ def test_a_w_refused_as_a_syntax_error_is_the_reading_of_its_fields():
     assert label("W", "code", {"after-run"}, set(), 5, 4) == syntax
     # refused at once for a value out of range: 4 there is the range's code missed
     assert label("W", "code", set(), set(), 5, 4) == "5.code.range"
+
+
+def test_a_w_run_ramped_to_its_speeds_answers_within_its_own_ramps():
+    # a simulator written from M84 alone that ramps its W run at A to n3 (the reference
+    # runs at n3): no switch within 100 steps, answered 5 a ramp later
+    ramped = "exec:" + shlex.join([sys.executable, str(CORPUS / "gve84-b" / "sim.py"),
+                                   "--cosim", "--model", "GVE84-100"])
+    d = _run(ramped, [Step(FRAME, body="WX,-100,1000,50,1000")])
+    assert d is not None and d.kind == "timing"
+    assert (d.rule, d.verdict) == ("10.2.motion.trapezoid", NON_STRICT)
+    assert _run(ramped, [Step(FRAME, body="WX,-100,1000,50,1000")], strict=True).verdict == FAIL
