@@ -67,6 +67,8 @@ class Course:
         #: it (a normal vector to a reader of "program považuje za normální vektor")
         self.zero_at: int | None = None
         self.longest_t_ns = profile.range("T").hi * 1_000_000
+        self.shortest_t_ns = profile.range("T").lo * 1_000_000
+        self.t_given = False               # a T taken: the dwell is no reader's choice
         self.top = profile.max_rate
         self.speed = profile.reset.V
         self.override = max(100, profile.reset.XM) / 100
@@ -160,6 +162,7 @@ class Course:
             self.vector_at = None          # what follows is the halt's, the resume's...
         elif command == "T" and (ms := decimal(body[1:])) is not None:
             self.t_ns = ms * 1_000_000
+            self.t_given = True
 
     def _queue(self, command: str, body: str) -> None:
         if command in _EMPTIES:      # D and K alike, as the timing takes them
@@ -225,6 +228,16 @@ class Course:
     @property
     def rate(self) -> int:
         return min(self.top, math.ceil(self.speed * self.override * self.up))
+
+    @property
+    def dwell_reach(self) -> tuple[int, int]:
+        """How much sooner and later than the reference's a start from rest may come for
+        its dwell T (ns): with no T taken, a reader's T after reset (1..24 ms, spec 9 [D])
+        placed before every start; with one taken, that T before every start, none
+        sooner."""
+        if self.t_given:
+            return 0, self.t_ns
+        return self.t_ns - self.shortest_t_ns, self.longest_t_ns
 
     @property
     def ramp_ns(self) -> int:

@@ -489,8 +489,9 @@ class Pair:
         ``body`` (a W's, answered when it ends) included."""
         c = self.course
         moves, ramps = c.own_run(command, body)
+        sooner, later = c.dwell_reach
         return profile_reach(starts=c.starts + moves, changes=self._course_changes,
-                             dwell_ns=c.t_ns, longest_dwell_ns=c.longest_t_ns,
+                             sooner_ns=sooner, later_ns=later,
                              ramp_ns=c.ramp_ns if c.path else 0,
                              run_ramps_ns=c.run_ramps_ns + ramps)
 

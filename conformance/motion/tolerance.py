@@ -184,14 +184,14 @@ def reading_band(a: Window, b: Window, rate: int, *,
 
 
 
-def profile_reach(*, starts: int, changes: int, dwell_ns: int, longest_dwell_ns: int,
+def profile_reach(*, starts: int, changes: int, sooner_ns: int, later_ns: int,
                   ramp_ns: int, run_ramps_ns: int = 0) -> tuple[int, int]:
     """How much earlier and how much later (ns) a unit of somebody else's may place a
     motion's events than the reference and still read the manuals: each event (the first,
     each start from rest, each frame that changed the course) a tick of its own either
-    way; each start from rest up to the reference's dwell `T` earlier (the dwell placed
-    after the end before it, or none before a first start) and up to the longest `T`
-    later (a dwell before every start, its value after reset a reader's: spec 9 [D]); and
+    way; each start from rest its dwell `T` up to ``sooner_ns`` earlier and ``later_ns``
+    later (a reader's T after reset, spec 9 [D], a dwell before every start: the
+    course's ``dwell_reach``); and
     under `VK` a whole ramp either way (along which length `A` accelerates is not fixed);
     a run at a speed of its own (`W`) its ramps at `A` to and from its speeds either way
     (``run_ramps_ns``: the manuals give its speeds, not whether it ramps to them).
@@ -199,5 +199,5 @@ def profile_reach(*, starts: int, changes: int, dwell_ns: int, longest_dwell_ns:
     rate times these; the instant the motion ends (an `H`'s or `W`'s answer, RUN or STOP
     read) by the larger."""
     ticks = TICK_NS * (1 + starts + changes)
-    return (ticks + starts * (dwell_ns + ramp_ns) + run_ramps_ns,
-            ticks + starts * (longest_dwell_ns + ramp_ns) + run_ramps_ns)
+    return (ticks + starts * (sooner_ns + ramp_ns) + run_ramps_ns,
+            ticks + starts * (later_ns + ramp_ns) + run_ramps_ns)

@@ -10,13 +10,16 @@ import shlex
 import sys
 from pathlib import Path
 
+from conformance.diff.course import Course
 from conformance.diff.engine import Pair
 from conformance.diff.labels import label
-from conformance.diff.sides import Side
+from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FRAME, WAIT, Step
+from conformance.link.framing import parse_response
 from conformance.motion.tolerance import TICK_NS, profile_reach
 from conformance.targets import parse_target
 from conformance.verdict import FAIL, NON_STRICT
+from gve_fixtures.profile import load_profile
 
 CORPUS = Path(__file__).resolve().parents[3] / "corpus"
 #: a simulator written from M84 alone that starts each motion on a 1 ms tick of its own
@@ -70,16 +73,33 @@ def test_a_rate_no_reading_allows_fails_through_another_profile():
     assert d.verdict == FAIL and d.tag in ("M", "M-ex")
 
 
-def test_the_reach_is_a_tick_an_event_and_the_dwell_later_than_earlier():
-    ahead, behind = profile_reach(starts=1, changes=1, dwell_ns=5_000_000,
-                                  longest_dwell_ns=24_000_000, ramp_ns=0)
-    assert ahead == 3 * TICK_NS + 5_000_000
+def test_the_reach_is_a_tick_an_event_and_the_dwell_a_reader_may_choose():
+    ahead, behind = profile_reach(starts=1, changes=1, sooner_ns=4_000_000,
+                                  later_ns=24_000_000, ramp_ns=0)
+    assert ahead == 3 * TICK_NS + 4_000_000
     assert behind == 3 * TICK_NS + 24_000_000
     # under VK a whole ramp either way, each start
-    ahead_vk, behind_vk = profile_reach(starts=2, changes=0, dwell_ns=5_000_000,
-                                        longest_dwell_ns=24_000_000, ramp_ns=50_000_000)
-    assert (ahead_vk, behind_vk) == (3 * TICK_NS + 2 * 55_000_000,
-                                     3 * TICK_NS + 2 * 74_000_000)
+    ahead_vk, behind_vk = profile_reach(starts=2, changes=0, sooner_ns=0,
+                                        later_ns=5_000_000, ramp_ns=50_000_000)
+    assert (ahead_vk, behind_vk) == (3 * TICK_NS + 2 * 50_000_000,
+                                     3 * TICK_NS + 2 * 55_000_000)
+
+
+def test_a_dwell_given_by_t_is_nobody_s_choice_to_shorten():
+    course = Course(load_profile("GVE84-100"))
+    sooner, later = course.dwell_reach          # T after reset: a reader's 1..24 ms
+    assert sooner > 0 and later == course.longest_t_ns
+    course.took("T", "T12", RoundTrip(b"", b"0\r", 0, 0, parse_response(b"0\r", summed=False)))
+    assert course.dwell_reach == (0, 12_000_000)
+
+
+def test_a_start_that_skips_a_given_dwell_fails_through_another_profile():
+    skips = "exec:" + shlex.join([*EMULATOR, "--mutant", "dwell-ignored"])
+    steps = [Step(FRAME, body="T24"), Step(FRAME, body="A10000"), Step(FRAME, body="L2,0,0"),
+             Step(WAIT, seconds=0.005), *_frames("L300,0,0", wait=0.006)]
+    d = _run(skips, steps)
+    assert d is not None and d.kind == "position" and "profile" not in d.context
+    assert d.verdict == FAIL and d.rule == "10.2.motion.dwell"
 
 
 def test_a_w_refused_as_a_syntax_error_is_the_reading_of_its_fields():
