@@ -23,6 +23,7 @@ _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 _COURSE_CHANGERS = classes(course=True)
 _VECTORS = classes(vector=True)
 _EMPTIES = classes(empties=True)
+_STOPS = classes(stops=True)
 #: moves at a speed of its own (the profile's top speed bounds it), not the modal V
 _OWN_SPEED = classes(own_speed=True)
 #: frames besides vectors that move the axes or set their counters (J restarts them;
@@ -96,6 +97,11 @@ class Course:
         self.heading = [0] * len(profile.axes)
         #: the ramps at A to and from the speeds of the runs at a speed of their own (W)
         self.run_ramps_ns = 0
+        #: GVE54: vectors held by a stop (H, SW6) that no D or K threw away, and an M taken
+        #: while they were: whether their remainder keeps the mode they were accepted in
+        #: is a reading (10.1.queue.captured [D])
+        self.held = False
+        self.mode_over_held = False
         self.reach: list[int] | None = [0] * len(profile.axes)
         self.caps: list[int] | None = None
         self.moved: set[int] = set()
@@ -165,8 +171,11 @@ class Course:
             self.t_given = True
 
     def _queue(self, command: str, body: str) -> None:
+        if command in _STOPS and self.queued is not None:
+            self.held = True
         if command in _EMPTIES:      # D and K alike, as the timing takes them
             self.queued = None
+            self.held = False
         elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             steps = _numbers(body[1:]) if command == "C" else None
             if steps and self.queued in ("C", "C+C") and self._last_c and any(
@@ -210,6 +219,7 @@ class Course:
                     self.moved.add(i)
         elif command == "M" and params in self.factors:
             self.factor = self.factors[params]
+            self.mode_over_held |= self.held
         elif command == "VL":
             self.caps = _numbers(params)
         elif command in _MOVERS or command.startswith("N"):

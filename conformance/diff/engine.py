@@ -416,6 +416,8 @@ class Pair:
             context.add(shipped)
         if self.course.mpg_on:
             context.add("mpg-on")
+        if self.course.mode_over_held:
+            context.add("mode-over-held")
         context |= _st6_differs(step.body, rec)
         if _released(out):
             context.add("released")

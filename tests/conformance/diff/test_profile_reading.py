@@ -12,7 +12,7 @@ from pathlib import Path
 
 from conformance.diff.course import Course
 from conformance.diff.engine import Pair
-from conformance.diff.labels import label
+from conformance.diff.labels import command_of, label
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FRAME, WAIT, Step
 from conformance.link.framing import parse_response
@@ -121,3 +121,37 @@ def test_a_w_run_ramped_to_its_speeds_answers_within_its_own_ramps():
     assert d is not None and d.kind == "timing"
     assert (d.rule, d.verdict) == ("10.2.motion.trapezoid", NON_STRICT)
     assert _run(ramped, [Step(FRAME, body="WX,-100,1000,50,1000")], strict=True).verdict == FAIL
+
+
+def _gve54(spec: str, steps: list[Step], *, strict: bool = False):
+    target = parse_target(spec, profile="GVE54", allow_destructive=True, strict=strict)
+    target.preflight()
+    try:
+        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE54")),
+                    target.profile)
+        return pair.run(steps).disagreement
+    finally:
+        target.session.finish()
+        target.close()
+
+
+def test_a_held_remainder_run_in_a_mode_taken_after_the_halt_is_a_reading():
+    # a GVE54 written from M54 alone runs a halted vector's remainder in the mode an M
+    # took while it was held; the reference keeps the mode it was accepted in
+    rescaled = "exec:" + shlex.join([sys.executable, str(CORPUS / "gve54-b" / "sim.py"),
+                                     "--cosim"])
+    steps = [Step(FRAME, body="C200,0,0"), Step(FRAME, body="H"), Step(FRAME, body="M4"),
+             Step(FRAME, body="G"), Step(WAIT, seconds=1.0), Step(FRAME, body="PF")]
+    d = _gve54(rescaled, steps)
+    assert d is not None and "mode-over-held" in d.context
+    assert (d.rule, d.verdict) == ("10.1.queue.captured", NON_STRICT)
+    assert _gve54(rescaled, steps, strict=True).verdict == FAIL
+    # with no vector held, the mode's unit is the mode's rule
+    course = Course(load_profile("GVE54"))
+    ok = RoundTrip(b"", b"0\r", 0, 0, parse_response(b"0\r", summed=False))
+    for body in ("C200,0,0", "M4"):
+        course.took(command_of(body), body, ok)
+    assert not course.mode_over_held
+    for body in ("H", "M2"):
+        course.took(command_of(body), body, ok)
+    assert course.mode_over_held
