@@ -191,13 +191,14 @@ def profile_reach(*, starts: int, changes: int, sooner_ns: int, later_ns: int,
     each start from rest, each frame that changed the course) a tick of its own either
     way; each start from rest its dwell `T` up to ``sooner_ns`` earlier and ``later_ns``
     later (a reader's T after reset, spec 9 [D], a dwell before every start: the
-    course's ``dwell_reach``); and
-    under `VK` a whole ramp either way (along which length `A` accelerates is not fixed);
-    a run at a speed of its own (`W`) its ramps at `A` to and from its speeds either way
-    (``run_ramps_ns``: the manuals give its speeds, not whether it ramps to them).
+    course's ``dwell_reach``); and later only, as the reference's profile is the
+    quicker: under `VK` a whole ramp each start (`A` along the path, not the dominant
+    axis: M84 12.5.4 does not say along which length it accelerates), and a run at a
+    speed of its own (`W`) its ramps at `A` to and from its speeds (``run_ramps_ns``: the
+    manuals give its speeds, not whether it ramps to them).
     A position read while the motion runs, or near its end, may be ahead or behind by the
     rate times these; the instant the motion ends (an `H`'s or `W`'s answer, RUN or STOP
     read) by the larger."""
     ticks = TICK_NS * (1 + starts + changes)
-    return (ticks + starts * (sooner_ns + ramp_ns) + run_ramps_ns,
+    return (ticks + starts * sooner_ns,
             ticks + starts * (later_ns + ramp_ns) + run_ramps_ns)

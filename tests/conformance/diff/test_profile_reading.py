@@ -65,6 +65,13 @@ def test_where_the_motion_ends_at_rest_is_exact_for_every_reading():
     assert _run(TICKED, _frames("VK", "L300,300,0", wait=2.0)) is None
 
 
+def test_a_path_speed_ignored_is_ahead_of_every_profile():
+    ignores_vk = "exec:" + shlex.join([*EMULATOR, "--mutant", "path-speed-ignored"])
+    d = _run(ignores_vk, _frames("VK", "L300,300,0", wait=0.4))
+    assert d is not None and d.kind == "position" and "profile" not in d.context
+    assert (d.rule, d.verdict) == ("10.2.motion.path-rate", FAIL)
+
+
 def test_a_rate_no_reading_allows_fails_through_another_profile():
     ignores_v = "exec:" + shlex.join([*EMULATOR, "--mutant", "velocity-ignored"])
     d = _run(ignores_v, _frames("V200", "L300,0,0", wait=1.0))
@@ -78,11 +85,12 @@ def test_the_reach_is_a_tick_an_event_and_the_dwell_a_reader_may_choose():
                                   later_ns=24_000_000, ramp_ns=0)
     assert ahead == 3 * TICK_NS + 4_000_000
     assert behind == 3 * TICK_NS + 24_000_000
-    # under VK a whole ramp either way, each start
+    # under VK a whole ramp later each start (A along the path is the slower reading),
+    # and a W's ramps later too: none sooner
     ahead_vk, behind_vk = profile_reach(starts=2, changes=0, sooner_ns=0,
-                                        later_ns=5_000_000, ramp_ns=50_000_000)
-    assert (ahead_vk, behind_vk) == (3 * TICK_NS + 2 * 50_000_000,
-                                     3 * TICK_NS + 2 * 55_000_000)
+                                        later_ns=5_000_000, ramp_ns=50_000_000,
+                                        run_ramps_ns=7_000_000)
+    assert (ahead_vk, behind_vk) == (3 * TICK_NS, 3 * TICK_NS + 2 * 55_000_000 + 7_000_000)
 
 
 def test_a_dwell_given_by_t_is_nobody_s_choice_to_shorten():
