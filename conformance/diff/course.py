@@ -23,6 +23,7 @@ _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 _COURSE_CHANGERS = classes(course=True)
 _VECTORS = classes(vector=True)
 _EMPTIES = classes(empties=True)
+_STOPS = classes(stops=True)
 #: moves at a speed of its own (the profile's top speed bounds it), not the modal V
 _OWN_SPEED = classes(own_speed=True)
 #: frames besides vectors that move the axes or set their counters (J restarts them;
@@ -67,6 +68,8 @@ class Course:
         #: it (a normal vector to a reader of "program považuje za normální vektor")
         self.zero_at: int | None = None
         self.longest_t_ns = profile.range("T").hi * 1_000_000
+        self.shortest_t_ns = profile.range("T").lo * 1_000_000
+        self.t_given = False               # a T taken: the dwell is no reader's choice
         self.top = profile.max_rate
         self.speed = profile.reset.V
         self.override = max(100, profile.reset.XM) / 100
@@ -84,6 +87,21 @@ class Course:
         #: the smallest acceleration it took (commanded steps/s²): the longest last step
         #: of a ramp to rest
         self.accel = profile.reset.A * 1000
+        #: the vectors that may have started from rest (every L, a C with no C to join),
+        #: the highest V they may have cruised at, and whether VK was taken: what another
+        #: profile of the same motion reads (Pair's reading_ns)
+        self.starts = 0
+        self.cruise = profile.reset.V
+        self.path = False
+        #: each axis's direction in the last vector that moved it (0: none did)
+        self.heading = [0] * len(profile.axes)
+        #: the ramps at A to and from the speeds of the runs at a speed of their own (W)
+        self.run_ramps_ns = 0
+        #: GVE54: vectors held by a stop (H, SW6) that no D or K threw away, and an M taken
+        #: while they were: whether their remainder keeps the mode they were accepted in
+        #: is a reading (10.1.queue.captured [D])
+        self.held = False
+        self.mode_over_held = False
         self.reach: list[int] | None = [0] * len(profile.axes)
         self.caps: list[int] | None = None
         self.moved: set[int] = set()
@@ -145,14 +163,19 @@ class Course:
             # a C with no C before it to join starts from rest: whether it waits the
             # dwell is a reading (10.2.motion.dwell-before-c [D])
             self.c_from_rest = command == "C" and self.queued in (None, "L")
+            self.starts += command == "L" or self.c_from_rest
         elif command in _COURSE_CHANGERS:
             self.vector_at = None          # what follows is the halt's, the resume's...
         elif command == "T" and (ms := decimal(body[1:])) is not None:
             self.t_ns = ms * 1_000_000
+            self.t_given = True
 
     def _queue(self, command: str, body: str) -> None:
+        if command in _STOPS and self.queued is not None:
+            self.held = True
         if command in _EMPTIES:      # D and K alike, as the timing takes them
             self.queued = None
+            self.held = False
         elif command in _VECTORS and not _ZERO_VECTOR.fullmatch(body.upper()):
             steps = _numbers(body[1:]) if command == "C" else None
             if steps and self.queued in ("C", "C+C") and self._last_c and any(
@@ -165,6 +188,9 @@ class Course:
         value = _first_number(body[len(command):])
         if command == "V" and value is not None:
             self.speed = max(self.speed, value)
+            self.cruise = max(self.cruise, value)
+        elif command == "VK":
+            self.path = True
         elif command == "XM" and value is not None:
             self.override = max(self.override, value / 100)
         elif command == "A" and value is not None and value > 0:
@@ -173,6 +199,9 @@ class Course:
             self.up *= 17 / 16
         elif command in _OWN_SPEED:
             self.speed = self.top
+            moves, ramps = self.own_run(command, body)
+            self.starts += moves
+            self.run_ramps_ns += ramps
 
     def _where(self, command: str, body: str) -> None:
         params = body[len(command):]
@@ -181,12 +210,16 @@ class Course:
             if d is None or self.reach is None:
                 self.reach = None
                 return
+            for i, n in enumerate(d[:len(self.heading)]):
+                if n:
+                    self.heading[i] = 1 if n > 0 else -1
             for i, n in enumerate(d[:len(self.reach)]):
                 self.reach[i] += abs(n) * self.factor
                 if n:
                     self.moved.add(i)
         elif command == "M" and params in self.factors:
             self.factor = self.factors[params]
+            self.mode_over_held |= self.held
         elif command == "VL":
             self.caps = _numbers(params)
         elif command in _MOVERS or command.startswith("N"):
@@ -205,6 +238,33 @@ class Course:
     @property
     def rate(self) -> int:
         return min(self.top, math.ceil(self.speed * self.override * self.up))
+
+    @property
+    def dwell_reach(self) -> tuple[int, int]:
+        """How much sooner and later than the reference's a start from rest may come for
+        its dwell T (ns): with no T taken, a reader's T after reset (1..24 ms, spec 9 [D])
+        placed before every start; with one taken, that T before every start, none
+        sooner."""
+        if self.t_given:
+            return 0, self.t_ns
+        return self.t_ns - self.shortest_t_ns, self.longest_t_ns
+
+    @property
+    def ramp_ns(self) -> int:
+        """The longest a vector's ramp from rest to its cruise can take (ns): the highest V
+        (raised by XM and XU) at the smallest A."""
+        cruise = min(self.top, self.cruise * self.override * self.up)
+        return math.ceil(cruise * 1_000_000_000 / self.accel)
+
+    def own_run(self, command: str, body: str) -> tuple[int, int]:
+        """A run at a speed of its own (`W<axis>,n2,n3,n4,n5`): its moves from rest (to
+        the switch and back) and how long ramps at the smallest A to and from its speeds
+        n3 and n5 take (ns); (0, 0) for anything else."""
+        fields = [int(n) for n in re.findall(r"-?\d+", body[len(command) + 1:])]
+        if command not in _OWN_SPEED or len(fields) != 4:
+            return 0, 0
+        speeds = abs(fields[1]) + abs(fields[3])
+        return 2, 2 * math.ceil(speeds * 1_000_000_000 / self.accel)
 
     def beyond_reach(self, position: list[str]) -> bool:
         """Whether ``position`` (a `P`/`PF` answer's values) has an axis farther from

@@ -31,7 +31,13 @@ from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step, frames
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
-from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
+from conformance.motion.tolerance import (
+    PLACEMENT_STEPS,
+    TICK_NS,
+    byte_ns,
+    profile_reach,
+    step_period,
+)
 from conformance.protocol.catalogue import classes
 from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
@@ -121,6 +127,7 @@ class Pair:
                            placement=placement,
                            unused_inputs=tuple(profile.unused_inputs.items()))
         self.course = Course(profile)
+        self.timing.reach = self._reading_ns
         #: the frames of the example that changed a motion's course (H, G, XA...): a unit
         #: of somebody else's may take each at its own next step
         self._course_changes = 0
@@ -394,14 +401,23 @@ class Pair:
             context.add("beyond-reach")
         if kind == "position" and self._placed(rec):
             context.add("placement")
+        elif "beyond-reach" not in context and self.timing.within(
+                command, step.body, kind, rec.target, rec.reference,
+                self.course.rate * self.course.factor, self.course.heading,
+                self._reading_ns(command, step.body)):
+            context.add("profile")
         if self.course.capped_elsewhere:
             context.add("capped-elsewhere")
+        if _ran(rec.reference, self.reference.link.baud):
+            context.add("after-run")
         context.add("kept" if self.course.kept else "nothing-kept")
         shipped = self.course.unwritten(command, step.body)
         if shipped:
             context.add(shipped)
         if self.course.mpg_on:
             context.add("mpg-on")
+        if self.course.mode_over_held:
+            context.add("mode-over-held")
         context |= _st6_differs(step.body, rec)
         if _released(out):
             context.add("released")
@@ -468,6 +484,18 @@ class Pair:
         except ValueError:
             return False
         return max(apart, default=0) <= self.judge.placement * (1 + self._course_changes)
+
+    def _reading_ns(self, command: str = "", body: str = "") -> tuple[int, int]:
+        """How much earlier and later a unit of somebody else's may place the example's
+        motion than the reference (tolerance.py's profile_reach), the run of the frame
+        ``body`` (a W's, answered when it ends) included."""
+        c = self.course
+        moves, ramps = c.own_run(command, body)
+        sooner, later = c.dwell_reach
+        return profile_reach(starts=c.starts + moves, changes=self._course_changes,
+                             sooner_ns=sooner, later_ns=later,
+                             ramp_ns=c.ramp_ns if c.path else 0,
+                             run_ramps_ns=c.run_ramps_ns + ramps)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
         """The index is compared from each side's first reading of it (index.py)."""
@@ -593,6 +621,15 @@ class Pair:
 
 #: the frames whose answer's value is ST6 (F's with its queue bit)
 _ST6_READS = ("SR6", "F")
+
+
+def _ran(reference: RoundTrip, baud: int) -> bool:
+    """Whether the reference answered a tick or more later than the bytes take: after a
+    run of its own (a W that met no switch), not at once (a value out of range)."""
+    if not reference.answer:
+        return False
+    lasted = reference.received_at - reference.sent_at
+    return lasted > (len(reference.sent) + len(reference.answer)) * byte_ns(baud) + TICK_NS
 
 
 def _st6_differs(body: str, rec: StepRecord) -> set[str]:

@@ -11,10 +11,14 @@ target's session measured and the example's own).
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+
 from conformance.diff.sides import RoundTrip, Side
 from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
+from conformance.motion.tolerance import PLACEMENT_STEPS
 from conformance.protocol.catalogue import classes
-from gve_fixtures.protocol import St6
+from gve_fixtures.protocol import SECOND, St6
 
 #: real time: how long the reference must have been at rest, besides the target's
 #: window, for positions to be compared exactly (a target's motion ends when the unit
@@ -35,6 +39,12 @@ _UNTIMED = _DEFERRED | {"input"}
 #: readings of the axes' positions (`>` repeats one, read while they may have moved)
 _READINGS = classes(position=True) | {">"}
 _EMPTIES = classes(empties=True)
+#: ST6's bits that tell where a motion is (a vector run, a stop ramp)
+_MOTION_BITS = St6.RUN | St6.STOP
+#: frames answered when the motion has stopped (H, W)
+_AT_REST = classes(deferred=True)
+#: the frames whose answer's value is ST6 (F's with its queue bit)
+_ST6_READS = ("SR6", "F")
 
 
 class Timing:
@@ -81,6 +91,21 @@ class Timing:
         """How far either side of its exchange the target may have acted on a frame or
         read its counters: nothing in virtual time."""
         return EXACT
+
+    #: how much earlier and how much later (ns) the target may place the motion's events
+    #: than the reference under another reading of its profile (set by the pair: it knows
+    #: the course); nothing where the target is the reference's own kind
+    reach: Callable[[], tuple[int, int]] = staticmethod(lambda: (0, 0))
+
+    def within(self, command: str, body: str, kind: str, target: RoundTrip,
+               reference: RoundTrip, rate: int, heading: list[int],
+               reach: tuple[int, int]) -> bool:
+        """Whether a difference of ``kind`` (to ``body``, of ``command``) lies within what
+        another profile of the same motion reads (:class:`Readings`); never where the
+        comparison is the reference's own. ``heading``: each axis's direction in the last
+        vector that moved it; ``reach``: how much earlier and later the target may place
+        the motion's events, this frame's run included (the pair's ``reach``)."""
+        return False
 
     def _follow(self, instant: int) -> None:
         """The reference waits until ``instant`` on the target's clock (if it is behind)."""
@@ -187,7 +212,108 @@ class RealTime(Timing):
         return reference.sent_at - self.idle_since < 2 * width + SETTLE_NS
 
 
+class Readings(Timing):
+    """Both sides in virtual time, the target somebody else's: as exact as :class:`Timing`,
+    and it watches the reference's motion (when RUN or STOP last changed, whether a frame
+    cut it short) so that a difference another profile of the same motion explains is
+    told apart from one no reading explains (:meth:`within`). The manuals fix V, A, B,
+    `$` and T, where a motion ends at rest and in what order things happen; not the tick a
+    unit steps, ramps and starts on, where the dwell falls, nor along which length A
+    accelerates under VK (conformance/motion/tolerance.py: ``profile_reach``)."""
+
+    def __init__(self, target: Side, reference: Side) -> None:
+        super().__init__(target, reference)
+        self.begin()
+
+    def begin(self) -> None:
+        self.st6 = 0
+        self.edge_at: int | None = None     # when RUN or STOP last changed
+        self.cut = self.lost = False        # a frame stopped the motion short of its end
+
+    def waited(self) -> None:
+        # looked at the reach before the wait's end too: an end within it is near the read
+        self._follow(self.target.now - max(self.reach()))
+        self._watch()
+        self._follow(self.target.now)
+        self._watch()
+
+    def retimed(self, command: str, target: RoundTrip | None,
+                reference: RoundTrip | None = None) -> None:
+        if command in _STOPPING and self.st6 & St6.RUN:
+            self.cut = True
+        if command in _EMPTIES and self.cut:
+            self.lost = True
+        self._watch()
+
+    def _watch(self) -> None:
+        rig = self.reference.link.rig
+        if rig is None:
+            return
+        st6 = int(rig.state()["status"][6], 16)
+        if (st6 ^ self.st6) & _MOTION_BITS:
+            self.edge_at = self.reference.now
+        self.st6 = st6
+        if not st6 & (St6.RUN | St6.INTA) and not self.lost:
+            self.cut = False               # every vector ran to its end after all
+
+    def within(self, command: str, body: str, kind: str, target: RoundTrip,
+               reference: RoundTrip, rate: int, heading: list[int],
+               reach: tuple[int, int]) -> bool:
+        self._watch()
+        ahead, behind = reach
+        longest = max(reach)
+        ended = self.edge_at is not None and self.reference.now - self.edge_at <= longest
+        if kind == "position":
+            if not (ended or self.cut or self.st6 & St6.RUN):
+                return False               # at rest, where every reading ends alike
+            return _numbers_within(target, reference, heading,
+                                   *(math.ceil(rate * ns / SECOND) + PLACEMENT_STEPS
+                                     for ns in (ahead, behind)))
+        if kind == "timing":
+            late = (target.received_at - target.sent_at) - (reference.received_at
+                                                             - reference.sent_at)
+            return command in _AT_REST and abs(late) <= longest
+        if kind == "data":
+            # RUN or STOP read as the motion ends: near an end seen, or in a stop ramp
+            # (another tick ends it sooner)
+            return body in _ST6_READS and (ended or bool(self.st6 & St6.STOP)) \
+                and _st6_motion_only(target, reference)
+        return False
+
+
+def _numbers_within(target: RoundTrip, reference: RoundTrip, heading: list[int],
+                    ahead: int, behind: int) -> bool:
+    """Whether each axis of the target's reading is at most ``ahead`` steps farther along
+    its direction than the reference's and at most ``behind`` short of it (an axis that
+    no vector moved: ``ahead`` either way)."""
+    try:
+        xs = [int(v) for v in target.response.values]
+        ys = [int(v) for v in reference.response.values]
+    except (AttributeError, ValueError):
+        return False
+    if len(xs) != len(ys):
+        return False
+    headings = [*heading, *[0] * len(xs)]
+    for x, y, h in zip(xs, ys, headings, strict=False):
+        lead = (x - y) * h if h else abs(x - y)
+        if lead > ahead or -lead > (behind if h else ahead):
+            return False
+    return True
+
+
+def _st6_motion_only(target: RoundTrip, reference: RoundTrip) -> bool:
+    """Two reads of ST6 (`SR6`, `F`) that differ in RUN or STOP only."""
+    try:
+        a, b = (int(x.response.values[0], 16) for x in (target, reference))
+    except (AttributeError, IndexError, ValueError):
+        return False
+    return bool(a ^ b) and not (a ^ b) & ~_MOTION_BITS
+
+
 def timing_for(target: Side, reference: Side) -> Timing:
-    """Exact when both sides are in virtual time, else real time."""
-    kind = Timing if target.virtual and reference.virtual else RealTime
-    return kind(target, reference)
+    """Exact when both sides are in virtual time (the target somebody else's: exact, and
+    watched for what another profile of the motion reads), else real time."""
+    if not (target.virtual and reference.virtual):
+        return RealTime(target, reference)
+    return Timing(target, reference) if target.target.info.strict else Readings(target,
+                                                                                reference)

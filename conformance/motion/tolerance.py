@@ -52,6 +52,9 @@ from gve_fixtures.protocol import SECOND
 BITS_PER_BYTE = 10
 #: steps a real target may differ by from the model at a known instant (step placement)
 PLACEMENT_STEPS = 1
+#: the tick a unit of somebody else's may step, ramp and start on: the manuals time the
+#: motion in whole milliseconds (the dwell `T` 1..24 ms) and fix no finer clock
+TICK_NS = 1_000_000
 
 
 def byte_ns(baud: int) -> int:
@@ -178,3 +181,24 @@ def reading_band(a: Window, b: Window, rate: int, *,
     itself)."""
     apart = max(a.hi - b.lo, b.hi - a.lo, 0)
     return math.ceil(rate * apart / SECOND) + placement
+
+
+
+def profile_reach(*, starts: int, changes: int, sooner_ns: int, later_ns: int,
+                  ramp_ns: int, run_ramps_ns: int = 0) -> tuple[int, int]:
+    """How much earlier and how much later (ns) a unit of somebody else's may place a
+    motion's events than the reference and still read the manuals: each event (the first,
+    each start from rest, each frame that changed the course) a tick of its own either
+    way; each start from rest its dwell `T` up to ``sooner_ns`` earlier and ``later_ns``
+    later (a reader's T after reset, spec 9 [D], a dwell before every start: the
+    course's ``dwell_reach``); and later only, as the reference's profile is the
+    quicker: under `VK` a whole ramp each start (`A` along the path, not the dominant
+    axis: M84 12.5.4 does not say along which length it accelerates), and a run at a
+    speed of its own (`W`) its ramps at `A` to and from its speeds (``run_ramps_ns``: the
+    manuals give its speeds, not whether it ramps to them).
+    A position read while the motion runs, or near its end, may be ahead or behind by the
+    rate times these; the instant the motion ends (an `H`'s or `W`'s answer, RUN or STOP
+    read) by the larger."""
+    ticks = TICK_NS * (1 + starts + changes)
+    return (ticks + starts * sooner_ns,
+            ticks + starts * (later_ns + ramp_ns) + run_ramps_ns)

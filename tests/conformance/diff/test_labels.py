@@ -161,6 +161,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "1.profile.version": ("1.profile.version", ("?", "data", set(), set(), 0, 0)),
     # C into a full queue taken, or C refused with room
     "10.1.queue.cont-buffer": ("5.errors.queue-full", ("C", "code", set(), {"C"}, 1, 0)),
+    # GVE54: a halted vector's remainder after an M taken while it was held
+    "10.1.queue.captured": ("10.1.measured.captured",
+                            ("PF", "position", {"mode-over-held"}, {"M", "H", "C"}, 0, 0)),
     # L while a vector runs taken
     "10.1.queue.line-alone": ("5.errors.refused-not-executed",
                               ("L", "code", set(), {"L"}, 1, 0)),
