@@ -202,6 +202,17 @@ def test_readings_combine():
     assert answers(("plus-sign", "queries-counted"), [b"!0V+100\r", b"!0@\r"]) == b"0\r0,2\r"
 
 
+def test_a_frame_the_index_never_counted_is_not_taken_back_when_refused():
+    # refused frames uncounted, queries counted: a frame whose checksum fails (4) and one
+    # the watchdog drops (2) never counted; the refused T99 (5) is taken back; `>` counts
+    both = ("refused-uncounted", "queries-counted")
+    assert answers(both, [b"!0%+\r", b"!0V100,00\r", b"!0@,BD\r"]) == \
+        b"0,5C\r4,60\r0,2,BA\r"
+    assert answers(both, [b"!0V10", 0.5, b"!0@\r"]) == b"2\r0,1\r"
+    assert answers(both, [b"!0T99\r", b"!0>\r", b"!0@\r"]) == \
+        b"5\r!0T99\r5\r0,2\r"
+
+
 def test_every_reading_reads_a_rule_the_manuals_leave_open():
     rules = load_rules()
     for name, spec in READINGS.items():
