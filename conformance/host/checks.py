@@ -322,10 +322,12 @@ def _resends(ex: Exchange, nxt: Exchange) -> bool:
 
 def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A vector or packet refused with 1 is sent again later (spec 5, 10.1). Not judged
-    when the host had to be stopped (it hung: that is its own finding)."""
+    when the host had to be stopped (it hung: that is its own finding), nor when it gave
+    up (exited non-zero) with no other motion sent after the refusal: it did not go on as
+    if the frame had been queued, and its giving up is 8.recovery.finishes's."""
     if line.exit_code is None:
         return
-    unsure = 0
+    unsure = gave_up = 0
     for i, ex in enumerate(rec.exchanges):
         if ex.parsed.command not in (*VECTORS, "*E") or ex.delivered is None:
             continue
@@ -338,7 +340,10 @@ def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
                  else any(e.frame.raw == ex.frame.raw for e in later))
         if again:
             continue
-        if _answer_late_by_relay(ex, rec):
+        went_on = any(e.parsed.command in (*VECTORS, "*E") for e in later)
+        if line.exit_code != 0 and not went_on:
+            gave_up += 1
+        elif _answer_late_by_relay(ex, rec):
             unsure += 1
         else:
             out.add("5.code.queue-full", _at(ex.frame.start, line), ex.text,
@@ -347,6 +352,10 @@ def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
         out.notes.append(f"{unsure} refusal(s) with 1 not judged for 5.code.queue-full: "
                          "the relay was late itself and gave the answer after the host "
                          "could take it for lost")
+    if gave_up:
+        out.notes.append(f"the host gave up (exit status {line.exit_code}) while its last "
+                         "refused frame waited for room, sending no other motion: not "
+                         "judged for 5.code.queue-full")
 
 
 def _answer_late_by_relay(ex: Exchange, rec: Recording) -> bool:

@@ -229,6 +229,27 @@ def test_a_full_queue_is_tried_again():
     assert broken(w.judge())["5.code.queue-full"] == ["!0L20,0,0"]
 
 
+def test_a_host_that_gives_up_while_a_refused_vector_waits_did_not_ignore_the_refusal():
+    # refused with 1 until the host gave up for a reason of its own (exit 4): its giving
+    # up is judged by 8.recovery.finishes, not as a vector left out
+    w = Wire()
+    w.frame(b"!0L10,0,0", 0)
+    w.frame(b"!0L20,0,0", 10, answer=b"1\r")
+    w.frame(b"!0L20,0,0", 20, answer=b"1\r")
+    w.frame(b"!0@", 30, answer=b"0,13\r")
+    j = w.judge(exit_code=4)
+    assert "5.code.queue-full" not in broken(j)
+    assert any("gave up" in n for n in j.notes)
+    # one that went on with the next vector after giving the refused one up left it out,
+    # whatever its exit
+    w.frame(b"!0L30,0,0", 40)
+    assert broken(w.judge(exit_code=4))["5.code.queue-full"] == ["!0L20,0,0"]
+    # and one that exits 0 never sent it again
+    w = Wire()
+    w.frame(b"!0L20,0,0", 10, answer=b"1\r")
+    assert broken(w.judge(exit_code=0))["5.code.queue-full"] == ["!0L20,0,0"]
+
+
 def test_refusals_are_the_hosts_fault():
     w = Wire()
     w.frame(b"!0l100,0,0", 0, answer=b"3\r")
