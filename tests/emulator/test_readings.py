@@ -33,6 +33,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # T99 refused (5): counted, or not
     "refused-uncounted": ([b"!0T99\r", b"!0@\r"], b"5\r0,1\r", b"5\r0,0\r"),
     "restore-nothing-kept-refused": ([b"!0R\r"], b"0\r", b"4\r"),
+    # STOP written as 1: nothing, or a stop request accepted (INTA, the answer's 8 too)
+    "sw6-stop-request": ([b"!0SW6,01\r", b"!0SR6\r"], b"0\r0,00\r", b"8\r8,80\r"),
     # the second K finds the first one's save held
     "second-keep-refused": ([b"!0K\r", b"!0K\r"], b"0\r0\r", b"0\r4\r"),
     # a long vector still running a second later
