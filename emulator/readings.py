@@ -173,6 +173,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                 "a C whose next C reverses an axis brakes to rest at their "
                                 "junction, not to B (\"U pokračujícího vektoru se nesmí "
                                 "příliš změnit úhel\": a reversal is no continuation)"),
+    "sw6-stop-request": (("10.3.sw6.answer-inta",),
+                         "SW6 writing STOP (bit 0, \"žádost o zastavení\") as 1 is a stop "
+                         "request the unit accepts: INTA is set and a motion stops on its "
+                         "ramp, as writing INTA does"),
 }.items()}
 
 #: readings whose behaviour lives in the stepper core

@@ -184,19 +184,24 @@ def run_bit(ctx: CaseContext) -> None:
     answers(ctx, ctx.link.send("SR6"), "0,00", "idle again", rule="10.3.st6.inta-run")
 
 
-@case("10.3.sw6.writing-st6", rules=("10.3.sw6.acts", "10.3.sw6.live-bits"))
+@case("10.3.sw6.writing-st6", rules=("10.3.sw6.acts", "10.3.sw6.live-bits",
+                                     "10.3.sw6.answer-inta", "4.response.inta-bit"))
 def sw6(ctx: CaseContext) -> None:
+    """SW6 sets and clears INTA: its own answer shows the write at once [D], the answers
+    after it show it whatever the instant (spec 4 [M])."""
     link = ctx.link
     code(ctx, link.send("SW6,80"), ErrorCode.OK,
-         "SW6,80 sets INTA", inta=True, rule="10.3.sw6.acts")
-    code(ctx, link.send("L" + vector(ctx, 100)), ErrorCode.OK,
-         "L is accepted while INTA = 1", inta=True, rule="10.3.sw6.acts")
+         "SW6,80 sets INTA", inta=True, rule="10.3.sw6.answer-inta")
+    r = link.send("L" + vector(ctx, 100))
+    code(ctx, r, ErrorCode.OK, "L is accepted while INTA = 1", rule="10.3.sw6.acts")
+    ctx.expect(r is not None and bool(r.inta), "the answer after SW6,80 carries INTA",
+               observed=show(r), expected="8", rule="4.response.inta-bit")
     link.wait(0.5)
     ctx.expect_equal(position(ctx), [0, 0, 0], "the vector waits for G", rule="10.3.sw6.acts")
     link = ctx.fresh_link()
     halted_line(ctx, 300, 0.1)
     code(ctx, link.send("SW6,00"), ErrorCode.OK,
-         "SW6,00 clears INTA", inta=False, rule="10.3.sw6.acts")
+         "SW6,00 clears INTA", inta=False, rule="10.3.sw6.answer-inta")
     r = link.poll("SR6", lambda r: r.values == ["00"], 10)
     ctx.expect(r is not None, "RUN clears when the resumed vector ends", observed=show(r),
                expected="0,00", rule="10.3.sw6.live-bits")

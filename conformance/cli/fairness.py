@@ -36,8 +36,6 @@ PROG = "gve-conformance fairness"
 #: one profile per family for the readings one at a time
 FIRST = ("GVE84-100", "GVE54", "GVE114-500")
 ALL = "all"
-#: readings tried alone only, not in all at once (see main)
-APART = ("refused-uncounted",)
 #: sequences diff draws after its probes on each profile, and the seed they come from
 DIFF_DRAWN = 50
 DIFF_SEED = 0
@@ -173,16 +171,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     names = args.reading or sorted(known)
-    # all at once leaves out the readings no model of the suite combines yet (each is still
-    # tried alone): refused frames left uncounted beside queries counted put the machines'
-    # index model off by the refused queries
-    together = [n for n in names if n not in APART]
     first = [p for p in FIRST if p in available_profiles()]
     jobs = [(n, [n], trial_profiles(known[n][0], first), args.cases or None) for n in names]
     if not args.reading:
         # all at once runs on every profile, the longest trial: first, so that the
         # workers do not wait for it at the end
-        jobs.insert(0, (ALL, together, available_profiles(), args.cases or None))
+        jobs.insert(0, (ALL, names, available_profiles(), args.cases or None))
     start = time.perf_counter()
     trials: list[Trial] = []
     with workers(args.jobs) as pool, Progress(len(jobs), unit="reading", quiet=args.quiet,

@@ -16,7 +16,7 @@ from conformance.host.examples import worked_frames
 from conformance.host.grammar import UNSUMMED
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
-from conformance.protocol.catalogue import classes, commands
+from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
@@ -28,7 +28,9 @@ ASKING = classes(asks=True)
 #: what a host may send again instead of asking: once or twice, the unit is left alike
 REPEATABLE = classes(repeatable=True)
 #: what only reads: sent while a host waits to ask, it trusts nothing
-QUERIES = frozenset(name for name, c in commands().items() if c.query)
+QUERIES = classes(query=True)
+#: the reads that tell what became of a frame: the index (`@`, `>`) and the positions
+TELLING = QUERIES & (ASKING | classes(position=True))
 
 
 @dataclass(frozen=True)
@@ -247,7 +249,10 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
     else and never resends a vector blindly (spec 8); in checksum mode an answer whose
     checksum fails is not trusted (spec 6). Sending a repeatable command again at once
     (a setting or a read: M84 12.5.12 "Většina příkazů se dá zopakovat") trusts nothing
-    and leaves the unit as one run would: a recovery the manual names, no finding."""
+    and leaves the unit as one run would: a recovery the manual names, no finding. Pure
+    reads (the catalogue's queries) trust nothing; a host that read the index or the
+    positions before it acted found out what became of the frame, and did not trust the
+    damaged answer (what it made of the reads, the executed motion judges)."""
     for i, ex in enumerate(rec.exchanges):
         if ex.fault is None or ex.fault in ("cut-frame", "queue-full", "interrupt",
                                             "restart"):
@@ -258,17 +263,26 @@ def recovery(rec: Recording, line: LineFacts, out: Judgement) -> None:
         if not rest:
             continue
         nxt = rest[0]
+        told = False
         if not _resends(ex, nxt):
-            # reads first (F until the motion ends, then `@`) trust nothing and change
-            # nothing: what the host does after them is what it made of the answer
-            nxt = next((e for e in rest if not _reads(e) or e.parsed.command in ASKING), nxt)
+            # reads first (F until the motion ends, then `@` or PF) trust nothing and
+            # change nothing: what the host does after them is what it made of the answer
+            # and of what they told it
+            acts = next((k for k, e in enumerate(rest)
+                         if not _reads(e) or e.parsed.command in ASKING), None)
+            if acts is None:
+                continue                    # it only read: it trusted nothing
+            told = any(e.parsed.command in TELLING for e in rest[:acts])
+            nxt = rest[acts]
         asked = nxt.parsed.command in ASKING
         shown = f"after {ex.text} ({ex.fault})"
         out.judged |= {"8.recovery.no-blind-resend", "8.recovery.ask-index"}
         repeated = _resends(ex, nxt) and ex.parsed.command in REPEATABLE
         if ex.fault == "corrupt-answer" and summed(ex):
             out.judged.add("6.checksum.response-sum")
-            if not asked and not repeated:
+            # a host that read the index or the positions first found out what became
+            # of the frame: what it then does rests on them (the motion judges it)
+            if not asked and not repeated and not told:
                 out.add("6.checksum.response-sum", _at(nxt.frame.start, line), nxt.text,
                         f"trusted an answer whose checksum fails {shown}")
                 continue
@@ -308,10 +322,12 @@ def _resends(ex: Exchange, nxt: Exchange) -> bool:
 
 def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """A vector or packet refused with 1 is sent again later (spec 5, 10.1). Not judged
-    when the host had to be stopped (it hung: that is its own finding)."""
+    when the host had to be stopped (it hung: that is its own finding), nor when it gave
+    up (exited non-zero) with no other motion sent after the refusal: it did not go on as
+    if the frame had been queued, and its giving up is 8.recovery.finishes's."""
     if line.exit_code is None:
         return
-    unsure = 0
+    unsure = gave_up = 0
     for i, ex in enumerate(rec.exchanges):
         if ex.parsed.command not in (*VECTORS, "*E") or ex.delivered is None:
             continue
@@ -324,7 +340,10 @@ def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
                  else any(e.frame.raw == ex.frame.raw for e in later))
         if again:
             continue
-        if _answer_late_by_relay(ex, rec):
+        went_on = any(e.parsed.command in (*VECTORS, "*E") for e in later)
+        if line.exit_code != 0 and not went_on:
+            gave_up += 1
+        elif _answer_late_by_relay(ex, rec):
             unsure += 1
         else:
             out.add("5.code.queue-full", _at(ex.frame.start, line), ex.text,
@@ -333,6 +352,10 @@ def queue_full(rec: Recording, line: LineFacts, out: Judgement) -> None:
         out.notes.append(f"{unsure} refusal(s) with 1 not judged for 5.code.queue-full: "
                          "the relay was late itself and gave the answer after the host "
                          "could take it for lost")
+    if gave_up:
+        out.notes.append(f"the host gave up (exit status {line.exit_code}) while its last "
+                         "refused frame waited for room, sending no other motion: not "
+                         "judged for 5.code.queue-full")
 
 
 def _answer_late_by_relay(ex: Exchange, rec: Recording) -> bool:

@@ -12,10 +12,13 @@ from conformance.case.context import CaseContext
 from conformance.link.framing import Response
 from conformance.link.link import MARGIN
 from conformance.model.unit import ModelUnit
+from conformance.protocol.catalogue import catalogue
 from conformance.protocol.parse import parse
 from conformance.verdicts.quoting import as_text
 from gve_fixtures.protocol import ErrorCode
 
+#: commands whose answer ends with another frame's answer (`>`: the remembered one's)
+REPEATS = frozenset(n for n, c in catalogue().items() if c.lines > 1)
 #: a frame every unit refuses and none can store (no command of spec 10 begins with Z)
 UNKNOWN_COMMAND = "Z"
 
@@ -72,8 +75,11 @@ class UnitMachine(RuleBasedStateMachine):
         """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
         the model (``checksum_ok``: whether its sum lets it count)."""
         r = self.link.send(body, **kw)
-        self.model.frame_arrived(parse(body).name or body[:1], checksum_ok=checksum_ok,
-                                 code=None if r is None else r.code)
+        name = parse(body).name or body[:1]
+        # `>` answers with the remembered frame's answer: its code refuses that frame,
+        # not the `>`, which a unit counting queries has counted
+        own = None if r is None or name in REPEATS else r.code
+        self.model.frame_arrived(name, checksum_ok=checksum_ok, code=own)
         return r
 
     def fits(self, body: str) -> bool:

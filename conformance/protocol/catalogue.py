@@ -71,6 +71,7 @@ class Command:
     empties: bool = False
     still: bool = False
     summing: bool = False
+    query: bool = False
     resumes: str | None = None
     examples: tuple[str, ...] = field(default=(), compare=False)
 
@@ -91,15 +92,6 @@ class Command:
         vector, a marker, a motion, a stop, a restart or a packet's end."""
         return not (self.vector or self.motion or self.marks or self.stops or self.restart
                     or self.empties or self.packet in ("opens", "closes"))
-
-    @property
-    def query(self) -> bool:
-        """Whether it only reads: repeatable, and it sets nothing (no modal parameter,
-        setting, EEPROM, checksum mode, speed, course, hand wheel, reaction or restart)."""
-        return self.repeatable and not (
-            self.modal or self.setting or self.eeprom or self.checksums or self.exchanges
-            or self.course or self.retimes or self.paces or self.reaction
-            or self.destructive or self.own_speed)
 
     @property
     def switch(self) -> bool:

@@ -377,6 +377,8 @@ class Device:
             s.status[6] = value & ~(RUN | STOP)
         else:
             was = s.inta
+            if value & STOP and self.readings.active("sw6-stop-request"):
+                value |= INTA                     # the stop request, accepted at once
             # RUN, STOP and FREE describe the stepper: writing them changes nothing
             s.status[6] = value & ~(RUN | STOP | FREE)
             if s.inta and not was:

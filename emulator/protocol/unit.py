@@ -197,15 +197,16 @@ class Unit:
         dropped, answered as a count mismatch is, `2,k` (k members received)."""
         members, self.session.packet = self.session.packet or [], None
         self._packet_quiet = None
-        self._answer(b"", ErrorCode.WATCHDOG, [str(len(members))], t, remember=False)
+        self._answer(b"", ErrorCode.WATCHDOG, [str(len(members))], t, remember=False,
+                     arrived=False)
 
     def _watchdog(self, head: bytes, t: int) -> None:
         if len(head) < 2 and self.readings.active("lone-bang-answered"):
-            self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False)
+            self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False, arrived=False)
             return
         if len(head) < 2 or self._address(head) is None:
             return                                  # only '!' arrived, or not ours
-        self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False)
+        self._answer(head, ErrorCode.WATCHDOG, [], t, remember=False, arrived=False)
 
     # -- bytes in ---------------------------------------------------------------------------
     def receive(self, data: bytes, t: int, byte_ns: int) -> None:
@@ -265,7 +266,7 @@ class Unit:
                     ses.packet.append(Member(None, None, ErrorCode.SYNTAX))
                 else:
                     name, _ = split(body.decode("latin-1"))
-                    self._answer(raw, ErrorCode.SYNTAX, [], t,
+                    self._answer(raw, ErrorCode.SYNTAX, [], t, arrived=False,
                                  remember=COMMANDS.get(name or "", _NONE).remembered)
                 return
         text = body.decode("latin-1")
@@ -361,12 +362,14 @@ class Unit:
         self.session.history = (last, answer)
 
     def _answer(self, raw: bytes, code: int, values: list[str], t: int, *,
-                remember: bool = True) -> None:
+                remember: bool = True, arrived: bool = True) -> None:
+        """Answer ``raw``; ``arrived``: whether the index counted it when it arrived (a
+        frame the watchdog dropped, or whose checksum failed, never was)."""
         ses = self.session
         # a refused frame the index counted is taken back; a query (@, >) counts only
         # where a reading or a mutant makes it count
-        counted = remember or self.readings.active("queries-counted") \
-            or self.mutant.active("index-counts-queries")
+        counted = arrived and (remember or self.readings.active("queries-counted")
+                               or self.mutant.active("index-counts-queries"))
         if code and counted and (self.mutant.active("index-skips-refused")
                                  or self.readings.active("refused-uncounted")):
             ses.index = (ses.index - 1) & 0xFF

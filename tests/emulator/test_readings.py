@@ -33,6 +33,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # T99 refused (5): counted, or not
     "refused-uncounted": ([b"!0T99\r", b"!0@\r"], b"5\r0,1\r", b"5\r0,0\r"),
     "restore-nothing-kept-refused": ([b"!0R\r"], b"0\r", b"4\r"),
+    # STOP written as 1: nothing, or a stop request accepted (INTA, the answer's 8 too)
+    "sw6-stop-request": ([b"!0SW6,01\r", b"!0SR6\r"], b"0\r0,00\r", b"8\r8,80\r"),
     # the second K finds the first one's save held
     "second-keep-refused": ([b"!0K\r", b"!0K\r"], b"0\r0\r", b"0\r4\r"),
     # a long vector still running a second later
@@ -200,6 +202,17 @@ def test_a_reading_of_the_gve54_answers_its_point_otherwise(name):
 
 def test_readings_combine():
     assert answers(("plus-sign", "queries-counted"), [b"!0V+100\r", b"!0@\r"]) == b"0\r0,2\r"
+
+
+def test_a_frame_the_index_never_counted_is_not_taken_back_when_refused():
+    # refused frames uncounted, queries counted: a frame whose checksum fails (4) and one
+    # the watchdog drops (2) never counted; the refused T99 (5) is taken back; `>` counts
+    both = ("refused-uncounted", "queries-counted")
+    assert answers(both, [b"!0%+\r", b"!0V100,00\r", b"!0@,BD\r"]) == \
+        b"0,5C\r4,60\r0,2,BA\r"
+    assert answers(both, [b"!0V10", 0.5, b"!0@\r"]) == b"2\r0,1\r"
+    assert answers(both, [b"!0T99\r", b"!0>\r", b"!0@\r"]) == \
+        b"5\r!0T99\r5\r0,2\r"
 
 
 def test_every_reading_reads_a_rule_the_manuals_leave_open():

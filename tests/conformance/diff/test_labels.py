@@ -141,6 +141,15 @@ def test_an_input_interrupting_is_the_manuals_and_when_it_does_the_decision():
     assert label("SW", "inta", set(), {"SW"}, 0) == "4.response.inta-bit"
 
 
+def test_the_inta_of_an_sw6_answer_is_the_writes_own_decision():
+    assert label("SW6", "inta", set(), set(), 0) == "10.3.sw6.answer-inta"
+    assert verdict_of("10.3.sw6.answer-inta", False)[0] == NON_STRICT
+    # an answer after it: what the write did, the write's rule
+    assert label("V", "inta", set(), {"SW6"}, 0) == "10.3.sw6.acts"
+    # any other answer's INTA bit stays the manual's
+    assert label("V", "inta", set(), set(), 0) == "4.response.inta-bit"
+
+
 def test_a_clear_with_an_input_its_polarity_made_active_is_when_inputs_interrupt():
     for command in ("G", "D", "K", "R", "SW6"):
         assert label(command, "inta", set(), {"SW"}, 0) == "10.3.inputs.level-triggered"
@@ -204,6 +213,8 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "10.3.status.all-bits": ("10.3.status.all-bits-stored",
                              ("SR", "data", set(), {"SW"}, 0, 0)),
     "10.3.sw6.acts": ("10.3.sw6.writing-st6", ("PF", "position", set(), {"L", "SW6"}, 0, 0)),
+    # SW6,01 answered 8 where the reference wrote STOP alone: the write's own answer
+    "10.3.sw6.answer-inta": ("10.3.sw6.writing-st6", ("SW6", "inta", set(), set(), 0, 0)),
     "10.4.delete": ("10.4.delete.refused-while-moving", ("D", "code", set(), {"C"}, 7, 0)),
     "10.4.go.resume": ("10.4.go.resumes-exactly",
                        ("PF", "position", set(), {"L", "H", "G"}, 0, 0)),

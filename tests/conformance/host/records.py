@@ -43,9 +43,9 @@ class Wire:
         self.rec.exchanges.append(ex)
         return ex
 
-    def judge(self):
+    def judge(self, exit_code: int | None = 0):
         views = line_views([(p, a) for a, p in self.units.items()])
-        return judge(self.rec, LineFacts(views, self.units, 115200, 0, exit_code=0))
+        return judge(self.rec, LineFacts(views, self.units, 115200, 0, exit_code=exit_code))
 
 
 def broken(j) -> dict[str, list[str]]:

@@ -4,6 +4,7 @@ is and kept where it is not."""
 from __future__ import annotations
 
 from conformance.host.checks import MS, PATIENCE_MS
+from conformance.host.grammar import byte_sum
 from conformance.host.oracle import HOST_CHECKS
 from gve_fixtures.rules import load_rules
 from tests.conformance.host.records import Wire, broken
@@ -157,6 +158,53 @@ def test_reads_while_the_host_waits_to_ask_trust_nothing():
     assert broken(w.judge())["6.checksum.response-sum"] == ["!0L10,0,0,E2"]
 
 
+def _summed(body: bytes) -> bytes:
+    return body + b",%02X" % byte_sum(body + b",")
+
+
+def test_a_host_that_read_the_positions_after_a_damaged_answer_did_not_trust_it():
+    # a damaged answer to a packet's *E: *E0, F until the motion ends, PF until it rests,
+    # then the next packet's setting: it found out by the positions what became of it
+    def damaged_packet() -> Wire:
+        w = Wire()
+        w.frame(_summed(b"!0*S"), 0, answer=None, checksums=True)
+        w.frame(_summed(b"!0C0,-400,0"), 1, answer=None, checksums=True)
+        w.frame(_summed(b"!0*E1"), 2, answer=_summed(b"0,1") + b"\r",
+                given=_summed(b"0,1").replace(b"0,", b"1,", 1) + b"\r",
+                fault="corrupt-answer", checksums=True)
+        w.frame(_summed(b"!0*E0"), 10, answer=_summed(b"4,0") + b"\r", checksums=True)
+        w.frame(_summed(b"!0F"), 20, answer=_summed(b"0,40") + b"\r", checksums=True)
+        w.frame(_summed(b"!0F"), 30, answer=_summed(b"0,00") + b"\r", checksums=True)
+        w.frame(_summed(b"!0PF"), 40, answer=_summed(b"0,0,-400,0") + b"\r",
+                checksums=True)
+        return w
+    w = damaged_packet()
+    w.frame(_summed(b"!0B10"), 50, answer=_summed(b"0") + b"\r", checksums=True)
+    found = broken(w.judge())
+    assert "6.checksum.response-sum" not in found
+    # the manual's recovery is `@`: going on after the positions alone is its [D] rule's
+    assert found == {"8.recovery.ask-index": [_summed(b"!0B10").decode()]}
+    # a host that only read after it and stopped trusted nothing either
+    assert broken(damaged_packet().judge()) == {}
+    # the same reads, then the packet sent again without asking: a blind resend
+    w = damaged_packet()
+    w.frame(_summed(b"!0*S"), 50, answer=None, checksums=True)
+    found = broken(w.judge())
+    assert "6.checksum.response-sum" not in found
+    assert found["8.recovery.no-blind-resend"] == [_summed(b"!0*S").decode()]
+
+
+def test_a_status_read_tells_nothing_of_a_damaged_answer():
+    # F alone says whether the unit moves, not what became of the frame: a setting after
+    # it rests on the damaged answer
+    w = Wire()
+    w.frame(b"!0L10,0,0,E2", 0, answer=b"0,5C\r", given=b"1,5C\r", fault="corrupt-answer",
+            checksums=True)
+    w.frame(b"!0F,C3", 10, answer=b"0,40,EC\r", checksums=True)
+    w.frame(b"!0V1000,94", 20, answer=b"0,5C\r", checksums=True)
+    assert broken(w.judge())["6.checksum.response-sum"] == ["!0V1000,94"]
+
+
 def test_a_setting_sent_again_after_a_damaged_answer_trusts_nothing():
     w = Wire()
     w.frame(b"!0SW2,00,E5", 0, answer=b"0,5C\r", given=b"1,5C\r", fault="corrupt-answer",
@@ -179,6 +227,27 @@ def test_a_full_queue_is_tried_again():
     w.frame(b"!0L20,0,0", 10, answer=b"1\r")
     w.frame(b"!0L10,0,0", 20)
     assert broken(w.judge())["5.code.queue-full"] == ["!0L20,0,0"]
+
+
+def test_a_host_that_gives_up_while_a_refused_vector_waits_did_not_ignore_the_refusal():
+    # refused with 1 until the host gave up for a reason of its own (exit 4): its giving
+    # up is judged by 8.recovery.finishes, not as a vector left out
+    w = Wire()
+    w.frame(b"!0L10,0,0", 0)
+    w.frame(b"!0L20,0,0", 10, answer=b"1\r")
+    w.frame(b"!0L20,0,0", 20, answer=b"1\r")
+    w.frame(b"!0@", 30, answer=b"0,13\r")
+    j = w.judge(exit_code=4)
+    assert "5.code.queue-full" not in broken(j)
+    assert any("gave up" in n for n in j.notes)
+    # one that went on with the next vector after giving the refused one up left it out,
+    # whatever its exit
+    w.frame(b"!0L30,0,0", 40)
+    assert broken(w.judge(exit_code=4))["5.code.queue-full"] == ["!0L20,0,0"]
+    # and one that exits 0 never sent it again
+    w = Wire()
+    w.frame(b"!0L20,0,0", 10, answer=b"1\r")
+    assert broken(w.judge(exit_code=0))["5.code.queue-full"] == ["!0L20,0,0"]
 
 
 def test_refusals_are_the_hosts_fault():

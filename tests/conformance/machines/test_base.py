@@ -24,9 +24,9 @@ from conformance.targets import parse_target
 CASE = "6.machine.checksum-framing"
 
 
-def context(profile: str = "GVE84-100") -> CaseContext:
+def context(profile: str = "GVE84-100", readings: str = "") -> CaseContext:
     (case,) = select([CASE])
-    target = parse_target(f"emu:{profile}")
+    target = parse_target(f"emu:{profile}" + (f"?reading={readings}" if readings else ""))
     return CaseContext(case, target.profile, target.info, settings_profiles.get("ci"),
                        target.session.open_link)
 
@@ -44,6 +44,17 @@ class Booked(UnitMachine):
     @rule()
     def speed(self) -> None:
         assert self.send("V1000").code == 0
+
+
+class Repeats(UnitMachine):
+    """Refused frames, each repeated by `>` (whose answer is the refused frame's)."""
+
+    index_is_the_models = index_invariant()
+
+    @rule()
+    def refused_then_repeated(self) -> None:
+        assert self.send("T99").code == 5
+        assert self.send(">", lines=2).code == 5
 
 
 class Unbooked(UnitMachine):
@@ -138,3 +149,13 @@ def test_an_example_that_cannot_start_from_the_known_state_is_could_not_test():
         run_machine(ctx, Booked)
     assert not failed(ctx)
     assert len(opened) == 3                 # not tried again once it could not start
+
+
+@pytest.mark.parametrize("readings", ["", "refused-uncounted", "queries-counted",
+                                      "refused-uncounted,queries-counted"])
+def test_the_model_combines_what_counts_as_the_unit_measured(readings):
+    # whether refused frames count and whether queries count, measured, both at once:
+    # the code `>` answers with is the refused frame's, not a refusal of the `>`
+    ctx = context(readings=readings)
+    run_machine(ctx, Repeats)
+    assert not failed(ctx)

@@ -50,6 +50,19 @@ def test_what_commands_do_to_a_motion_follows_spec_10():
     assert cat.classes(switch=True) == {"VK", "VN"}
 
 
+def test_the_pure_reads_read_and_set_nothing():
+    queries = cat.classes(query=True)
+    assert queries == {"?", "Q", "P", "PF", "ER", "EFR", "EUR", "I0", "I1", "I2", "SR", "F",
+                       "@", ">"}
+    sets = ("vector", "motion", "marks", "stops", "restart", "empties", "modal", "setting",
+            "eeprom", "checksums", "exchanges", "course", "retimes", "paces", "reaction",
+            "destructive", "own_speed", "summing")
+    for name in queries:
+        c = cat.catalogue()[name]
+        assert c.repeatable and c.packet in (None, "breaker"), name
+        assert not any(getattr(c, flag) for flag in sets), name
+
+
 def test_an_unknown_resumed_place_is_refused(tmp_path):
     path = tmp_path / "commands.toml"
     path.write_text('[command.G]\nresumes = "stack"\n', encoding="utf-8")
