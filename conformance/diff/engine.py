@@ -32,7 +32,7 @@ from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
 from conformance.motion.tolerance import PLACEMENT_STEPS, step_period
-from conformance.protocol.catalogue import classes
+from conformance.protocol.catalogue import catalogue, classes
 from conformance.protocol.parse import parse
 from conformance.targets.session import StepFailed
 from conformance.verdict import CouldNotTest
@@ -48,6 +48,8 @@ except ImportError:
     _providers = _Constants = None
 
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: W with a comma after its axis letter (the format line's form, not M114's example's)
+_AXIS_COMMA = re.compile(r"W[A-Za-z],")
 #: the frames that change a running motion's course (H, G, XA...)
 _COURSE = classes(retimes=True)
 #: real time: how long the fresh reference stands before a sequence
@@ -586,9 +588,21 @@ class Pair:
             "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
             and step.body.upper() != name,
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
+            "long-hex": _long_hex(name, parse(step.body).fields),
+            "axis-comma": name == "W" and bool(_AXIS_COMMA.match(step.body)),
             "enables": name == "SW" and step.body[2:4] in ("0,", "1,"),
         }
         return {k for k, on in flags.items() if on}
+
+
+def _long_hex(name: str, fields: tuple[str, ...]) -> bool:
+    """Whether a hex field of the frame has more than the two digits the manuals write
+    (00..FF)."""
+    command = catalogue().get(name)
+    # a frame may carry more or fewer fields than the command takes
+    return command is not None and any(
+        f.kind == "hex" and len(v.strip()) > 2
+        for f, v in zip(command.fields, fields, strict=False))
 
 
 #: the frames whose answer's value is ST6 (F's with its queue bit)
