@@ -141,8 +141,8 @@ def _mpg_values(ctx: CaseContext) -> list[tuple[int, bool]]:
       rules=("9.reset.mpg", "10.cmd.mpg", "9.reset.mpg-inert", "9.reset.mpg-held-at-reset"))
 def mpg_values(ctx: CaseContext) -> None:
     """Each value of the MPG enable byte the manual lists (M114 12.2: 01, 02, 81, 82)
-    holds the axes after J (RUN = 1, vectors 7) and `Y-`, `Y&`, `Y+` switch it off and
-    on; every value beside them leaves the MPG inert, `Y&` too."""
+    holds the axes after J, or from a `Y&` sent (RUN = 1, vectors 7), and `Y-`, `Y&`,
+    `Y+` switch it off and on; every value beside them leaves the MPG inert, `Y&` too."""
     mpg, link = ctx.profile.mpg, ctx.link
     enable = "%02X" % mpg.enable_address
     # every other MPG parameter in range first (M114 12: otherwise "the MPG cannot be
