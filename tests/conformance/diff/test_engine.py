@@ -284,6 +284,9 @@ def test_a_hex_field_longer_than_the_manuals_two_digits_is_its_context(body, lon
     assert engine._long_hex(command_of(body), parse_frame(body).fields) is long
 
 
-def test_a_w_with_a_comma_after_its_axis_is_its_context():
-    assert engine._AXIS_COMMA.match("WX,-100,1000,50,1000")
-    assert not engine._AXIS_COMMA.match("WX-100,1000,50,1000")
+def test_a_w_with_a_comma_after_its_axis_and_its_numbers_in_range_is_its_context():
+    assert engine._axis_comma("WX,-100,1000,50,1000")
+    assert not engine._axis_comma("WX-100,1000,50,1000")
+    # a field out of range: the reference's 5 is the range's, the target's 4 its bug
+    assert not engine._axis_comma("WX,1,900,-1,900")
+    assert not engine._axis_comma("WX,1,900,1")
