@@ -45,6 +45,17 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                            "frame"),
     "hex-upper-only": (("3.params.hex-digits",),
                        "hex fields take upper-case digits only: a-f is a syntax error (4)"),
+    "hex-two-digits": (("3.params.hex-digits",),
+                       "hex fields take one or two digits, as the manuals write them "
+                       "(00..FF): three or more (`SW0,001`, `ER100`) are a syntax error "
+                       "(4), not a value range-checked"),
+    "set-axis-xyz-only": (("10.cmd.set-axis-a",),
+                          "GVE114: N<axis> takes the axes its manual names (X, Y, Z): `NA` "
+                          "is a syntax error (4)"),
+    "mpg-on-when-sent": (("9.reset.mpg-held-at-reset",),
+                         "GVE114: the MPG holds the axes only from a `Y&` or `Y+` sent: "
+                         "after power-on and J its `&` mode is inert and ST6 = 00, as M114 "
+                         "13.5 gives the reset state"),
     "queries-counted": (("8.index.queries-uncounted",),
                         "@ and > advance the index like every other command"),
     "refused-uncounted": (("8.index.refused-counted",),

@@ -41,6 +41,18 @@ def code(ctx: CaseContext, r: Response | None, value: ErrorCode, what: str, *,
                       rule=rule)
 
 
+def refused_beyond_ff(ctx: CaseContext, r: Response | None, what: str, *,
+                      rule: str) -> None:
+    """A hex field one beyond FF (`100`): refused under ``rule`` by every reading (the
+    manuals write hex fields 00..FF, so three digits may be a syntax error, 4), and 5, a
+    value range-checked, as 3.params.hex-digits decides."""
+    ctx.expect(r is not None and r.code in (ErrorCode.SYNTAX, ErrorCode.RANGE),
+               f"{what}: refused", observed=show(r), expected="code 5 (or 4: three hex digits)",
+               rule=rule)
+    code(ctx, r, ErrorCode.RANGE, f"{what}: three hex digits range-checked → 5",
+         rule="3.params.hex-digits")
+
+
 def vector(ctx: CaseContext, x: int, y: int = 0, z: int = 0) -> str:
     """The parameters of an L/C vector for the profile's axes."""
     return f"{x},{y},{z}"

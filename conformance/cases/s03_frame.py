@@ -151,13 +151,19 @@ def hex_fields(ctx: CaseContext) -> None:
     setup(ctx, "SW3,10")
     answers(ctx, ctx.link.send("SR3"), "0,10", "SW's value is hex: 10 is sixteen",
             rule="3.params.hex-fields")
-    # the EEPROM holds the owner's bytes: the same address written three ways reads alike
+    # the EEPROM holds the owner's bytes: the same address written three ways reads alike.
+    # The manuals write the address 00..FF: its two digits are the manual's, one or three
+    # digits the project's decision
     forms = {body: ctx.link.send(body) for body in ("ER0D", "ERD", "ER00D")}
+    first = forms["ER0D"]
+    ctx.expect(first is not None and first.ok and len(first.values) == 1,
+               "ER's address is hex: ER0D reads one byte", observed=show(first),
+               expected="0,XX", rule="3.params.hex-fields")
     ok = all(r is not None and r.ok and len(r.values) == 1 for r in forms.values())
     read = {r.hex() for r in forms.values()} if ok else set()
-    ctx.expect(ok and len(read) == 1, "ER's address is hex: ER0D, ERD and ER00D read one byte",
+    ctx.expect(ok and len(read) == 1, "ERD and ER00D read the byte ER0D reads",
                observed=", ".join(f"{b} → {show(r)}" for b, r in forms.items()),
-               expected="0,XX three times", rule="3.params.hex-fields")
+               expected="0,XX three times", rule="3.params.hex-digits")
     for body in ("ER0G", "ERG"):
         answers(ctx, ctx.link.send(body), "4", f"{body}: not a hex address → 4",
                 rule="3.params.hex-fields")

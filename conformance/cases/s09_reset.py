@@ -67,18 +67,16 @@ def reset_motion(ctx: CaseContext) -> None:
 
 @case("9.reset.mpg-enabled", requires=("Y",), destructive=True,
       rules=("9.reset.mpg", "5.moving.definition", "10.cmd.mpg", "10.cmd.restart",
-             "9.reset.mpg-parameters"))
+             "9.reset.mpg-parameters", "9.reset.mpg-held-at-reset"))
 def mpg_moving(ctx: CaseContext) -> None:
     link = ctx.link
     # enabled, every parameter in range (M114 12); with one out of range and no leave to
     # write it, what the MPG mode does is a reading
-    rule = "9.reset.mpg" if configured(ctx, "mpg", required=False) \
-        else "9.reset.mpg-parameters"
+    ready = configured(ctx, "mpg", required=False)
+    rule = "9.reset.mpg" if ready else "9.reset.mpg-parameters"
     answers(ctx, link.send("J"), "0", "J → 0", rule="10.cmd.restart")
     link.wait(2.5, Spent.MANUAL)
-    r = link.send("SR6")
-    ctx.expect(r is not None and r.values == ["40"], "after J the MPG holds RUN = 1",
-               observed=show(r), expected="0,40", rule=rule)
+    _mpg_on(ctx, "after J", "10.cmd.mpg" if ready else rule)
     code(ctx, link.send("L" + vector(ctx, 10)), ErrorCode.BUSY,
          "vectors are refused: 7", rule=rule)
     for body in ("D", "K", "R", "EW40,00", "EFW44,1", "EUW48,1"):
@@ -88,6 +86,23 @@ def mpg_moving(ctx: CaseContext) -> None:
     # an MPG that did not take effect let the vector run: it has ended by the idiom's 0
     finished(ctx, 30, lambda r: r.code != ErrorCode.QUEUE_FULL)
     answers(ctx, link.send("SR6"), "0,00", "and RUN clears", rule="10.cmd.mpg")
+
+
+def _mpg_on(ctx: CaseContext, shown: str, rule: str) -> None:
+    """The MPG the EEPROM enables on after a restart: holding RUN at once (the reset's `&`,
+    9.reset.mpg-held-at-reset [D]), or, to a reader of M114 13.5's ST6 = 00, from a `Y&`
+    sent, which ``rule`` judges ("Při odeslání Y+ nebo Y& je stav stroje v chodu")."""
+    link = ctx.link
+    r = link.send("SR6")
+    held = r is not None and r.values == ["40"]
+    ctx.expect(held, f"{shown} the MPG holds RUN = 1", observed=show(r), expected="0,40",
+               rule="9.reset.mpg-held-at-reset")
+    if held:
+        return
+    answers(ctx, link.send("Y&"), "0,Y&", f"{shown}: Y& turns the MPG on", rule=rule)
+    r = link.send("SR6")
+    ctx.expect(r is not None and r.values == ["40"], f"{shown}: with Y& sent it holds RUN = 1",
+               observed=show(r), expected="0,40", rule=rule)
 
 
 # a unit whose EEPROM 06 is known to be as shipped (FF): the emulator's
@@ -122,11 +137,11 @@ def _mpg_values(ctx: CaseContext) -> list[tuple[int, bool]]:
 
 
 @case("9.reset.mpg-enabling-values", requires=("Y",), destructive=True,
-      rules=("9.reset.mpg", "10.cmd.mpg", "9.reset.mpg-inert"))
+      rules=("9.reset.mpg", "10.cmd.mpg", "9.reset.mpg-inert", "9.reset.mpg-held-at-reset"))
 def mpg_values(ctx: CaseContext) -> None:
     """Each value of the MPG enable byte the manual lists (M114 12.2: 01, 02, 81, 82)
-    holds the axes after J (RUN = 1, vectors 7) and `Y-`, `Y&`, `Y+` switch it off and
-    on; every value beside them leaves the MPG inert, `Y&` too."""
+    holds the axes after J, or from a `Y&` sent (RUN = 1, vectors 7), and `Y-`, `Y&`,
+    `Y+` switch it off and on; every value beside them leaves the MPG inert, `Y&` too."""
     mpg, link = ctx.profile.mpg, ctx.link
     enable = "%02X" % mpg.enable_address
     # every other MPG parameter in range first (M114 12: otherwise "the MPG cannot be
@@ -138,10 +153,8 @@ def mpg_values(ctx: CaseContext) -> None:
         setup(ctx, "J")
         link.wait(ctx.profile.restart_ms / 1000 + 0.5)
         shown = f"EEPROM {enable} = {value:02X}"
-        r = link.send("SR6")
         if enables:
-            ctx.expect(r is not None and r.values == ["40"], f"{shown}: after J the MPG holds "
-                       "RUN = 1", observed=show(r), expected="0,40", rule="9.reset.mpg")
+            _mpg_on(ctx, f"{shown}: after J", "10.cmd.mpg")
             code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.BUSY,
                  f"{shown}: a vector → 7", rule="9.reset.mpg")
             answers(ctx, link.send("Y-"), "0,Y-", f"{shown}: Y- turns it off",
@@ -155,6 +168,7 @@ def mpg_values(ctx: CaseContext) -> None:
                            observed=show(r), expected="0,40", rule="10.cmd.mpg")
                 answers(ctx, link.send("Y-"), "0,Y-", f"{shown}: Y-", rule="10.cmd.mpg")
             continue
+        r = link.send("SR6")
         ctx.expect(r is not None and r.values == ["00"], f"{shown}: MPG inert, ST6 = 00",
                    observed=show(r), expected="0,00", rule="9.reset.mpg-inert")
         # where the MPG is not allowed (M114 12.2 "jiná: MPG nepovoleno"), what Y& answers

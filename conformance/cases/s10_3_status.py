@@ -11,6 +11,7 @@ from conformance.cases._kit import (
     finished,
     halted_line,
     position,
+    refused_beyond_ff,
     setup,
     show,
     vector,
@@ -148,7 +149,8 @@ def inputs(ctx: CaseContext) -> None:
 
 
 @case("10.3.status.register-ends",
-      rules=("10.3.status.all-bits", "10.cmd.status-words", "5.code.range"))
+      rules=("10.3.status.all-bits", "10.cmd.status-words", "5.code.range",
+             "3.params.hex-digits"))
 def register_ends(ctx: CaseContext) -> None:
     link = ctx.link
     for n in WORDS:
@@ -159,8 +161,8 @@ def register_ends(ctx: CaseContext) -> None:
             ctx.expect(r is not None and r.values == [value], f"SR{n} after SW{n},{value}",
                        observed=r.text if r else None, expected=value,
                        rule="10.3.status.all-bits")
-        code(ctx, link.send(f"SW{n},100"), ErrorCode.RANGE, f"SW{n},100: one beyond FF → 5",
-             inta=None, rule="5.code.range")
+        refused_beyond_ff(ctx, link.send(f"SW{n},100"), f"SW{n},100: one beyond FF",
+                          rule="5.code.range")
         r = link.send(f"SR{n}")
         ctx.expect(r is not None and r.values == ["FF"], f"ST{n} still FF after the refusal",
                    observed=r.text if r else None, expected="FF", rule="10.cmd.status-words")
@@ -168,8 +170,7 @@ def register_ends(ctx: CaseContext) -> None:
         link.send("D")                          # whatever an interrupt left
     answers(ctx, link.send("SW6,00"), "0", "SW6,00 when idle", rule="10.cmd.status-words")
     answers(ctx, link.send("SR6"), "0,00", "SR6: ST6 idle", rule="10.cmd.status-words")
-    code(ctx, link.send("SW6,100"), ErrorCode.RANGE,
-         "SW6,100: one beyond FF → 5", rule="5.code.range")
+    refused_beyond_ff(ctx, link.send("SW6,100"), "SW6,100: one beyond FF", rule="5.code.range")
 
 
 @case("10.3.status.run-bit",

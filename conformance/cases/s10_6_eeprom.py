@@ -5,7 +5,7 @@ The 256 bytes that outlive restarts."""
 from __future__ import annotations
 
 from conformance.case.context import CaseContext, case
-from conformance.cases._kit import answers, code, setup, show, vector
+from conformance.cases._kit import answers, code, refused_beyond_ff, setup, show, vector
 from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
@@ -28,7 +28,8 @@ PATTERNS = (0x5A, 0xA5)
 
 
 # a unit known never to have been written: the emulator's (a real unit's may have been)
-@case("10.6.eeprom.as-shipped", rig=True, rules=("10.6.eeprom.defaults", "10.6.eeprom.erased"))
+@case("10.6.eeprom.as-shipped", rig=True,
+      rules=("10.6.eeprom.defaults", "10.6.eeprom.erased", "3.params.hex-digits"))
 def as_shipped(ctx: CaseContext) -> None:
     # the bytes a manual names (the profile's defaults; the GVE54's manual names none)
     defaults = ctx.profile.eeprom.defaults
@@ -38,12 +39,12 @@ def as_shipped(ctx: CaseContext) -> None:
     for address in (a for a in UNWRITTEN if a not in defaults):
         answers(ctx, ctx.link.send("ER%02X" % address), "0,FF",
                 f"EEPROM {address:02X} never written: erased", rule="10.6.eeprom.erased")
-    code(ctx, ctx.link.send("ER100"), ErrorCode.RANGE, "256 bytes: 100 is out of range",
-         rule="10.6.eeprom.defaults")
+    refused_beyond_ff(ctx, ctx.link.send("ER100"), "256 bytes: ER100 is out of range",
+                      rule="10.6.eeprom.defaults")
 
 
 @case("10.6.eeprom.every-address", destructive=True,
-      rules=("10.cmd.eeprom-bytes", "10.6.eeprom.defaults"))
+      rules=("10.cmd.eeprom-bytes", "10.6.eeprom.defaults", "3.params.hex-digits"))
 def every_address(ctx: CaseContext) -> None:
     link = ctx.link
     size = ctx.profile.eeprom.size
@@ -67,11 +68,10 @@ def every_address(ctx: CaseContext) -> None:
                    or "every byte as written",
                    expected="0,<address XOR %02X> at each address" % key,
                    rule="10.cmd.eeprom-bytes")
-    code(ctx, link.send("EW%X,00" % size), ErrorCode.RANGE,
-         f"{size} bytes: EW{size:X} is out of range",
-         rule="10.6.eeprom.defaults")
-    code(ctx, link.send("ER%X" % size), ErrorCode.RANGE,
-         f"and ER{size:X}", rule="10.6.eeprom.defaults")
+    refused_beyond_ff(ctx, link.send("EW%X,00" % size),
+                      f"{size} bytes: EW{size:X} is out of range", rule="10.6.eeprom.defaults")
+    refused_beyond_ff(ctx, link.send("ER%X" % size), f"and ER{size:X}",
+                      rule="10.6.eeprom.defaults")
 
 
 @case("10.6.eeprom.kept-across-restarts", destructive=True, rig=True,

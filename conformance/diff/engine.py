@@ -38,8 +38,8 @@ from conformance.motion.tolerance import (
     profile_reach,
     step_period,
 )
-from conformance.protocol.catalogue import classes
-from conformance.protocol.parse import parse
+from conformance.protocol.catalogue import catalogue, classes
+from conformance.protocol.parse import parse, read_int
 from conformance.targets.session import StepFailed
 from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
@@ -54,6 +54,8 @@ except ImportError:
     _providers = _Constants = None
 
 _LONG_DECIMAL = re.compile(r"\d{13,}")
+#: W with a comma after its axis letter (the format line's form, not M114's example's)
+_AXIS_COMMA = re.compile(r"W[A-Za-z],")
 #: the frames that change a running motion's course (H, G, XA...)
 _COURSE = classes(retimes=True)
 #: real time: how long the fresh reference stands before a sequence
@@ -614,9 +616,39 @@ class Pair:
             "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
             and step.body.upper() != name,
             "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
+            "long-hex": _long_hex(name, parse(step.body).fields),
+            "axis-comma": name == "W" and _axis_comma(step.body),
             "enables": name == "SW" and step.body[2:4] in ("0,", "1,"),
         }
         return {k for k, on in flags.items() if on}
+
+
+def _long_hex(name: str, fields: tuple[str, ...]) -> bool:
+    """Whether a hex field of the frame has more than the two digits the manuals write
+    (00..FF)."""
+    command = catalogue().get(name)
+    # a frame may carry more or fewer fields than the command takes
+    return command is not None and any(
+        f.kind == "hex" and len(v.strip()) > 2
+        for f, v in zip(command.fields, fields, strict=False))
+
+
+def _axis_comma(body: str) -> bool:
+    """Whether ``body`` is a W with a comma after its axis letter and every number within
+    the catalogue's ranges: where the reference answers 5 it found no switch (a field out
+    of range is the range's rule, whatever the form)."""
+    if not _AXIS_COMMA.match(body):
+        return False
+    fields = parse(body).fields
+    command = catalogue()["W"]
+    if len(fields) != len(command.fields):
+        return False
+    for f, text in zip(command.fields, fields, strict=True):
+        value = read_int(text, strict=True) if f.kind == "dec" else 0
+        lo, hi = f.range if isinstance(f.range, tuple) else (value, value)
+        if value is None or not lo <= value <= hi:
+            return False
+    return True
 
 
 #: the frames whose answer's value is ST6 (F's with its queue bit)

@@ -47,9 +47,14 @@ class Refusal(NamedTuple):
     rule: str | None = None
     state: str | None = None
     address: str = UNIT
+    #: other codes a reading allows, its [D] choice graded in its own case
+    also: tuple[ErrorCode, ...] = ()
 
 
 E = ErrorCode
+#: a hex field of three digits: range-checked (5), or to a reader of the manuals' 00..FF
+#: a syntax error (4; 3.params.hex-digits)
+LONG_HEX = (ErrorCode.SYNTAX,)
 #: every frame the machine has refused, in the order it tries them
 REFUSALS: tuple[Refusal, ...] = (
     Refusal("A0", E.RANGE, "10.cmd.accel-range"),
@@ -63,8 +68,8 @@ REFUSALS: tuple[Refusal, ...] = (
     Refusal("M4,5", E.SYNTAX, "5.code.syntax"),      # a stored 4 would move 4 sixteenths
     Refusal("N", E.BUSY, "5.code.busy-run", HALTED),
     Refusal("NY5", E.BUSY, "5.code.busy-run", HALTED),
-    Refusal("O0,1A5", E.RANGE, "5.code.range"),
-    Refusal("SW2,1A5", E.RANGE, "5.code.range"),
+    Refusal("O0,1A5", E.RANGE, "5.code.range", also=LONG_HEX),
+    Refusal("SW2,1A5", E.RANGE, "5.code.range", also=LONG_HEX),
     Refusal("SW8,F1", E.RANGE, "5.code.range"),
     Refusal("T0", E.RANGE),
     Refusal("T20,5", E.SYNTAX, "5.code.syntax"),     # a stored 20 would lengthen the dwell
@@ -466,7 +471,7 @@ class ReadBackMachine(UnitMachine):
             address = self.address(refusal)
             r = self.send(body, address=address)
             code_rule = refusal.rule or range_rule(body, self.ctx.profile)
-            holds(r is not None and r.code == refusal.code, code_rule,
+            holds(r is not None and r.code in (refusal.code, *refusal.also), code_rule,
                   f"!{address}{body} answered {r}, expected code {refusal.code}")
             self.repeated(body, r.raw, address)
             if address != self.link.address:

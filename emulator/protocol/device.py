@@ -64,18 +64,26 @@ class Device:
         #: the line rate read at the last power-on (None: the line's, as above)
         self.rate: int | None = None
         self._position_read: int | None = None     # the position the last power-on read
-        self.state: DeviceState = reset_state(profile)
+        self.state: DeviceState = self._reset_state()
         self.deaf_until = origin          # restarting (power-on, J) until then
         self._was_active = self._active()  # the reading edge-triggered-inputs: last seen
         #: work due later that answers nothing (the mutant reference-answers-early's run)
         self.due: list[tuple[int, Callable[[int], object]]] = []
 
     # -- power ------------------------------------------------------------------------
+    def _reset_state(self) -> DeviceState:
+        """Spec 9's reset state; under the reading mpg-on-when-sent the MPG mode is none
+        until a `Y` is sent (its `&` of the reset inert)."""
+        state = reset_state(self.profile)
+        if state.mpg and self.readings.active("mpg-on-when-sent"):
+            state.mpg = ""
+        return state
+
     def reset(self, t: int) -> None:
         """Power-on or J: the reset state of spec 9, deaf for the restart. The axes stay
         where they are (the counters read 0) and so do the input levels."""
         p = self.profile
-        self.state = reset_state(p)
+        self.state = self._reset_state()
         self.motion.clear(t)
         for axis in range(len(p.axes)):
             self.motion.set_position(axis, 0, t)

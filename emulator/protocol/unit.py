@@ -42,6 +42,9 @@ _LONG_DECIMAL = re.compile(r"[0-9]{13}")
 #: a + at the start of a field (the reading plus-sign drops it)
 _PLUS = re.compile(r"(^|,)\+(?=[0-9])")
 _LOWER_HEX = re.compile(r"[a-f]")
+#: the hex fields of each command, by position (the reading hex-two-digits)
+_HEX_FIELDS = {"ER": (0,), "EW": (0, 1), "EFR": (0,), "EFW": (0,), "EUR": (0,), "EUW": (0,),
+               "O": (1,), "SW": (1,)}
 #: N<axis> and I<port>: the letter after the command is a parameter (spec 5, code 3)
 _LACKING = re.compile(r"N[A-Z]\Z|I[0-9]\Z")
 #: the reading slow-watchdog: a second, the time a reader may take for "in time"
@@ -54,6 +57,12 @@ LONG_FRAME = 255
 
 def _discard(data: bytes, t: int) -> None:
     pass
+
+
+def _long_hex(name: str | None, params: str) -> bool:
+    """Whether a hex field of the frame has more than two characters."""
+    parts = params.split(",")
+    return any(i < len(parts) and len(parts[i]) > 2 for i in _HEX_FIELDS.get(name or "", ()))
 
 
 def begins_one(name: str, commands: Iterable[str]) -> bool:
@@ -322,6 +331,10 @@ class Unit:
                 params = _PLUS.sub(r"\1", params)
             if reads("hex-upper-only") and _LOWER_HEX.search(params):
                 raise CommandError(ErrorCode.SYNTAX, "lower-case hex digits")
+            if reads("hex-two-digits") and _long_hex(name, params):
+                raise CommandError(ErrorCode.SYNTAX, "a hex field of more than two digits")
+            if name == "NA" and reads("set-axis-xyz-only"):
+                raise CommandError(ErrorCode.SYNTAX, "N takes the axes X, Y, Z")
             if command.bare and params:
                 if not act("params-ignored-on-bare-commands"):
                     raise CommandError(ErrorCode.SYNTAX, "this command takes no parameters")

@@ -29,6 +29,8 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "missing-letter-range": ([b"!0NA0\r"], b"3\r", b"5\r"),
     "lone-bang-answered": ([b"!"], b"", b"2\r"),
     "hex-upper-only": ([b"!0SW2,ab\r"], b"0\r", b"4\r"),
+    # three hex digits: a value in range (0) and one beyond FF (5), or syntax errors both
+    "hex-two-digits": ([b"!0SW2,001\r", b"!0SW2,100\r"], b"0\r5\r", b"4\r4\r"),
     "queries-counted": ([b"!0@\r", b"!0@\r"], b"0,0\r0,0\r", b"0,1\r0,2\r"),
     # T99 refused (5): counted, or not
     "refused-uncounted": ([b"!0T99\r", b"!0@\r"], b"5\r0,1\r", b"5\r0,0\r"),
@@ -120,6 +122,10 @@ POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
                                    b"!0SR6\r", b"!0Y+\r"],
                                   b"0\r" * 17 + b"0,40\r0,Y+\r",
                                   b"0\r" * 17 + b"0,00\r5\r"),
+    # the MPG enabled, then J: the reset's & holds RUN at once, or only once Y& is sent
+    "mpg-on-when-sent": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r", b"!0Y&\r", b"!0SR6\r"],
+                         b"0\r0\r0,40\r0,Y&\r0,40\r", b"0\r0\r0,00\r0,Y&\r0,40\r"),
+    "set-axis-xyz-only": ([b"!0NA5\r", b"!0NX5\r"], b"0\r0\r", b"4\r0\r"),
 }
 
 #: readings of what only the GVE54 has (its motor mode M)

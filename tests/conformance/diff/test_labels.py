@@ -60,6 +60,24 @@ def test_a_plus_sign_or_a_lower_case_digit_names_the_parameter_rule():
     assert label("EW", "code", {"lower"}, set(), 3, 0) == "3.frame.upper-case"
 
 
+def test_three_hex_digits_refused_as_syntax_are_the_hex_digits_rule():
+    assert label("SW", "code", {"long-hex"}, set(), 5, 4) == "3.params.hex-digits"
+    assert label("ER", "code", {"long-hex"}, set(), 0, 4) == "3.params.hex-digits"
+    # a two-digit field out of range answered 4 is still the range rule
+    assert label("SW", "code", set(), set(), 5, 4) == "5.code.range"
+
+
+def test_w_with_a_comma_after_the_axis_refused_as_syntax_is_the_w_syntax_rule():
+    # the reference ran it and found no switch (5): the target's 4 is still the form's
+    assert label("W", "code", {"axis-comma"}, set(), 5, 4) == "10.cmd.reference-syntax"
+    assert label("W", "code", set(), set(), 5, 4) == "5.code.range"
+
+
+def test_na_refused_is_the_a_axis_decision_on_the_gve114_only():
+    assert label("NA", "code", set(), set(), 5, 4, "GVE114") == "10.cmd.set-axis-a"
+    assert label("NX", "code", set(), set(), 0, 4, "GVE114") == "5.code.ok"
+
+
 def test_the_index_off_by_the_queries_is_the_counting_rule():
     assert label("@", "data", {"queries-counted"}, {"@"}, 0) == "8.index.queries-uncounted"
     assert label("@", "data", set(), {"@", "L"}, 0) == "8.index.counts"
@@ -255,6 +273,8 @@ PAIRS: dict[str, tuple[str, tuple]] = {
                         ("PF", "position", set(), {"L", "XM"}, 0, 0)),
     "10.cmd.port-bits": ("10.cmd.ports.bit-by-bit", ("I1", "data", set(), {"input"}, 0, 0)),
     "10.cmd.set-axis": ("10.commands.zero-axis", ("PF", "position", set(), {"NX"}, 0, 0)),
+    # the GVE114's NA refused: its manual names the axes X, Y, Z
+    "10.cmd.set-axis-a": ("10.commands.formats", ("NA", "code", set(), set(), 0, 4, "GVE114")),
     "12.spindle.feed-independent": ("12.spindle.measured.feed-unchanged",
                                     ("PF", "position", set(), {"spindle", "L"}, 0, 0)),
     "3.frame.other-address-whole": ("2.link.other-address-ignored",

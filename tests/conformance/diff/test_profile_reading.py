@@ -18,7 +18,7 @@ from conformance.diff.steps import FRAME, WAIT, Step
 from conformance.link.framing import parse_response
 from conformance.motion.tolerance import TICK_NS, profile_reach
 from conformance.targets import parse_target
-from conformance.verdict import FAIL, NON_STRICT
+from conformance.verdicts.verdict import FAIL, NON_STRICT
 from gve_fixtures.profile import load_profile
 
 CORPUS = Path(__file__).resolve().parents[3] / "corpus"

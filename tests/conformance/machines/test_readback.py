@@ -42,3 +42,11 @@ def test_every_setting_a_probe_reads_has_a_refusal_that_would_set_it():
     assert {effect_of(b) for b in bodies} - {None} == {"pace", "junction", "dwell",
                                                       "microstep"}
     assert any(r.address == SPINDLE for r in REFUSALS)
+
+
+def test_only_a_hex_field_of_three_digits_may_be_refused_as_syntax_instead():
+    from conformance.protocol.parse import parse
+    from gve_fixtures.protocol import ErrorCode
+    also = {r.body for r in REFUSALS if ErrorCode.SYNTAX in r.also}
+    assert also == {"O0,1A5", "SW2,1A5"}
+    assert all(max(len(f) for f in parse(b).fields) == 3 for b in also)
