@@ -16,10 +16,9 @@ from conformance.cli.unit import consent, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    job_options,
     one_line,
     positive,
-    report_options,
-    seconds,
     summary,
     writable_folder,
 )
@@ -71,14 +70,14 @@ def common(ap: argparse.ArgumentParser) -> None:
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES,
-                parents=[report_options(
+                parents=[job_options(
                     "also print each disagreement's transcript (the reports keep it too)",
                     seed="the search's seed: the same N draws the same sequences "
-                         "(default: a fresh one, printed and recorded in the reports)")])
+                         "(default: a fresh one, printed and recorded in the reports)",
+                    time_limit="search for S seconds (instead of a number of sequences)")])
     common(ap)
     ap.add_argument("--examples", type=positive, metavar="N",
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
-    ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
     ap.add_argument("--no-probes", action="store_true",
                     help="draw sequences only (the written probes and the sweep of every "
                     "table value, run first by default, are left out)")

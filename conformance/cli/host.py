@@ -21,8 +21,8 @@ from conformance.cli.ending import claimed, counted, end, new_run_id, progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    job_options,
     positive,
-    report_options,
     seconds,
     summary,
     writable_folder,
@@ -63,8 +63,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         at = argv.index("--")
         argv, command = argv[:at], argv[at + 1:]
     ap = Parser(prog="gve-conformance host", description=summary(__doc__),
-                epilog=PORT_FORMS, examples=EXAMPLES, parents=[report_options(
-                    "print a line for every scenario (the default)", seed=None)])
+                epilog=PORT_FORMS, examples=EXAMPLES, parents=[job_options(
+                    "print a line for every scenario (the default)", seed=None,
+                    jobs="scenarios run side by side (launched, pty or tcp port 0)",
+                    jobs_default=4)])
     ap.add_argument("--profile", help="the unit played to the host, at its default address")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable; instead of --profile)")
@@ -75,8 +77,6 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                     help="a host silent this long without exiting hangs (default 5)")
     ap.add_argument("--port", default="pty",
                     help="pty (default), tcp:HOST:PORT, or a serial device path")
-    ap.add_argument("--jobs", "-j", type=positive, default=4, metavar="N",
-                    help="scenarios run side by side (launched, pty or tcp port 0)")
     ap.add_argument("--strict", action="store_true",
                     help="the host claims the project's decisions: [D] rules FAIL too")
     ap.add_argument("--expect-motion", action="append", default=[],

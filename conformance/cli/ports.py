@@ -22,7 +22,7 @@ import sys
 
 from serial.tools import list_ports
 
-from conformance.cli.usage import Parser, UsageError, summary
+from conformance.cli.usage import Parser, UsageError, job_options, summary
 
 #: the device majors of Linux's pseudo-terminal slaves: the old BSD-style ones
 #: (PTY_SLAVE_MAJOR) and UNIX98_PTY_SLAVE_MAJOR and up; a serial port (ttyS*: 4,
@@ -41,7 +41,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "gve-conformance ports",
         "gve-conformance ports --probe                    # who answers `?` on each",
         "gve-conformance ports --probe /dev/pts/7         # a simulator's pty, named",
-        "gve-conformance ports --glob '/dev/pts/*'        # list the ptys too"))
+        "gve-conformance ports --glob '/dev/pts/*'        # list the ptys too"),
+        parents=[job_options("the same lines (every port is always listed)",
+                             reports=False, seed=None)])
     ap.add_argument("device", nargs="*", metavar="PATH",
                     help="also list (and with --probe ask) this port; a pseudo-terminal is "
                          "probed only when named here")

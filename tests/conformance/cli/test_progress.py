@@ -20,7 +20,8 @@ def _steps(out: str) -> list[tuple[int, int, str]]:
 
 def test_mutation_numbers_each_mutant_in_a_log(capsys):
     mutants = ["range-error-code", "lower-case-command"]
-    argv = ["mutation", "--profile", "GVE84-100", "--cases", "1.*", "--cases", "3.*"]
+    argv = ["mutation", "--no-reports",
+            "--profile", "GVE84-100", "--cases", "1.*", "--cases", "3.*"]
     for m in mutants:
         argv += ["--mutant", m]
     assert main(argv) == 0
@@ -30,7 +31,7 @@ def test_mutation_numbers_each_mutant_in_a_log(capsys):
 
 
 def test_mutation_quiet_prints_its_score_only_when_nothing_failed(capsys):
-    assert main(["mutation", "--profile", "GVE84-100", "--cases", "1.*",
+    assert main(["mutation", "--no-reports", "--profile", "GVE84-100", "--cases", "1.*",
                  "--mutant", "range-error-code", "-q"]) == 0
     (line,) = capsys.readouterr().out.splitlines()
     assert line.startswith("PASSED — mutation score: 1/1")
@@ -38,7 +39,8 @@ def test_mutation_quiet_prints_its_score_only_when_nothing_failed(capsys):
 
 def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
     # `?` answers alike whatever the range code: that case alone misses the mutant
-    assert main(["mutation", "--profile", "GVE84-100", "--cases", "1.profile.version",
+    assert main(["mutation", "--no-reports",
+                 "--profile", "GVE84-100", "--cases", "1.profile.version",
                  "--mutant", "range-error-code", "-q"]) == 1
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("what failed") and "range-error-code" in lines[1]
@@ -46,7 +48,8 @@ def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
 
 
 def test_fairness_numbers_each_reading_in_a_log(capsys):
-    assert main(["fairness", "--reading", "plus-sign", "--cases", "3.params.*"]) == 0
+    assert main(["fairness", "--no-reports",
+                 "--reading", "plus-sign", "--cases", "3.params.*"]) == 0
     # (lines saying it is still working, every 5 s, count nothing done)
     (step,) = [s for s in _steps(capsys.readouterr().out) if s[0] > 0]
     assert step[:2] == (1, 1) and "plus-sign" in step[2]
