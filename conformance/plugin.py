@@ -41,7 +41,7 @@ import pytest
 from conformance import settings as settings_profiles
 from conformance.case import Case
 from conformance.consent import Consent, NoConsent
-from conformance.explain import reason
+from conformance.explain import plain, reason
 from conformance.link.interrupts import Interrupts
 from conformance.operator import Console
 from conformance.plugin_stop import before_item, hold, interrupted
@@ -288,7 +288,7 @@ class GveItem(pytest.Item):
             why = reason(r)
             lines = [verdict_line(r)]
             lines += [f"the rule: {why.cites()}"] if why.rule else []
-            lines += [f"the case: {r.rule} ({r.source})"]
+            lines += [f"the case: {plain(r.rule)} ({plain(r.source)})"]
             lines += [f"  [{c['tag']}] {c['what']}: observed {quoted(c['observed'])}, "
                       f"expected {quoted(c['expected'])}" for c in r.failed_checks]
             path, line = _where(self.case)
