@@ -235,7 +235,7 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     ap = Parser(prog=PROG, description=summary(__doc__), examples=(
         "gve-conformance corpus --jobs 2",
-        "gve-conformance corpus --implementation unit84-a -v"),
+        "gve-conformance corpus --implementation gve84-a -v"),
         parents=[job_options("also list what every job said",
                              seed="diff's seed (default 0: the same sequences every run)",
                              jobs="implementations judged in parallel",

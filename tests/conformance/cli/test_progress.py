@@ -1,14 +1,18 @@
 """Long jobs show they are moving: in a log (not a terminal) `mutation`, `fairness` and
 a fleet print a numbered line per step (n/N), `diff` a line at every tenth of its
-sequences with how many it ran; a terminal gets a bar instead."""
+sequences with how many it ran; a terminal gets a bar instead. The jobs whose steps are
+long (mutation, fairness, corpus, a launched host) show something at least every 5 s
+while a step runs."""
 
 from __future__ import annotations
 
 import io
 import re
 
-from conformance.cli import main
-from conformance.cli.progress import Progress
+import pytest
+
+from conformance.cli import corpus, fairness, main, mutation
+from conformance.cli.progress import HEARTBEAT, Progress
 
 STEP = re.compile(r"\[(\d+)/(\d+)\] ")
 
@@ -104,3 +108,45 @@ def test_a_long_step_still_shows_the_job_is_moving():
     assert lines[0].startswith("[0/3] 0 % in ") and lines[0].endswith(" s, still working")
     ended = log.getvalue()
     assert shown._beat is None and log.getvalue() == ended
+
+
+#: a long job -> (its step's function, a step done at once, its command line)
+LONG = {"mutation": ("_hunt", lambda _: mutation.Hunt("m", "1", "a mutant", caught_by="c"),
+                     ["--mutant", "range-error-code"]),
+        "fairness": ("_trial", lambda _: fairness.Trial("plus-sign", ["GVE84-100"]),
+                     ["--reading", "plus-sign"]),
+        "corpus": ("_trial", lambda _: corpus.Trial("gve84-a"),
+                   ["--implementation", "gve84-a"])}
+
+
+@pytest.mark.parametrize("job", sorted(LONG))
+def test_a_long_job_shows_it_is_moving_within_five_seconds(job, monkeypatch, capsys):
+    step, done, argv = LONG[job]
+    beats: list[float | None] = []
+    made = Progress.__init__
+
+    def spy(self, *args, **kw):
+        beats.append(kw.get("heartbeat"))
+        made(self, *args, **kw)
+    monkeypatch.setattr(Progress, "__init__", spy)
+    monkeypatch.setattr(f"conformance.cli.{job}.{step}", done)
+    assert main([job, "--no-reports", *argv]) == 0, capsys.readouterr().out
+    assert beats == [HEARTBEAT] and HEARTBEAT <= 5.0
+
+
+def test_a_launched_host_shows_it_is_moving_too(capsys):
+    import sys
+    beats = []
+    made = Progress.__init__
+
+    def spy(self, *args, **kw):
+        beats.append(kw.get("heartbeat"))
+        made(self, *args, **kw)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Progress, "__init__", spy)
+        main(["host", "--profile", "GVE84-100", "--no-reports", "--scenarios",
+              "2.host.clean", "--", sys.executable, "-m", "gve_host", "{port}", "--job",
+              "gve_host/jobs/square-packets.job"])
+    out = capsys.readouterr().out
+    assert beats == [HEARTBEAT], out
+    assert re.search(r"^\[\s*1/\d+\] PASS\s+2.host.clean", out, re.M), out
