@@ -277,7 +277,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{time.perf_counter() - gate.start:.1f} s"
         + (f"; {still_open} FAIL(s) of the suite's open defects listed" if still_open
            else ""),
-        interrupted=pool.interrupted, timed_out=pool.timed_out,
+        interrupted=pool.interrupted, timed_out=pool.timed_out, failed_word="unfair",
         under_way=under_way(args.jobs, len(chosen), len(trials)))
 
 

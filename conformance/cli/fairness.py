@@ -201,7 +201,7 @@ def main(argv: list[str] | None = None) -> int:
         f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
         f"{time.perf_counter() - gate.start:.1f} s ({args.jobs} job(s)); "
         f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO",
-        interrupted=pool.interrupted, timed_out=pool.timed_out,
+        interrupted=pool.interrupted, timed_out=pool.timed_out, failed_word="unfair",
         under_way=under_way(args.jobs, len(jobs), len(trials)))
 
 

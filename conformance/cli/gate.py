@@ -47,10 +47,12 @@ class Gate:
             self.folder = claimed(args.report_dir, args.run_id)
 
     def end(self, items: Sequence[GateItem], not_run: Sequence[str], noun: str, score: str,
-            *, interrupted: bool, timed_out: bool, under_way: int = 0) -> int:
+            *, interrupted: bool, timed_out: bool, under_way: int = 0,
+            failed_word: str = "failed") -> int:
         """The end (see the module's text): ``items`` judged, ``not_run`` the names of
         those the job did not finish, ``noun`` what an item is (``mutant``), ``score``
-        the score line of what was judged. The exit status."""
+        the score line of what was judged, ``failed_word`` what a failed item is called
+        (``unfair``). The exit status."""
         failed = [item for item in items if not item.passed]
         if failed:
             print(f"what failed ({len(failed)} {noun}(s)):", flush=True)
@@ -62,7 +64,7 @@ class Gate:
         if interrupted:
             verdict, reason = FAILED, (
                 f"{self.job} interrupted by a signal after {len(items)} of {total} "
-                f"{noun}s finished ({len(failed)} failed; {under_way} under way) in "
+                f"{noun}s finished ({len(failed)} {failed_word}; {under_way} under way) in "
                 f"{elapsed:.1f} s: no score")
         elif failed:
             verdict, reason = FAILED, score
