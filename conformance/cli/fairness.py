@@ -11,7 +11,11 @@ to (a packet's reading on the GVE84 and GVE114, which have packets): elsewhere i
 nothing (:func:`trial_profiles`). diff runs on those profiles (all at once too: the
 catalogue covers every profile), its budget its written sequences (probes, the tables'
 sweep, the matrix's cells) and DIFF_DRAWN drawn ones from seed DIFF_SEED
-(:func:`diff_budget`): the same sequences on every run, a few seconds a profile."""
+(:func:`diff_budget`): the same sequences on every run, a few seconds a profile.
+
+It ends as every gate does (cli/gate.py): the reports (a JUnit testcase per reading) and
+one last line; ``--seconds`` bounds it, and a trial its time limit cut short ends
+INCOMPLETE (exit status 3)."""
 
 from __future__ import annotations
 

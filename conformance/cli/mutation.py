@@ -15,6 +15,10 @@ mutant's rule area (the spec section it breaks) run first, then the rest of the
 catalogue; each on the profiles in turn (one per family first: a mutant of the GVE54's
 micro-stepping shows only there). Hypothesis machines run with the ``mutation`` settings
 (no shrinking).
+
+It ends as every gate does (cli/gate.py): the reports (a JUnit testcase per mutant) and
+one last line; ``--seconds`` bounds it, and a hunt its time limit cut short ends
+INCOMPLETE (exit status 3).
 """
 
 from __future__ import annotations
