@@ -11,7 +11,7 @@ import sys
 from conformance.check import Check
 from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
-from conformance.cli.progress import Progress
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.unit import consent, unattended
 from conformance.cli.usage import (
     Parser,
@@ -189,8 +189,9 @@ def main(argv: list[str] | None = None) -> int:
     say(f"diff: {target.info.spec} against {reference.info.spec} "
         f"({target.profile.name}), seed {seed} (the same sequences again: --seed {seed}), "
         + (f"{examples} sequences" if examples else f"{args.seconds:g} s"))
+    # a sequence on a real unit may take seconds: the heartbeat shows the search moving
     progress = Progress(examples or int(args.seconds), unit="seq" if examples else "s",
-                        quiet=args.quiet, verbose=args.verbose,
+                        quiet=args.quiet, verbose=args.verbose, heartbeat=HEARTBEAT,
                         status=lambda: (f"{budget.used} sequences, {budget.frames} frames, "
                                         f"{len(run.results)} disagreement(s)"))
     budget = _Watched(progress, examples=examples, seconds=args.seconds)
