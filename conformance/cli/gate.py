@@ -33,6 +33,11 @@ def under_way(jobs: int, total: int, finished: int) -> int:
     return min(jobs, total - finished)
 
 
+def _many(n: int, noun: str) -> str:
+    """``1 mutant``, ``2 mutants``."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
 class Gate:
     """One gate's run from its parsed ``args`` (the shared job options: cli/usage.py):
     its report folder taken before anything runs (UsageError when it cannot be), then
@@ -63,16 +68,16 @@ class Gate:
         total = len(items) + len(not_run)
         if interrupted:
             verdict, reason = FAILED, (
-                f"{self.job} interrupted by a signal after {len(items)} of {total} "
-                f"{noun}s finished ({len(failed)} {failed_word}; {under_way} under way) in "
-                f"{elapsed:.1f} s: no score")
+                f"{self.job} interrupted by a signal after {len(items)} of "
+                f"{_many(total, noun)} finished ({len(failed)} {failed_word}; {under_way} "
+                f"under way) in {elapsed:.1f} s: no score")
         elif failed:
             verdict, reason = FAILED, score
         elif timed_out:
             verdict, reason = INCOMPLETE, (
                 f"{self.job}: the time limit of {self.args.seconds:g} s came after "
-                f"{len(items)} of {total} {noun}s; not tested: {len(not_run)} {noun}s; "
-                f"so far {score}")
+                f"{len(items)} of {_many(total, noun)}; not tested: "
+                f"{_many(len(not_run), noun)}; so far {score}")
         else:
             verdict, reason = PASSED, score
         lost = self._reports(items, not_run, verdict, reason, elapsed)
