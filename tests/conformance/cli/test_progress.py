@@ -18,8 +18,11 @@ STEP = re.compile(r"\[(\d+)/(\d+)\] ")
 
 
 def _steps(out: str) -> list[tuple[int, int, str]]:
+    """The numbered lines of steps done (not the heartbeat's, which a loaded machine may
+    add between them)."""
     return [(int(m.group(1)), int(m.group(2)), line[m.end():])
-            for line in out.splitlines() if (m := STEP.match(line))]
+            for line in out.splitlines()
+            if (m := STEP.match(line)) and not line.endswith(", still working")]
 
 
 def test_mutation_numbers_each_mutant_in_a_log(capsys):
