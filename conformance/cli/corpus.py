@@ -22,9 +22,17 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from conformance.cli.pool import gate_end, workers
-from conformance.cli.progress import Progress
-from conformance.cli.usage import INTERRUPTED, Parser, UsageError, add_loudness, positive, summary
+from conformance.cli.gate import Gate, GateItem, under_way
+from conformance.cli.pool import workers
+from conformance.cli.progress import HEARTBEAT, Progress
+from conformance.cli.usage import (
+    TIME_LIMIT_HELP,
+    Parser,
+    UsageError,
+    job_options,
+    positive,
+    summary,
+)
 from conformance.verdicts.verdict import CHECK_TAGS, FAIL
 from conformance.verdicts.verdict import grade as grade_of
 
@@ -224,19 +232,20 @@ def _trial(args: tuple[Implementation, int, float]) -> Trial:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     ap = Parser(prog=PROG, description=summary(__doc__), examples=(
         "gve-conformance corpus --jobs 2",
-        "gve-conformance corpus --implementation unit84-a -v"))
+        "gve-conformance corpus --implementation gve84-a -v"),
+        parents=[job_options("also list what every job said",
+                             seed="diff's seed (default 0: the same sequences every run)",
+                             jobs="implementations judged in parallel",
+                             time_limit=TIME_LIMIT_HELP)])
     ap.add_argument("--implementation", action="append", default=[], metavar="NAME",
                     help="only this implementation (repeatable; default: every one)")
     ap.add_argument("--manifest", type=Path, default=MANIFEST,
                     help="the corpus's manifest (default %(default)s)")
-    ap.add_argument("--jobs", "-j", type=positive, default=1,
-                    help="implementations judged in parallel")
-    ap.add_argument("--seed", type=int, default=0, help="diff's seed (default 0)")
     ap.add_argument("--timeout", type=positive, default=900,
                     help="seconds one job may take before it counts as unfair (default 900)")
-    add_loudness(ap, "also list what every job said")
     try:
         args = ap.parse_args(argv)
         corpus = load_manifest(args.manifest)
@@ -245,31 +254,31 @@ def main(argv: list[str] | None = None) -> int:
         if wrong:
             raise UsageError(f"unknown implementation(s) {', '.join(wrong)} "
                              f"(known: {', '.join(sorted(names))})")
+        gate = Gate("corpus", args, argv)
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     chosen = [i for i in corpus if not args.implementation or i.name in args.implementation]
-    start = time.perf_counter()
+    seed = 0 if args.seed is None else args.seed
     trials: list[Trial] = []
-    with workers(args.jobs) as pool, Progress(len(chosen), unit="implementation",
-                                              quiet=args.quiet, verbose=args.verbose,
-                                              every_step=True) as shown:
-        for t in pool.map(_trial, [(i, args.seed, float(args.timeout)) for i in chosen]):
+    with workers(args.jobs, args.seconds) as pool, Progress(
+            len(chosen), unit="implementation", quiet=args.quiet, verbose=args.verbose,
+            every_step=True, heartbeat=HEARTBEAT) as shown:
+        for t in pool.map(_trial, [(i, seed, float(args.timeout)) for i in chosen]):
             trials.append(t)
             shown.step("\n".join(_lines(t, args.verbose)), routine=t.fair)
     fair = sum(t.fair for t in trials)
-    unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
-    if gate_end("corpus", unfair, f"{len(trials) - fair} implementation(s)", pool.interrupted,
-                f"{len(trials)} of {len(chosen)} implementations", start):
-        return INTERRUPTED
-    verdict = "PASSED" if fair == len(trials) else "FAILED"
     still_open = sum(len(t.open) for t in trials)
-    print(f"{verdict} — corpus: {fair}/{len(trials)} implementations fair (every FAIL a "
-          f"documented departure, every departure still FAILed) in "
-          f"{time.perf_counter() - start:.1f} s"
-          + (f"; {still_open} FAIL(s) of the suite's open defects listed" if still_open
-             else ""))
-    return 0 if fair == len(trials) else 1
+    items = [GateItem(t.name, t.fair, t.seconds, _lines(t, False)) for t in trials]
+    return gate.end(
+        items, [i.name for i in chosen[len(trials):]], "implementation",
+        f"corpus: {fair}/{len(trials)} implementations fair (every FAIL a documented "
+        f"departure, every departure still FAILed) in "
+        f"{time.perf_counter() - gate.start:.1f} s"
+        + (f"; {still_open} FAIL(s) of the suite's open defects listed" if still_open
+           else ""),
+        interrupted=pool.interrupted, timed_out=pool.timed_out, failed_word="unfair",
+        under_way=under_way(args.jobs, len(chosen), len(trials)))
 
 
 def _lines(t: Trial, verbose: bool) -> list[str]:

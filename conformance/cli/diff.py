@@ -11,15 +11,14 @@ import sys
 from conformance.case.settings import fresh_seed
 from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
-from conformance.cli.progress import Progress
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.unit import consent, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    job_options,
     one_line,
     positive,
-    report_options,
-    seconds,
     summary,
     writable_folder,
 )
@@ -71,14 +70,14 @@ def common(ap: argparse.ArgumentParser) -> None:
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES,
-                parents=[report_options(
+                parents=[job_options(
                     "also print each disagreement's transcript (the reports keep it too)",
                     seed="the search's seed: the same N draws the same sequences "
-                         "(default: a fresh one, printed and recorded in the reports)")])
+                         "(default: a fresh one, printed and recorded in the reports)",
+                    time_limit="search for S seconds (instead of a number of sequences)")])
     common(ap)
     ap.add_argument("--examples", type=positive, metavar="N",
                     help=f"sequences to try (default {DEFAULT_EXAMPLES} unless --seconds)")
-    ap.add_argument("--seconds", type=seconds, metavar="S", help="search for S seconds")
     ap.add_argument("--no-probes", action="store_true",
                     help="draw sequences only (the written probes and the sweep of every "
                     "table value, run first by default, are left out)")
@@ -190,8 +189,9 @@ def main(argv: list[str] | None = None) -> int:
     say(f"diff: {target.info.spec} against {reference.info.spec} "
         f"({target.profile.name}), seed {seed} (the same sequences again: --seed {seed}), "
         + (f"{examples} sequences" if examples else f"{args.seconds:g} s"))
+    # a sequence on a real unit may take seconds: the heartbeat shows the search moving
     progress = Progress(examples or int(args.seconds), unit="seq" if examples else "s",
-                        quiet=args.quiet, verbose=args.verbose,
+                        quiet=args.quiet, verbose=args.verbose, heartbeat=HEARTBEAT,
                         status=lambda: (f"{budget.used} sequences, {budget.frames} frames, "
                                         f"{len(run.results)} disagreement(s)"))
     budget = _Watched(progress, examples=examples, seconds=args.seconds)

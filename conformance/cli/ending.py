@@ -20,8 +20,8 @@ from conformance.reports.files import RunFolderTaken, claim, new_run_id
 from conformance.run.runner import CaseResult, RunResult
 from conformance.verdicts.verdict import ERROR, FAIL, MISSING, NON_STRICT, ORDER, last_line, overall
 
-__all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "say_all",
-           "written"]
+__all__ = ["claimed", "counted", "end", "new_run_id", "progress", "recap", "result_line",
+           "say_all", "written"]
 
 
 def claimed(report_dir: str | Path, run_id: str | None = None) -> Path:
@@ -44,6 +44,11 @@ def written(write: Callable[[], Path], prog: str = "gve-conformance") -> Path | 
         return None
 
 
+def result_line(r: CaseResult, more: str | None) -> str:
+    """One result's line: its verdict, ID and profile, and ``more`` (why) after it."""
+    return f"{r.verdict:15} {r.id} [{r.profile}]{f'  -- {more}' if more else ''}"
+
+
 def progress(quiet: bool, detail: Callable[[CaseResult], str | None]
              ) -> Callable[[CaseResult], None]:
     """A printer of one line per result (``quiet``: none), with ``detail(result)`` after
@@ -51,9 +56,7 @@ def progress(quiet: bool, detail: Callable[[CaseResult], str | None]
     def show(r: CaseResult) -> None:
         if quiet:
             return
-        more = detail(r)
-        print(f"{r.verdict:15} {r.id} [{r.profile}]{f'  -- {more}' if more else ''}",
-              flush=True)
+        print(result_line(r, detail(r)), flush=True)
     return show
 
 

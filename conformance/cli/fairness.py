@@ -11,7 +11,11 @@ to (a packet's reading on the GVE84 and GVE114, which have packets): elsewhere i
 nothing (:func:`trial_profiles`). diff runs on those profiles (all at once too: the
 catalogue covers every profile), its budget its written sequences (probes, the tables'
 sweep, the matrix's cells) and DIFF_DRAWN drawn ones from seed DIFF_SEED
-(:func:`diff_budget`): the same sequences on every run, a few seconds a profile."""
+(:func:`diff_budget`): the same sequences on every run, a few seconds a profile.
+
+It ends as every gate does (cli/gate.py): the reports (a JUnit testcase per reading) and
+one last line; ``--seconds`` bounds it, and a trial its time limit cut short ends
+INCOMPLETE (exit status 3)."""
 
 from __future__ import annotations
 
@@ -19,16 +23,10 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import gate_end, gate_line, under_way, workers
+from conformance.cli.gate import Gate, GateItem, under_way
+from conformance.cli.pool import workers
 from conformance.cli.progress import HEARTBEAT, Progress
-from conformance.cli.usage import (
-    INTERRUPTED,
-    Parser,
-    UsageError,
-    add_loudness,
-    positive,
-    summary,
-)
+from conformance.cli.usage import TIME_LIMIT_HELP, Parser, UsageError, job_options, summary
 from conformance.link.framing import readable
 from conformance.verdicts.verdict import ERROR, FAIL, INFO, NON_STRICT
 
@@ -58,7 +56,7 @@ class Trial:
 
 
 def trial(reading: str, readings: list[str], profiles: list[str],
-          include: list[str] | None) -> Trial:
+          include: list[str] | None, exclude: list[str] | None = None) -> Trial:
     """Run the catalogue on ``profiles`` with the emulator taking ``readings``."""
     from conformance.run.runner import run_case
     from conformance.run.selection import select
@@ -68,7 +66,7 @@ def trial(reading: str, readings: list[str], profiles: list[str],
     start = time.perf_counter()
     for p in profiles:
         target = parse_target(f"emu:{p}?reading={','.join(readings)}", allow_destructive=True)
-        for c in select(include or None):
+        for c in select(include or None, exclude or None):
             r = run_case(c, target, "mutation")
             where = f"{c.id} [{p}]"
             failed = [ch for ch in r.checks if not ch["ok"]]
@@ -143,23 +141,24 @@ def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
                         + (", ".join(said) if said else "no difference"))
 
 
-def _trial(args: tuple[str, list[str], list[str], list[str] | None]) -> Trial:
+def _trial(args: tuple[str, list[str], list[str], list[str] | None, list[str] | None]
+           ) -> Trial:
     return trial(*args)
 
 
 def main(argv: list[str] | None = None) -> int:
     from conformance.targets.emu import emulator_readings
     from gve_fixtures.profile import available_profiles
+    argv = sys.argv[1:] if argv is None else list(argv)
     ap = Parser(prog=PROG, description=summary(__doc__), examples=(
         "gve-conformance fairness --jobs 2",
-        "gve-conformance fairness --reading NAME -v"))
+        "gve-conformance fairness --reading NAME -v",
+        "gve-conformance fairness --jobs 2 --seconds 900 --junitxml fairness.xml"),
+        parents=[job_options("also list every difference each reading made", seed=None,
+                             jobs="readings tried in parallel", cases=True,
+                             time_limit=TIME_LIMIT_HELP)])
     ap.add_argument("--reading", action="append", default=[], metavar="NAME",
                     help="only this reading (repeatable; default: every one, and all at once)")
-    ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
-                    help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
-                    help="readings tried in parallel")
-    add_loudness(ap, "also list every difference each reading made")
     try:
         args = ap.parse_args(argv)
         known = emulator_readings()
@@ -167,37 +166,41 @@ def main(argv: list[str] | None = None) -> int:
         if wrong:
             raise UsageError(f"unknown reading(s) {', '.join(wrong)} "
                              f"(known: {', '.join(sorted(known))})")
+        from conformance.run.selection import select
+        if (args.cases or args.exclude) and not select(args.cases or None,
+                                                         args.exclude or None):
+            raise UsageError("no case matches " + " ".join(
+                [f"--cases {g!r}" for g in args.cases]
+                + [f"--exclude {g!r}" for g in args.exclude]))
+        gate = Gate("fairness", args, argv)
     except UsageError as err:
         print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     names = args.reading or sorted(known)
     first = [p for p in FIRST if p in available_profiles()]
-    jobs = [(n, [n], trial_profiles(known[n][0], first), args.cases or None) for n in names]
+    chosen = (args.cases or None, args.exclude or None)
+    jobs = [(n, [n], trial_profiles(known[n][0], first), *chosen) for n in names]
     if not args.reading:
         # all at once runs on every profile, the longest trial: first, so that the
         # workers do not wait for it at the end
-        jobs.insert(0, (ALL, names, available_profiles(), args.cases or None))
-    start = time.perf_counter()
+        jobs.insert(0, (ALL, names, available_profiles(), *chosen))
     trials: list[Trial] = []
-    with workers(args.jobs) as pool, Progress(len(jobs), unit="reading", quiet=args.quiet,
-                                              verbose=args.verbose, every_step=True,
-                                              heartbeat=HEARTBEAT) as shown:
+    with workers(args.jobs, args.seconds) as pool, Progress(
+            len(jobs), unit="reading", quiet=args.quiet, verbose=args.verbose,
+            every_step=True, heartbeat=HEARTBEAT) as shown:
         for t in pool.map(_trial, jobs):
             trials.append(t)
             shown.step("\n".join(_lines(t, args.verbose)), routine=t.fair)
     fair = sum(t.fair for t in trials)
     score = 100.0 * fair / len(trials) if trials else 100.0
-    unfair = [line for t in trials if not t.fair for line in _lines(t, False)]
-    if gate_end("fairness", unfair, f"{len(trials) - fair} reading(s)", pool.interrupted,
-                f"{len(trials)} of {len(jobs)} readings finished ({len(trials) - fair} "
-                f"unfair; {under_way(args.jobs, len(jobs), len(trials))} under way)", start):
-        return INTERRUPTED
-    print(gate_line(fair == len(trials),
-                    f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
-                    f"{time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-                    f"{sum(len(t.differences) for t in trials)} differences graded "
-                    "NON-STRICT or INFO"))
-    return 0 if fair == len(trials) else 1
+    items = [GateItem(t.reading, t.fair, t.seconds, _lines(t, False)) for t in trials]
+    return gate.end(
+        items, [job[0] for job in jobs[len(trials):]], "reading",
+        f"fairness score: {fair}/{len(trials)} = {score:.1f} % in "
+        f"{time.perf_counter() - gate.start:.1f} s ({args.jobs} job(s)); "
+        f"{sum(len(t.differences) for t in trials)} differences graded NON-STRICT or INFO",
+        interrupted=pool.interrupted, timed_out=pool.timed_out, failed_word="unfair",
+        under_way=under_way(args.jobs, len(jobs), len(trials)))
 
 
 def _lines(t: Trial, verbose: bool) -> list[str]:

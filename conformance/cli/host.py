@@ -17,12 +17,13 @@ import fnmatch
 import sys
 
 from conformance.cli.colour import wanted
-from conformance.cli.ending import claimed, counted, end, new_run_id, progress
+from conformance.cli.ending import claimed, counted, end, new_run_id, progress, result_line
+from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import (
     Parser,
     UsageError,
+    job_options,
     positive,
-    report_options,
     seconds,
     summary,
     writable_folder,
@@ -63,8 +64,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         at = argv.index("--")
         argv, command = argv[:at], argv[at + 1:]
     ap = Parser(prog="gve-conformance host", description=summary(__doc__),
-                epilog=PORT_FORMS, examples=EXAMPLES, parents=[report_options(
-                    "print a line for every scenario (the default)", seed=None)])
+                epilog=PORT_FORMS, examples=EXAMPLES, parents=[job_options(
+                    "print a line for every scenario (the default)", seed=None,
+                    jobs="scenarios run side by side (launched, pty or tcp port 0)",
+                    jobs_default=4)])
     ap.add_argument("--profile", help="the unit played to the host, at its default address")
     ap.add_argument("--unit", action="append", default=[], metavar="MODEL@ADDRESS",
                     help="a unit on the line (repeatable; instead of --profile)")
@@ -75,8 +78,6 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                     help="a host silent this long without exiting hangs (default 5)")
     ap.add_argument("--port", default="pty",
                     help="pty (default), tcp:HOST:PORT, or a serial device path")
-    ap.add_argument("--jobs", "-j", type=positive, default=4, metavar="N",
-                    help="scenarios run side by side (launched, pty or tcp port 0)")
     ap.add_argument("--strict", action="store_true",
                     help="the host claims the project's decisions: [D] rules FAIL too")
     ap.add_argument("--expect-motion", action="append", default=[],
@@ -175,15 +176,24 @@ def main(argv: list[str] | None = None) -> int:
         """Why a scenario did not pass: its deciding check, or why it did not run."""
         return reason(r).line() if r.verdict != PASS else None
 
+    # a launched host's scenarios run on their own: a bar on a terminal, a line at least
+    # every HEARTBEAT seconds in a log; an attended one's operator reads the console
+    shown = None if plan.command is None else Progress(
+        len(plan.scenarios), unit="scenario", quiet=args.quiet, verbose=True,
+        every_step=True, heartbeat=HEARTBEAT)
     try:
         run_id = (args.run_id or new_run_id()) if folder is None else folder.name
-        result = certify(plan, run_id, progress(args.quiet, why), console=sys.stdout,
-                         operator=sys.stdin)
+        on_result = progress(args.quiet, why) if shown is None else (
+            lambda r: shown.step(result_line(r, why(r))))
+        result = certify(plan, run_id, on_result, console=sys.stdout, operator=sys.stdin)
     except (HostStartError, ValueError) as err:
         if folder is not None:
             release(folder)
         print(f"gve-conformance host: {err}", file=sys.stderr)
         return 2
+    finally:
+        if shown is not None:
+            shown.close()
     result.meta.command = ["host", *argv]
     result.meta.host_command = list(args.command or [])
     result.meta.host_flags = flags_of(args, plan)

@@ -15,6 +15,10 @@ mutant's rule area (the spec section it breaks) run first, then the rest of the
 catalogue; each on the profiles in turn (one per family first: a mutant of the GVE54's
 micro-stepping shows only there). Hypothesis machines run with the ``mutation`` settings
 (no shrinking).
+
+It ends as every gate does (cli/gate.py): the reports (a JUnit testcase per mutant) and
+one last line; ``--seconds`` bounds it, and a hunt its time limit cut short ends
+INCOMPLETE (exit status 3).
 """
 
 from __future__ import annotations
@@ -23,19 +27,14 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from conformance.cli.pool import gate_end, gate_line, under_way, workers
+from conformance.cli.gate import Gate, GateItem, under_way
+from conformance.cli.pool import workers
 from conformance.cli.progress import HEARTBEAT, Progress
-from conformance.cli.usage import (
-    INTERRUPTED,
-    Parser,
-    UsageError,
-    add_loudness,
-    positive,
-    summary,
-)
+from conformance.cli.usage import TIME_LIMIT_HELP, Parser, UsageError, job_options, summary
 from conformance.verdicts.verdict import ERROR, FAIL
 from gve_fixtures.rules import load_rules
 
+PROG = "gve-conformance mutation"
 #: profiles tried first, one per family; the others follow
 FIRST = ("GVE84-100", "GVE114-500", "GVE54")
 
@@ -76,7 +75,8 @@ def closeness(case, area: str) -> int:
 
 
 def hunt(mutant: str, profiles: list[str] | None = None,
-         include: list[str] | None = None, sweep: bool = False) -> Hunt:
+         include: list[str] | None = None, sweep: bool = False,
+         exclude: list[str] | None = None) -> Hunt:
     """Run cases against ``mutant`` until one FAILs (see the module's text); with
     ``sweep`` go on through the catalogue on one profile per family, noting ERRORs."""
     from conformance.run.runner import run_case
@@ -84,7 +84,7 @@ def hunt(mutant: str, profiles: list[str] | None = None,
     from conformance.targets import emu, parse_target
     area, description = emu.mutants()[mutant]
     result = Hunt(mutant, area, description)
-    cases = select(include or None)
+    cases = select(include or None, exclude or None)
     ordered = sorted(cases, key=lambda c: closeness(c, area))      # stable: spec order
     area_cases = [c for c in ordered if closeness(c, area) < 2]
     names = profiles_in_order(profiles)
@@ -140,48 +140,53 @@ def clean_run(case, clean) -> tuple[str, frozenset[str]]:
     return _CLEAN[key]
 
 
-def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool]) -> Hunt:
+def _hunt(args: tuple[str, list[str] | None, list[str] | None, bool, list[str] | None]
+          ) -> Hunt:
     return hunt(*args)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = Parser(prog="gve-conformance mutation", description=summary(__doc__), examples=(
+    argv = sys.argv[1:] if argv is None else list(argv)
+    ap = Parser(prog=PROG, description=summary(__doc__), examples=(
         "gve-conformance mutation --jobs 2",
         "gve-conformance mutation --mutant NAME --profile GVE84-100",
-        "gve-conformance mutation --sweep --jobs 2"))
+        "gve-conformance mutation --sweep --jobs 2 --seconds 600 --junitxml mutation.xml"),
+        parents=[job_options("print a line for every mutant on a terminal too (a log "
+                             "always has them)", seed=None, jobs="mutants hunted in "
+                             "parallel", cases=True, time_limit=TIME_LIMIT_HELP)])
     ap.add_argument("--profile", action="append", default=[],
                     help="hunt on this profile only (repeatable; default: every profile)")
     ap.add_argument("--mutant", action="append", default=[], metavar="NAME",
                     help="only this mutant (repeatable; default: every one)")
-    ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
-                    help="only cases whose ID matches (repeatable)")
-    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
-                    help="mutants hunted in parallel")
     ap.add_argument("--sweep", action="store_true",
                     help="also run the rest of the catalogue against each mutant (one "
                          "profile per family), failing on any ERROR")
-    add_loudness(ap, "print a line for every mutant on a terminal too (a log always has "
-                     "them)")
     try:
         args = ap.parse_args(argv)
+        from conformance.run.selection import select
+        from conformance.targets import emu
+        from gve_fixtures.profile import available_profiles
+        known = emu.mutants()
+        wrong = [m for m in args.mutant if m not in known]
+        wrong += [p for p in args.profile if p not in available_profiles()]
+        if wrong:
+            raise UsageError(f"unknown {', '.join(wrong)}")
+        if (args.cases or args.exclude) and not select(args.cases or None,
+                                                         args.exclude or None):
+            raise UsageError("no case matches " + " ".join(
+                [f"--cases {g!r}" for g in args.cases]
+                + [f"--exclude {g!r}" for g in args.exclude]))
+        gate = Gate("mutation", args, argv)
     except UsageError as err:
-        print(f"gve-conformance mutation: {err}", file=sys.stderr)
-        return 2
-    from conformance.targets import emu
-    from gve_fixtures.profile import available_profiles
-    known = emu.mutants()
-    wrong = [m for m in args.mutant if m not in known]
-    wrong += [p for p in args.profile if p not in available_profiles()]
-    if wrong:
-        print(f"gve-conformance mutation: unknown {', '.join(wrong)}", file=sys.stderr)
+        print(f"{PROG}: {err}", file=sys.stderr)
         return 2
     names = args.mutant or sorted(known)
-    jobs = [(m, args.profile or None, args.cases or None, args.sweep) for m in names]
-    start = time.perf_counter()
-    results = []
-    with workers(args.jobs) as pool, Progress(len(jobs), unit="mutant", quiet=args.quiet,
-                                              verbose=args.verbose, every_step=True,
-                                              heartbeat=HEARTBEAT) as shown:
+    jobs = [(m, args.profile or None, args.cases or None, args.sweep, args.exclude or None)
+            for m in names]
+    results: list[Hunt] = []
+    with workers(args.jobs, args.seconds) as pool, Progress(
+            len(jobs), unit="mutant", quiet=args.quiet, verbose=args.verbose,
+            every_step=True, heartbeat=HEARTBEAT) as shown:
         for h in pool.map(_hunt, jobs):
             results.append(h)
             shown.step("\n".join(_lines(h)), routine=h.caught and not h.errors
@@ -189,21 +194,17 @@ def main(argv: list[str] | None = None) -> int:
     caught = sum(h.caught for h in results)
     score = 100.0 * caught / len(results) if results else 100.0
     errors = sum(len(h.errors) for h in results)
-    failed = [line for h in results if not h.caught or h.errors for line in _lines(h)]
-    if gate_end("mutation", failed,
-                f"{sum(not h.caught or bool(h.errors) for h in results)} mutant(s)",
-                pool.interrupted,
-                f"{len(results)} of {len(jobs)} mutants finished ({caught} caught, "
-                f"{errors} ERROR; {under_way(args.jobs, len(jobs), len(results))} under "
-                "way)", start):
-        return INTERRUPTED
-    print(gate_line(caught == len(results) and not errors,
-                    f"mutation score: {caught}/{len(results)} = {score:.1f} % "
-                    f"in {time.perf_counter() - start:.1f} s ({args.jobs} job(s)); "
-                    f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
-                    + (f"; {sum(h.unreached for h in results)} not run, the mutant's code "
-                       "unreached" if args.sweep else "")))
-    return 0 if caught == len(results) and not errors else 1
+    items = [GateItem(h.mutant, h.caught and not h.errors, h.seconds, _lines(h))
+             for h in results]
+    return gate.end(
+        items, names[len(results):], "mutant",
+        f"mutation score: {caught}/{len(results)} = {score:.1f} % in "
+        f"{time.perf_counter() - gate.start:.1f} s ({args.jobs} job(s)); "
+        f"{sum(h.runs for h in results)} case runs, {errors} ERROR"
+        + (f"; {sum(h.unreached for h in results)} not run, the mutant's code unreached"
+           if args.sweep else ""),
+        interrupted=pool.interrupted, timed_out=pool.timed_out,
+        under_way=under_way(args.jobs, len(jobs), len(results)))
 
 
 def _runs(n: int) -> str:

@@ -12,6 +12,10 @@ worker whose parent is gone (killed outright) ends as if signalled: no orphan ru
 
 One job runs in this process; a signal raises :class:`Stopped` where the job stands (one
 that lands where Python cannot raise, in a finalizer, is delivered again at once).
+
+A time limit (``seconds``) ends the map as a signal would, the job under way with it
+(raised where it stands in this process, the workers stopped), and says so in
+:attr:`Workers.timed_out` instead of :attr:`Workers.interrupted`.
 """
 
 from __future__ import annotations
@@ -30,7 +34,6 @@ from typing import Any
 
 from conformance.cli.usage import INTERRUPTED
 from conformance.link.signals import STOPPING, Interrupts
-from conformance.verdicts.verdict import FAILED, PASSED
 
 #: how long the workers may take to end once stopped, before they are killed
 ENDING_SECONDS = 10.0
@@ -51,16 +54,24 @@ def _leave(*_: object) -> None:
     os._exit(INTERRUPTED)
 
 
+#: how soon a swallowed Stopped is raised again (seconds): once the hook has returned
+_AGAIN = 0.001
+
+
 @contextlib.contextmanager
-def _redelivered() -> Iterator[None]:
+def _redelivered(which: Callable[[], int]) -> Iterator[None]:
     """A Stopped that a finalizer or a callback swallowed ("Exception ignored in ...")
-    is raised again, where Python can raise it: the signal is not lost, nothing is
-    printed."""
+    is raised again, where Python can raise it: the signal that raised it (``which()``)
+    sent once more from another thread, so that its handler runs after the hook has
+    returned (raised inside the hook, it would be swallowed again). The signal is not
+    lost, nothing is printed."""
     before = sys.unraisablehook
 
     def hook(unraisable: Any) -> None:
         if isinstance(unraisable.exc_value, Stopped):
-            signal.raise_signal(signal.SIGTERM)
+            again = threading.Timer(_AGAIN, os.kill, (os.getpid(), which()))
+            again.daemon = True
+            again.start()
         else:
             before(unraisable)
 
@@ -89,9 +100,11 @@ class _Stopping(Interrupts):
 class Workers:
     """``map`` of a function over items, ``jobs`` at a time (see the module's text)."""
 
-    def __init__(self, jobs: int) -> None:
+    def __init__(self, jobs: int, seconds: float | None = None) -> None:
         self.jobs = jobs
+        self.seconds = seconds
         self.interrupted = False
+        self.timed_out = False      # the time limit ended the map
         self.failed = ""            # the traceback of a job that raised
         self._processes: list[multiprocessing.Process] = []
         self._conns: list[Connection] = []            # to each worker
@@ -121,14 +134,23 @@ class Workers:
             if working:
                 raise Stopped
 
+        def time_up(*_: object) -> None:
+            self.timed_out = True
+            if working:
+                raise Stopped
+
         before = {sig: signal.signal(sig, stop) for sig in STOPPING}
+        if self.seconds is not None:
+            before[signal.SIGALRM] = signal.signal(signal.SIGALRM, time_up)
+            signal.setitimer(signal.ITIMER_REAL, self.seconds)
         try:
             for item in items:
-                if self.interrupted:
+                if self.interrupted or self.timed_out:
                     return
                 try:
                     working = True
-                    with _redelivered():
+                    with _redelivered(lambda: signal.SIGALRM if self.timed_out
+                                      else signal.SIGTERM):
                         result = fn(item)
                     working = False
                 except Stopped:
@@ -136,6 +158,11 @@ class Workers:
                     return
                 yield result
         finally:
+            if self.seconds is not None:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+                if before[signal.SIGALRM] in (signal.SIG_DFL, None):
+                    # a late one (redelivered) must not end the process as SIGALRM would
+                    before[signal.SIGALRM] = signal.SIG_IGN
             for sig, handler in before.items():
                 signal.signal(sig, handler)
 
@@ -172,7 +199,11 @@ class Workers:
             idle.append(here)
             self._conns.append(here)
         pending, following = list(todo), 0
+        deadline = None if self.seconds is None else time.monotonic() + self.seconds
         while (pending or busy) and not stopping.stopped and not self.failed:
+            if deadline is not None and time.monotonic() >= deadline:
+                self.timed_out = True           # _end stops the workers under way
+                return
             while idle and pending:
                 conn = idle.pop()
                 index, item = pending.pop(0)
@@ -210,7 +241,7 @@ class Workers:
                 conn.close()
         self._conns.clear()
         for process in self._processes:
-            if self.interrupted and process.is_alive():
+            if (self.interrupted or self.timed_out) and process.is_alive():
                 with contextlib.suppress(ProcessLookupError):
                     os.kill(process.pid, signal.SIGTERM)
         for process in self._processes:
@@ -260,31 +291,7 @@ def _watch_parent() -> None:
     threading.Thread(target=watch, name="parent-watch", daemon=True).start()
 
 
-def workers(jobs: int) -> Workers:
-    """A pool whose ``map`` runs ``jobs`` at a time (in order of the items)."""
-    return Workers(jobs)
-
-
-def gate_end(job: str, failed: list[str], count: str, interrupted: bool, done: str,
-             start: float) -> bool:
-    """The end of a gate run by workers: what failed listed again under ``count`` (how
-    many, and of what), then, when a signal stopped it, one line saying how far it got
-    (``done``: what finished, and what was under way) and True: no score is given
-    then."""
-    for line in [f"what failed ({count}):", *failed] if failed else []:
-        print(line, flush=True)
-    if interrupted:
-        print(f"{FAILED} — {job} interrupted by a signal after {done} in "
-              f"{time.perf_counter() - start:.1f} s: no score", flush=True)
-    return interrupted
-
-
-def under_way(jobs: int, total: int, finished: int) -> int:
-    """How many items a pool of ``jobs`` workers had begun and not finished when it
-    was stopped."""
-    return min(jobs, total - finished)
-
-
-def gate_line(passed: bool, score: str) -> str:
-    """A gate's last line, as every job ends: ``PASSED — mutation score: ...``."""
-    return f"{PASSED if passed else FAILED} — {score}"
+def workers(jobs: int, seconds: float | None = None) -> Workers:
+    """A pool whose ``map`` runs ``jobs`` at a time (in order of the items), for at most
+    ``seconds`` when given."""
+    return Workers(jobs, seconds)

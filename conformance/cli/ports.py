@@ -22,7 +22,7 @@ import sys
 
 from serial.tools import list_ports
 
-from conformance.cli.usage import Parser, UsageError, summary
+from conformance.cli.usage import Parser, UsageError, job_options, summary
 
 #: the device majors of Linux's pseudo-terminal slaves: the old BSD-style ones
 #: (PTY_SLAVE_MAJOR) and UNIX98_PTY_SLAVE_MAJOR and up; a serial port (ttyS*: 4,
@@ -41,7 +41,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "gve-conformance ports",
         "gve-conformance ports --probe                    # who answers `?` on each",
         "gve-conformance ports --probe /dev/pts/7         # a simulator's pty, named",
-        "gve-conformance ports --glob '/dev/pts/*'        # list the ptys too"))
+        "gve-conformance ports --glob '/dev/pts/*'        # list the ptys too"),
+        parents=[job_options("the same lines (every port is always listed)",
+                             reports=False, seed=None)])
     ap.add_argument("device", nargs="*", metavar="PATH",
                     help="also list (and with --probe ask) this port; a pseudo-terminal is "
                          "probed only when named here")
@@ -100,13 +102,29 @@ def main(argv: list[str]) -> int:
         from conformance.targets.identify import probe
     named = set(args.device)
     width = max(len(device) for device, _, _ in ports)
+    said: list[str] = []
     for device, description, hwid in ports:
         line = f"{device:{width}}  {description}  [{hwid}]"
         if args.probe:
             asked = device in named or not is_pseudo_terminal(device)
-            line += f"  -> {probe(device) if asked else NAME_IT.format(device=device)}"
+            said.append(probe(device) if asked else NAME_IT.format(device=device))
+            line += f"  -> {said[-1]}"
         print(line, flush=True)
+    print(last_line(len(ports), said if args.probe else None), flush=True)
     return 0
+
+
+def last_line(listed: int, said: list[str] | None) -> str:
+    """What the listing found, as its last line: an inventory judges nothing, so no
+    verdict word (docs/decisions.md); ``said``: what each probe said (None: no probe)."""
+    from conformance.targets.identify import SILENT
+    ports = f"{listed} port{'s' if listed != 1 else ''} listed"
+    if said is None:
+        return f"{ports}; none probed (--probe asks each who it is)"
+    skipped = sum(s.startswith("skipped") for s in said)
+    silent = sum(s == SILENT for s in said)
+    return (f"{ports}; a GVE unit answered on {len(said) - skipped - silent}, no answer on "
+            f"{silent}, {skipped} skipped untouched")
 
 
 if __name__ == "__main__":

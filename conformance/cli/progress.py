@@ -22,6 +22,7 @@ old bar above the summary.
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 import threading
 import time
@@ -92,12 +93,15 @@ class Progress:
     def _heartbeat(self, every: float) -> None:
         """Every ``every`` seconds without a line: the bar's clock redrawn, or in a log
         a line saying how far the job is and that it is still working."""
-        while not self._stop.wait(every / 4):
-            if time.perf_counter() - self._said < every:
-                continue
+        # woken a little before ``every`` has passed since the last line or redraw, so
+        # that a loaded machine's late wake-up still shows one within ``every``
+        soon = 0.9 * every
+        while not self._stop.wait(max(0.0, self._said + soon - time.perf_counter())):
             with self._lock:
                 if self._stop.is_set():
                     return
+                if time.perf_counter() - self._said < soon:
+                    continue
                 if self.bar is not None:
                     self.bar.refresh()
                     self._said = time.perf_counter()
@@ -113,10 +117,16 @@ class Progress:
 
     def _print(self, text: str) -> None:
         self._said = time.perf_counter()
-        if self.bar is not None:
-            self.bar.write(text, file=self.stream)
-        else:
-            print(text, file=self.stream, flush=True)
+        try:
+            if self.bar is not None:
+                self.bar.write(text, file=self.stream)
+            else:
+                print(text, file=self.stream, flush=True)
+        except BrokenPipeError:
+            # its reader is gone (`| head`): the job goes on, its lines go nowhere
+            self.quiet = True
+            with contextlib.suppress(OSError, ValueError):
+                os.dup2(os.open(os.devnull, os.O_WRONLY), self.stream.fileno())
 
     def step(self, text: str | None = None, *, routine: bool = False, advance: int = 1,
              label: str | None = None) -> None:

@@ -16,7 +16,7 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
-    add_loudness,
+    job_options,
     one_line,
     summary,
 )
@@ -39,10 +39,11 @@ EXAMPLES = (
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES)
+    ap = Parser(prog=PROG, description=summary(__doc__), targets=True, examples=EXAMPLES,
+                parents=[job_options("print every frame (the default)", reports=False,
+                                     seed=None)])
     ap.add_argument("file", help="a .gvt transcript")
     common(ap)
-    add_loudness(ap, "print every frame (the default)")
     try:
         args = ap.parse_args(argv)
         t = load(args.file)

@@ -32,8 +32,8 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
+    job_options,
     positive,
-    report_options,
     summary,
     writable_folder,
 )
@@ -70,9 +70,11 @@ EXAMPLES = (
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = Parser(prog=PROG, description=f"{summary(ABOUT)}\n\n{subcommands_help()}",
-                targets=True, examples=EXAMPLES, parents=[report_options(
+                targets=True, examples=EXAMPLES, parents=[job_options(
                     "print a line for every case (a terminal and a log show only those "
-                    "that did not PASS)", seed=SEED_HELP)])
+                    "that did not PASS)", seed=SEED_HELP, cases=True,
+                    jobs="run the targets in N parallel processes: one report per target "
+                         "under reports/<run id>/ and a summary across them")])
     ap.add_argument("--target", action="append", default=[],
                     help="where the suite runs (forms below; default: the embedded "
                          "emulator on every profile); repeatable")
@@ -87,10 +89,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="real units: a technician stands in for the test rig (ground an "
                          "input, cycle the power, read the outputs; each step read back, "
                          "s skips it); default: when standard input is a terminal")
-    ap.add_argument("--cases", action="append", default=[], metavar="GLOB",
-                    help="run only cases whose ID matches (repeatable)")
-    ap.add_argument("--exclude", action="append", default=[], metavar="GLOB",
-                    help="leave out cases whose ID matches (repeatable; after --cases)")
     ap.add_argument("--settings", default=None, choices=sorted(PROFILES),
                     help="Hypothesis settings profile (default: ci in virtual time, the "
                          "emulator's or a co-simulator's; hardware on serial/tcp/exec "
@@ -106,9 +104,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                     help="grade a serial/tcp/exec target by the project's decisions too: a "
                          "[D] difference FAILs instead of NON-STRICT (the embedded emulator "
                          "always is)")
-    ap.add_argument("--jobs", "-j", type=positive, default=1, metavar="N",
-                    help="run the targets in N parallel processes: one report per target "
-                         "under reports/<run id>/ and a summary across them")
     ap.add_argument("--hypothesis-db", metavar="DIR|redis://HOST:PORT/N|none",
                     help="where the machines keep failing examples, tried first by the next "
                          "run (redis: by every bench sharing it); default: "

@@ -88,28 +88,52 @@ SEED_HELP = ("the seed of what the job draws at random: the same N draws the sam
              "(default: a fresh one, printed and recorded in the reports)")
 
 
-def report_options(verbose: str, seed: str | None = SEED_HELP) -> argparse.ArgumentParser:
-    """The options of every subcommand that writes reports, with the same names,
-    defaults and help everywhere: a parent parser (``Parser(parents=[...])``).
-    ``verbose``: what -v shows on this subcommand; ``seed``: what its seed seeds (None:
-    a job that draws nothing at random has no --seed)."""
+def job_options(verbose: str, *, reports: bool = True, seed: str | None = SEED_HELP,
+                jobs: str | None = None, jobs_default: int = 1, cases: bool = False,
+                time_limit: str | None = None) -> argparse.ArgumentParser:
+    """The options the subcommands share, with the same names, defaults and help
+    everywhere: one parent parser (``Parser(parents=[job_options(...)])``), of which each
+    job takes the parts that mean something to it. Always ``-q``/``-v`` (``verbose``: what
+    -v shows on this job) and ``--color``; ``reports``: --report-dir, --run-id,
+    --no-reports, --junitxml and --accept-incomplete; ``seed``: what its --seed seeds
+    (None: a job that draws nothing at random has none); ``jobs``: what -j/--jobs runs
+    side by side (``jobs_default`` of them); ``cases``: --cases and --exclude, for a job
+    that runs the catalogue's cases; ``time_limit``: what --seconds S does."""
     ap = argparse.ArgumentParser(add_help=False)
     out = ap.add_argument_group("reports and output")
-    out.add_argument("--report-dir", default="reports",
-                     help="where reports/<run id>/ go (default %(default)s)")
-    out.add_argument("--run-id", type=run_id, metavar="NAME",
-                     help="the report folder's name (default: date, time and a random tag)")
-    out.add_argument("--no-reports", action="store_true",
-                     help="write no report folder (--junitxml still writes its file)")
-    out.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
-    out.add_argument("--accept-incomplete", action="store_true",
-                     help=f"exit 0 for a run that ends INCOMPLETE (nothing failed, yet some "
-                          f"cases were not tested: motion declined, no rig...); otherwise "
-                          f"its exit status is {INCOMPLETE_STATUS}")
-    if seed is not None:
-        out.add_argument("--seed", type=int, metavar="N", help=seed)
+    if reports:
+        out.add_argument("--report-dir", default="reports",
+                         help="where reports/<run id>/ go (default %(default)s)")
+        out.add_argument("--run-id", type=run_id, metavar="NAME",
+                         help="the report folder's name (default: date, time and a random "
+                              "tag)")
+        out.add_argument("--no-reports", action="store_true",
+                         help="write no report folder (--junitxml still writes its file)")
+        out.add_argument("--junitxml", metavar="PATH", help="also write the JUnit XML at PATH")
+        out.add_argument("--accept-incomplete", action="store_true",
+                         help=f"exit 0 for a run that ends INCOMPLETE (nothing failed, yet "
+                              f"some of it was not tested: motion declined, no rig, the time "
+                              f"limit...); otherwise its exit status is {INCOMPLETE_STATUS}")
     add_loudness(out, verbose)
+    job = ap.add_argument_group("what runs")
+    if jobs is not None:
+        job.add_argument("--jobs", "-j", type=positive, default=jobs_default, metavar="N",
+                         help=f"{jobs} (default %(default)s)")
+    if cases:
+        job.add_argument("--cases", action="append", default=[], metavar="GLOB",
+                         help="run only cases whose ID matches (repeatable)")
+        job.add_argument("--exclude", action="append", default=[], metavar="GLOB",
+                         help="leave out cases whose ID matches (repeatable; after --cases)")
+    if time_limit is not None:
+        job.add_argument("--seconds", type=seconds, metavar="S", help=time_limit)
+    if seed is not None:
+        job.add_argument("--seed", type=int, metavar="N", help=seed)
     return ap
+
+
+#: --seconds' help on a job that ends early when its time is up
+TIME_LIMIT_HELP = ("stop after S seconds: what finished by then is reported, the rest not "
+                   "tested (the job ends INCOMPLETE unless something failed)")
 
 
 class _Version(argparse.Action):

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import pytest
 
-from conformance.case import settings as settings_profiles
+from conformance import settings as settings_profiles
 from conformance.case.context import Case
 from conformance.case.settings import PROFILES
 from conformance.link.signals import Interrupts
@@ -47,7 +47,7 @@ from conformance.operator.console import Console
 from conformance.pytest_plugin.stop import before_item, hold, interrupted
 from conformance.run.runner import CaseResult, run_case
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
-from conformance.verdicts.explain import reason
+from conformance.verdicts.explain import plain, reason
 from conformance.verdicts.quoting import quoted
 from conformance.verdicts.verdict import (
     COULD_NOT_TEST,
@@ -288,12 +288,13 @@ class GveItem(pytest.Item):
             why = reason(r)
             lines = [verdict_line(r)]
             lines += [f"the rule: {why.cites()}"] if why.rule else []
-            lines += [f"the case: {r.rule} ({r.source})"]
+            lines += [f"the case: {plain(r.rule)} ({plain(r.source)})"]
             lines += [f"  [{c['tag']}] {c['what']}: observed {quoted(c['observed'])}, "
                       f"expected {quoted(c['expected'])}" for c in r.failed_checks]
             path, line = _where(self.case)
+            from conformance.reports.junit import message
             return CaseReport(lines + r.notes + ["wire log:", *r.wire_log],
-                              _Crash(path, line, lines[0]))
+                              _Crash(path, line, message(r)))
         return super().repr_failure(excinfo, style)
 
     def reportinfo(self):
@@ -410,6 +411,7 @@ def pytest_configure(config: pytest.Config) -> None:
     config.stash[_INTERRUPTS] = interrupts
     config.stash[_VERDICT] = verdict = RunVerdict()
     config.pluginmanager.register(verdict, "gve-conformance-verdict")
+    config.pluginmanager.register(WholeReasons(), WholeReasons.NAME)
     hold(config, interrupts, controller=controller)
 
 
@@ -469,23 +471,48 @@ def pytest_report_teststatus(report: pytest.TestReport, config: pytest.Config
 @pytest.hookimpl(wrapper=True, tryfirst=True)
 def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config
                             ) -> Generator[None, None, None]:
-    """After pytest's short summary: the FAIL and ERROR cases, then the NON-STRICT and
-    INFO ones, each with why, whole (pytest's own summary line drops the reason where the
-    node ID fills the terminal's width), wherever the summary lists what did not pass
-    (``-r`` with f, s or p: the default, -ra, -rA)."""
+    """After pytest's short summary (whose FAILED lines carry why, whole:
+    :class:`WholeReasons`): the NON-STRICT and INFO cases, which it does not list, each
+    with why, wherever the summary lists what did not pass (``-r`` with f, s or p: the
+    default, -ra, -rA)."""
     yield
+    whole = config.pluginmanager.get_plugin(WholeReasons.NAME)
+    if whole is not None:
+        whole.restore(config)
     chars = getattr(terminalreporter, "reportchars", "")
     if not any(c in chars for c in "fsp"):
         return
-    for title, words, colour in (("FAIL and ERROR", ("failed",), {"red": True}),
-                                 ("NON-STRICT and INFO", ("non-strict", "info"),
-                                  {"yellow": True})):
-        reports = [rep for word in words for rep in terminalreporter.stats.get(word, [])
-                   if getattr(rep, "gve_why", None) and rep.when == "call"]
-        if reports:
-            terminalreporter.write_sep("=", f"gve-conformance: {title}", **colour)
-            for rep in reports:
-                terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
+    reports = [rep for word in ("non-strict", "info") for rep in
+               terminalreporter.stats.get(word, [])
+               if getattr(rep, "gve_why", None) and rep.when == "call"]
+    if reports:
+        terminalreporter.write_sep("=", "gve-conformance: NON-STRICT and INFO", yellow=True)
+        for rep in reports:
+            terminalreporter.write_line(f"{rep.gve_verdict} {rep.nodeid} - {rep.gve_why}")
+
+
+class WholeReasons:
+    """pytest's short summary (``FAILED <node ID> - <why>``) with why whole: pytest trims
+    it to the terminal's width, and drops it where the node ID (a case, its profile's
+    section and its target) fills the width alone, except at ``-vv``. The summary is
+    written at ``-vv`` and the verbosity given back right after it (registered with the
+    suite's targets only: no other pytest run is changed)."""
+
+    NAME = "gve-conformance-whole-reasons"
+
+    def __init__(self) -> None:
+        self.given: int | None = None
+
+    @pytest.hookimpl(wrapper=True, trylast=True)
+    def pytest_terminal_summary(self, config: pytest.Config) -> Generator[None, None, None]:
+        # inside pytest's own wrapper, whose short summary follows this one's end
+        yield
+        self.given = config.option.verbose
+        config.option.verbose = max(self.given, 2)
+
+    def restore(self, config: pytest.Config) -> None:
+        if self.given is not None:
+            config.option.verbose, self.given = self.given, None
 
 
 @dataclass

@@ -26,7 +26,7 @@ from markupsafe import Markup
 import conformance.reports.plots as plots
 from conformance.verdicts.quoting import quoted
 from conformance.reports.banner import run_verdict
-from conformance.reports.failures import failures
+from conformance.reports.failures import failures, natural
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import clean, rule_html
@@ -190,7 +190,7 @@ def _coverage(run: RunResult) -> dict | None:
             "rows": [(section_title(s), [cells[s].get(p, "") for p in profiles])
                      for s in sorted(cells, key=section_key)],
             "totals": [f"{pc['covered']}/{pc['total']}" for pc in report],
-            "uncovered": sorted(uncovered.items())}
+            "uncovered": sorted(uncovered.items(), key=lambda kv: natural(kv[0]))}
 
 
 def render_html(run: RunResult, full_logs: bool | None = None) -> str:

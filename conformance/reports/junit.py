@@ -25,7 +25,7 @@ import datetime
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from conformance.verdicts.explain import reason
+from conformance.verdicts.explain import plain, reason
 from conformance.reports.banner import run_verdict
 from conformance.reports.files import write_text
 from conformance.reports.logs import compact
@@ -89,7 +89,7 @@ def _head(r: CaseResult) -> str:
     why = reason(r)
     return "\n".join([message(r), *([f"the rule: {why.cites()}"] if why.rule else []),
                       f"the case: {r.id}, tag {r.tag}, section {section_title(r.section)}; "
-                      f"{r.rule} ({r.source})", ""])
+                      f"{plain(r.rule)} ({plain(r.source)})", ""])
 
 
 def _testcase(suite: ET.Element, r: CaseResult, strict: bool, full: bool) -> None:

@@ -10,7 +10,8 @@ from conformance.reports.banner import run_verdict
 from conformance.run.runner import RunResult
 from conformance.targets.info import EMULATOR
 
-HEADERS = ("target", "profile", "firmware (`?`)", "processor id (`Q`)",
+HEADERS = ("target", "profile", "firmware (its answer to ?)",
+           "processor id (its answer to Q)",
            "motion envelope (full steps per axis)", "largest excursion (full steps)",
            "verdict")
 #: what the emulator's columns say where a real unit's hold figures
@@ -45,8 +46,9 @@ def _rows(run: RunResult) -> list[dict]:
 
 def _found(s: dict) -> list[str]:
     ident = s.get("identity") or {}
-    out = [*((f"firmware (`?`): {ident['version']}",) if "version" in ident else ()),
-           *((f"processor id (`Q`): {ident['processor_id']}",)
+    out = [*((f"firmware (its answer to ?): {ident['version']}",) if "version" in ident
+             else ()),
+           *((f"processor id (its answer to Q): {ident['processor_id']}",)
              if "processor_id" in ident else ())]
     found = dict(s.get("found") or {})
     words = [f"{k} {found.pop(k)}" for k in [k for k in found if k.startswith("ST")]]

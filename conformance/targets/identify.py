@@ -129,6 +129,10 @@ def choose(identity: Identity, variant: str | None = None,
     raise ValueError(f"--variant {variant}: a {family} is one of {choices}")
 
 
+#: what a probe says of a port where nothing answered `?`
+SILENT = "no GVE unit answered"
+
+
 def probe(url: str, address: int = 0) -> str:
     """What `gve-conformance ports --probe` says of the port at ``url``: the unit that
     answers `?` (asked nothing else), no answer, or why the port was skipped untouched
@@ -139,9 +143,9 @@ def probe(url: str, address: int = 0) -> str:
     except LeftAlone as err:
         return f"skipped: {err}"
     except (serial.SerialException, OSError, ValueError):
-        return "no GVE unit answered"
+        return SILENT
     if identity is None:
-        return "no GVE unit answered"
+        return SILENT
     family = family_of(identity.version) or "unknown family"
     return f"{family}: ? {shown(identity.version)} at {identity.baud} baud, address {address}"
 

@@ -6,6 +6,7 @@ for a verdict no check made (ERROR, COULD-NOT-TEST, MISSING) the note that says 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -82,11 +83,23 @@ class Reason:
                         if p)
 
     def cites(self) -> str:
-        """The rule's sentence and its source: ``$ takes 1..65535 ... (M54 $; M84
-        12.5.3)``."""
+        """The rule's sentence and its source as plain text (:func:`plain`): ``$ takes
+        1..65535 ... (M54 $; M84 12.5.3)``."""
         if not self.rule:
             return ""
-        return f"{self.rule} ({self.source})" if self.source else self.rule
+        return plain(f"{self.rule} ({self.source})" if self.source else self.rule)
+
+
+#: the Markdown the rules' sentences are written in (fixtures/rules.toml: docs/spec.md is
+#: made of them): code spans and bold
+_MARKUP = re.compile(r"`([^`]+)`|\*\*([^*]+)\*\*")
+
+
+def plain(text: str) -> str:
+    """A rule's sentence (or a case's, or a source) for a console, a log or JUnit: its
+    Markdown code spans and bold as their text (``!0H`` for `` `!0H` ``), no markup shown.
+    The HTML report sets them as HTML instead (reports/text.py)."""
+    return _MARKUP.sub(lambda m: m.group(1) or m.group(2), text)
 
 
 def _why_not_judged(notes: Sequence[str]) -> str:

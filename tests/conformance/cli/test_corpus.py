@@ -96,7 +96,7 @@ def test_the_gate_end_to_end(tmp_path, capsys):
         '[[implementation]]\nname = "clean"\nkind = "unit"\nfolder = "."\n'
         'command = "{python} -m emulator --model GVE84-100 --cosim"\n'
         'profiles = ["GVE84-100"]\nwritten-from = "the reference emulator"\n')
-    status = main(["corpus", "--manifest", str(tmp_path / "corpus.toml"), "-q"])
+    status = main(["corpus", "--no-reports", "--manifest", str(tmp_path / "corpus.toml"), "-q"])
     out = capsys.readouterr().out
     assert status == 0, out
     assert out.strip().splitlines()[-1].startswith("PASSED — corpus: 1/1 implementations fair")
@@ -112,7 +112,7 @@ def test_a_manifest_key_it_does_not_know_is_refused(tmp_path):
 
 def test_an_unknown_implementation_is_one_line_and_exit_2(tmp_path, capsys):
     (tmp_path / "corpus.toml").write_text("")
-    assert main(["corpus", "--manifest", str(tmp_path / "corpus.toml"),
+    assert main(["corpus", "--no-reports", "--manifest", str(tmp_path / "corpus.toml"),
                  "--implementation", "nosuch"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "unknown implementation(s) nosuch" in err

@@ -23,6 +23,7 @@ import pytest
 
 from conformance.cli import main
 from conformance.reports import files
+from conformance.verdicts.explain import plain
 from gve_fixtures.rules import load_rules
 from tests.conformance.safety.proxy import unit_behind_proxy
 
@@ -77,7 +78,8 @@ def test_the_recap_lists_what_failed_with_the_rule_s_sentence_under_quiet_too(mi
         assert CASE in recap[1] and recap[1].startswith("FAIL")
         named = recap[2].split()[0]
         rule = load_rules()[named]
-        assert rule.tag == "M" and recap[3].strip() == f"the rule: {rule.text} ({rule.source})"
+        assert rule.tag == "M" \
+            and recap[3].strip() == f"the rule: {plain(rule.text)} ({plain(rule.source)})"
     quiet = outs[True]
     assert quiet[0].startswith("what failed")            # -q: nothing before the recap
 

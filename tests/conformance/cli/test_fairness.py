@@ -32,7 +32,8 @@ def test_an_emulator_taking_a_reading_is_graded_by_the_tags():
 
 
 def test_the_fairness_score_of_one_reading(capsys):
-    status = main(["fairness", "--reading", "plus-sign", "--cases", "3.frame.*", "-v"])
+    status = main(["fairness", "--no-reports",
+                   "--reading", "plus-sign", "--cases", "3.frame.*", "-v"])
     out = capsys.readouterr().out
     assert status == 0
     assert "fair    plus-sign" in out and "NON-STRICT 3.frame.syntax-errors [GVE84-100]" \
@@ -41,7 +42,7 @@ def test_the_fairness_score_of_one_reading(capsys):
 
 
 def test_an_unknown_reading_is_one_line_and_exit_2(capsys):
-    assert main(["fairness", "--reading", "nosuch"]) == 2
+    assert main(["fairness", "--no-reports", "--reading", "nosuch"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "unknown reading(s) nosuch" in err
 
@@ -50,7 +51,8 @@ def test_diff_runs_against_the_reading_and_names_the_rule_it_reads(capsys):
     """The unit counting @ and > differs from the reference in diff too: NON-STRICT under
     the counting rule on each profile, not a FAIL of the index (its first @ is where the
     index is compared from)."""
-    status = main(["fairness", "--reading", "queries-counted", "--cases", "8.index.*"])
+    status = main(["fairness", "--no-reports",
+                   "--reading", "queries-counted", "--cases", "8.index.*"])
     out = capsys.readouterr().out
     assert status == 0, out
     for profile in ("GVE84-100", "GVE54", "GVE114-500"):
@@ -67,7 +69,8 @@ def test_a_signal_stops_every_worker_with_one_line(sig, group):
     """SIGINT (to the process group, as a terminal sends it), SIGTERM or SIGHUP at a
     drawn instant while two readings are tried: the workers end, one last line, 130."""
     delay = random.Random(f"fairness {sig}").uniform(0.0, 1.5)
-    argv = ["fairness", "--jobs", "2", "--reading", "plus-sign", "--reading", "queries-counted"]
+    argv = ["fairness", "--no-reports",
+            "--jobs", "2", "--reading", "plus-sign", "--reading", "queries-counted"]
     status, out, started = signalled(argv, sig, group=group, delay=delay,
                                      ready=lambda pid: len(descendants(pid)) >= 2)
     assert status == 130, out
@@ -104,7 +107,7 @@ def test_a_check_that_names_no_rule_makes_a_reading_unfair(monkeypatch):
 def test_fairness_runs_diff_and_names_the_rule_of_every_difference(capsys):
     # the reference's R with nothing kept answered 5: the empty save's rule, as the
     # catalogue grades it, not the exact restore's [M]
-    status = main(["fairness", "--reading", "restore-nothing-kept-range",
+    status = main(["fairness", "--no-reports", "--reading", "restore-nothing-kept-range",
                    "--cases", "10.5.restore.*"])
     out = capsys.readouterr().out
     assert status == 0, out

@@ -21,7 +21,7 @@ from tests.processes import alive, descendants, signalled
 
 def test_the_sweep_leaves_out_the_cases_that_never_reach_the_mutant(capsys):
     args = ["--mutant", "sw6-inert", "--profile", "GVE84-100", "--cases", "10.3.*"]
-    assert main([*args, "--sweep"]) == 0
+    assert main([*args, "--sweep", "--no-reports"]) == 0
     out = capsys.readouterr().out
     assert "caught  sw6-inert" in out
     (left_out,) = re.findall(r"(\d+) not run, the mutant's code unreached", out)
@@ -35,7 +35,7 @@ def test_the_sweep_leaves_out_the_cases_that_never_reach_the_mutant(capsys):
 
 
 #: a sweep of the catalogue against a few mutants: long enough to be stopped in
-SWEEP = ["mutation", "--jobs", "2", "--sweep", "--profile", "GVE84-100",
+SWEEP = ["mutation", "--no-reports", "--jobs", "2", "--sweep", "--profile", "GVE84-100",
          "--mutant", "go-without-inta", "--mutant", "sw6-inert", "--mutant", "velocity-ignored"]
 
 

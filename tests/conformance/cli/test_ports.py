@@ -2,7 +2,8 @@
 (TIOCEXCL, a lock) gets no byte and keeps its settings, and says
 why it was skipped; a free port gets `?` only and its settings back; a pseudo-terminal
 that was not named (found by a glob, as the docs' `--glob '/dev/pts/*'`: somebody's
-interactive terminal) gets no byte at all."""
+interactive terminal) gets no byte at all. The listing's last line counts what it found
+and what each probe said."""
 
 from __future__ import annotations
 
@@ -25,7 +26,8 @@ def only_globbed(monkeypatch):
 def probe(path: str, capsys) -> str:
     assert main(["ports", "--probe", path]) == 0         # named: a pty too is asked
     out = capsys.readouterr().out.splitlines()
-    assert len(out) == 1 and out[0].startswith(path)
+    assert len(out) == 2 and out[0].startswith(path)
+    assert out[1].startswith("1 port listed; ")
     return out[0]
 
 
@@ -78,7 +80,9 @@ def test_a_pseudo_terminal_a_glob_found_gets_no_byte(pty, capsys):  # noqa: F811
     master, slave, path = pty
     settings = cooked(slave)
     assert main(["ports", "--glob", path, "--probe"]) == 0
-    (line,) = capsys.readouterr().out.splitlines()
+    line, last = capsys.readouterr().out.splitlines()
+    assert last == ("1 port listed; a GVE unit answered on 0, no answer on 0, 1 skipped "
+                    "untouched")
     assert line.endswith(f"-> skipped: a pseudo-terminal (an interactive terminal, or "
                          f"another program's line): probed only when named, "
                          f"gve-conformance ports --probe {path}")

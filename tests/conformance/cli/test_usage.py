@@ -1,7 +1,10 @@
-"""One option set: every subcommand that writes reports takes --report-dir, --run-id,
---junitxml, --no-reports, -q and -v with the same defaults, and --seed where it draws at
-random (a fresh seed by default, printed and recorded); mutation and fairness take -q
-and -v; every option says what it does; diff's reports say what a run's say."""
+"""One option set: every subcommand that writes reports (the run, diff, host and the
+gates) takes --report-dir, --run-id, --junitxml, --no-reports, -q and -v with the same
+defaults, and --seed where it draws at random (a fresh seed by default, printed and
+recorded); every job takes -q, -v and --color, the long ones --seconds, those that run
+cases --cases and --exclude, those that run things side by side -j; a shared option says
+the same on every subcommand (one parent parser); every option says what it does; diff's
+reports say what a run's say."""
 
 from __future__ import annotations
 
@@ -20,7 +23,8 @@ from tests.conformance.reports.toy import toy_run
 #: a subcommand that writes reports -> the least it needs on its command line
 WRITERS = {"run": ["--target", "emu:GVE84-100"],
            "diff": ["--target", "emu:GVE84-100"],
-           "host": ["--profile", "GVE84-100", "--", "true", "{port}"]}
+           "host": ["--profile", "GVE84-100", "--", "true", "{port}"],
+           "mutation": [], "fairness": [], "corpus": []}
 COMMON = ("report_dir", "run_id", "no_reports", "junitxml", "quiet", "verbose")
 
 
@@ -55,7 +59,7 @@ def test_every_report_writer_takes_the_same_options_with_the_same_defaults(parse
                           "--no-reports", "-q", *least])
         assert (args.report_dir, args.run_id, args.junitxml, args.no_reports, args.quiet) \
             == ("r", "x", "j.xml", True, True), sub
-    assert defaults["run"] == defaults["diff"] == defaults["host"]
+    assert all(d == defaults["run"] for d in defaults.values()), defaults
 
 
 def test_the_seed_defaults_alike_where_a_job_draws_at_random(parsed):
@@ -76,8 +80,8 @@ def test_the_other_jobs_take_quiet_and_verbose(sub, parsed):
         assert getattr(args, name) is True
 
 
-@pytest.mark.parametrize("sub", ["run", "diff", "host", "mutation", "fairness", "replay",
-                                 "ports"])
+@pytest.mark.parametrize("sub", ["run", "diff", "host", "mutation", "fairness", "corpus",
+                                 "replay", "ports"])
 def test_every_option_says_what_it_does(sub, parsed):
     least = {"replay": ["t.gvt", "--target", "emu:GVE84-100"], **WRITERS}.get(sub, [])
     parser, _ = parsed([sub, *least])
@@ -111,10 +115,18 @@ def test_the_report_s_command_keeps_its_quoting():
 
 
 #: every subcommand that runs a job -> the least it needs on its command line
-JOBS = {**WRITERS, "mutation": [], "fairness": [],
+JOBS = {**WRITERS, "ports": [],
         "replay": ["fixtures/transcripts/g1-checksum-mode.gvt", "--target", "emu:GVE84-100"]}
 #: those that run several things side by side
-PARALLEL = ("run", "host", "mutation", "fairness")
+PARALLEL = ("run", "host", "mutation", "fairness", "corpus")
+#: those that run the catalogue's cases
+CASES = ("run", "mutation", "fairness")
+#: the long jobs: a time limit (diff: how long it searches)
+LONG = ("diff", "mutation", "fairness", "corpus")
+#: the options whose help is the same wherever they are (the others say what they do on
+#: each job: -v, --jobs, --seed, --seconds)
+SAME_HELP = ("--report-dir", "--run-id", "--no-reports", "--junitxml", "--accept-incomplete",
+             "--quiet", "--color", "--cases", "--exclude")
 
 
 def test_every_job_takes_color_and_the_parallel_ones_j(parsed):
@@ -126,3 +138,24 @@ def test_every_job_takes_color_and_the_parallel_ones_j(parsed):
     for sub in PARALLEL:
         _, args = parsed([sub, "-j", "2", *JOBS[sub]])
         assert args.jobs == 2, sub
+
+
+def test_cases_where_cases_run_and_a_time_limit_on_the_long_jobs(parsed):
+    for sub in CASES:
+        _, args = parsed([sub, "--cases", "5.*", "--exclude", "5.errors.busy", *JOBS[sub]])
+        assert (args.cases, args.exclude) == (["5.*"], ["5.errors.busy"]), sub
+    for sub in LONG:
+        _, args = parsed([sub, "--seconds", "2.5", *JOBS[sub]])
+        assert args.seconds == 2.5, sub
+
+
+def test_a_shared_option_says_the_same_on_every_subcommand(parsed):
+    helps: dict[str, set[str]] = {}
+    for sub, least in JOBS.items():
+        parser, _ = parsed([sub, *least])
+        for option in SAME_HELP:
+            action = parser._option_string_actions.get(option)
+            if action is not None:
+                helps.setdefault(option, set()).add(action.help)
+    assert set(helps) == set(SAME_HELP)
+    assert {o: h for o, h in helps.items() if len(h) > 1} == {}

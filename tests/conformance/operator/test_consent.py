@@ -1,9 +1,9 @@
 """Consent before real motion, decided by one module for every entry point: a unit in
 real time (serial, TCP, an exec: program serving a port) needs a yes, given up front or
 at the terminal; the embedded emulator and a co-simulator in virtual time need none.
-Through the CLI and the pytest plugin alike, a unit on a pty (the emulator, its wire
-logged) sees no motion frame without consent, and runs its cases with it; motion
-declined at the question ends the run INCOMPLETE, never PASSED."""
+Through the CLI and the pytest plugin alike (under pytest-xdist too), a unit on a pty
+(the emulator, its wire logged) sees no motion frame without consent, and runs its cases
+with it; motion declined at the question ends the run INCOMPLETE, never PASSED."""
 
 from __future__ import annotations
 
@@ -83,8 +83,11 @@ ENTRIES = {
                                  "GVE84-100", "--gve-cases", CASE, "--gve-cases", STILL, "-rA"]
     + (["--gve-yes"] if yes else []),
 }
+# under pytest-xdist: the controller asks (or refuses) once, its workers take its answer
+ENTRIES["plugin -n 2"] = lambda path, yes: [*ENTRIES["plugin"](path, yes), "-n", "2"]
 #: how each entry point refuses a run it cannot ask about: (exit status, the option)
-REFUSED = {"cli": (2, "--yes"), "plugin": (pytest.ExitCode.USAGE_ERROR, "--gve-yes")}
+REFUSED = {"cli": (2, "--yes"), "plugin": (pytest.ExitCode.USAGE_ERROR, "--gve-yes"),
+           "plugin -n 2": (pytest.ExitCode.USAGE_ERROR, "--gve-yes")}
 
 
 @pytest.mark.parametrize("entry", sorted(ENTRIES))
@@ -106,7 +109,7 @@ def test_consent_up_front_runs_the_cases(entry, tmp_path):
                               capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     last = done.stdout.rstrip().splitlines()[-1]
-    assert ("2 passed" in last) if entry == "plugin" else last.startswith("PASSED — 2 PASS")
+    assert ("2 passed" in last) if entry != "cli" else last.startswith("PASSED — 2 PASS")
     assert _motion_frames(log) != []
 
 

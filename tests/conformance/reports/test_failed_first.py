@@ -137,13 +137,14 @@ def test_plain_headers_and_the_state_as_found_and_as_left_in_view(no_plots):
     page = render_html(run)
     parse(page)
     top = page[:page.index("<h2>Verdicts by spec section</h2>")]
-    assert "<th>firmware (`?`)</th>" in top and "<th>processor id (`Q`)</th>" in top
+    assert "<th>firmware (its answer to ?)</th>" in top \
+        and "<th>processor id (its answer to Q)</th>" in top
     assert "version (?)" not in page
     assert "X -12..+1400, Y +0..+0, Z +0..+3" in top                 # the real unit
     assert "not tracked: every case starts a fresh emulated unit" in top   # the emulator
     state = top[top.index("The units as found and as left"):]
     assert "<details" not in state                                    # not behind a toggle
-    for shown in ("firmware (`?`): IP84 v3 27.1.2010", "status words: ST0 00, ST1 04",
+    for shown in ("firmware (its answer to ?): IP84 v3 27.1.2010", "status words: ST0 00, ST1 04",
                   "checksums: off", "restored: axes back where the run began",
                   "reset: set to the reset state (they cannot be read): XM100",
                   "PROBLEM: EEPROM 07 not put back",

@@ -176,3 +176,15 @@ def test_a_hostile_answer_is_shown_escaped_and_never_raw(no_plots):
     reader.feed(page)
     shown = "8,D0<script>alert('x')</script> & \"q\" \\x00\\x1B[2J\\x7F"
     assert reader.text.count(shown) == 5
+
+
+def test_the_rules_no_case_can_fail_are_listed_in_the_spec_s_order():
+    """10 after 9 in the page's coverage, as everywhere sections are listed."""
+    from conformance.reports.html import _coverage
+    run = toy_run()
+    run.meta.coverage = [{"profile": "GVE84-100", "covered": 1, "total": 4, "sections": [
+        {"section": "10", "covered": 1, "uncovered": ["10.cmd.b", "10.cmd.a"]},
+        {"section": "9", "covered": 0, "uncovered": ["9.reset.a"]}]}]
+    view = _coverage(run)
+    assert [rule for rule, _ in view["uncovered"]] == ["9.reset.a", "10.cmd.a", "10.cmd.b"]
+    assert [title.split()[0] for title, _ in view["rows"]] == ["9", "10"]

@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 
 from junitparser import Failure, JUnitXml, Properties, Skipped
 
+from conformance.verdicts.explain import plain
 from conformance.reports import to_json, write_junit, write_reports
 from conformance.verdicts.verdict import FAILED
 from gve_fixtures.rules import load_rules
@@ -104,7 +105,8 @@ def test_a_failure_names_the_rule_and_cites_its_sentence(tmp_path):
     assert failure.message.startswith("FAIL: 1.profile.dollar-range [M] ")
     rule = load_rules()["1.profile.dollar-range"]
     out = cases["6.toy.fails[GVE84-100]"].system_out
-    assert f"the rule: {rule.text} ({rule.source})" in out
+    # its sentence as plain text: the Markdown of rules.toml without its backticks
+    assert f"the rule: {plain(rule.text)} ({plain(rule.source)})" in out and "`" not in out
 
 
 def test_could_not_test_is_skipped_with_its_reason(tmp_path):

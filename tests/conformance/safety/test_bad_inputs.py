@@ -170,3 +170,17 @@ def test_mutation_refuses_no_jobs_in_one_line(capsys):
 def test_mutation_refuses_an_unknown_option_in_one_line(capsys):
     _refused(["mutation", "--bogus"], "unrecognized arguments: --bogus", capsys,
              "gve-conformance mutation")
+
+
+@pytest.mark.parametrize(("argv", "says"), [
+    (["mutation", "--report-dir", "FILE"], "it is a file, not a folder"),
+    (["fairness", "--seconds", "0"], "give a number of seconds above 0"),
+    (["corpus", "--seconds", "nan"], "give a number of seconds above 0"),
+    (["mutation", "--cases", "zz*"], "no case matches --cases 'zz*'"),
+    (["fairness", "--exclude", "*"], "no case matches --exclude '*'"),
+])
+def test_a_gate_refuses_a_mistake_in_one_line(argv, says, tmp_path, capsys):
+    (tmp_path / "FILE").write_text("")
+    argv = [str(tmp_path / a) if a == "FILE" else a for a in argv]
+    _refused(argv, says, capsys, f"gve-conformance {argv[0]}")
+    assert list(tmp_path.iterdir()) == [tmp_path / "FILE"]      # no report folder left

@@ -4,7 +4,7 @@ note for a verdict no check made."""
 
 from __future__ import annotations
 
-from conformance.verdicts.explain import deciding_check, reason
+from conformance.verdicts.explain import deciding_check, plain, reason
 from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, NON_STRICT
 from gve_fixtures.rules import load_rules
 from tests.conformance.reports.toy import result
@@ -28,7 +28,7 @@ def test_a_broken_manual_rule_decides_a_fail_before_a_decision_that_failed_first
     rule = load_rules()[m]
     assert (why.rule_id, why.tag, why.rule, why.source) == (m, "M", rule.text, rule.source)
     assert why.line().startswith(f"{m} [M] the manual's rule: ")
-    assert why.cites() == f"{rule.text} ({rule.source})"
+    assert why.cites() == plain(f"{rule.text} ({rule.source})")
 
 
 def test_non_strict_and_info_are_decided_by_their_own_checks():
@@ -56,3 +56,22 @@ def test_one_format_for_what_was_seen_and_wanted():
         {"ok": False, "what": "an invariant", "observed": "", "expected": "", "tag": "M",
          "rule": ""}]))
     assert nothing.seen() == "" and nothing.line() == "[M] an invariant"
+
+
+def test_a_rule_s_sentence_is_plain_text_in_a_console_and_junit_and_html_in_the_page(
+        tmp_path, capsys):
+    """The rules are written in Markdown (`!0SW8,F1` → `5`): the console's recap and the
+    JUnit file show the text without the backticks, the HTML page sets it as code."""
+    from conformance.cli import main
+    rule = load_rules()["5.code.range"]
+    assert "`" in rule.text
+    assert main(["--target", "emu:GVE84-100?mutant=range-error-code", "--cases",
+                 "5.errors.out-of-range", "--report-dir", str(tmp_path), "--run-id", "r",
+                 "-q"]) == 1
+    out = capsys.readouterr().out
+    sentence = rule.text.replace("`", "")
+    assert f"the rule: {sentence} ({rule.source})" in out and "`" not in out, out
+    junit = (tmp_path / "r" / "junit.xml").read_text()
+    assert f"the rule: {sentence}" in junit and "`" not in junit
+    page = (tmp_path / "r" / "report.html").read_text()
+    assert "<code>!0SW8,F1</code>" in page and "`" not in page
