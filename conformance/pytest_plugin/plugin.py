@@ -38,7 +38,7 @@ from pathlib import Path
 
 import pytest
 
-from conformance import settings as settings_profiles
+from conformance.case import settings as settings_profiles
 from conformance.case.context import Case
 from conformance.case.settings import PROFILES
 from conformance.link.signals import Interrupts
