@@ -132,6 +132,12 @@ class Pair:
         #: a co-simulator is told each sequence's frames ahead where the guard can judge
         #: them (told.py); False: one exchange a frame
         self.ahead = True
+        #: a co-simulator that keeps a state (`snapshot`, docs/cosim.md): its first unit
+        #: powered on is kept, and each next sequence begins from it restored instead of
+        #: powered on (the same findings, fewer commands). Off by default: a restore
+        #: never shows a power-on that leaves something behind (only the first is run),
+        #: and the emulator's restore (a fork) costs more than its power-on
+        self.restores = False
         self._teller: Teller | None = None     # the example's frames told ahead
         #: when the search's time is up (``--seconds``): a sequence stops between steps
         self.out_of_time: Callable[[], bool] = _never
@@ -275,7 +281,7 @@ class Pair:
         a power-on that left something behind shows in the sequence's first answers, a
         finding of its own. False where the target is not begun so (a real unit, a
         real-time simulator, a rig that refuses `power-on`): the known state then."""
-        if self.target.open_powered() is None:
+        if self.target.open_powered(kept=self.restores) is None:
             return False
         self.reference.open()
         self._same_eeprom()

@@ -109,6 +109,7 @@ class CosimLine:
         #: frames told ahead whose reply is not read yet (tell): the command, its plan
         self._told: tuple[str, list[tuple[bytes, int]]] | None = None
         self.broken = ""
+        self.exchanges = 0                    # commands sent
 
     # -- the channel -------------------------------------------------------------------------
     def _break(self, why: str) -> NoReturn:
@@ -120,6 +121,7 @@ class CosimLine:
             raise ProtocolBroken(self.broken)
 
     def _send(self, command: str) -> None:
+        self.exchanges += 1
         if not self.program.send(command):
             self._ended(command)
 
@@ -187,6 +189,24 @@ class CosimLine:
         if due is not None:
             return due
         self._break(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
+
+    # -- a state kept (the `snapshot` extension) --------------------------------------------------
+    def snapshot(self) -> bool:
+        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
+        False where it does not offer it, or refuses it (not used from then on)."""
+        if "snapshot" not in self.extensions:
+            return False
+        if self.ask("snapshot").strip().lower() != "ok":
+            self.extensions = self.extensions - {"snapshot"}
+            return False
+        return True
+
+    def restore(self) -> None:
+        """Back to the state the last `snapshot` kept, the clock not going back: the
+        unit has stood since then (its reply `now T` is the present instant)."""
+        self._flush()
+        self._catch_up()
+        self._move("restore", self.now, self.now, self.now)
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -566,6 +586,14 @@ class CosimPort:
     def ran(self, data: bytes) -> bool:
         """Whether ``data`` written now was told ahead and run already (CosimLine.ran)."""
         return self.line.ran(data)
+
+    def snapshot(self) -> bool:
+        """The simulator keeps its state (CosimLine.snapshot): whether it did."""
+        return self.line.snapshot()
+
+    def restore(self) -> None:
+        """Back to the state kept (CosimLine.restore)."""
+        self.line.restore()
 
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""

@@ -190,3 +190,29 @@ def test_a_power_on_that_leaves_the_checksum_mode_on_is_found_and_named():
         assert bool(found) == findings
         assert all(f.disagreement.rule == "9.reset.state" and f.disagreement.verdict == FAIL
                    and "summing-after-power-on" in f.disagreement.context for f in found)
+
+
+@pytest.mark.parametrize("mutant", ["lower-case-command", "packet-count-ignored",
+                                    "inta-bit-missing"])
+def test_a_kept_power_on_restored_finds_the_same_with_fewer_commands(mutant):
+    """A co-simulator that keeps a state (`snapshot`, docs/cosim.md): each sequence begins
+    from its first power-on restored, and the search finds the same, sending the same
+    frames, in fewer commands (one `restore` for `power-on`, the restart's `until` and
+    `state`); without the extension it runs as it does."""
+    seen = []
+    for offered, restores in (((), True), (("--snapshot",), False), (("--snapshot",), True)):
+        p = pair(cosim("--mutant", mutant, *offered))
+        p.restores = restores
+        try:
+            budget = Budget(examples=60)
+            found = search(p, EVERYTHING, budget, seed=0, with_probes=False)
+            line = p.target.link.port.line
+            seen.append(([(f.disagreement.signature, [str(s) for s in f.steps], f.frames)
+                          for f in found], budget.used, budget.frames, line.exchanges))
+        finally:
+            p.target.session.finish()
+            p.target.target.close()
+    (without, *_, sent), (plain, *_, plain_sent), (kept, *_, fewer) = seen
+    assert without and without == plain == kept
+    assert seen[0][1:3] == seen[1][1:3] == seen[2][1:3]
+    assert sent == plain_sent and fewer < sent - 3 * seen[0][1]
