@@ -299,3 +299,54 @@ def test_a_restart_seen_in_the_reads_after_the_known_state_ends_only_that_sequen
     assert out.refused == ["the known state: the unit restarted by itself: PF read 0,0,0 "
                            "at rest"]
 
+
+def _refusing(monkeypatch, refuse) -> list[engine.ExampleRun]:
+    """Pair's start refused by the guard where ``refuse(n)`` (n: the sequences begun so
+    far): the sequence then sends nothing. The outcomes of every sequence run."""
+    begun, outcomes = [0], []
+    real_begin, real_run = Pair._begin, Pair.run
+
+    def begin(self, out):
+        begun[0] += 1
+        if refuse(begun[0]):
+            out.refused.append("the known state: refused for the test")
+            return False
+        return real_begin(self, out)
+
+    def run(self, steps):
+        outcomes.append(real_run(self, steps))
+        return outcomes[-1]
+
+    monkeypatch.setattr(Pair, "_begin", begin)
+    monkeypatch.setattr(Pair, "run", run)
+    return outcomes
+
+
+def test_a_sequence_that_sends_no_frame_is_not_counted():
+    p = pair(None)
+    budget = Budget(examples=5)
+    hunt = engine._Search(p, budget, None, None)
+    hunt.trial([Step(WAIT, seconds=0.01)])
+    assert (budget.used, hunt.skipped, budget.frames) == (0, 1, 0)
+    hunt.trial([Step(FRAME, body="?")])
+    assert (budget.used, hunt.skipped, budget.frames) == (1, 1, 1)
+
+
+def test_the_budget_is_spent_on_sequences_that_ran(monkeypatch):
+    outcomes = _refusing(monkeypatch, lambda n: n % 3 == 0)
+    budget = Budget(examples=30)
+    assert search(pair(None), EVERYTHING, budget, with_probes=False) == []
+    ran = [o for o in outcomes if o.frames]
+    assert budget.used == len(ran) == 30
+    assert len(outcomes) > 30 and budget.frames == sum(o.frames for o in outcomes)
+
+
+def test_a_search_whose_sequences_send_nothing_ends_could_not_test(monkeypatch):
+    """Sequences that send nothing never make a search that ended (a PASS): after
+    IDLE_MOST in a row it ends KnownStateLost, having counted none."""
+    _refusing(monkeypatch, lambda n: n > 3)
+    budget = Budget(examples=200)
+    with pytest.raises(engine.KnownStateLost, match="20 sequences in a row sent no frame: "
+                       "the known state: refused for the test"):
+        search(pair(None), EVERYTHING, budget, with_probes=False)
+    assert budget.used == 3
