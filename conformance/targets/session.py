@@ -392,6 +392,7 @@ class RealSession(Session):
             link.port.restore()
             rig.forget_hands()             # restored as they were kept: off
             rig.on_power_on()
+            link.checksums = False
             self.since_power_on = self._kept_power_on
         else:
             try:
@@ -400,13 +401,13 @@ class RealSession(Session):
             except CouldNotTest as err:
                 self._power_on_refused = str(err)
                 return None
+            link.checksums = False
             powered = link.now
             link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
             self.since_power_on = link.now - powered
             snapshot = getattr(link.port, "snapshot", None)
             if kept and snapshot is not None and snapshot():
                 self._kept_power_on = self.since_power_on
-        link.checksums = False
         self.guard.recentre()
         link.log.clear()
         return link
