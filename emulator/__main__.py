@@ -100,6 +100,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     where.add_argument("--cosim", action="store_true",
                        help="co-simulation in virtual time on standard input and output "
                        "(docs/cosim.md)")
+    ap.add_argument("--snapshot", action="store_true",
+                    help="with --cosim: offer `snapshot` and `restore` (docs/cosim.md; by "
+                    "fork, which costs more than the power-on a restore stands in for)")
     ap.add_argument("--baud", type=_positive, default=None,
                     help="pace bytes at this rate (default: delivered at once; with "
                     "--cosim the profile's rate until `baud N`)")
@@ -149,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     if host is None:
         with _ending_quietly(line):
-            serve_cosim(line)
+            serve_cosim(line, snapshots=parse_args(argv).snapshot)
         return 0
     try:
         say(host.name)

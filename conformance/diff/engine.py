@@ -45,14 +45,6 @@ from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, ErrorCode, St6
 
-try:
-    # internals of Hypothesis, used only to empty its pool of constants while a search
-    # runs; where they moved the pool is left as it is (see _seed_alone)
-    from hypothesis.internal.conjecture import providers as _providers
-    from hypothesis.internal.constants_ast import Constants as _Constants
-except ImportError:
-    _providers = _Constants = None
-
 _LONG_DECIMAL = re.compile(r"\d{13,}")
 #: W with a comma after its axis letter (the format line's form, not M114's example's)
 _AXIS_COMMA = re.compile(r"W[A-Za-z],")
@@ -141,6 +133,12 @@ class Pair:
         #: a co-simulator is told each sequence's frames ahead where the guard can judge
         #: them (told.py); False: one exchange a frame
         self.ahead = True
+        #: a co-simulator that keeps a state (`snapshot`, docs/cosim.md): its first unit
+        #: powered on is kept, and each next sequence begins from it restored instead of
+        #: powered on (the same findings, fewer commands). Off by default: a restore
+        #: never shows a power-on that leaves something behind (only the first is run),
+        #: and the emulator's restore (a fork) costs more than its power-on
+        self.restores = False
         self._teller: Teller | None = None     # the example's frames told ahead
         #: when the search's time is up (``--seconds``): a sequence stops between steps
         self.out_of_time: Callable[[], bool] = _never
@@ -284,7 +282,7 @@ class Pair:
         a power-on that left something behind shows in the sequence's first answers, a
         finding of its own. False where the target is not begun so (a real unit, a
         real-time simulator, a rig that refuses `power-on`): the known state then."""
-        if self.target.open_powered() is None:
+        if self.target.open_powered(kept=self.restores) is None:
             return False
         self.reference.open()
         self._same_eeprom()
@@ -781,14 +779,24 @@ _RESTARTS = classes(restart=True)
 
 def minimise(pair: Pair, finding: Finding, budget: Budget, *,
              frames_only: bool = False) -> Finding:
-    """Hypothesis shrinks by its own measure (the choices it drew); this last pass makes
-    each step the least the same command still disagrees the same way with, so the
-    transcript and the steps its label reads are what the disagreement needs: a step
+    """The last pass over a disagreement, for what Hypothesis's shrinking cannot do.
+    Hypothesis shrinks the choices it drew, by its own measure, to any disagreement not
+    kept yet; it cannot (1) shrink a written sequence at all (the probes, the tables'
+    sweep and the matrix's cells are run as written: there are no choices to shrink),
+    (2) put in a value the run only tells, a frame replaced by a wait as long as its
+    exchange took (a frame that only let time pass, which a motion's timing may need),
+    nor join two steps into one whose value is their sum (two waits, two fills of one
+    frame), and (3) hold to the disagreement it began with (the same command and kind):
+    what it shrinks to may be another, which the transcript would then not show.
+    tests/conformance/diff/test_engine.py shows each: a probe left as written is longer,
+    and a drawn sequence Hypothesis alone left keeps frames that a wait stands for here.
+
+    Each step is made the least the same command still disagrees the same way with, so
+    the transcript and the steps its label reads are what the disagreement needs: a step
     taken out, else sent plain (its own checksum, no stall), else replaced by a wait as
-    long as its exchange took (a frame that only let time pass); two fills of one frame
-    or two waits become one, a fill is tried half as full; the pass is repeated until it
-    changes nothing. With ``frames_only`` a frame may only be taken out: waits and fills
-    stay as they are."""
+    long as its exchange took; two fills of one frame or two waits become one, a fill is
+    tried half as full; the pass is repeated until it changes nothing. With
+    ``frames_only`` a frame may only be taken out: waits and fills stay as they are."""
     steps, outcome = finding.steps, finding.outcome
     want = (outcome.disagreement.command, outcome.disagreement.kind)
     runs = 0
@@ -864,30 +872,11 @@ class _Spent(Exception):
     """The budget ran out inside Hypothesis."""
 
 
-@contextlib.contextmanager
-def _seed_alone() -> Iterator[None]:
-    """Hypothesis now and then draws a constant found in the source of the modules the
-    process has imported: which modules those are (a test run's, a CLI's) would decide
-    the sequences as much as the seed. The pool is emptied while the search runs (an
-    internal of Hypothesis: where it is missing there is nothing to empty)."""
-    pool = getattr(_providers, "_get_local_constants", None)
-    cache = getattr(_providers, "CONSTANTS_CACHE", None)
-    if pool is None or cache is None or _Constants is None:
-        yield
-        return
-    empty = _Constants()
-    cache.cache.clear()
-    _providers._get_local_constants = lambda: empty
-    try:
-        yield
-    finally:
-        _providers._get_local_constants = pool
-        cache.cache.clear()
-
-
 def _settings(examples: int) -> settings:
     """Hypothesis's own defaults, not whatever profile the process loaded (the suite's
-    pytest plugin loads derandomized ones): the seed alone decides the sequences."""
+    pytest plugin loads derandomized ones): the seed decides the sequences (with the
+    constants Hypothesis now and then draws from the source of the modules the process
+    imported: the same in every run of one command, docs/diff.md)."""
     return settings(settings.get_profile("default"), derandomize=False,
                     max_examples=max(1, examples), database=None, deadline=None,
                     phases=(Phase.generate, Phase.shrink), report_multiple_bugs=False,
@@ -958,8 +947,7 @@ class _Search:
         b = self.budget
         left = (b.examples - b.used) if b.examples is not None else 10**6
         try:
-            with _seed_alone():
-                find(strategy, fails, settings=_settings(left), random=random.Random(seed))
+            find(strategy, fails, settings=_settings(left), random=random.Random(seed))
         except (NoSuchExample, _Spent):
             pass
         except Flaky:

@@ -64,6 +64,10 @@ def agreement_result(*, profile: str, target: str, examples: int, frames: int,
     r.checks = [Check(True, f"{examples} sequences, {frames} frames: every answer alike",
                       tag="M").to_dict()]
     r.frames, r.seconds = frames, seconds
+    if not examples:
+        # a search that ran no sequence (its time up before the first) has shown nothing
+        r.verdict, r.checks = COULD_NOT_TEST, []
+        r.notes = [f"no sequence ran in {seconds:.1f} s: nothing was compared"]
     return r
 
 

@@ -52,6 +52,9 @@ class Side:
         #: where the rig saw the axes at the latest power-on, where the guard's envelope
         #: was re-centred and the known state brings them back (None: from 0)
         self._physical: list[int] | None = None
+        #: where the rig saw the axes of the unit the simulator keeps (a 1-tuple; None:
+        #: not read yet)
+        self._kept_physical: tuple[list[int] | None] | None = None
 
     @property
     def virtual(self) -> bool:
@@ -84,24 +87,31 @@ class Side:
         self._origin = self.link.now
         return self.link
 
-    def open_powered(self) -> Link | None:
+    def open_powered(self, *, kept: bool = False) -> Link | None:
         """A co-simulator's link begun at its power-on through the rig in place of the
-        known state (RealSession.open_powered), and where its rig then sees the axes, from
-        which the sequence's physical positions count (a fresh reference's count from 0);
+        known state (RealSession.open_powered; with ``kept``, the unit powered on first
+        kept where the simulator keeps a state, and restored for the next), and where its
+        rig then sees
+        the axes, from which the sequence's physical positions count (a fresh reference's
+        count from 0): read once for the unit kept, since a restored one is that unit;
         None where the target cannot be begun so (the known state then)."""
         if self.session is None:
             self.session = self.target.begin()
         if not getattr(self.session, "powers_on", False):
             return None
-        link = self.session.open_powered()
+        link = self.session.open_powered(kept=kept)
         if link is None:
             return None
         self.link = link
         self._origin = link.now
+        if self.session.restored and self._kept_physical is not None:
+            self._physical = self._kept_physical[0]
+            return link
         self._physical = None
         state = self.rig_state()
         seen = None if state is None else state.get("physical")
         self._physical = list(seen) if _counts(seen) else None
+        self._kept_physical = (self._physical,)
         return link
 
     def age(self, seconds: float) -> None:

@@ -8,9 +8,11 @@ as well (its own entry, derived from ``SW`` with the properties of ``[command.SW
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from functools import cache
 from pathlib import Path
+from types import MappingProxyType
 
 from gve_fixtures.profile import KNOWN_COMMANDS
 
@@ -143,9 +145,15 @@ def _range(value: object) -> str | tuple[int, int] | None:
     return value if isinstance(value, str) else None
 
 
-def commands() -> dict[str, Command]:
-    """The commands of spec 10 by wire name (without the ``SW6`` class)."""
-    return {n: c for n, c in catalogue().items() if n != ST6_WRITE}
+def commands() -> Mapping[str, Command]:
+    """The commands of spec 10 by wire name (without the ``SW6`` class); built once
+    (read per frame by the suite), read-only."""
+    return _commands()
+
+
+@cache
+def _commands() -> Mapping[str, Command]:
+    return MappingProxyType({n: c for n, c in catalogue().items() if n != ST6_WRITE})
 
 
 @cache

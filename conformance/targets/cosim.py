@@ -98,6 +98,7 @@ class Conversation:
     def __init__(self, program: Channel) -> None:
         self.program = program
         self.broken = ""
+        self.exchanges = 0                    # commands sent
 
     def fail(self, why: str) -> NoReturn:
         self.broken = self.broken or f"the co-simulator broke the protocol: {why}"
@@ -108,6 +109,7 @@ class Conversation:
             raise ProtocolBroken(self.broken)
 
     def send(self, command: str) -> None:
+        self.exchanges += 1
         if not self.program.send(command):
             self.ended(command)
 
@@ -170,6 +172,11 @@ class CosimLine:
         """Why the line is broken for good ("" while it is not)."""
         return self.talk.broken
 
+    @property
+    def exchanges(self) -> int:
+        """The commands sent to the simulator so far."""
+        return self.talk.exchanges
+
     def start(self) -> str:
         """The line at the target's rate (`baud N`), then the reply to `state`: the
         rig's state, or an ``error:`` line when it has none."""
@@ -201,6 +208,24 @@ class CosimLine:
         if due is not None:
             return due
         self.talk.fail(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
+
+    # -- a state kept (the `snapshot` extension) --------------------------------------------------
+    def snapshot(self) -> bool:
+        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
+        False where it does not offer it, or refuses it (not used from then on)."""
+        if "snapshot" not in self.extensions:
+            return False
+        if self.ask("snapshot").strip().lower() != "ok":
+            self.extensions = self.extensions - {"snapshot"}
+            return False
+        return True
+
+    def restore(self) -> None:
+        """Back to the state the last `snapshot` kept, the clock not going back: the
+        unit has stood since then (its reply `now T` is the present instant)."""
+        self._flush()
+        self._catch_up()
+        self._move("restore", self.now, self.now, self.now)
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -580,6 +605,14 @@ class CosimPort:
     def ran(self, data: bytes) -> bool:
         """Whether ``data`` written now was told ahead and run already (CosimLine.ran)."""
         return self.line.ran(data)
+
+    def snapshot(self) -> bool:
+        """The simulator keeps its state (CosimLine.snapshot): whether it did."""
+        return self.line.snapshot()
+
+    def restore(self) -> None:
+        """Back to the state kept (CosimLine.restore)."""
+        self.line.restore()
 
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""

@@ -147,6 +147,12 @@ class ControlRig:
     def spindle(self, address: int | None = None) -> int:
         return self._number("spindle", decimal)
 
+    def forget_hands(self) -> None:
+        """The simulator was restored to a state kept with the hands off (docs/cosim.md,
+        `restore`): nothing the suite set since is set any more."""
+        self._touched.clear()
+        self._switches.clear()
+
     def hands_off(self) -> None:
         """The rig as found: the inputs the suite set back to their levels then, the
         switches it placed removed (part of a real unit's known state)."""

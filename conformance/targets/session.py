@@ -210,6 +210,10 @@ class RealSession(Session):
                                          self.found)
         self._power_on_refused = ""                # why the rig did not power the unit on
         self.since_power_on = 0                     # ns: the restart waited out (open_powered)
+        #: the simulator keeps a unit just powered on, this long after its power-on
+        #: (open_powered with ``kept``; None: none kept)
+        self._kept_power_on: int | None = None
+        self.restored = False       # the latest open_powered restored the unit kept
 
     def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
         return Guard(self.profile, self.target.address, max_travel=info.max_travel,
@@ -265,7 +269,7 @@ class RealSession(Session):
         return info.real and info.virtual_time and self._power_on_refused == "" \
             and getattr(self.target, "rig", None) is not None
 
-    def open_powered(self) -> Link | None:
+    def open_powered(self, *, kept: bool = False) -> Link | None:
         """A link to the unit just powered on through its rig, in place of the known state:
         the rig's hands off, the power cycled (the guard books it as a restart: counters
         zeroed, the axes where they stand), the restart waited out on the suite's clock
@@ -273,21 +277,36 @@ class RealSession(Session):
         (spec 9 [M]). The axes are then taken as standing where the run began: the guard's
         envelope re-centred there, since a co-simulator's axes are numbers, not a machine
         (docs/decisions.md). None where the rig refused `power-on` (the known state
-        then, from here on)."""
+        then, from here on). ``kept``: where the simulator keeps a state (`snapshot`,
+        docs/cosim.md), the first unit so powered on is kept and the next ones are that
+        one restored (:attr:`restored`): the same reset state without the power-on and
+        its wait (for a caller whose units leave nothing behind that a power-on keeps,
+        EEPROM bytes and the rig's rate switch: diff puts back what it wrote)."""
         self.start()
         self.guard.check_idle()
         link = self._new_link()
         rig = link.rig
-        try:
-            rig.hands_off()
-            rig.power_on()
-        except CouldNotTest as err:
-            self._power_on_refused = str(err)
-            return None
-        link.checksums = False
-        powered = link.now
-        link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
-        self.since_power_on = link.now - powered
+        self.restored = kept and self._kept_power_on is not None
+        if self.restored:
+            link.port.restore()
+            rig.forget_hands()             # restored as they were kept: off
+            rig.on_power_on()
+            link.checksums = False
+            self.since_power_on = self._kept_power_on
+        else:
+            try:
+                rig.hands_off()
+                rig.power_on()
+            except CouldNotTest as err:
+                self._power_on_refused = str(err)
+                return None
+            link.checksums = False
+            powered = link.now
+            link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
+            self.since_power_on = link.now - powered
+            snapshot = getattr(link.port, "snapshot", None)
+            if kept and snapshot is not None and snapshot():
+                self._kept_power_on = self.since_power_on
         self.guard.recentre()
         link.log.clear()
         return link

@@ -11,6 +11,10 @@ in-process `gve://` line would give it.
                    extension `batch`, offered on the first line: `cosim 1 batch`), ending
                    after the first frame that got no CR to the host (`batch-stops`)
     baud N         the line's rate
+    snapshot       the whole simulation kept as it is now (the extension `snapshot`,
+                   offered with --snapshot)
+    restore        back to the last snapshot, the clock not going back: the unit stands
+                   from the snapshot's instant to now (`now T`, T the present instant)
     in, switch, power-on, state, quit, help: the test rig (docs/rig.md)
 
 `tx` and `until` answer `rx T HEX` for the bytes that reached the host meanwhile, then
@@ -19,8 +23,11 @@ in-process `gve://` line would give it.
 
 from __future__ import annotations
 
+import gc
+import os
 import sys
-from typing import BinaryIO, TextIO
+from collections.abc import Callable
+from typing import BinaryIO, NoReturn, TextIO
 
 from emulator.link import control
 from emulator.link.control import Quit
@@ -30,13 +37,13 @@ from emulator.link.words import decimal
 
 VERSION = 1
 #: the optional extensions this simulator speaks, named on its first line (docs/cosim.md)
-EXTENSIONS = ("batch", "batch-stops")
+EXTENSIONS = ("batch", "batch-stops", "snapshot")
 CR = b"\r"
 #: the fastest line `baud` takes: a byte must take at least a nanosecond
 MAX_BAUD = 10**9
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
-        "| in PORT HEX | switch AXIS POS|none | rate POS|none | power-on | state | quit  "
-        "[@ADDRESS on in, switch, rate, power-on, state]")
+        "| snapshot | restore | in PORT HEX | switch AXIS POS|none | rate POS|none "
+        "| power-on | state | quit  [@ADDRESS on in, switch, rate, power-on, state]")
 
 
 class CosimError(ValueError):
@@ -163,6 +170,12 @@ class Cosim:
         self.line.byte_ns = byte_time(self.line.baud)
         return ["ok"]
 
+    def stand(self, t: int) -> list[str]:
+        """The unit left alone until the instant ``t`` (a restored state brought to the
+        present): the reply to `restore`."""
+        self.line.advance_to(t)
+        return [*_rx_lines(self.line.take_timed()), f"now {self.line.now}"]
+
     def _help(self, args: list[str]) -> list[str]:
         return [HELP]
 
@@ -175,13 +188,104 @@ _COMMANDS = {"tx": Cosim._tx, "until": Cosim._until, "batch": Cosim._batch,
              "next": Cosim._next, "baud": Cosim._baud, "help": Cosim._help}
 
 
-def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None = None
-                ) -> None:
+#: the exit status of a serving process that handed over to its snapshot's standby
+_RESTORED = 75
+
+
+class _Snapshots:
+    """`snapshot` and `restore` by fork, as snapshot fuzzers keep a state. `snapshot`
+    forks: the parent keeps the state as it was (the keeper), the child serves on; the
+    keeper forks a standby from the kept state at once, which waits. `restore`: the
+    serving process wakes the standby with the present instant and ends; the standby
+    stands until that instant, answers and serves on, and the keeper forks the next
+    standby meanwhile. A newer snapshot gives the older one up (its standby ends; its
+    keeper only waits for the process it forked to end). A keeper ends, with that
+    process's status, once it ended otherwise than by a `restore` (`quit`, the end of
+    input): the process the driver started ends last."""
+
+    def __init__(self) -> None:
+        self.wake: int | None = None       # the pipe to the latest snapshot's standby
+
+    def snapshot(self, flush: Callable[[], None]) -> int | None:
+        """Fork; None in the child that serves on; in a standby woken by a `restore`,
+        the instant it stands until."""
+        flush()
+        # the objects as they are now stay out of the collector's walks: a process forked
+        # from them then copies only the pages it writes, not every page it would walk
+        gc.collect()
+        gc.freeze()
+        if self.wake is not None:
+            os.close(self.wake)            # the older snapshot's standby ends
+            self.wake = None
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(r)
+            self.wake = w
+            return None
+        os.close(w)
+        return self._keep(pid, r)
+
+    def _keep(self, serving: int, r: int) -> int:
+        """The keeper: a standby at a time, woken through ``r``; returns in a woken
+        standby (the instant to stand until)."""
+        while True:
+            next_r, next_w = os.pipe()
+            standby = os.fork()
+            if standby == 0:
+                os.close(next_r)
+                word = _read_word(r)
+                os.close(r)
+                if word is None:           # the serving process ended: so does this one
+                    os._exit(0)
+                self.wake = next_w
+                return word
+            os.close(r)
+            os.close(next_w)
+            r = next_r
+            _, status = os.waitpid(serving, 0)
+            code = os.waitstatus_to_exitcode(status)
+            if code != _RESTORED:
+                os.close(r)
+                os.waitpid(standby, 0)
+                os._exit(code)
+            serving = standby
+
+    def restore(self, now: int) -> NoReturn:
+        """In the serving process: the standby is woken with the present instant; this
+        process ends (the standby answers the `restore`)."""
+        assert self.wake is not None
+        os.write(self.wake, f"{now}\n".encode())
+        os._exit(_RESTORED)
+
+
+def _read_word(fd: int) -> int | None:
+    """The instant a serving child wrote (None: it ended without one)."""
+    data = b""
+    while not data.endswith(b"\n"):
+        try:
+            part = os.read(fd, 64)
+        except InterruptedError:
+            continue
+        if not part:
+            return None
+        data += part
+    return int(data)
+
+
+def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None = None,
+                *, snapshots: bool = False) -> None:
     """Speak the protocol on ``stdin``/``stdout`` (default: the process's) until `quit`
-    or the end of input (the driver is gone)."""
+    or the end of input (the driver is gone). ``snapshots``: offer `snapshot` and
+    `restore` (by fork: the process's own standard input and output only; each restore
+    forks the next standby, which on a busy machine costs more than a power-on and its
+    restart in virtual time, hence not offered unless asked)."""
     stdin = stdin if stdin is not None else sys.stdin.buffer
     stdout = stdout if stdout is not None else sys.stdout
     cosim = Cosim(line)
+    kept = _Snapshots() if snapshots and hasattr(os, "fork") else None
+    offered = EXTENSIONS if kept is not None else tuple(
+        x for x in EXTENSIONS if x != "snapshot")
 
     def say(lines: list[str]) -> None:
         try:
@@ -190,7 +294,7 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
         except BrokenPipeError:
             raise StdoutGone from None
 
-    say([" ".join(("cosim", str(VERSION), *EXTENSIONS))])
+    say([" ".join(("cosim", str(VERSION), *offered))])
     while True:
         raw = stdin.readline(CONTROL_LIMIT + 1)
         if not raw:
@@ -200,9 +304,32 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
                 raw = stdin.readline(CONTROL_LIMIT + 1)
             say([f"error: a command line longer than {CONTROL_LIMIT} bytes"])
             continue
+        text = raw.decode("utf-8", "replace")
+        words = text.split()
+        verb = words[0].lower() if words else ""
+        if verb in ("snapshot", "restore") and kept is not None:
+            say(_snapshot_or_restore(cosim, kept, verb, words[1:], stdout.flush))
+            continue
         try:
-            replies = cosim.handle(raw.decode("utf-8", "replace"))
+            replies = cosim.handle(text)
         except Quit:
             return
         if replies:
             say(replies)
+
+
+def _snapshot_or_restore(cosim: Cosim, kept: _Snapshots, verb: str, args: list[str],
+                         flush: Callable[[], None]) -> list[str]:
+    """The reply to `snapshot` or `restore` (given in the process that serves on)."""
+    if args:
+        return [f"error: {verb} takes no arguments"]
+    if verb == "restore":
+        if kept.wake is None:
+            return ["error: restore: no snapshot was taken"]
+        kept.restore(cosim.line.now)           # ends here; the keeper's child goes on
+    # a child the keeper made after a `restore` comes back here, with the instant to
+    # stand until
+    stand = kept.snapshot(flush)
+    if stand is None:
+        return ["ok"]
+    return cosim.stand(stand)

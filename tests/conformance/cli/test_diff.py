@@ -248,3 +248,31 @@ def test_diff_prints_what_it_reached_beside_its_verdict(capsys):
                         r"matrix cells 0/\d+ \(\d+ %\)", out[reached])
     assert out[reached + 1].startswith("  not reached: ")
     assert out[-1].startswith("PASSED")
+
+
+def test_a_search_whose_sequences_send_nothing_is_never_a_pass(capsys, monkeypatch):
+    """Every sequence's start refused: no sequence is counted, the search ends
+    COULD-NOT-TEST with one line, and the run is no PASS."""
+    from conformance.diff.engine import Pair
+
+    def refused(self, out):
+        out.refused.append("the known state: refused for the test")
+        return False
+
+    monkeypatch.setattr(Pair, "_begin", refused)
+    status = main(["diff", "--target", "emu:GVE84-100", "--examples", "50", "--no-reports"])
+    captured = capsys.readouterr()
+    assert status != 0 and "Traceback" not in captured.err
+    assert "COULD-NOT-TEST: 20 sequences in a row sent no frame" in captured.err
+    counted, last = captured.out.splitlines()[-2:]
+    assert counted.startswith("0 sequences, 0 frames") and "PASS" not in counted, counted
+    assert last.startswith("FAILED — no case could judge the target"), last
+
+
+def test_a_search_whose_time_is_up_before_any_sequence_is_never_a_pass(capsys):
+    status = main(["diff", "--target", "emu:GVE84-100", "--seconds", "0.0001",
+                   "--no-reports"])
+    counted, last = capsys.readouterr().out.splitlines()[-2:]
+    assert status != 0
+    assert counted.startswith("0 sequences, 0 frames") and "PASS" not in counted, counted
+    assert "PASS" not in last, last

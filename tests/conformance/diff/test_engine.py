@@ -3,17 +3,18 @@ of itself the disagreement is found, shrunk to a few frames and labelled with a 
 the mutant's area; the transcript replays it."""
 
 import itertools
+from pathlib import Path
 
 import pytest
 
 from conformance.cli.diff import DEFAULT_EXAMPLES
 from conformance.diff import engine
 from conformance.diff.engine import Budget, Pair, search
-from conformance.diff.grammar import Grammar, Options, probes
+from conformance.diff.grammar import Grammar, Options, load_grammar, probes
 from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.labels import label
 from conformance.diff.sides import Side
-from conformance.diff.steps import FILL, FRAME, WAIT
+from conformance.diff.steps import FILL, FRAME, WAIT, Step
 from conformance.link.safety import UnitRestarted
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
@@ -166,34 +167,59 @@ def test_every_mutant_is_found_and_named_by_its_area(mutant):
     assert in_area(f.disagreement.rule, mutant), (f.disagreement.rule, f.steps)
 
 
-def test_the_seed_alone_decides_the_search(tmp_path, monkeypatch):
-    """Hypothesis draws now and then a constant from the source of the modules imported:
-    a module full of them, imported between two searches, changes nothing."""
+def test_the_seed_decides_the_search():
+    """The same seed draws the same sequences again; another seed draws others."""
     first = hunt("queue-one-short", 600, probes=False)[1]
-    (tmp_path / "many_constants.py").write_text(
-        "VALUES = [" + ", ".join(str(n) for n in range(-300, 300, 7)) + "]\n"
-        "WORDS = ['C50,0,0', 'L1,2,3', 'SW6,80', 'XM10']\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    __import__("many_constants")
     again = hunt("queue-one-short", 600, probes=False)[1]
     assert [str(s) for s in again.steps] == [str(s) for s in first.steps]
     assert again.frames == first.frames
+    runs = []
+    for seed in (0, 0, 1):
+        p = pair("go-without-inta")
+        seen: list[str] = []
+        p.run = lambda steps, _run=p.run, _seen=seen: (_seen.append(str(steps)),
+                                                         _run(steps))[1]
+        search(p, EVERYTHING, Budget(examples=30), seed=seed, with_probes=False)
+        runs.append(seen)
+    assert runs[0] == runs[1] != runs[2]
 
 
-def test_without_hypothesis_internals_the_search_runs_as_it_is(monkeypatch):
-    """Where Hypothesis's internals moved, its pool of constants is left alone and the
-    search still runs; where they are, the pool is empty only while it runs."""
-    providers = engine._providers
-    pool = providers._get_local_constants
-    with engine._seed_alone():
-        assert providers._get_local_constants is not pool
-        assert not list(providers._get_local_constants())
-    assert providers._get_local_constants is pool
-    monkeypatch.setattr(engine, "_providers", None)
-    with engine._seed_alone():
-        assert providers._get_local_constants is pool
-    p = pair("go-without-inta")
-    assert search(p, EVERYTHING, Budget(examples=40), stop_after=1, with_probes=False)
+def test_the_search_imports_no_internals_of_hypothesis():
+    source = Path(engine.__file__).read_text()
+    assert "hypothesis.internal" not in source
+
+
+def test_hypothesis_cannot_shrink_a_written_probe_the_minimiser_does(monkeypatch):
+    """A probe is run as written (Hypothesis has no choices to shrink): without the
+    minimiser the findings keep steps the disagreement does not need, and one is
+    labelled by a rule those steps touch (a refused T before the trapezoid's probe)."""
+    def probe_findings():
+        p = pair("velocity-ignored")
+        budget = Budget(examples=len(probes(p.profile, EVERYTHING)))
+        return {f.disagreement.signature: f for f in search(p, EVERYTHING, budget)}
+    shrunk = probe_findings()
+    monkeypatch.setattr(engine, "MINIMISE_RUNS", 0)
+    as_written = probe_findings()
+    both = set(shrunk) & set(as_written)
+    assert both and all(len(shrunk[k].steps) <= len(as_written[k].steps) for k in both)
+    assert any(len(shrunk[k].steps) < len(as_written[k].steps) for k in both)
+    assert set(as_written) != set(shrunk)
+
+
+def test_hypothesis_cannot_put_a_wait_for_a_frame_the_minimiser_does():
+    """Frames that only let time pass, as Hypothesis may leave them: the minimiser puts
+    in their place a wait as long as their exchanges took, a value the run alone tells
+    (Hypothesis draws its waits from the grammar's table and cannot join steps)."""
+    p = pair("dwell-ignored")
+    steps = [Step(FRAME, body="L3,0,0"), *[Step(FRAME, body="SR0")] * 12]
+    out = p.run(steps)
+    assert out.disagreement is not None and out.disagreement.kind == "position"
+    f = engine.minimise(p, engine.Finding(steps, out), Budget(examples=None))
+    restart = load_profile("GVE84-100").restart_ms / 1000 + 0.05
+    drawn = {*load_grammar()["moves"]["waits"], restart}
+    assert [s.kind for s in f.steps] == [FRAME, WAIT] and f.frames == 1, f.steps
+    assert f.steps[1].seconds not in drawn
+    assert f.disagreement.signature == out.disagreement.signature
 
 
 def test_the_minimiser_never_sends_a_frame_into_a_restart():
@@ -290,3 +316,53 @@ def test_a_w_with_a_comma_after_its_axis_and_its_numbers_in_range_is_its_context
     # a field out of range: the reference's 5 is the range's, the target's 4 its bug
     assert not engine._axis_comma("WX,1,900,-1,900")
     assert not engine._axis_comma("WX,1,900,1")
+def _refusing(monkeypatch, refuse) -> list[engine.ExampleRun]:
+    """Pair's start refused by the guard where ``refuse(n)`` (n: the sequences begun so
+    far): the sequence then sends nothing. The outcomes of every sequence run."""
+    begun, outcomes = [0], []
+    real_begin, real_run = Pair._begin, Pair.run
+
+    def begin(self, out):
+        begun[0] += 1
+        if refuse(begun[0]):
+            out.refused.append("the known state: refused for the test")
+            return False
+        return real_begin(self, out)
+
+    def run(self, steps):
+        outcomes.append(real_run(self, steps))
+        return outcomes[-1]
+
+    monkeypatch.setattr(Pair, "_begin", begin)
+    monkeypatch.setattr(Pair, "run", run)
+    return outcomes
+
+
+def test_a_sequence_that_sends_no_frame_is_not_counted():
+    p = pair(None)
+    budget = Budget(examples=5)
+    hunt = engine._Search(p, budget, None, None)
+    hunt.trial([Step(WAIT, seconds=0.01)])
+    assert (budget.used, hunt.skipped, budget.frames) == (0, 1, 0)
+    hunt.trial([Step(FRAME, body="?")])
+    assert (budget.used, hunt.skipped, budget.frames) == (1, 1, 1)
+
+
+def test_the_budget_is_spent_on_sequences_that_ran(monkeypatch):
+    outcomes = _refusing(monkeypatch, lambda n: n % 3 == 0)
+    budget = Budget(examples=30)
+    assert search(pair(None), EVERYTHING, budget, with_probes=False) == []
+    ran = [o for o in outcomes if o.frames]
+    assert budget.used == len(ran) == 30
+    assert len(outcomes) > 30 and budget.frames == sum(o.frames for o in outcomes)
+
+
+def test_a_search_whose_sequences_send_nothing_ends_could_not_test(monkeypatch):
+    """Sequences that send nothing never make a search that ended (a PASS): after
+    IDLE_MOST in a row it ends KnownStateLost, having counted none."""
+    _refusing(monkeypatch, lambda n: n > 3)
+    budget = Budget(examples=200)
+    with pytest.raises(engine.KnownStateLost, match="20 sequences in a row sent no frame: "
+                       "the known state: refused for the test"):
+        search(pair(None), EVERYTHING, budget, with_probes=False)
+    assert budget.used == 3

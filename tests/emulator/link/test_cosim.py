@@ -365,3 +365,50 @@ def test_a_baud_change_keeps_the_byte_begun_and_times_the_rest_anew():
     runs = [(int(t), len(bytes.fromhex(d))) for _, t, d in (r.split() for r in got)]
     ends = [t + (n - 1) * slow for t, n in runs]
     assert ends[-1] == 5 * B + 19 * slow                   # 19 bytes more at 9600 baud
+
+
+def _ask(p: subprocess.Popen, command: str) -> list[str]:
+    """One command to a running `--cosim`, its reply lines up to the final one."""
+    p.stdin.write(command + "\n")
+    p.stdin.flush()
+    lines = []
+    while True:
+        lines.append(p.stdout.readline().strip())
+        if not lines[-1].startswith("rx "):
+            return lines
+
+
+def test_snapshot_and_restore_are_offered_only_when_asked():
+    done = subprocess.run([sys.executable, "-m", "emulator", "--cosim"],
+                          input="snapshot\nrestore\n", capture_output=True, text=True,
+                          timeout=60)
+    first, *replies = done.stdout.splitlines()
+    assert "snapshot" not in first.split()
+    assert [r.split(":")[0] for r in replies] == ["error", "error"]
+
+
+def test_restore_brings_back_the_state_kept_and_the_clock_does_not_go_back():
+    p = subprocess.Popen([sys.executable, "-m", "emulator", "--model", "GVE84-100", "--cosim",
+                          "--snapshot"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         text=True)
+    try:
+        assert p.stdout.readline().split()[2:] == ["batch", "batch-stops", "snapshot"]
+        assert _ask(p, "restore")[0].startswith("error: restore: no snapshot")
+        assert _ask(p, "snapshot") == ["ok"]
+        moved = _now(_ask(p, "tx " + b"!0L100,0,0\r".hex() + " 300000000"))
+        _ask(p, f"until {moved + 300_000_000}")
+        where = _ask(p, "tx " + b"!0PF\r".hex() + f" {moved + 400_000_000}")
+        assert rx(where[:-1]) == b"0,100,0,0\r"
+        for _ in range(3):          # each restore from the same kept state
+            before = _now(_ask(p, f"until {moved + 500_000_000}"))
+            assert _ask(p, "restore") == [f"now {before}"]
+            back = _ask(p, "tx " + b"!0PF\r".hex() + f" {before + 100_000_000}")
+            assert rx(back[:-1]) == b"0,0,0,0\r" and _now(back) > before
+            moved = _now(back)
+        _ask(p, "quit")
+        assert p.wait(30) == 0              # the process started ends, the keeper's last
+    finally:
+        if p.poll() is None:
+            p.kill()
+        p.stdin.close()
+        p.stdout.close()
