@@ -238,8 +238,11 @@ class Guard:
         #: the frames booked since a position read at rest last agreed, with their answers
         self.since: list[str] = []
         #: what the unit read since then of the other power-on facts (spec 9): ST0..ST6
-        #: by name, and `@` as (the index read, the frames booked before it)
-        self._facts: dict[str, int | tuple[int, int]] = {}
+        #: and `@` by name, each (the value read, the frames booked before it)
+        self._facts: dict[str, tuple[int, int]] = {}
+        #: the frames booked before the latest one that went unanswered since then: a
+        #: restart there, facts read before it are the unit's from before
+        self._silent_at = 0
         self._lost_by: Restart | Untracked | None = None    # what set :attr:`lost`
         #: why no motion frame may go out (the axes are not known to be anywhere exact
         #: since a restart); "" while they are
@@ -486,7 +489,7 @@ class Guard:
             self._lost_by.then = (f"the test rig then located them at "
                                   f"{self.whereabouts()}, and motion went on from there")
         self.lost, self.unanswered, self._lost_by = "", 0, None
-        self.since, self._facts = [], {}
+        self.since, self._facts, self._silent_at = [], {}, 0
 
     def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -590,13 +593,13 @@ class Guard:
         if self._unmoved:                  # nothing moved since: a counter, not the axes
             e.anchor(counters)
             self.unanswered = 0
-            self.since, self._facts = [], {}
+            self.since, self._facts, self._silent_at = [], {}, 0
             return
         expected = e.expected(sorted(counters))
         read = e.observe(counters, silence=self.unanswered > 0)
         if read in (Read.AGREES, Read.UNHELD):
             self.unanswered = 0
-            self.since, self._facts = [], {}
+            self.since, self._facts, self._silent_at = [], {}, 0
         if read not in (Read.RESTARTED, Read.CONTRADICTS):
             return
         shown = ",".join(str(v) for v in counters.values())
@@ -607,7 +610,7 @@ class Guard:
         followed = self._unfollowed()
         against, unread = self._power_on_facts(summed)
         self.unanswered = 0
-        self.since, self._facts = [], {}
+        self.since, self._facts, self._silent_at = [], {}, 0
         if read is Read.RESTARTED and (against or (unread and not unanswered)):
             # the power-on counters, but not the other power-on facts (spec 9): no restart
             # is said; the unit may have moved by a wrong amount back to where it began
@@ -663,20 +666,23 @@ class Guard:
         that agreed: those it contradicted (a status word not 00, an index that did not
         count from 0 since, the read's answer summed: ``summed``, the checksum mode on),
         and those it did not read."""
+        # after frames went unanswered, only what was read after the last of them
+        since = self._silent_at if self.unanswered else 0
+        facts = {k: v for k, v in self._facts.items() if v[1] >= since}
         against, unread = [], []
         for n in range(7):
-            value = self._facts.get(f"ST{n}")
+            value = facts.get(f"ST{n}", (None, 0))[0]
             # ST6: the GVE114's hand wheel enabled in EEPROM holds RUN after power-on
             allowed = {0, St6.RUN} if n == 6 and self.profile.mpg is not None else {0}
             if value is None:
                 unread.append(f"ST{n}")
             elif value not in allowed:
                 against.append(f"ST{n} read {value:02X}")
-        index = self._facts.get("@")
+        index = facts.get("@")
         if index is None:
             unread.append("the index (@)")
-        elif isinstance(index, tuple) and index[0] > index[1]:
-            against.append(f"@ read {index[0]} after {index[1]} frame(s) since")
+        elif index[0] > index[1] - since:
+            against.append(f"@ read {index[0]} after {index[1] - since} frame(s) since")
         if summed:
             against.append("the answer came summed: the checksum mode is on")
         return against, unread
@@ -687,7 +693,7 @@ class Guard:
             n = _number(command.params)
             value = r.values[0] if r.values else ""
             if n.exact and 0 <= n.lo <= 6 and is_hex_byte(value):
-                self._facts[f"ST{int(n.lo)}"] = int(value, 16)
+                self._facts[f"ST{int(n.lo)}"] = (int(value, 16), len(self.since))
         elif command.name == "@" and r.values:
             index = decimal(r.values[0])
             if index is not None:
@@ -753,6 +759,7 @@ class Guard:
             # bytes that are no answer the suite could read (a `>` answered in one line
             # where it awaited two) came from a unit that was there to send them
             self.unanswered += 1
+            self._silent_at = len(self.since)
             self._summing = False
         if response is not None:
             self.garbage = response.text

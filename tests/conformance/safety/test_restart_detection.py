@@ -210,6 +210,19 @@ def test_power_on_counters_alone_are_no_restart(facts, why):
     assert g.lost and "no motion" in _refused(g, "L-1,0,0")
 
 
+def test_facts_read_before_the_frames_were_lost_are_the_units_from_before():
+    """An index read before frames went unanswered counts from before a restart that
+    came with the silence: it does not say the unit did not restart."""
+    g = guard()
+    sent(g, "@", "0,121")
+    sent(g, "L480,0,0")
+    sent(g, "SR6", None)                # deaf: restarting
+    sent(g, "SR6", "0,00")
+    with pytest.raises(UnitRestarted):
+        sent(g, "PF", "0,0,0,0")
+    assert len(g.restarts) == 1 and not g.untracked
+
+
 def test_power_on_counters_with_the_checksum_mode_still_on_are_no_restart():
     g = guard()
     sent(g, "%+", "0,5C", summed=True)
