@@ -44,6 +44,23 @@ def after_j(ctx: CaseContext) -> None:
     ctx.expect(position(ctx) == [0, 0, 0], "position zeroed", rule="9.reset.state")
 
 
+@case("9.reset.after-power-on", rig=True, rules=("9.reset.state",), timing=True)
+def after_power_on(ctx: CaseContext) -> None:
+    """The rig's power-on restores the reset state as `J` does, the checksum mode too:
+    a unit left summing and with ST2 written answers a plain `SR2` 0,00 after it."""
+    link = ctx.link
+    summing = "%" in ctx.profile.commands
+    if summing:
+        setup(ctx, "%+")
+    setup(ctx, "SW2,2B")
+    link.rig.power_on()
+    link.checksums = False              # the host's side of the reset state (spec 9)
+    link.wait(2.5, Spent.MANUAL)
+    answers(ctx, link.send("SR2"), "0,00",
+            "after power-on ST2 reset" + (", the frame taken without a checksum"
+                                          if summing else ""), rule="9.reset.state")
+
+
 @case("9.reset.gve54-sixteenths", requires=("M",), rules=("9.reset.gve54-motor",))
 def gve54_reset(ctx: CaseContext) -> None:
     fresh_reset(ctx)

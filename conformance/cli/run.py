@@ -192,7 +192,8 @@ def _main(args: argparse.Namespace, argv: list[str]) -> int:
             raise UsageError(str(err).strip("'\"")) from None
         print(format_coverage(report, args.coverage))
         # a gate for CI: a rule no case can fail is a defect of the suite
-        return 1 if any(pc.uncovered for pc in report) else 0
+        return 1 if any(pc.uncovered or (pc.matrix and pc.matrix.lacking)
+                        for pc in report) else 0
     if not args.no_reports:
         writable_folder(args.report_dir)
     with ExitStack() as run_scope:

@@ -27,7 +27,7 @@ from conformance.diff.matrix import Cell, cells
 from conformance.diff.reach import Reach
 from conformance.diff.rigstate import observed, response
 from conformance.diff.sides import RoundTrip, Side
-from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step, frames_in
+from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
 from conformance.link.safety import SafetyStop, TargetNotResponding
@@ -185,6 +185,8 @@ class Pair:
                     out.records.append(StepRecord(step, place=place))
                 elif step.kind == INPUT:
                     self._input(step, place, out, earlier)
+                elif step.kind == RIG:
+                    self._rig_act(step, place, out, earlier)
                 elif step.kind == STATE:
                     if self._rig_state(step, place, out, earlier):
                         break
@@ -204,14 +206,21 @@ class Pair:
         return self._end(out)
 
     def _left_summing(self, out: ExampleRun) -> None:
-        """A sequence begun at power-on whose first frame's answers differ: whether the
-        power-on left the checksum mode on is asked as a session asks a unit it finds
-        (`?` without its checksum refused 4, with it taken: spec 6); if it did, the
-        disagreement is the reset state's (context `summing-after-power-on`: checksums
-        off after power-on, 9.reset.state [M])."""
+        """A sequence begun at power-on (or a rig's power-on in it) whose first frame's
+        answers after it differ: whether the power-on left the checksum mode on is asked
+        as a session asks a unit it finds (`?` without its checksum refused 4, with it
+        taken: spec 6); if it did, the disagreement is the reset state's (context
+        `summing-after-power-on`: checksums off after power-on, 9.reset.state [M])."""
         d = out.disagreement
-        if not (self.started_at_power_on and d is not None and not any(
-                r.step.kind in (FRAME, FILL) for r in out.records[:d.index])):
+        if d is None:
+            return
+        before = out.records[:d.index]
+        # the frames since the latest power-on: the sequence's start at one, or the rig's
+        powered = [i for i, r in enumerate(before) if r.step.kind == RIG
+                   and r.step.body == "power-on"]
+        since = before[powered[-1] + 1:] if powered else before
+        if not (powered or self.started_at_power_on) or any(
+                r.step.kind in (FRAME, FILL) for r in since):
             return
         link = self.target.link
         try:
@@ -307,6 +316,25 @@ class Pair:
             earlier.add("input")
             if self.reach is not None:
                 self.reach.took(step, None)
+
+    def _rig_act(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
+        """Another act of the rigs' hands on both sides alike (a power-on, a reference
+        switch placed or taken off), left out where a side has no rig. After a power-on
+        both sides' index counts from 0 again (spec 9)."""
+        if not (self.target.has_rig and self.reference.has_rig):
+            return
+        if self._teller is not None:
+            self._teller.finish()          # the frames told ahead are all taken first
+        sent_at = self.target.now
+        done = self.target.rig_act(step.body)
+        self.timing.retimed("input", RoundTrip(b"", b"ok" * done, sent_at, self.target.now,
+                                               None))
+        if done and self.reference.rig_act(step.body):
+            out.records.append(StepRecord(step, place=place))
+            earlier.add(step.body.split()[0])
+            if step.body == "power-on":
+                self._index = IndexBase(0)
+                self.judge = replace(self.judge, index_offset=0)
 
     def _rig_state(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:
         """What the rigs see of both sides (outputs, spindle, where the axes are),
@@ -859,8 +887,10 @@ def _restarts_wait(steps: list[Step], i: int) -> bool:
     """Step ``i`` is the wait out of a restart: without it the next frames go to a unit
     that is deaf while it restarts, and a unit that lives on between sequences is then
     silent for the run's guard (no host sends so; a target right to be deaf)."""
-    return (steps[i].kind == WAIT and i > 0 and steps[i - 1].kind == FRAME
-            and command_of(steps[i - 1].body) in _RESTARTS)
+    before = steps[i - 1] if i > 0 else None
+    return steps[i].kind == WAIT and before is not None and (
+        (before.kind == FRAME and command_of(before.body) in _RESTARTS)
+        or (before.kind == RIG and before.body == "power-on"))
 
 
 #: sequences in a row that sent no frame before the search ends COULD-NOT-TEST: it never

@@ -1,6 +1,8 @@
 """Spec 10's commands as Hypothesis strategies for one profile (``grammar.toml``): valid
-and invalid parameters, checksums right, wrong and missing, other addresses, packets,
-a filled queue, waits, rig inputs; destructive commands only when allowed."""
+and invalid parameters, checksums right, wrong and missing, other addresses and every
+address the model serves (the GVE114's spindle's), packets, a filled queue, waits, the
+rig's hands (inputs, a reference switch, a power-on) where both sides have a rig;
+destructive commands only when allowed."""
 
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ from pathlib import Path
 from hypothesis import strategies as st
 
 from conformance.diff.labels import command_of
-from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from gve_fixtures.profile import Profile
 
@@ -30,11 +32,17 @@ _SENT = {
     "spindle": lambda profile: {"address": profile.spindle.address},
 }
 _PREFIX = re.compile(r"^(%s):" % "|".join(_SENT))
+#: the rig's acts besides an input, written as its control channel's words (docs/rig.md)
+_SWITCH = re.compile(r"switch ([XYZA]) (-?\d+|none)")
+#: commands never drawn at the spindle's address among those it does not serve: motion
+#: there would be another unit's for the run's guard
+_MOTION = classes(motion=True)
 
 
 @dataclass(frozen=True)
 class Options:
-    """What a run allows: destructive commands, rig inputs (both sides have a rig)."""
+    """What a run allows: destructive commands, the rig's hands (both sides have a rig:
+    inputs, a power-on, a reference switch where `W` is drawn too)."""
 
     destructive: bool = False
     rig: bool = False
@@ -225,6 +233,9 @@ class Grammar:
         self.profile = profile
         self.options = options
         self.names = command_names(profile, options)
+        #: the names an idiom's frame may have (catalogue and known-as names, SW6)
+        self._allowed = set(self.names) | {"SW6"} | {
+            n for n, c in commands().items() if c.known_as in self.names}
         self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
         kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
         self.invalid = {k: _invalid(profile, k, g) for k in kinds}
@@ -243,6 +254,24 @@ class Grammar:
         self.kinds = ["frame"] * steps["frame"] + ["wait"] * steps["wait"]
         if options.rig and profile.input_ports:
             self.kinds += ["input"] * steps["input"]
+        if options.rig:
+            self.kinds += ["power-on"] * steps["power_on"]
+        # a switch only W sees (docs/rig.md): placed where a W is drawn to meet it
+        self.switch_axes = list(profile.axes) if "W" in self.names else []
+        if options.rig and self.switch_axes:
+            self.kinds += ["switch"] * steps["switch"]
+        spindle = profile.spindle
+        self.spindle_names = [n for n in self.names if spindle is not None
+                              and n in spindle.commands]
+        self.spindle_others = [n for n in self.names if spindle is not None
+                               and n not in spindle.commands and n not in _MOTION
+                               and n in profile.commands]
+        if self.spindle_names:
+            self.kinds += ["spindle"] * g["spindle"]["weight"]
+            r = spindle.range
+            self.spindle_values = st.one_of(st.integers(r.lo, r.hi),
+                                            st.sampled_from([r.lo, r.lo + 1, r.hi, r.hi + 1])
+                                            ).map(str)
         if "*S" in profile.commands:
             self.kinds += ["packet"] * g["packet"]["weight"]
         if "C" in profile.commands:
@@ -272,8 +301,7 @@ class Grammar:
 
     def _can(self, idiom: list[str]) -> bool:
         """Whether every step of an idiom can be sent on this profile and run."""
-        allowed = set(self.names) | {"SW6"} | {
-            n for n, c in commands().items() if c.known_as in self.names}
+        allowed = self._allowed
         for f in idiom:
             if f.startswith("input "):
                 if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
@@ -283,7 +311,7 @@ class Grammar:
                     return False
             elif f.startswith("wait "):
                 continue
-            elif f == "state":
+            elif f == "state" or f == "power-on" or _SWITCH.fullmatch(f):
                 if not self.options.rig:
                     return False
             elif (command_of(_PREFIX.sub("", f)) not in allowed
@@ -506,6 +534,12 @@ class Grammar:
             return self.readback(draw)
         if kind == "scenario":
             return self.scenario(draw)
+        if kind == "power-on":
+            return [Step(RIG, "power-on"), self.restart_wait()]
+        if kind == "switch":
+            return self.switch(draw)
+        if kind == "spindle":
+            return self.spindle(draw)
         if kind == "tables":
             return self.idiom(self.pick(draw, self.tables))
         return self.fill(draw)
@@ -516,6 +550,49 @@ class Grammar:
         out = [Step(INPUT, port=port, value=draw(self.input_values))]
         if f"I{port}" in self.names and self.number(draw, 0, 1):
             out.append(self.fixed(f"I{port}"))
+        return out
+
+    def switch(self, draw) -> list[Step]:
+        """A reference switch placed on an axis within W's travel from where the sequence
+        began (its far side now and then), then a W on that axis (whether the run meets
+        it, and where it zeroes), now and then the switch taken off again."""
+        axis = self.pick(draw, self.switch_axes)
+        travel = self.g["moves"]["travel"]
+        where = self.number(draw, -2 * travel, 2 * travel)
+        entry = self.g["command"]["W"]
+        kinds = entry["params"][1:]
+        w = _body("W", entry, [axis, *(draw(self.valid[k]) for k in kinds)])
+        out = [Step(RIG, f"switch {axis} {where}"), self.fixed(w)]
+        if self.number(draw, 0, 1):
+            out.append(Step(RIG, f"switch {axis} none"))
+        return out
+
+    def spindle(self, draw) -> list[Step]:
+        """A frame to the spindle's address (spec 12): a command it serves, drawn as at the
+        unit's own address (`V` a setting of the spindle's range), now and then one it does
+        not serve (answered 3 [D]); a write read back at once, at either address; else now
+        and then a read at the unit's own address of what the spindle's frame may have
+        changed there (`after`)."""
+        sp = self.g["spindle"]
+        at = self.profile.spindle.address
+        others = self.spindle_others and self.number(draw, 0, 99) < sp["others"] * 100
+        name = self.pick(draw, self.spindle_others if others else self.spindle_names)
+        if name == "V" and self.number(draw, 0, 99) >= self.invalid_chance:
+            body = "V" + draw(self.spindle_values)
+        else:
+            body = self.body(draw, name)
+        out = [replace(self.fixed(body), address=at)]
+        if self.g["command"][name].get("then_wait") == "restart":
+            out.append(self.restart_wait())
+        reader = dict(self.readbacks).get(name)
+        if reader is not None:
+            text = self.g["command"][name].get("text", name)
+            place = body[len(text):].split(",")[0]
+            read = self.fixed(self.g["command"][reader].get("text", reader) + place)
+            out.append(replace(read, address=at) if self.number(draw, 0, 1) else read)
+        elif self.number(draw, 0, 1):
+            out.append(self.fixed(self.pick(draw, [n for n in sp["after"]
+                                                  if n in self.profile.commands])))
         return out
 
     def scenario(self, draw) -> list[Step]:
@@ -540,6 +617,10 @@ class Grammar:
                 out.append(Step(WAIT, seconds=float(rest)))
             elif f == "state":
                 out.append(Step(STATE))
+            elif f == "power-on":
+                out += [Step(RIG, f), self.restart_wait()]
+            elif _SWITCH.fullmatch(f):
+                out.append(Step(RIG, f))
             elif word == "input":
                 port, value = rest.split()
                 out.append(Step(INPUT, port=int(port), value=int(value, 16)))
@@ -709,6 +790,12 @@ def _filled(line: str, name: str, value: str | dict[str, str]) -> str:
     return line.replace("{%s}" % name, value)
 
 
+@cache
+def _commands() -> dict[str, Command]:
+    """The catalogue's commands, read once (every idiom's frames look theirs up)."""
+    return commands()
+
+
 def _silent_in_packets(steps: list[Step]) -> list[Step]:
     """The frames of an open packet are answered by nothing until one ends it (`*E`, a
     breaker: spec 7), as a drawn packet's members are sent: a frame that waited for an
@@ -716,7 +803,7 @@ def _silent_in_packets(steps: list[Step]) -> list[Step]:
     out, open_packet = [], False
     for step in steps:
         if step.kind == FRAME:
-            command = commands().get(command_of(step.body))
+            command = _commands().get(command_of(step.body))
             ends = command is not None and command.ends_packet
             if open_packet and not ends:
                 step = replace(step, answer=False)

@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 
 from conformance.diff.engine import Finding, StepRecord
-from conformance.diff.steps import FILL, FRAME, INPUT, STATE, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step
 from conformance.link.framing import HostFramer, readable
 from conformance.reports.files import write_text
 from gve_fixtures.transcript import (
@@ -75,6 +75,8 @@ def _lines(rec: StepRecord, disagreeing: bool, rule: str | None, verdict: str) -
         return [Record(ACTION, f"wait {step.seconds:g}".encode())]
     if step.kind == INPUT:
         return [Record(ACTION, f"input {step.port} {step.value:02X}".encode())]
+    if step.kind == RIG:
+        return [Record(ACTION, step.body.encode())]
     if step.kind == STATE:
         note = ""
         if rec.target is not None and rec.reference is not None:
@@ -182,9 +184,23 @@ def _fill(words: list[str]) -> Step:
     return Step(FILL, _body(data), times=times, raw=data)
 
 
+def _power_on(words: list[str]) -> Step:
+    if len(words) != 1:
+        raise ValueError("give power-on alone")
+    return Step(RIG, "power-on")
+
+
+def _switch(words: list[str]) -> Step:
+    axis, where = words[1:] if len(words) == 3 else ("", "")
+    if axis not in ("X", "Y", "Z", "A") or not (
+            where == "none" or (where.lstrip("-").isdigit() and len(where) <= 12)):
+        raise ValueError("give an axis (X, Y, Z, A) and a position or none")
+    return Step(RIG, f"switch {axis} {where}")
+
+
 #: the actions a replay performs (the others, e.g. a log's `= fault`, are notes)
 _ACTIONS = {"wait": _wait, "input": _input, "fill": _fill,
-            "state": lambda words: Step(STATE)}
+            "state": lambda words: Step(STATE), "power-on": _power_on, "switch": _switch}
 
 
 def _action(words: list[str]) -> Step:

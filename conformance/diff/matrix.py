@@ -58,11 +58,17 @@ def load_matrix(path: Path = MATRIX_FILE) -> dict:
     return tomllib.loads(path.read_text(encoding="utf-8"))
 
 
-def _states(profile: Profile) -> list[tuple[str, list[str]]]:
-    """The states of the matrix this profile distinguishes: the file's, then one per
-    micro-step mode and current setting the profile lists (its reset mode is `idle`)."""
+def states(profile: Profile) -> list[tuple[str, list[str] | None]]:
+    """The states of the matrix this profile distinguishes: the file's (None: a state the
+    model has not), then one per micro-step mode and current setting the profile lists
+    (its reset mode is `idle`)."""
     m = load_matrix()
-    out = [(s["name"], list(s["steps"])) for s in m["state"]]
+    one = profile.high_mask & -profile.high_mask
+    places = {"high_one": "%02X" % one, "high_grounded": "%02X" % (0xFF ^ one)}
+    # a state that needs an interrupt input behind ST1 the model lacks: none (no such state)
+    out = [(s["name"], [f.format(**places) for f in s["steps"]]
+            if one or not any("{high_" in f for f in s["steps"]) else None)
+           for s in m["state"]]
     ms = profile.microstep
     if ms is not None:
         out += [(f"mode-{mode}", [f.format(mode=mode) for f in m["microstep"]["mode"]])
@@ -120,9 +126,10 @@ def _alone(profile: Profile, name: str) -> list[str]:
     return [name + ",".join("100" if i == j else "0" for j in range(n)) for i in range(n)]
 
 
-def cells(profile: Profile, options: Options) -> list[Cell]:
+def cells(profile: Profile, options: Options, *, built: bool = True) -> list[Cell]:
     """Every cell of the matrix on ``profile`` under ``options``: those it can send with
-    their steps, the others with why they are left out."""
+    their steps (``built``; else none: a census of what runs), the others with why they
+    are left out."""
     m = load_matrix()
     grammar = Grammar(profile, options)
     every = Grammar(profile, Options(destructive=True, rig=True))
@@ -132,30 +139,37 @@ def cells(profile: Profile, options: Options) -> list[Cell]:
     move = [o for o in m["observers"]["move"] if grammar._can([o])]
     spindle = profile.spindle
     out = []
-    for state, setup in _states(profile):
+    for state, setup in states(profile):
         lines_after = observers + rest + (held if state in m["observers"]["held_states"]
                                           else []) + move
         for form in forms(profile, every.names):
-            out.append(_cell(grammar, every, state, setup, form, lines_after))
+            out.append(_cell(grammar, every, state, setup, form, lines_after, built))
         if spindle is not None and state == "idle":
             for form in forms(profile, [n for n in every.names if n in spindle.commands]):
                 out.append(_cell(grammar, every, "spindle", [], f"spindle:{form}",
-                                 observers + rest + move))
+                                 observers + rest + move, built))
     return out
 
 
-def _cell(grammar: Grammar, every: Grammar, state: str, setup: list[str], form: str,
-          after: list[str]) -> Cell:
-    lines = [*setup, form, *after]
-    if not every._can(setup):
+def _cell(grammar: Grammar, every: Grammar, state: str, setup: list[str] | None, form: str,
+          after: list[str], built: bool = True) -> Cell:
+    if setup is None or not every._can(setup):
         return Cell(state, form, left_out=f"the {every.profile.family} has no such state")
+    lines = [*setup, form, *after]
     if not every._can(lines):
         return Cell(state, form, left_out=f"the {every.profile.family} cannot send it")
     if not grammar._can(lines):
         why = ("needs a test rig" if any(x.startswith("input ") for x in setup)
                else "needs --allow-destructive")
         return Cell(state, form, left_out=why)
-    return Cell(state, form, tuple(grammar.idiom(lines)))
+    return Cell(state, form, tuple(grammar.idiom(lines)) if built else ())
+
+
+def observers(profile: Profile) -> list[str]:
+    """The observers the matrix reads at once after each command on ``profile`` (the rig's
+    `state` among them)."""
+    every = Grammar(profile, Options(destructive=True, rig=True))
+    return [o for o in load_matrix()["observers"]["now"] if every._can([o])]
 
 
 def summary(all_cells: list[Cell]) -> str:

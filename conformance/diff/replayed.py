@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from conformance.diff.compare import TIMING, delays
 from conformance.diff.engine import Disagreement, ExampleRun, StepRecord
-from conformance.diff.steps import FILL, FRAME, INPUT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, RIG, Step
 from conformance.link.framing import readable
 from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 
@@ -76,7 +76,7 @@ def frame_lines(outcome: ExampleRun, steps: list[Step], expected: list[bytes]) -
             out.append(f"  ... {len(steps) - place} step(s) not sent: {why}")
             break
         recs = by_place.get(place, [])
-        if not recs and step.kind == INPUT:
+        if not recs and step.kind in (INPUT, RIG):
             out.append(f"  = {step}: not replayed (a side has no rig, or its rig stopped "
                        "answering)")
             continue
@@ -115,8 +115,8 @@ def _different(d: Disagreement) -> str:
 def _not_run(steps: list[Step], outcome: ExampleRun) -> list[Step]:
     """The rig's input steps left out (a side without a rig, or one that stopped
     answering)."""
-    done = {rec.place for rec in outcome.records if rec.step.kind == INPUT}
-    return [s for i, s in enumerate(steps) if s.kind == INPUT and i not in done]
+    done = {rec.place for rec in outcome.records if rec.step.kind in (INPUT, RIG)}
+    return [s for i, s in enumerate(steps) if s.kind in (INPUT, RIG) and i not in done]
 
 
 def verdict(outcome: ExampleRun, steps: list[Step], meta: dict[str, str]) -> Verdict:

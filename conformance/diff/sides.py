@@ -182,6 +182,34 @@ class Side:
             return False
         return True
 
+    def rig_act(self, words: str) -> bool:
+        """Another act of the rig's hands (docs/rig.md): `power-on` (the host then takes
+        the checksum mode off, as the reset state has it, spec 9) or `switch AXIS POS|none`,
+        POS counted from where this side's axes stood when the example began; False (and
+        the rig lost) when the rig does not do it."""
+        word, *rest = words.split()
+        try:
+            if word == "power-on":
+                self.link.rig.power_on()
+                self.link.checksums = False
+            else:
+                axis, where = rest
+                i = self.target.profile.axes.index(axis)
+                self.link.rig.set_switch(axis, None if where == "none"
+                                         else int(where) + self._origin_of(i))
+        except CouldNotTest as err:
+            self.rig_lost = str(err)
+            return False
+        return True
+
+    def _origin_of(self, axis: int) -> int:
+        """Where the rig sees ``axis`` stand when an example begins: at the latest
+        power-on, or where the run began (the known state brings the axes back there)."""
+        if self._physical is not None and axis < len(self._physical):
+            return self._physical[axis]
+        found = getattr(self.session, "_rig_origin", None) if self.real else None
+        return found.get(axis, 0) if isinstance(found, dict) else 0
+
     def rig_state(self) -> dict | None:
         """What the rig sees of the unit now (docs/rig.md `state`); None (and the rig
         lost) when it does not say."""

@@ -3,7 +3,9 @@
 A step is a frame (one command, as the grammar drew it: its body, how its checksum is
 written, its address, whether an answer is due), a wait, an input set by the test rig,
 what the test rig sees of the unit (its `state`: outputs, spindle, where the axes are),
-or a queue filled to the brim (one frame sent until the unit answers anything but 0).
+another act of the rig's hands (its `power-on`, a reference switch placed or taken off:
+the rig's own words as the body), or a queue filled to the brim (one frame sent until
+the unit answers anything but 0).
 The bytes of a frame are made when it is sent, from the checksum mode the host believes
 in then, so a sequence means the same on any unit.
 """
@@ -14,7 +16,7 @@ from dataclasses import dataclass
 
 from conformance.link.framing import byte_sum, frame
 
-FRAME, WAIT, INPUT, FILL, STATE = "frame", "wait", "input", "fill", "state"
+FRAME, WAIT, INPUT, FILL, STATE, RIG = "frame", "wait", "input", "fill", "state", "rig"
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,8 @@ class Step:
             return f"fill {self.times} {self.body}"
         if self.kind == STATE:
             return "state"
+        if self.kind == RIG:
+            return self.body
         extra = [w for w, on in (("bad checksum", self.checksum == "bad"),
                                  ("no checksum", self.checksum == "none"),
                                  (f"to {self.address}", self.address is not None),

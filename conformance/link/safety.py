@@ -14,7 +14,10 @@ answer.
 
 A unit that restarts by itself is seen in what it reads back (the envelope's
 :meth:`~conformance.link.envelope.Envelope.observe`): the power-on counters (spec 9)
-where the frames put the axes elsewhere. The case in which it is seen ends
+where the frames put the axes elsewhere, after frames went unanswered (spec 2: bytes are
+lost while a unit restarts) or with the other power-on facts read since (ST0..ST6 00,
+the index counting from 0, the checksum mode off: spec 9); counters 0 alone are no
+restart (a unit that moved by a wrong amount may read them). The case in which it is seen ends
 (:class:`UnitRestarted`), the restart is kept in :attr:`Guard.restarts` for the
 report, and where the axes are is no longer known unless they cannot have moved since
 they last were: then no motion frame goes out (:attr:`Guard.lost`) until the session
@@ -234,6 +237,12 @@ class Guard:
         self.untracked: list[Untracked] = []
         #: the frames booked since a position read at rest last agreed, with their answers
         self.since: list[str] = []
+        #: what the unit read since then of the other power-on facts (spec 9): ST0..ST6
+        #: and `@` by name, each (the value read, the frames booked before it)
+        self._facts: dict[str, tuple[int, int]] = {}
+        #: the frames booked before the latest one that went unanswered since then: a
+        #: restart there, facts read before it are the unit's from before
+        self._silent_at = 0
         self._lost_by: Restart | Untracked | None = None    # what set :attr:`lost`
         #: why no motion frame may go out (the axes are not known to be anywhere exact
         #: since a restart); "" while they are
@@ -480,7 +489,7 @@ class Guard:
             self._lost_by.then = (f"the test rig then located them at "
                                   f"{self.whereabouts()}, and motion went on from there")
         self.lost, self.unanswered, self._lost_by = "", 0, None
-        self.since = []
+        self.since, self._facts, self._silent_at = [], {}, 0
 
     def _event(self, command: Body, outcome: Outcome,
                code: int | None) -> Callable[[Envelope], None] | None:
@@ -561,6 +570,7 @@ class Guard:
             self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
+        self._fact(command, r)
         if (name == "SR" and _number(command.params) == point(6)) or name == "F":
             st6 = r.values[0] if r.values else ""
             if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
@@ -569,25 +579,27 @@ class Guard:
             axes = 2 if name == "P" else min(3, self.envelope.axes)
             read = [decimal(v, signed=True) for v in r.values[:axes]]
             if len(read) == axes and None not in read:
-                self._read(name, dict(enumerate(read)))
+                self._read(name, dict(enumerate(read)),
+                           summed=bool(r.checksum_ok))
 
-    def _read(self, name: str, counters: dict[int, int]) -> None:
-        """A position read: when it tells the counters no longer count from where the
-        frames say, the axes are located on their trail and the event is kept for the
-        report; motion stops unless they cannot have moved since. The power-on counters
-        (a restart) end the case; other counters go back to the case, which judges
-        them."""
+    def _read(self, name: str, counters: dict[int, int], *, summed: bool = False) -> None:
+        """A position read (``summed``: its answer carried a right checksum): when it tells the
+        counters no longer count from where the frames say, the axes are located on their
+        trail and the event is kept for the report; motion stops unless they cannot have
+        moved since. A restart (the power-on counters after frames were lost, or with
+        the other power-on facts of spec 9 read since) ends the case; other counters, the
+        power-on counters alone among them, go back to the case, which judges them."""
         e = self.envelope
         if self._unmoved:                  # nothing moved since: a counter, not the axes
             e.anchor(counters)
             self.unanswered = 0
-            self.since = []
+            self.since, self._facts, self._silent_at = [], {}, 0
             return
         expected = e.expected(sorted(counters))
         read = e.observe(counters, silence=self.unanswered > 0)
         if read in (Read.AGREES, Read.UNHELD):
             self.unanswered = 0
-            self.since = []
+            self.since, self._facts, self._silent_at = [], {}, 0
         if read not in (Read.RESTARTED, Read.CONTRADICTS):
             return
         shown = ",".join(str(v) for v in counters.values())
@@ -595,8 +607,23 @@ class Guard:
         silent = (f" after {self.unanswered} frame(s) went unanswered" if self.unanswered
                   else "")
         led, unanswered = self._frames_since(), self.unanswered
+        followed = self._unfollowed()
+        against, unread = self._power_on_facts(summed)
         self.unanswered = 0
-        self.since = []
+        self.since, self._facts, self._silent_at = [], {}, 0
+        if read is Read.RESTARTED and (against or (unread and not unanswered)):
+            # the power-on counters, but not the other power-on facts (spec 9): no restart
+            # is said; the unit may have moved by a wrong amount back to where it began
+            why = ("; ".join(against) if against else
+                   f"{', '.join(unread)} not read since, no frame lost")
+            record = Untracked(
+                f"the position counters disagree with the frames: {name} read {shown} at "
+                f"rest (the power-on counters, spec 9, but no restart: {why}) where the "
+                f"frames since the last read that agreed put them at {frames}"
+                f"{followed} (frames: {led or 'none'})", "", "")
+            self.untracked.append(record)
+            self._locate_on_trail(record)
+            return
         if read is Read.CONTRADICTS and not unanswered:
             # no power-on counters and no frame lost: no restart is said (spec 2, 9); the
             # unit moved otherwise than the frames say, or its axes were moved by other
@@ -604,7 +631,7 @@ class Guard:
             record = Untracked(
                 f"the position counters disagree with the frames: {name} read {shown} at "
                 f"rest where the frames since the last read that agreed put them at "
-                f"{frames} (frames: {led or 'none'})", "", "")
+                f"{frames}{followed} (frames: {led or 'none'})", "", "")
             self.untracked.append(record)
             self._locate_on_trail(record)
             return
@@ -624,6 +651,53 @@ class Guard:
                     "moved")
         self.restarts.append(Restart(what, "", ""))
         self._locate_on_trail(self.restarts[-1])
+
+    def _unfollowed(self) -> str:
+        """The first motion frame since the last read that agreed: the one whose run the
+        guard could not follow (the counters tell another)."""
+        for entry in self.since:
+            body = entry.split(" → ")[0]
+            if Body.parse(body).name in MOTION:
+                return f"; the first frame it could not follow: {entry}"
+        return ""
+
+    def _power_on_facts(self, summed: bool) -> tuple[list[str], list[str]]:
+        """The other power-on facts of spec 9 as the unit read them since the last read
+        that agreed: those it contradicted (a status word not 00, an index that did not
+        count from 0 since, the read's answer summed: ``summed``, the checksum mode on),
+        and those it did not read."""
+        # after frames went unanswered, only what was read after the last of them
+        since = self._silent_at if self.unanswered else 0
+        facts = {k: v for k, v in self._facts.items() if v[1] >= since}
+        against, unread = [], []
+        for n in range(7):
+            value = facts.get(f"ST{n}", (None, 0))[0]
+            # ST6: the GVE114's hand wheel enabled in EEPROM holds RUN after power-on
+            allowed = {0, St6.RUN} if n == 6 and self.profile.mpg is not None else {0}
+            if value is None:
+                unread.append(f"ST{n}")
+            elif value not in allowed:
+                against.append(f"ST{n} read {value:02X}")
+        index = facts.get("@")
+        if index is None:
+            unread.append("the index (@)")
+        elif index[0] > index[1] - since:
+            against.append(f"@ read {index[0]} after {index[1] - since} frame(s) since")
+        if summed:
+            against.append("the answer came summed: the checksum mode is on")
+        return against, unread
+
+    def _fact(self, command: Body, r: Response) -> None:
+        """A power-on fact read (spec 9): a status word, the index."""
+        if command.name == "SR":
+            n = _number(command.params)
+            value = r.values[0] if r.values else ""
+            if n.exact and 0 <= n.lo <= 6 and is_hex_byte(value):
+                self._facts[f"ST{int(n.lo)}"] = (int(value, 16), len(self.since))
+        elif command.name == "@" and r.values:
+            index = decimal(r.values[0])
+            if index is not None:
+                self._facts["@"] = (index, len(self.since))
 
     def _locate_on_trail(self, record: Restart | Untracked) -> None:
         """Where the axes are after a read the frames cannot explain: exact where they
@@ -685,6 +759,7 @@ class Guard:
             # bytes that are no answer the suite could read (a `>` answered in one line
             # where it awaited two) came from a unit that was there to send them
             self.unanswered += 1
+            self._silent_at = len(self.since)
             self._summing = False
         if response is not None:
             self.garbage = response.text

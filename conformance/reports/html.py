@@ -190,7 +190,34 @@ def _coverage(run: RunResult) -> dict | None:
             "rows": [(section_title(s), [cells[s].get(p, "") for p in profiles])
                      for s in sorted(cells, key=section_key)],
             "totals": [f"{pc['covered']}/{pc['total']}" for pc in report],
-            "uncovered": sorted(uncovered.items(), key=lambda kv: natural(kv[0]))}
+            "uncovered": sorted(uncovered.items(), key=lambda kv: natural(kv[0])),
+            "matrix": _matrix_rows(report)}
+
+
+def _matrix_rows(report: list[dict]) -> dict | None:
+    """The matrix diff runs, per model: cells run of all, observers read after each,
+    state x command x observer reads, status-bit clauses with a cell; and what is left
+    out (a state or form the model has not is meaningless there)."""
+    shown = [pc for pc in report if pc.get("matrix")]
+    if not shown:
+        return None
+    rows = [("cells (state x command form) run", lambda m: f"{m['run']}/{m['cells']}"),
+            ("observers read after each", lambda m: str(m["observers"])),
+            ("state x command x observer reads", lambda m: str(m["read"])),
+            ("status-bit clauses of [M] rules with a cell",
+             lambda m: f"{m['clauses'] - len(m['lacking']) - len(m['meaningless'])}"
+                       f"/{m['clauses']}")]
+    notes = []
+    for pc in shown:
+        m = pc["matrix"]
+        for why, names in sorted(m["left_out"].items()):
+            kind = "meaningless" if why.startswith("the ") else "not run"
+            notes.append(f"{pc['profile']}: {len(names)} cell(s) {kind} ({why})")
+        notes += [f"{pc['profile']}: no cell can fail {c}" for c in m["lacking"]]
+        notes += [f"{pc['profile']}: meaningless on the model: {c}" for c in m["meaningless"]]
+    return {"profiles": [pc["profile"] for pc in shown],
+            "rows": [(title, [value(pc["matrix"]) for pc in shown]) for title, value in rows],
+            "notes": notes}
 
 
 def render_html(run: RunResult, full_logs: bool | None = None) -> str:

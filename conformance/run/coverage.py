@@ -8,6 +8,12 @@ implement the project's decisions, INFO for ``[D-info]``). Coverage is counted o
 embedded emulator, which has the test rig and allows destructive cases; on a real unit
 those cases are COULD-NOT-TEST unless the run allows them.
 
+The state x command x observer matrix `diff` runs (conformance/diff/matrix.py) is
+counted beside them, per model, as the emulator runs it (rig and destructive commands
+allowed): its cells run, those the model makes meaningless (listed as such), the
+observers each cell reads, and the clauses of `[M]` rules that set or clear a status bit
+without a cell that can fail them (conformance/diff/clauses.py).
+
 Host-role rules are judged by the host certification's checks, not by cases: that
 module registers each check with the rules it judges (:func:`register_host_check`), and
 ``coverage(role="host")`` counts them the same way.
@@ -17,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from functools import cache
 
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 from gve_fixtures.rules import Rule, load_rules
@@ -49,9 +56,58 @@ class SectionCoverage:
 
 
 @dataclass
+class MatrixCoverage:
+    """The matrix on one model: cells (state x command form) run and left out (why: a
+    state or form the model has not is meaningless there), the observers each reads at
+    once, and the clauses that set or clear a status bit with no cell to fail them."""
+
+    cells: int = 0
+    run: int = 0
+    observers: int = 0
+    left_out: dict[str, list[str]] = field(default_factory=dict)   # why -> cell names
+    clauses: int = 0
+    lacking: list[str] = field(default_factory=list)        # clauses no cell can fail
+    meaningless: list[str] = field(default_factory=list)    # clauses the model cannot show
+
+    @property
+    def meaningless_cells(self) -> int:
+        return sum(len(names) for why, names in self.left_out.items()
+                   if why.startswith("the "))
+
+    def as_dict(self) -> dict:
+        return {"cells": self.cells, "run": self.run, "observers": self.observers,
+                "read": self.run * self.observers, "left_out": self.left_out,
+                "meaningless_cells": self.meaningless_cells, "clauses": self.clauses,
+                "lacking": self.lacking, "meaningless": self.meaningless}
+
+
+@cache
+def matrix_coverage(profile: str) -> MatrixCoverage:
+    """The matrix on ``profile`` as the emulator runs it."""
+    from conformance.diff.clauses import clauses, missing
+    from conformance.diff.grammar import Options
+    from conformance.diff.matrix import cells, observers
+
+    p = load_profile(profile)
+    every = cells(p, Options(destructive=True, rig=True), built=False)
+    out = MatrixCoverage(cells=len(every), run=sum(1 for c in every if not c.left_out),
+                         observers=len(observers(p)))
+    for c in every:
+        if c.left_out:
+            out.left_out.setdefault(c.left_out, []).append(c.name)
+    rules = load_rules()
+    out.clauses = sum(1 for c in clauses()
+                      if rules[c.rule].applies_to(p.name, p.family))
+    lacking, meaningless = missing(p, every)
+    out.lacking, out.meaningless = [str(c) for c in lacking], [str(c) for c in meaningless]
+    return out
+
+
+@dataclass
 class ProfileCoverage:
     profile: str
     sections: list[SectionCoverage] = field(default_factory=list)
+    matrix: MatrixCoverage | None = None
 
     @property
     def covered(self) -> int:
@@ -68,7 +124,8 @@ class ProfileCoverage:
     def as_dict(self) -> dict:
         return {"profile": self.profile, "covered": self.covered, "total": self.total,
                 "sections": [{"section": s.section, "covered": s.covered,
-                              "uncovered": s.uncovered} for s in self.sections]}
+                              "uncovered": s.uncovered} for s in self.sections],
+                "matrix": None if self.matrix is None else self.matrix.as_dict()}
 
 
 def _judges(role: str, cases) -> list[tuple[str, tuple[str, ...], object]]:
@@ -105,6 +162,8 @@ def coverage(profiles: Iterable[str] | None = None, *, role: str = "unit",
             else:
                 s.uncovered.append(rule.id)
         result.sections = sorted(by_section.values(), key=lambda s: _order(s.section))
+        if role == "unit":
+            result.matrix = matrix_coverage(p.name)
         out.append(result)
     return out
 
@@ -145,6 +204,7 @@ def format_coverage(report: list[ProfileCoverage], role: str = "unit") -> str:
     lines.append(f"{'total':<8}" + " ".join(f"{f'{pc.covered}/{pc.total}':>{width}}"
                                               for pc in report))
     missing = uncovered_rules(report)
+    lines += _format_matrix(report)
     lines.append("")
     if not missing:
         lines.append("Every rule is covered on every profile it applies to.")
@@ -154,3 +214,47 @@ def format_coverage(report: list[ProfileCoverage], role: str = "unit") -> str:
             on = "every profile" if len(where) == len(report) else ", ".join(where)
             lines.append(f"  {rule_id} [{rules[rule_id].tag}] on {on}: {rules[rule_id].text}")
     return "\n".join(lines)
+
+
+def _format_matrix(report: list[ProfileCoverage]) -> list[str]:
+    """The matrix's part of the console table: per model, cells run of all, the
+    observers each reads, the state x command x observer reads; then the cells left out,
+    by why (meaningless on the model, or not sent by this run), and the clauses setting
+    or clearing a status bit that no cell can fail."""
+    shown = [pc for pc in report if pc.matrix is not None]
+    if not shown:
+        return []
+    width = max(9, *(len(pc.profile) for pc in shown))
+    rows = (("cells", lambda m: f"{m.run}/{m.cells}"),
+            ("observed", lambda m: str(m.observers)),
+            ("reads", lambda m: str(m.run * m.observers)),
+            ("clauses", lambda m: f"{m.clauses - len(m.lacking) - len(m.meaningless)}"
+                                  f"/{m.clauses}"))
+    lines = ["", "The state x command x observer matrix diff runs, per model (cells run/all, "
+             "observers read after each, state x command x observer reads, clauses setting "
+             "or clearing a status bit with a cell that can fail them):", "",
+             "matrix  " + " ".join(f"{pc.profile:>{width}}" for pc in shown)]
+    lines += [f"{title:<8}" + " ".join(f"{value(pc.matrix):>{width}}" for pc in shown)
+              for title, value in rows]
+    for pc in shown:
+        m = pc.matrix
+        for why, names in sorted(m.left_out.items()):
+            kind = "meaningless" if why.startswith("the ") else "not run"
+            lines.append(f"  {pc.profile}: {len(names)} cell(s) {kind} ({why}): "
+                         f"{_cells_named(names)}")
+        for clause in m.lacking:
+            lines.append(f"  {pc.profile}: no cell can fail {clause}")
+        for clause in m.meaningless:
+            lines.append(f"  {pc.profile}: meaningless on the model: {clause}")
+    return lines
+
+
+def _cells_named(names: list[str]) -> str:
+    """Cells named compactly: a state whose every form is left out by its state name."""
+    by_state: dict[str, list[str]] = {}
+    for n in names:
+        state, _, form = n.partition(" x ")
+        by_state.setdefault(state, []).append(form)
+    return "; ".join(f"{state} x {', '.join(forms)}" if len(forms) <= 6
+                     else f"{state} x every form ({len(forms)})"
+                     for state, forms in by_state.items())

@@ -112,6 +112,7 @@ PROBES: dict[str, tuple[str, str]] = {
     "short-read-ignores-microstep": ("p24-short-read-in-sixteenths", "GVE54"),
     "current-resets-mode": ("p25-current-apart-from-mode", "GVE54"),
     "input-stop-drops-queue": ("p26-input-stop-holds-queue", "GVE84-100"),
+    "power-on-keeps-checksums": ("p28-power-on-checksums-off", "GVE84-100"),
 }
 
 

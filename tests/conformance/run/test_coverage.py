@@ -64,3 +64,36 @@ def test_every_unit_rule_is_covered_on_every_profile():
     report = coverage()
     missing = {pc.profile: pc.uncovered for pc in report if pc.uncovered}
     assert not missing, format_coverage(report)
+
+
+def test_the_matrix_is_counted_per_model_and_its_meaningless_cells_listed(capsys):
+    (gve84, gve54) = coverage(["GVE84-100", "GVE54"], cases=[])
+    for pc in (gve84, gve54):
+        m = pc.matrix
+        assert 0 < m.run < m.cells and m.observers >= 10 and m.lacking == []
+        assert m.clauses >= 10
+    # the GVE84 has no input behind ST1: that state's cells, and the clauses clearing
+    # ST5, are meaningless there, listed as such; the GVE54 has the state
+    assert gve84.matrix.meaningless_cells > 0 and gve84.matrix.meaningless
+    assert not [n for n in gve54.matrix.left_out.get("the GVE54 has no such state", [])
+                if n.startswith("input2-held")]
+    assert main(["--coverage", "--profile", "GVE84-100"]) == 0
+    out = capsys.readouterr().out
+    assert f"cells     {gve84.matrix.run}/{gve84.matrix.cells}" in out
+    assert ("cell(s) meaningless (the GVE84 has no such state): input2-held x every form"
+            in out)
+    assert "meaningless on the model: 10.4.go.resume: G clears ST5" in out
+
+
+def test_the_report_shows_the_matrix(tmp_path):
+    from conformance.reports.html import render_html
+    from conformance.run.runner import RunResult
+
+    run = RunResult("r", targets=["emu:GVE84-100"], settings="none")
+    run.meta.coverage = [pc.as_dict() for pc in coverage(["GVE84-100"], cases=[])]
+    for d in run.meta.coverage:
+        d["sections"] = [{**s, "covered": len(s["covered"])} for s in d["sections"]]
+    page = render_html(run)
+    assert "state &times; command &times; observer matrix" in page
+    assert "cells (state x command form) run" in page
+    assert "meaningless (the GVE84 has no such state)" in page

@@ -56,10 +56,17 @@ def x(g: Guard) -> Span:
     return g.envelope.reach()[0]
 
 
+def power_on_facts(g: Guard, index: int = 1) -> None:
+    """The other power-on facts of spec 9 read: ST0..ST6 00, the index counting from 0."""
+    for n in range(7):
+        sent(g, f"SR{n}", "0,00")
+    sent(g, "@", f"0,{index}")
+
+
 def test_power_on_counters_where_the_frames_say_otherwise_are_a_restart():
     g = guard()
     sent(g, "L1500,0,0")
-    sent(g, "SR6", "0,00")              # the restart's own idle: RUN = 0 (spec 9)
+    power_on_facts(g)                   # ST6 too: the restart's own idle, RUN = 0
     with pytest.raises(UnitRestarted) as told:
         sent(g, "PF", "0,0,0,0")        # the frames say 1500: the power-on counters
     assert "restarted by itself: PF read 0,0,0" in str(told.value)
@@ -168,11 +175,63 @@ def test_counters_the_frames_cannot_explain_leave_the_axes_anywhere_either_way()
     said = str(g.untracked[0])
     assert "restart" not in said
     assert ("PF read 450,0,0 at rest where the frames since the last read that agreed put "
-            "them at 300,0,0 (frames: L300,0,0 → 0; L0,0,0 → 0; PF → 0,450,0,0)") in said
+            "them at 300,0,0; the first frame it could not follow: L300,0,0 → 0 (frames: "
+            "L300,0,0 → 0; L0,0,0 → 0; PF → 0,450,0,0)") in said
     # where the counter says (450), or 450 from anywhere the axis had been (0..300)
     assert x(g) == Span(450, 750) and g.lost
     assert "no motion: the position counters disagree" in _refused(g, "L-1,0,0")
     sent(g, "SR6", "0,00")              # what cannot move still goes out
+
+
+@pytest.mark.parametrize("facts, why", [
+    # nothing else read, no frame lost: a unit that moved by a wrong amount reads 0 too
+    ([("SR6", "0,00")], "ST0, ST1, ST2, ST3, ST4, ST5, the index (@) not read since"),
+    # a status word the power-on would have cleared
+    ([("SR2", "0,2B"), ("SR6", "0,00")], "ST2 read 2B"),
+    # an index that counted on from before
+    ([("SR6", "0,00"), ("@", "0,57")], "@ read 57 after 3 frame(s) since"),
+])
+def test_power_on_counters_alone_are_no_restart(facts, why):
+    """Counters 0 where the frames put the axes elsewhere, without the other power-on facts
+    of spec 9 seen (or with one contradicted): no restart is said. The case is not stopped
+    and judges what it read; the guard names the frame it could not follow, and nothing
+    moves until the axes are located."""
+    g = guard()
+    sent(g, "L480,0,0")
+    for body, reply in facts:
+        sent(g, body, reply)
+    sent(g, "PF", "0,0,0,0")            # no exception: the case goes on
+    g.check_idle()
+    assert not g.restarts and len(g.untracked) == 1
+    said = str(g.untracked[0])
+    assert "restarted" not in said
+    assert f"but no restart: {why}" in said
+    assert "the first frame it could not follow: L480,0,0 → 0" in said
+    assert g.lost and "no motion" in _refused(g, "L-1,0,0")
+
+
+def test_facts_read_before_the_frames_were_lost_are_the_units_from_before():
+    """An index read before frames went unanswered counts from before a restart that
+    came with the silence: it does not say the unit did not restart."""
+    g = guard()
+    sent(g, "@", "0,121")
+    sent(g, "L480,0,0")
+    sent(g, "SR6", None)                # deaf: restarting
+    sent(g, "SR6", "0,00")
+    with pytest.raises(UnitRestarted):
+        sent(g, "PF", "0,0,0,0")
+    assert len(g.restarts) == 1 and not g.untracked
+
+
+def test_power_on_counters_with_the_checksum_mode_still_on_are_no_restart():
+    g = guard()
+    sent(g, "%+", "0,5C", summed=True)
+    sent(g, "L480,0,0", "0,5C", summed=True)
+    for n in range(7):
+        sent(g, f"SR{n}", "0,00,E8", summed=True)
+    sent(g, "@", "0,3,E8", summed=True)
+    sent(g, "PF", "0,0,0,0,70", summed=True)      # summed: the mode outlived it
+    assert not g.restarts and "the checksum mode is on" in str(g.untracked[0])
 
 
 def test_the_case_is_told_once_and_the_sessions_own_frames_go_on():
@@ -190,7 +249,7 @@ def test_the_case_is_told_once_and_the_sessions_own_frames_go_on():
 def test_the_rigs_eyes_locate_the_axes_and_motion_may_go_on():
     g = guard()
     sent(g, "L1500,0,0")
-    sent(g, "SR6", "0,00")
+    power_on_facts(g)
     with pytest.raises(UnitRestarted):
         sent(g, "PF", "0,0,0,0")
     g.locate({0: 1010, 1: 0, 2: 0}, {0: 0, 1: 0, 2: 0})

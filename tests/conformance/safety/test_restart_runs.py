@@ -64,8 +64,8 @@ def test_a_restart_anywhere_stays_within_the_envelope_and_is_named(place, eyes, 
     lost_at: list[list[int]] = []       # where the axes physically were once the guard knew
     read = safety.Guard._read
 
-    def watched(guard, name, counters):
-        read(guard, name, counters)
+    def watched(guard, name, counters, **kw):
+        read(guard, name, counters, **kw)
         if guard.lost and not lost_at:
             lost_at.append(unit.state()["physical"])
     monkeypatch.setattr(safety.Guard, "_read", watched)
