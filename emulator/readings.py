@@ -162,6 +162,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                             "down: a counter shows a step one step period after the suite's "
                             "arithmetic places it (up to one step behind on each axis while "
                             "moving), and H answers one step period after the last step"),
+    "counters-a-tick-late": (("10.2.motion.trapezoid", "10.2.motion.step-placement"),
+                             "the counters follow the axes on a 1 ms tick of the unit's own "
+                             "(the manuals time the motion in whole milliseconds): while "
+                             "the axes move P and PF read where they were a tick ago"),
     "zero-vector-dwells": (("10.2.motion.zero-length",),
                            "`L0,0,0` is a normal vector with no motion (\"program považuje za "
                            "normální vektor\"), so the T dwell between vectors that are not "

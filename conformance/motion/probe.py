@@ -27,6 +27,7 @@ from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
 from conformance.motion.model import DWELL_TICK, MotionModel
 from conformance.motion.plan import Params
 from conformance.motion.tolerance import (
+    TICK_NS,
     Tolerance,
     Window,
     answer_window,
@@ -404,10 +405,13 @@ class Probe:
         if not period:
             return False
         if self._placements is None:
-            # each event the unit may take up to a step period either side of its window
+            # each event the unit may take up to a step period, and a tick of its own
+            # (tolerance.py: the manuals fix no clock finer than the millisecond), either
+            # side of its window
+            shift = period + TICK_NS
             self._placements = variants + [
                 self.model({i: t}) for i, e in enumerate(self.events)
-                for t in (e.window.lo - period, e.window.hi + period)]
+                for t in (e.window.lo - shift, e.window.hi + shift)]
         band = _band(model, self._placements, Window(w.lo - period, w.hi + period),
                      tol.steps)
         return all(b0 <= g <= b1 for g, (b0, b1) in zip(got, band, strict=True))

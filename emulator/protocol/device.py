@@ -30,6 +30,8 @@ from gve_fixtures.protocol import ErrorCode
 MS = 1_000_000
 #: the reading steps-a-period-late: how far back a step period is looked for
 LATE_WINDOW = 100 * MS
+#: the reading counters-a-tick-late: the tick its counters follow the axes on
+TICK = MS
 #: the mutant slow-rates-floored: the slowest rate its timer runs (pulses/s)
 SLOWEST = 100
 #: input ports read FF with nothing connected (spec 10.3)
@@ -236,7 +238,20 @@ class Device:
             return tuple((x + (1 << 23)) % (1 << 24) - (1 << 23) for x in here)
         if self.readings.active("steps-a-period-late"):
             return self._a_period_late(here, t)
+        if self.readings.active("counters-a-tick-late") and self.motion.flags(t).moving:
+            return self._a_tick_late(here, t)
         return here
+
+    def _a_tick_late(self, here: tuple[int, ...], t: int) -> tuple[int, ...]:
+        """The reading counters-a-tick-late: counted on a 1 ms tick of the unit's own,
+        the counters show where the axes were a tick ago (the pulses since taken back)."""
+        times, masks = self.motion.pulses(max(0, t - TICK + 1), t + 1)
+        out = list(here)
+        for mask in (int(m) for m in masks[:len(times)]):
+            for i in range(len(out)):
+                if (mask >> i) & 1:
+                    out[i] -= -1 if (mask >> (4 + i)) & 1 else 1
+        return tuple(out)
 
     def _a_period_late(self, here: tuple[int, ...], t: int) -> tuple[int, ...]:
         """The reading steps-a-period-late: a counter shows a step one step period after

@@ -103,6 +103,10 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "reversal-brakes-to-rest": ([b"!0A5\r", 0.001, b"!0B500\r", 0.001, b"!0V2000\r", 0.001,
                                  b"!0C700,0,0\r", 0.001, b"!0C-700,0,0\r", 0.7, b"!0PF\r"],
                                 b"0\r" * 5 + b"0,677,0,0\r", b"0\r" * 5 + b"0,694,0,0\r"),
+    # 0.5 s into L30000 at V20000 and the reset's A20 (20 000 pulses/s², 2500 steps in, at
+    # 10 000 pulses/s): a tick earlier the counter read 10 steps less
+    "counters-a-tick-late": ([b"!0V20000\r", b"!0L30000,0,0\r", 0.5, b"!0PF\r"],
+                             b"0\r0\r0,2499,0,0\r", b"0\r0\r0,2489,0,0\r"),
     # 50 ms into L100 at the reset's A20 the X counter shows one step less
     "steps-a-period-late": ([b"!0L100,0,0\r", 0.05, b"!0PF\r"], b"0\r0,24,0,0\r",
                             b"0\r0,23,0,0\r"),

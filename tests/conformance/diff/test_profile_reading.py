@@ -163,3 +163,23 @@ def test_a_held_remainder_run_in_a_mode_taken_after_the_halt_is_a_reading():
     for body in ("H", "M2"):
         course.took(command_of(body), body, ok)
     assert course.mode_over_held
+
+
+def _in_process(spec: str, *, strict: bool = False, wait: float = 0.5):
+    target = parse_target(spec, strict=strict)
+    pair = Pair(Side(target), Side(parse_target("emu:GVE84-100")), target.profile)
+    return pair.run([Step(FRAME, body="V20000"),
+                     *_frames("L30000,0,0", wait=wait)]).disagreement
+
+
+def test_counters_on_a_tick_of_their_own_are_the_profile_s_reading():
+    # the reading counters-a-tick-late: 10 steps behind at 10 000 pulses/s
+    late = "emu:GVE84-100?reading=counters-a-tick-late"
+    d = _in_process(late)
+    assert d is not None and "profile" in d.context
+    assert (d.rule, d.verdict) == ("10.2.motion.trapezoid", NON_STRICT)
+    assert _in_process(late, strict=True).verdict == FAIL
+    # at rest it reads where the reference does
+    assert _in_process(late, wait=4.0) is None
+    d = _in_process(late + "&mutant=velocity-ignored")
+    assert (d.rule, d.verdict) == ("10.2.motion.dominant-rate", FAIL)
