@@ -37,7 +37,7 @@ from conformance.protocol import index as indexes
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
-from conformance.protocol.parse import parse
+from conformance.protocol.parse import Parsed, parse
 from conformance.protocol.wire import Response, is_hex_byte
 from gve_fixtures.protocol import St6
 
@@ -125,7 +125,7 @@ class View:
     def listened(self) -> View:
         """The line was listened to after the frames pending (a wait): what did not come
         meanwhile answers none of them (a unit answers as soon as possible, spec 2)."""
-        return replace(self, pending=())
+        return _with(self, pending=()) if self.pending else self
 
     def restarted(self) -> View:
         """The unit restarted (a taken `J`, a power cycle): the reset state (spec 9)."""
@@ -144,15 +144,14 @@ def observe(view: View, body: str, answer: Response | None, address: int | None 
     with none awaited stays pending, to be given an answer that comes later (:func:`late`).
     An awaited answer read ends every pending frame's chance of one."""
     where = min(view.addresses) if address is None else address
-    if awaited:
-        view = replace(view, pending=())
+    if awaited and view.pending:
+        view = _with(view, pending=())
     if where not in view.addresses:
         return view
-    before = view
-    view = _fold(view, body, answer)
+    after = _fold(view, body, answer)
     if not awaited and answer is None:
-        view = replace(view, pending=(*view.pending, Pending(body, where, before)))
-    return view
+        after = _with(after, pending=(*after.pending, Pending(body, where, view)))
+    return after
 
 
 def answered_late(view: View) -> Pending | None:
@@ -167,57 +166,73 @@ def late(view: View, answer: Response) -> View | None:
     there. None: no frame pending may have it (it is nobody's)."""
     for i, p in enumerate(view.pending):
         if _may_answer(p):
-            out = replace(_fold(p.before, p.body, answer), pending=())
+            out = _with(_fold(p.before, p.body, answer), pending=())
             for q in view.pending[i + 1:]:
                 out = observe(out, q.body, None, q.address, awaited=False)
             return out
     return None
 
 
+def _with(view: View, **changes: object) -> View:
+    """``view`` with ``changes``: what dataclasses.replace does, without its checks (a
+    view is folded on every frame)."""
+    twin = object.__new__(View)
+    twin.__dict__.update(view.__dict__)
+    twin.__dict__.update(changes)
+    return twin
+
+
 def _fold(view: View, body: str, answer: Response | None) -> View:
     parsed = parse(body)
     name = parsed.key
     answered = answer is not None and answer.code is not None
-    taken = answered and answer.ok
-    view = replace(view, since_index=view.since_index + (name not in _UNCOUNTED))
+    changes: dict[str, object] = {}
+    if name not in _UNCOUNTED:
+        changes["since_index"] = view.since_index + 1
     # the packet (spec 7)
+    packet = view.packet
     if name in _OPENS and not answered:
-        view = replace(view, packet=(), role="opens")
-    elif view.packet is not None and not answered:
+        changes.update(packet=(), role="opens")
+    elif packet is not None and not answered:
         role = ("member" if name in _SURE_MEMBERS else "unclosed" if name in _CLOSES
                 else "kept")
-        view = replace(view, packet=(*view.packet, body), role=role)
-    elif view.packet is not None:
-        view = replace(view, packet=None, role="closes")
-    else:
-        view = replace(view, role="")
-    if not taken:
-        return view
-    assert answer is not None
-    # what a frame the unit took sets or shows
-    if name in _RESTARTS:
-        return view.restarted()
+        changes.update(packet=(*packet, body), role=role)
+    elif packet is not None:
+        changes.update(packet=None, role="closes")
+    elif view.role:
+        changes["role"] = ""
+    if answered and answer.ok:
+        # what a frame the unit took sets or shows
+        if name in _RESTARTS:
+            return view.restarted()
+        changes.update(_taken(view, parsed, list(answer.values)))
+    return _with(view, **changes) if changes else view
+
+
+def _taken(view: View, parsed: Parsed, values: list[str]) -> dict[str, object]:
+    """What a frame the unit took sets (the mode, a setting) or shows (the index, the
+    counters, RUN)."""
+    name = parsed.key
     mode = _MODE_AFTER.get(f"{parsed.name}{parsed.params}")
     if mode is not None:
-        return replace(view, checksums=mode)
-    values = list(answer.values)
+        return {"checksums": mode}
     if name == "@" and values:
         form = view.index_form or indexes.evident(values[0])
         read = indexes.value(values[0], form) if form is not None else None
-        return replace(view, index=read, since_index=0)
+        return {"index": read, "since_index": 0}
     if name in _MODAL:
-        return replace(view, modal=_set(view.modal, name, parsed.params))
+        return {"modal": _set(view.modal, name, parsed.params)}
     if name == "SW" and len(parsed.fields) >= 2:
-        return replace(view, status=_set(view.status, parsed.fields[0], parsed.fields[1]))
+        return {"status": _set(view.status, parsed.fields[0], parsed.fields[1])}
     if name in _POSITION:
         counters = tuple(values)
         if all(decimal(v, signed=True) is not None for v in counters):
-            return replace(view, position=counters)
-        return view
+            return {"position": counters}
+        return {}
     if (name == "F" or (name == "SR" and parsed.params.strip() == "6")) and values \
             and is_hex_byte(values[0]):
-        return replace(view, moving=bool(int(values[0], 16) & St6.RUN))
-    return view
+        return {"moving": bool(int(values[0], 16) & St6.RUN)}
+    return {}
 
 
 def _set(pairs: tuple[tuple[str, str], ...], key: str, value: str) -> tuple[tuple[str, str], ...]:
