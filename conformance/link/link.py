@@ -57,13 +57,13 @@ from conformance.link.framing import (
     readable,
     shown_bytes,
 )
-from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.signals import Interrupted
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol import index
 from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
-from conformance.protocol.parse import parse
+from conformance.protocol.view import View, answered_late, late, observe
 from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
@@ -80,9 +80,6 @@ LATE = 1.0
 #: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
 END_QUIET = 0.05
 
-#: answers summed after the command whatever the mode before (spec 6, 10 J)
-_MODE_AFTER = {"%+": True, "%-": False, "J": False}
-
 # what the last frame left on the line
 _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
 
@@ -92,7 +89,6 @@ LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an
 #: dropped without an answer, a frame answered 2, a packet never closed by time)
 WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
                   OPEN_PACKET: "7.packet.open-until-end"}
-_PACKET_BREAKERS = classes(packet="breaker")
 #: frames that set no axis moving, whatever the unit is, and those whose answer tells
 #: where the axes are
 _MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
@@ -127,10 +123,10 @@ class Link:
         self.virtual = virtual
         self.guard = guard
         self.rig = rig
-        self.checksums = False
-        #: the form `@` writes the index in, once read (protocol/index.py); the unit's
-        #: addresses share one index
-        self.index_form: Form | None = None
+        #: the unit as the wire shows it (protocol/view.py), fed once per exchange: the
+        #: checksum mode, the open packet, the index's form...; the unit's addresses
+        #: share it
+        self.view = View(addresses=frozenset(guard.addresses))
         #: real time: the line's round trip as the session measured it at its start
         #: (``SessionReport.line``; empty when it was not), for the timing bands
         self.round_trip: dict[str, float] = {}
@@ -149,7 +145,6 @@ class Link:
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
         self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
         self._dropped = False
-        self._packet = False      # a packet the suite opened and has not seen closed
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
         #: a later link of the case took over: what this one left went to a unit that
@@ -162,10 +157,31 @@ class Link:
         #: answer, or its absence, is booked with it
         self._exchange: list[int] | None = None
         self._answered_as = Spent.ANSWERS
+        #: what the guard said of the frames written last (Guard.admit)
+        self._admitted = Admitted()
         #: work of the caller's done once, while the port runs the next frames told
         #: ahead (:meth:`tell`), or by the caller when none are told
         self.meanwhile: Callable[[], None] | None = None
         self._origin = self._clock()
+
+    # -- what the view holds -------------------------------------------------------------
+    @property
+    def checksums(self) -> bool:
+        """Whether the unit reads and writes checksums (the view's mode)."""
+        return self.view.checksums
+
+    @checksums.setter
+    def checksums(self, on: bool) -> None:
+        self.view = self.view.assume(checksums=on)
+
+    @property
+    def index_form(self) -> Form | None:
+        """The form `@` writes the index in, once read (protocol/index.py)."""
+        return self.view.index_form
+
+    @index_form.setter
+    def index_form(self, form: Form | None) -> None:
+        self.view = self.view.assume(index_form=form)
 
     # -- time ------------------------------------------------------------------------------
     def _clock(self) -> int:
@@ -218,8 +234,10 @@ class Link:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
         the frame's and an answer's bytes, a margin, what the command itself takes when it
         answers at its end, and what the line adds (:meth:`line_seconds`)."""
-        slow = self.guard.answer_seconds(body) or 0.0
-        return MARGIN + self.byte_seconds(size + 64) + slow + self.line_seconds()
+        return self._timeout(self.guard.answer_seconds(body), size)
+
+    def _timeout(self, slow: float | None, size: int) -> float:
+        return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
 
     def line_seconds(self) -> float:
         """Real time: twice the slowest round trip the session measured (a USB adapter
@@ -237,7 +255,7 @@ class Link:
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
         the command (spec 6, 10 J)."""
-        return _MODE_AFTER.get(body, self.checksums)
+        return self.view.summed_after(body)
 
     def wait(self, seconds: float, spent: Spent = Spent.WAITS) -> bytes:
         """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
@@ -250,14 +268,16 @@ class Link:
                 data = self._whole_line(self.port.read(self.port.in_waiting))
             else:
                 data = self._listen(seconds, stop_early=False)
-        if data:
-            self._record(UNIT, data)
-            self._after_answer(data, "during a wait", judged=True)
-        self._last = (_UNASKED, b"", b"")
         # raw frames not read for an answer: booked as unanswered now, not only when a
         # later frame goes out on this link (there may be none: a `*S` that ends an
         # example must still leave the guard knowing that a packet may be open)
         self._book_unbooked(None)
+        rest = self._answers_late(data)
+        self.view = self.view.listened()
+        if rest:
+            self._record(UNIT, rest)
+            self._after_answer(rest, "during a wait", judged=True)
+        self._last = (_UNASKED, b"", b"")
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool, already: float = 0.0) -> bytes:
@@ -314,14 +334,17 @@ class Link:
 
     def _transmit(self, data: bytes, summed: bool | None) -> list[HostFrame]:
         """Write ``data`` (host faults apply) once the guard has judged every frame it
-        completes; returns those frames."""
+        completes (once, :meth:`Guard.admit`: a frame told a co-simulator ahead was
+        judged when told); returns those frames."""
         self._book_unbooked(None)
         fault = self._fault("host")
         pieces = fault.apply(data) if fault else [(data, 0.0)]
         wire = b"".join(p for p, _ in pieces)
         frames = self._framer.frames(wire, commit=False)
-        self.guard.check_frames(frames, summed)
         self.settle()
+        ran = getattr(self.port, "ran", None)
+        self._admitted = self.guard.admit(frames, summed,
+                                          judged=ran is not None and ran(wire))
         self.wrote_at = self.now
         self._framer.frames(wire)
         if fault:
@@ -340,22 +363,23 @@ class Link:
         return frames
 
     def _write(self, data: bytes) -> None:
-        """Write ``data`` unless the run must stop now. The guard judged the frames before
-        the link waited for a quiet line (or paused for an injected delay); a signal that
-        came meanwhile must still keep them off the line, so the guard is asked again at
-        the instant of writing, with the signals held between the question and the
-        write."""
+        """Write ``data`` unless the run must stop now. The guard judged the frames just
+        before (or before an injected delay's pause); a signal that came since must
+        still keep them off the line, so the signals are asked at the instant of
+        writing, held between the question and the write."""
         ran = getattr(self.port, "ran", None)
         if ran is not None and ran(data):
             # told a co-simulator ahead, it ran them then: no signal keeps them off its
             # line any more, nothing to hold
             self._put(data)
             return
-        with self.guard.interrupts.held():
+        interrupts = self.guard.interrupts
+        with interrupts.held():
+            if not self._admitted.urgent and interrupts.bars(own=self._admitted.own):
+                raise Interrupted
             self._put(data)
 
     def _put(self, data: bytes) -> None:
-        self.guard.check_idle()
         self._record(HOST, data)
         if self._exchange is None:
             self._exchange = [self._clock(), 0, 0]
@@ -379,17 +403,18 @@ class Link:
         self.frames += 1
         sent = self._transmit(data, summed is not False)
         if not answer:
-            self._book(sent, None)
+            self._book(sent, None, awaited=False)
             return None
         late = 0.0
         if self._dropped:
             timeout = 0.0            # an injected fault dropped it: no answer can come
         elif timeout is None:
-            timeout = self.answer_timeout(body, len(data))
+            timeout = self._timeout(self._admitted.answer_seconds, len(data))
             late = 0.0 if self.virtual else LATE
         self._unbooked = sent
         # H and W answer when their motion ends: the wait for them is the motion's
-        self._answered_as = Spent.MOTION if self.guard.answer_seconds(body) else Spent.ANSWERS
+        self._answered_as = (Spent.MOTION if self._admitted.answer_seconds
+                             else Spent.ANSWERS)
         r = self.read_response(timeout, lines, summed=self.summed_after(body), late=late)
         if r is not None:
             r.sent_at = self.wrote_at
@@ -457,26 +482,43 @@ class Link:
         return (getattr(self.port, "expect", None) is not None and not self._faults
                 and not self._framer.in_frame)
 
-    def _book(self, frames: list[HostFrame], answer: Response | None) -> None:
-        """Book frames with the answer to the last one (the others got none)."""
+    def _book(self, frames: list[HostFrame], answer: Response | None, *,
+              awaited: bool = True, heard: bool = False) -> None:
+        """Book frames with the answer to the last one (the others got none; with
+        ``awaited`` false none was waited for, and one may come later): the view observes
+        each frame once, and the guard books them with the views they left in one call
+        (``heard``: with what was read for the last one, Guard.answered)."""
+        exchanges = []
         for i, f in enumerate(frames):
-            r = answer if i == len(frames) - 1 else None
+            last = i == len(frames) - 1
+            r = answer if last else None
             body = f.bodies(self.checksums)[0]
             address = self.address if f.address is None else f.address
-            if r is not None and r.ok and address in self.guard.addresses:
-                self._learn(body)
-            self._follow_packet(body, r)
-            self.guard.accepted(body, r, address)
+            self.view = observe(self.view, body, r, address, awaited=awaited and last)
+            exchanges.append((body, r, address, self.view))
+        if exchanges or heard:
+            self.guard.book(exchanges, answer, self._origin + self.wrote_at, heard=heard)
 
-    def _follow_packet(self, body: str, r: Response | None) -> None:
-        """Whether a packet the suite opened may still be open: `*S` goes unanswered when
-        a unit takes it (spec 7); an answered `*E`, or a breaker answered, closes it."""
-        name = parse(body).name
-        if name == "*S":
-            self._packet = r is None
-        elif r is not None and r.code is not None and (
-                name == "*E" or name in _PACKET_BREAKERS):
-            self._packet = False
+    def _answers_late(self, data: bytes) -> bytes:
+        """Give each whole line of ``data`` that came after its frame to the frame it
+        answers: the first sent with no answer awaited that may have one (a frame the
+        unit did not take as a packet's member); returns the lines nobody's."""
+        lines = data.split(CR)
+        taken = 0
+        for line in lines[:-1]:
+            if not self.view.answerable:
+                break
+            r = parse_response(line + CR, summed=self.checksums)
+            after = late(self.view, r) if r is not None and r.code is not None else None
+            if after is None:
+                break
+            owner = answered_late(self.view)
+            assert owner is not None
+            frame_text = readable(frame(owner.body, owner.address, owner.before.checksums))
+            self._record(UNIT, line + CR, f"the answer to {frame_text}, sent before")
+            self.view = after
+            taken += len(line) + 1
+        return data[taken:]
 
     def left_open(self) -> str:
         """What the suite's bytes so far leave for a watchdog to end (LONE_BANG,
@@ -486,11 +528,14 @@ class Link:
             return LONE_BANG
         if partial:
             return OPEN_FRAME
-        return OPEN_PACKET if self._packet else ""
+        return OPEN_PACKET if self.view.packet_open else ""
 
-    def _book_unbooked(self, answer: Response | None) -> None:
+    def _book_unbooked(self, answer: Response | None, *, awaited: bool = False,
+                       heard: bool = False) -> None:
+        """Book the raw frames sent with ``answer`` (None: none read), the last one's
+        answer ``awaited`` (else one may come later), ``heard`` as :meth:`_book`."""
         frames, self._unbooked = self._unbooked, []
-        self._book(frames, answer)
+        self._book(frames, answer, awaited=awaited, heard=heard)
 
     def read_index(self, address: int | None = None) -> int | None:
         """The index `@` answers (None: no answer, or a refusal), read in the form the
@@ -530,13 +575,6 @@ class Link:
         r = self.send("@", address=address)
         return r.values[0] if r is not None and r.ok and r.values else None
 
-    def _learn(self, body: str) -> None:
-        """The host's belief about the checksum mode follows the commands that set it."""
-        if body == "%+":
-            self.checksums = True
-        elif body in ("%-", "J"):
-            self.checksums = False
-
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
                       summed: bool | None = None, settle: bool = True,
                       late: float = 0.0) -> Response | None:
@@ -569,7 +607,7 @@ class Link:
             if not chunk.endswith(CR):
                 break
             self.port.timeout = MARGIN + self.line_seconds()
-        data = bytes(raw)
+        data = self._behind_late(bytes(raw), lines)
         # an answer that did not come (or not whole) was waited for to the suite's deadline
         self._book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
                             began)
@@ -584,7 +622,8 @@ class Link:
                       self._last[1], data)
         if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
-        self._book_unbooked(real)
+        # a frame an injected fault dropped is not a silence of the unit's
+        self._book_unbooked(real, awaited=True, heard=not self._dropped)
         r = real
         fault = self._fault("unit")
         if fault is not None:
@@ -594,9 +633,22 @@ class Link:
             r = parse_response(faulted, summed=summed, lines=lines) if faulted else None
             if r is not None:
                 r.received_at = self.now
-        if not self._dropped:
-            self.guard.answered(real, self._origin + self.wrote_at)
         return r
+
+    def _behind_late(self, data: bytes, lines: int) -> bytes:
+        """The answer to the frame just sent, when frames sent before it with no answer
+        awaited may have been answered all the same (a unit that did not take one as a
+        packet's member): answers keep the order of their frames, so while another
+        answer follows at once, the one before it is an earlier frame's
+        (:meth:`_answers_late`)."""
+        while (lines == 1 and data.endswith(CR) and self.view.answerable
+               and not self.guard.interrupts.pending):
+            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+            behind = self._whole_line(self.port.read_until(CR))
+            if not behind.endswith(CR) or self._answers_late(data):
+                return data + behind
+            data = behind
+        return data
 
     def rest_of_answer(self, seconds: float = MARGIN) -> bytes:
         """The lines that follow an answer at once, taken as part of it (not as a
@@ -638,12 +690,13 @@ class Link:
         if waiting:
             data += self.port.read(waiting)
         data = self._whole_line(data)
-        if not data:
-            if kept_quiet:               # the timed-out frame's answer can come no more
+        rest = self._answers_late(data)
+        if not rest:
+            if kept_quiet or data:       # the timed-out frame's answer can come no more
                 self._last = (_UNASKED, b"", b"")
-            return b""
-        self._record(UNIT, data, "unsolicited")
-        self._after_answer(data, "after")
+            return data
+        self._record(UNIT, rest, "unsolicited")
+        self._after_answer(rest, "after")
         self._last = (_UNASKED, b"", b"")
         return data
 
@@ -695,7 +748,7 @@ class Link:
         too (its time is the watchdog-time rule's, which the watchdog case judges); a
         lone `!` answered, or a packet closed by time, is a reading of its rule."""
         if kind == OPEN_PACKET:
-            self._packet = False
+            self.view = self.view.assume(packet=None)
         if kind == OPEN_FRAME or judged:
             return
         self.violations.append(Stray(f"{kind} was ended by a watchdog answering "

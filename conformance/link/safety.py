@@ -31,16 +31,19 @@ no motion frame out until the axes are located.
 
 Public interface (docs/suite.md, "The session and its guard")::
 
+    guard.admit(frames, summed)          # a link's frames about to go out: judged once
+    guard.book(exchanges, answer, at)    # ... and booked once with what the link read
     guard.check(body, address)           # before sending: raises SafetyStop / Interrupted
     guard.check_frames(frames, summed)   # the same for raw bytes, framed as a unit would
-    guard.accepted(body, response, address)   # after the answer (None: no answer seen)
+    guard.accepted(body, response, address, view)   # after the answer (None: no answer
+                                                    # seen), with the view it left
 """
 
 from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -61,6 +64,7 @@ from conformance.link.signals import Interrupted, Interrupts
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.parse import parse
+from conformance.protocol.view import View, observe
 from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode, St6
@@ -125,8 +129,6 @@ DESTRUCTIVE = classes(destructive=True)
 #: the longest an answer is waited for (a `W` whose run would take longer: the unit
 #: refuses such a travel or rate, or the run is not one a test should wait out)
 LONGEST_ANSWER_S = 600.0
-#: frames a unit answers at once inside an open packet, discarding it (spec 7)
-_PACKET_BREAKERS = classes(packet="breaker")
 _PACKET_MEMBERS = classes(packet="member")
 #: frames that set the checksum mode, and so how the unit reads the frames after them
 _SUMMING = classes(summing=True)
@@ -192,6 +194,31 @@ def _number(text: str, base: int = 10) -> Span:
         return UNKNOWN
 
 
+@dataclass(frozen=True)
+class Admitted:
+    """What the guard said of frames it let out: how long the last one's answer may
+    take (None: at once), and whether they are the session's own frames or its `H` and
+    `D` after Ctrl-C (``own``, ``urgent``), which a signal that comes before they are
+    written keeps off the line or not (:meth:`Interrupts.bars`)."""
+
+    answer_seconds: float | None = None
+    own: bool = False
+    urgent: bool = False
+
+
+def _readings(frames: list[HostFrame], summed: bool | None,
+              address: int) -> Iterator[tuple[str, int]]:
+    """Each frame's body in every reading the unit may give it (``summed``: in checksum
+    mode its last field is its checksum, spec 6; None, and after a frame that may set
+    the mode: with and without), with the address it is for."""
+    for f in frames:
+        bodies = f.bodies(summed)
+        for body in bodies:
+            yield body, f.address if f.address is not None else address
+        if any(Body.parse(body).name in _SUMMING for body in bodies):
+            summed = None
+
+
 def outcome_of(r: Response | None) -> Outcome:
     if r is None or r.code is None:
         return Outcome.UNCLEAR
@@ -216,7 +243,9 @@ class Guard:
             tuple(micro.factors.values()) if micro else (1,),
             micro.factors[micro.reset_mode] if micro else 1)
         self.addresses = {address} | ({profile.spindle.address} if profile.spindle else set())
-        self.packet_open = False                  # *S booked, no *E nor breaker since
+        #: the unit as the wire shows it (protocol/view.py), as the link that sent the
+        #: last frame booked saw it: the guard reads the open packet there
+        self.view = View(addresses=frozenset(self.addresses))
         self.eeprom = EepromLedger()
         self.before_motion: Callable[[], bool | None] | None = None
         self.motion_confirmed: bool | None = None
@@ -258,6 +287,11 @@ class Guard:
         """The envelope's reach either side, in counter units."""
         return max_travel * self.scale
 
+    @property
+    def packet_open(self) -> bool:
+        """Whether a packet may be open (the view's): its members go unanswered."""
+        return self.view.packet_open
+
     # -- who is sending ----------------------------------------------------------------------
     def own_frames(self) -> _Depth:
         """The session's own frames (known state, snapshot, restorations): after Ctrl-C
@@ -285,7 +319,7 @@ class Guard:
         before every frame and every wait of a case."""
         if self._emergency:
             return
-        if self.interrupts.pending or (self.interrupts.stopped and not self._own):
+        if self.interrupts.bars(own=bool(self._own)):
             raise Interrupted
         if self.dead:
             raise TargetNotResponding(self._not_responding())
@@ -327,17 +361,49 @@ class Guard:
             return False
         return True
 
+    def admit(self, frames: list[HostFrame], summed: bool | None, *,
+              judged: bool = False) -> Admitted:
+        """Judge the frames a link is about to write (:meth:`check_frames`; ``judged``:
+        judged already, as they were told a co-simulator ahead, so only whether the run
+        stops here) and say what the link needs of them: one question per exchange."""
+        if judged:
+            self.check_idle()
+            # what judging them booked on the copy, the run's guard books now: the EEPROM
+            # bytes they may write, in every reading they were judged in
+            for body, address in _readings(frames, None, self.address):
+                self._eeprom_written(body, address)
+        else:
+            self.check_frames(frames, summed)
+        body = frames[-1].bodies(summed)[0] if frames else ""
+        return Admitted(self.answer_seconds(body) if body else None, bool(self._own),
+                        bool(self._emergency))
+
+    def book(self, exchanges: list[tuple[str, Response | None, int, View]],
+             answer: Response | None = None, at: int | None = None, *,
+             heard: bool = False) -> None:
+        """Book the frames of one exchange, each with its answer and the view it left
+        (:meth:`accepted`), and, ``heard``: what the link read for the last one
+        (:meth:`answered`, ``at`` the instant it went out): one call per exchange."""
+        for body, response, address, view in exchanges:
+            self.accepted(body, response, address, view)
+        if heard:
+            self.answered(answer, at)
+
     def check_frames(self, frames: list[HostFrame], summed: bool | None) -> None:
         """:meth:`check` raw frames as the unit reads them: in checksum mode (``summed``)
         a frame's last field is its checksum, not a component (spec 6); when the mode is
         not known (None), and after a frame that may set it, every reading (with and
         without a trailing checksum)."""
-        for f in frames:
-            bodies = f.bodies(summed)
-            for body in bodies:
-                self.check(body, f.address if f.address is not None else self.address)
-            if any(Body.parse(body).name in _SUMMING for body in bodies):
-                summed = None
+        for body, address in _readings(frames, summed, self.address):
+            self.check(body, address)
+
+    def _eeprom_written(self, body: str, address: int) -> None:
+        """Book the EEPROM bytes the frame ``body`` judged already may write."""
+        command = Body.parse(body)
+        width = eeprom_width(command.name)
+        if address in self.addresses and width:
+            # (one whose bytes cannot be told is refused: it was never told)
+            self.eeprom.write(self._eeprom_bytes(command, width))
 
     def _check_destructive(self, body: str, command: Body) -> None:
         if not self.allow_destructive:
@@ -399,14 +465,19 @@ class Guard:
             raise SafetyStop(f"{body}: motion was not confirmed")
 
     # -- after a frame ------------------------------------------------------------------------
-    def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
-        """Book the frame ``body`` with its answer (None when none was seen)."""
+    def accepted(self, body: str, response: Response | None, address: int | None = None,
+                 view: View | None = None) -> None:
+        """Book the frame ``body`` with its answer (None when none was seen); ``view``:
+        the unit as the wire shows it after the exchange (a link's, which observed it),
+        else the guard's own view observes it."""
         address = self.address if address is None else address
         if address not in self.addresses:
             return
+        self.view = (observe(self.view, body, response, address) if view is None
+                     else view)
         command = Body.parse(body)
         outcome = outcome_of(response)
-        if command.name in _PACKET_MEMBERS and self.packet_open:
+        if command.name in _PACKET_MEMBERS and self.view.role == "member":
             if command.name == "C":
                 # a member (unanswered) may be committed as it arrives, or only at *E,
                 # or never (all-or-nothing is our reading [D]): maybe, from now on;
@@ -468,7 +539,7 @@ class Guard:
         """The unit restarted by other means than `J` (a test rig's power cycle): booked
         as a `J` it accepted (counters zeroed, queue and packet gone, the axes stay)."""
         self.envelope.discard(Outcome.ACCEPTED, restart=True)
-        self.packet_open = False
+        self.view = self.view.restarted()
         self._restarting = True
 
     def recentre(self) -> None:
@@ -557,17 +628,9 @@ class Guard:
         return lambda e: e.reference(i, travel, outcome, zeroed=zeroed)
 
     def _learn(self, command: Body, r: Response | None, outcome: Outcome) -> None:
-        """What an answer tells beyond the command itself: packets open and close, the
-        unit shows it rests, a position is read."""
+        """What an answer tells beyond the command itself: the unit shows it rests, a
+        position is read (the open packet is the view's)."""
         name = command.name
-        if name == "*S":
-            self.packet_open = True
-        elif name == "*E":
-            self.packet_open = False
-        elif name in _PACKET_BREAKERS and r is not None:
-            # unanswered, it may have been taken as a member: that a breaker closes the
-            # packet is our reading [D], and only *E is sure to (spec 7)
-            self.packet_open = False
         if outcome is not Outcome.ACCEPTED or r is None:
             return
         self._fact(command, r)
@@ -749,7 +812,7 @@ class Guard:
                 self.unanswered = 0
             self._tell_restart()
             return
-        if response is None and self.packet_open:
+        if response is None and self.view.silent_by_rule:
             return              # a packet's members are answered by nothing (spec 7)
         self.silences += 1
         if self._silent_from is None:
@@ -829,7 +892,8 @@ class EmulatorGuard(Guard):
     def check(self, body: str, address: int | None = None) -> None:
         self.check_idle()
 
-    def accepted(self, body: str, response: Response | None, address: int | None = None) -> None:
+    def accepted(self, body: str, response: Response | None, address: int | None = None,
+                 view: View | None = None) -> None:
         return None
 
     def restarted(self) -> None:

@@ -56,6 +56,11 @@ class Interrupts:
         if self.count >= self.HARD:
             raise KeyboardInterrupt
 
+    def bars(self, *, own: bool = False) -> bool:
+        """Whether a frame may not go out now: a signal no `H` has answered yet, or any
+        signal at all unless the session sends its own frames (``own``)."""
+        return self.pending or (self.stopped and not own)
+
     def handle(self) -> None:
         """The sessions sent H and D for every signal so far."""
         self.handled = self.count

@@ -232,8 +232,8 @@ class RealSession(Session):
     def _new_link(self, address: int | None = None) -> Link:
         before = self._link
         link = super()._new_link(address)
-        if before is not None:                      # the same unit: its mode too
-            link.checksums = before.checksums
+        if before is not None:      # the same unit: its view from the wire too (its mode)
+            link.view = before.view
         link.round_trip = self.report.line
         return link
 
