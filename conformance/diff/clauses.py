@@ -30,7 +30,7 @@ _ONE = re.compile(_BIT)
 #: the commands a state's bits are read with at once, by the word they are in
 _READ = {6: ("SR6", "F"), 4: ("SR4",), 5: ("SR5",)}
 #: forms that read and change nothing: what an input's clause is read after
-_READS = ("P", "PF", "F", "@", "?", "Q")
+_READS = tuple(load_matrix()["reads_alone"])
 
 
 @dataclass(frozen=True)

@@ -180,17 +180,21 @@ class HandRig:
         step = self._step("power-on", words["cycle"])
 
         def verify() -> str | None:
+            # a unit that restarted is in the reset state, its checksums off (spec 9): the
+            # index is asked as of it; the mode as it was where no restart is seen
+            summing, link.checksums = link.checksums, False
             after = None
             for _ in range(min(words["asks"], SILENCE_LIMIT - 1)):
                 link.wait(words["ready_seconds"], Spent.MANUAL)
                 after = self._index()
                 if after is not None:
                     break
+            if after is None or not after <= 1 < before:
+                link.checksums = summing
             if after is None:
                 raise CouldNotTest(words["no_answer"].format(instruction=step.instruction))
             if after <= 1 < before:
                 link.guard.restarted()           # counters zeroed, the axes where they were
-                link.checksums = False           # the reset state: checksums off
                 self.console.say(words["verified"].format(after=after, before=before))
                 return None
             return words["found"].format(after=after, before=before)

@@ -172,11 +172,6 @@ class CosimLine:
         """Why the line is broken for good ("" while it is not)."""
         return self.talk.broken
 
-    @property
-    def exchanges(self) -> int:
-        """The commands sent to the simulator so far."""
-        return self.talk.exchanges
-
     def start(self) -> str:
         """The line at the target's rate (`baud N`), then the reply to `state`: the
         rig's state, or an ``error:`` line when it has none."""

@@ -7,6 +7,7 @@ with --accept-incomplete), never PASSED on a score of what it did not all try.""
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 
 from conformance.cli import main
@@ -46,10 +47,13 @@ def test_the_time_limit_ends_a_gate_incomplete(tmp_path, capsys):
     status = main(argv)
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert status == INCOMPLETE_STATUS, last
-    assert last.startswith("INCOMPLETE — mutation: the time limit of 0.5 s came after 0 of "
-                           "2 mutants; not tested: 2 mutants"), last
+    # how many mutants end within the limit is the machine's speed: none or one of two
+    done = re.match(r"INCOMPLETE — mutation: the time limit of 0\.5 s came after ([01]) of "
+                    r"2 mutants; not tested: (\d) mutant", last)
+    assert done and int(done[1]) + int(done[2]) == 2, last
     cases = _testcases(tmp_path / "t" / "junit.xml")
-    assert all(tc.find("skipped") is not None for tc in cases.values()) and len(cases) == 2
+    skipped = [tc for tc in cases.values() if tc.find("skipped") is not None]
+    assert len(cases) == 2 and len(skipped) == int(done[2])
     assert json.loads((tmp_path / "t" / "results.json").read_text())["verdict"] == "INCOMPLETE"
     assert main([*argv[:-1], "t2", "--accept-incomplete"]) == 0
 

@@ -209,7 +209,7 @@ def test_a_kept_power_on_restored_finds_the_same_with_fewer_commands(mutant):
             found = search(p, EVERYTHING, budget, seed=0, with_probes=False)
             line = p.target.link.port.line
             seen.append(([(f.disagreement.signature, [str(s) for s in f.steps], f.frames)
-                          for f in found], budget.used, budget.frames, line.exchanges))
+                          for f in found], budget.used, budget.frames, line.talk.exchanges))
         finally:
             p.target.session.finish()
             p.target.target.close()

@@ -34,7 +34,7 @@ RIG_OR_ADDRESS = {
 }
 
 
-def _drawn(grammar: Grammar, n: int = 400) -> list[Step]:
+def _drawn(grammar: Grammar, n: int = 400, kind: str = "group") -> list[Step]:
     from hypothesis import HealthCheck, given, settings
     from hypothesis import strategies as st
 
@@ -42,7 +42,7 @@ def _drawn(grammar: Grammar, n: int = 400) -> list[Step]:
 
     @settings(max_examples=n, database=None, derandomize=True,
               suppress_health_check=list(HealthCheck))
-    @given(st.composite(lambda draw: grammar.group(draw))())
+    @given(st.composite(lambda draw: getattr(grammar, kind)(draw))())
     def each(group):
         out.extend(group)
 
@@ -74,7 +74,8 @@ def test_every_command_the_spindle_serves_is_drawn_at_its_address():
     grammar = Grammar(p, EVERYTHING)
     # the pool drawn from: every command the profile's spindle serves
     assert set(grammar.spindle_names) == set(p.spindle.commands)
-    steps = _drawn(grammar, 1500)
+    # the spindle's draw itself: how often a group draws it is the grammar's weights'
+    steps = _drawn(grammar, 600, "spindle")
     at_spindle = {command_of(s.body) for s in steps
                   if s.kind == FRAME and s.address == p.spindle.address}
     assert {"V", "ER", "EW", "%", "Q"} <= at_spindle, at_spindle

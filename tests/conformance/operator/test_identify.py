@@ -71,7 +71,9 @@ def test_ports_lists_the_system_ports(monkeypatch, capsys):
     monkeypatch.setattr(ports.list_ports, "comports", lambda include_links: [_Listed()])
     assert main(["ports"]) == 0
     assert capsys.readouterr().out == ("/dev/ttyUSB7  FT232R USB UART  "
-                                       "[USB VID:PID=0403:6001]\n")
+                                       "[USB VID:PID=0403:6001]\n"
+                                       "1 port listed; none probed (--probe asks each "
+                                       "who it is)\n")
 
 
 @pytest.mark.parametrize("unit", ["GVE54"], indirect=True)
