@@ -32,6 +32,7 @@ from conformance.cli.usage import (
     INTERRUPTED,
     Parser,
     UsageError,
+    chosen_cases,
     job_options,
     positive,
     summary,
@@ -44,7 +45,6 @@ from conformance.reports.files import release
 from conformance.run.coverage import coverage, format_coverage
 from conformance.run.metadata import RunMeta, now_iso
 from conformance.run.runner import RunResult, run, settings_for
-from conformance.run.selection import select
 from conformance.targets import DEFAULT_MAX_TRAVEL, Target, parse_target
 from conformance.verdicts.quoting import escaped
 from gve_fixtures.profile import ProfileError, available_profiles
@@ -172,10 +172,7 @@ def example_database_of(args: argparse.Namespace) -> str | None:
 
 
 def _main(args: argparse.Namespace, argv: list[str]) -> int:
-    cases = select(args.cases or None, args.exclude or None)
-    if not cases:
-        raise UsageError("no case matches " + " ".join(
-            [f"--cases {g!r}" for g in args.cases] + [f"--exclude {g!r}" for g in args.exclude]))
+    cases = chosen_cases(args)
     if args.list:
         for c in cases:
             print(f"{c.id:48} {c.tag:6} {c.rule}")

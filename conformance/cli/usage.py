@@ -172,6 +172,17 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+def chosen_cases(args: argparse.Namespace) -> list:
+    """The cases ``--cases``/``--exclude`` select (all where neither is given); a
+    UsageError where they select none."""
+    from conformance.run.selection import select  # the catalogue loads only when asked
+    cases = select(args.cases or None, args.exclude or None)
+    if not cases:
+        raise UsageError("no case matches " + " ".join(
+            [f"--cases {g!r}" for g in args.cases] + [f"--exclude {g!r}" for g in args.exclude]))
+    return cases
+
+
 def one_line(err: BaseException) -> str:
     """An error as one line for the user (a KeyError's text without its quotes)."""
     text = err.args[0] if err.args and isinstance(err.args[0], str) else str(err)

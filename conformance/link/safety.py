@@ -83,9 +83,9 @@ class BeyondEnvelope(SafetyStop):
 
 
 @dataclass
-class Restart:
-    """A restart the guard saw: what the unit showed, where the axes may have been, and
-    what the run did about it."""
+class Sighting:
+    """What the guard saw of the axes it could not follow: what the unit showed, where
+    the axes may be, and what the run did about it."""
 
     seen: str
     where: str
@@ -95,18 +95,13 @@ class Restart:
         return f"{self.seen}; {self.where}: {self.then}"
 
 
-@dataclass
-class Untracked:
-    """Counters read at rest that the frames cannot explain, and no power-on counters: the
-    frames since the last read that agreed, what was read, where the axes may be, and
-    what the run did about it."""
+class Restart(Sighting):
+    """A restart the guard saw (the power-on facts read)."""
 
-    seen: str
-    where: str
-    then: str
 
-    def __str__(self) -> str:
-        return f"{self.seen}; {self.where}: {self.then}"
+class Untracked(Sighting):
+    """Counters read at rest that the frames cannot explain, and no power-on facts: what
+    was read after the frames since the last read that agreed."""
 
 
 #: the frames since the last read that agreed that a disagreement names (the last ones)

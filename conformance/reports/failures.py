@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from conformance.verdicts.explain import Reason, reason
 from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.explain import Reason, reason
 from conformance.verdicts.verdict import ERROR, FAIL, NON_STRICT, ORDER
 
 #: the verdicts the list shows, worst first

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from conformance.reports.files import write_text
-from conformance.reports.text import clean
+from conformance.reports.text import element
 
 
 @dataclass
@@ -45,36 +45,28 @@ class GateRun:
                 "items": [{**asdict(i), "seconds": round(i.seconds, 3)} for i in self.items]}
 
 
-def _element(parent: ET.Element, tag: str, text: str | None = None, **attrs: object
-             ) -> ET.Element:
-    el = ET.SubElement(parent, tag, {k: clean(v) for k, v in attrs.items()})
-    if text is not None:
-        el.text = clean(text)
-    return el
-
-
 def render_gate_junit(run: GateRun) -> str:
     root = ET.Element("testsuites", name=f"gve-conformance {run.job}")
-    suite = _element(
+    suite = element(
         root, "testsuite", name=run.job, tests=len(run.items),
         failures=sum(i.passed is False for i in run.items), errors=0,
         skipped=sum(i.passed is None for i in run.items), time=f"{run.seconds:.3f}")
-    props = _element(suite, "properties")
+    props = element(suite, "properties")
     for name, value in (("verdict", f"{run.verdict} — {run.reason}"),
                         ("started", run.started), ("command", " ".join(run.command))):
-        _element(props, "property", name=name, value=value)
+        element(props, "property", name=name, value=value)
     for item in run.items:
-        tc = _element(suite, "testcase", name=item.name, classname=f"gve.{run.job}",
+        tc = element(suite, "testcase", name=item.name, classname=f"gve.{run.job}",
                       time=f"{item.seconds:.3f}")
         said = "\n".join(item.lines)
         if item.passed is False:
-            _element(tc, "failure", said, message=item.lines[0] if item.lines else item.name,
+            element(tc, "failure", said, message=item.lines[0] if item.lines else item.name,
                      type="FAILED")
         elif item.passed is None:
-            _element(tc, "skipped", message=item.lines[0] if item.lines else "not run")
+            element(tc, "skipped", message=item.lines[0] if item.lines else "not run")
         else:
-            _element(tc, "system-out", said)
-    _element(suite, "system-out", f"{run.verdict} — {run.reason}\n")
+            element(tc, "system-out", said)
+    element(suite, "system-out", f"{run.verdict} — {run.reason}\n")
     ET.indent(root)
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
 

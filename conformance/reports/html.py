@@ -24,7 +24,6 @@ from jinja2 import Environment, PackageLoader, StrictUndefined
 from markupsafe import Markup
 
 import conformance.reports.plots as plots
-from conformance.verdicts.quoting import quoted
 from conformance.reports.banner import run_verdict
 from conformance.reports.failures import failures, natural
 from conformance.reports.logs import compact, compact_checks
@@ -32,6 +31,7 @@ from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import clean, rule_html
 from conformance.reports.units import units_view
 from conformance.run.runner import CaseResult, RunResult
+from conformance.verdicts.quoting import quoted
 from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS
 
 #: verdicts whose case opens by itself

@@ -25,14 +25,23 @@ import datetime
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from conformance.verdicts.explain import plain, reason
 from conformance.reports.banner import run_verdict
 from conformance.reports.files import write_text
 from conformance.reports.logs import compact
 from conformance.reports.sections import section_title
-from conformance.reports.text import clean
+from conformance.reports.text import element
 from conformance.run.runner import CaseResult, RunResult
-from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, INFO, MISSING, NON_STRICT, ORDER, PASS
+from conformance.verdicts.explain import plain, reason
+from conformance.verdicts.verdict import (
+    COULD_NOT_TEST,
+    ERROR,
+    FAIL,
+    INFO,
+    MISSING,
+    NON_STRICT,
+    ORDER,
+    PASS,
+)
 
 #: verdicts a CI sees as skipped (unless --strict makes NON-STRICT a failure)
 SKIPPED = (NON_STRICT, INFO, COULD_NOT_TEST, MISSING)
@@ -69,18 +78,10 @@ def _failed(r: CaseResult, strict: bool) -> bool:
     return r.verdict == FAIL or (strict and r.verdict == NON_STRICT)
 
 
-def _element(parent: ET.Element, tag: str, text: str | None = None, **attrs: object
-             ) -> ET.Element:
-    el = ET.SubElement(parent, tag, {k: clean(v) for k, v in attrs.items()})
-    if text is not None:
-        el.text = clean(text)
-    return el
-
-
 def _properties(parent: ET.Element, items: dict[str, object]) -> None:
-    props = _element(parent, "properties")
+    props = element(parent, "properties")
     for key, value in items.items():
-        _element(props, "property", name=key, value=value)
+        element(props, "property", name=key, value=value)
 
 
 def _head(r: CaseResult) -> str:
@@ -93,23 +94,23 @@ def _head(r: CaseResult) -> str:
 
 
 def _testcase(suite: ET.Element, r: CaseResult, strict: bool, full: bool) -> None:
-    tc = _element(suite, "testcase", name=f"{r.id}[{r.profile}]",
+    tc = element(suite, "testcase", name=f"{r.id}[{r.profile}]",
                   classname=classname(r.profile, r.section), time=f"{r.seconds:.3f}")
     _properties(tc, {"verdict": r.verdict, "tag": r.tag,
                      "section": section_title(r.section)})
     log = "\n".join(compact(r.wire_log, r.verdict, full))
     failed = _failed(r, strict)
     if failed:
-        _element(tc, "failure", log, message=message(r), type=r.verdict)
+        element(tc, "failure", log, message=message(r), type=r.verdict)
     elif r.verdict == ERROR:
-        _element(tc, "error", "\n".join(r.notes) + "\n" + log, message=message(r),
+        element(tc, "error", "\n".join(r.notes) + "\n" + log, message=message(r),
                  type=r.verdict)
     elif r.verdict in SKIPPED:
-        _element(tc, "skipped", message=message(r))
+        element(tc, "skipped", message=message(r))
     if r.verdict == PASS and not full:
         return                  # its properties say it all; the JSON keeps the rest
     # the log once: in the failure or error when there is one
-    _element(tc, "system-out", _head(r) + ("" if failed or r.verdict == ERROR else log))
+    element(tc, "system-out", _head(r) + ("" if failed or r.verdict == ERROR else log))
 
 
 def _testsuite(root: ET.Element, run: RunResult, target: str, number: int, full: bool
@@ -119,7 +120,7 @@ def _testsuite(root: ET.Element, run: RunResult, target: str, number: int, full:
     t = run.meta.target(target)
     profile = t.profile or (results[0].profile if results else "")
     verdict, reason_text = run_verdict(run)
-    suite = _element(
+    suite = element(
         root, "testsuite", name=target, package=package(profile), id=number,
         tests=len(results), failures=sum(_failed(r, strict) for r in results),
         errors=sum(r.verdict == ERROR for r in results),
@@ -137,8 +138,8 @@ def _testsuite(root: ET.Element, run: RunResult, target: str, number: int, full:
         **{f"count {v}": sum(r.verdict == v for r in results) for v in reversed(ORDER)}})
     for r in results:
         _testcase(suite, r, strict, full)
-    _element(suite, "system-out", f"{verdict} — {reason_text}\n")
-    _element(suite, "system-err", "")
+    element(suite, "system-out", f"{verdict} — {reason_text}\n")
+    element(suite, "system-err", "")
 
 
 def render_junit(run: RunResult, full_logs: bool | None = None) -> str:

@@ -245,7 +245,7 @@ def step_train_chart(pulses: Sequence[tuple[float, int]], axes: Sequence[str], k
     fig = _figure(7.5, height, {"left": 0.06, "right": 0.98, "top": 1 - 0.3 / height,
                                 "bottom": 0.5 / height})
     ax = fig.add_subplot()
-    for i, name in enumerate(axes):
+    for i in range(len(axes)):
         for negative, alpha in ((False, 1.0), (True, 0.45)):
             times = [t for t, m in shown if m >> i & 1 and bool(m >> (4 + i) & 1) == negative]
             if times:

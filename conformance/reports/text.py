@@ -5,6 +5,7 @@ stays well-formed XML 1.0."""
 from __future__ import annotations
 
 import re
+import xml.etree.ElementTree as ET
 from html import escape
 
 # XML 1.0 allows TAB, LF, CR and the characters from U+0020 on, less the surrogates and
@@ -34,3 +35,11 @@ def rule_html(text: object) -> str:
     escaped = re.sub(r"`([^`]+)`", r"<code>\1</code>", escaped)
     return re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", escaped)
 
+
+def element(parent: ET.Element, tag: str, text: str | None = None, **attrs: object
+            ) -> ET.Element:
+    """An XML element under ``parent``, its text and attributes made clean."""
+    el = ET.SubElement(parent, tag, {k: clean(v) for k, v in attrs.items()})
+    if text is not None:
+        el.text = clean(text)
+    return el

@@ -29,11 +29,11 @@ TICKED = "exec:" + shlex.join([sys.executable, str(CORPUS / "gve84-a" / "sim.py"
 EMULATOR = [sys.executable, "-m", "emulator", "--model", "GVE84-100", "--cosim"]
 
 
-def _run(spec: str, steps: list[Step], *, strict: bool = False):
-    target = parse_target(spec, profile="GVE84-100", allow_destructive=True, strict=strict)
+def _run(spec: str, steps: list[Step], *, strict: bool = False, profile: str = "GVE84-100"):
+    target = parse_target(spec, profile=profile, allow_destructive=True, strict=strict)
     target.preflight()
     try:
-        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE84-100")),
+        pair = Pair(Side(target, target.begin()), Side(parse_target(f"emu:{profile}")),
                     target.profile)
         return pair.run(steps).disagreement
     finally:
@@ -132,15 +132,7 @@ def test_a_w_run_ramped_to_its_speeds_answers_within_its_own_ramps():
 
 
 def _gve54(spec: str, steps: list[Step], *, strict: bool = False):
-    target = parse_target(spec, profile="GVE54", allow_destructive=True, strict=strict)
-    target.preflight()
-    try:
-        pair = Pair(Side(target, target.begin()), Side(parse_target("emu:GVE54")),
-                    target.profile)
-        return pair.run(steps).disagreement
-    finally:
-        target.session.finish()
-        target.close()
+    return _run(spec, steps, strict=strict, profile="GVE54")
 
 
 def test_a_held_remainder_run_in_a_mode_taken_after_the_halt_is_a_reading():

@@ -37,7 +37,7 @@ def test_a_full_disk_leaves_the_file_as_it_was_and_nothing_partial(tmp_path, mon
 def test_a_run_id_taken_is_refused_and_its_folder_left_alone(tmp_path):
     folder = claim(tmp_path, "nightly")
     (folder / "results.json").write_text("{}")
-    with pytest.raises(RunFolderTaken, match="--run-id nightly: .* exists"):
+    with pytest.raises(RunFolderTaken, match=r"--run-id nightly: .* exists"):
         claim(tmp_path, "nightly")
     assert (folder / "results.json").read_text() == "{}"
 

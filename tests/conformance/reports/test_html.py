@@ -16,7 +16,7 @@ from tests.conformance.reports.toy import HOSTILE, result, toy_run
 class _Tags(HTMLParser):
     """Collects start tags and checks that every opened element (but the void ones)
     is closed in order: the page is well nested."""
-    VOID = {"meta", "input", "br", "img", "link", "path", "use", "rect", "stop"}
+    VOID = frozenset({"meta", "input", "br", "img", "link", "path", "use", "rect", "stop"})
 
     def __init__(self) -> None:
         super().__init__()

@@ -10,8 +10,8 @@ import xml.etree.ElementTree as ET
 
 from junitparser import Failure, JUnitXml, Properties, Skipped
 
-from conformance.verdicts.explain import plain
 from conformance.reports import to_json, write_junit, write_reports
+from conformance.verdicts.explain import plain
 from conformance.verdicts.verdict import FAILED
 from gve_fixtures.rules import load_rules
 from tests.conformance.reports.toy import HOSTILE, toy_run

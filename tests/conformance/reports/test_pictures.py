@@ -3,9 +3,9 @@ through the emulator's rig, and the motion traces the measured cases record."""
 
 from __future__ import annotations
 
-from conformance.run.selection import select
 from conformance.reports.html import render_html
 from conformance.run.runner import run
+from conformance.run.selection import select
 from conformance.targets import parse_target
 
 
