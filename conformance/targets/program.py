@@ -66,6 +66,11 @@ class Program:
         self._lines: queue.Queue[str | None] = queue.Queue()
         self._background = False
         self._eof = False
+        # stop() wakes the reader through this pipe and waits for it before closing
+        # standard output: a reader left blocked on a closed descriptor would read the
+        # next program's output once its number is reused
+        self._wake_r, self._wake_w = os.pipe()
+        self._reader: threading.Thread | None = None
 
     # -- what it says ---------------------------------------------------------------------
     def _take(self, timeout: float | None) -> str | None:
@@ -84,8 +89,9 @@ class Program:
                 return None
             left = None if end is None else max(0.0, end - time.monotonic())
             try:
-                ready = select.select([self._fd], [], [], left)[0]
-                data = os.read(self._fd, 1 << 16) if ready else None
+                ready = select.select([self._fd, self._wake_r], [], [], left)[0]
+                data = (b"" if self._wake_r in ready else
+                        os.read(self._fd, 1 << 16) if ready else None)
             except (OSError, ValueError):              # closed by stop()
                 data = b""
             if data is None:
@@ -102,8 +108,9 @@ class Program:
         co-simulator's replies, docs/cosim.md)."""
         if not self._background:
             self._background = True
-            threading.Thread(target=self._read, name=f"exec-{self.process.pid}",
-                             daemon=True).start()
+            self._reader = threading.Thread(target=self._read, daemon=True,
+                                            name=f"exec-{self.process.pid}")
+            self._reader.start()
 
     def _read(self) -> None:
         while (text := self._take(None)) is not None:
@@ -198,11 +205,17 @@ class Program:
                     break
         self.process.wait()                            # reaped: no zombie
         _end_group(group)                              # what it started: no orphan
+        with contextlib.suppress(OSError):
+            os.write(self._wake_w, b"\n")
+        if self._reader not in (None, threading.current_thread()):
+            self._reader.join()
         for stream in (self.process.stdin, self.process.stdout):
             with contextlib.suppress(OSError, ValueError):
                 if stream is not None:
                     stream.close()
         self._stderr.close()
+        for end in (self._wake_r, self._wake_w):
+            os.close(end)
 
 
 def _end_group(group: int) -> None:

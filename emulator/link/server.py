@@ -44,9 +44,11 @@ class StdoutGone(Exception):
 
 
 def say(text: str) -> None:
-    """One line on standard output (the port, control replies)."""
+    """One line on standard output (the port, control replies), in one write: a reader
+    never sees half of it, also when Python's output is unbuffered."""
     try:
-        print(text, flush=True)
+        sys.stdout.write(text + "\n")
+        sys.stdout.flush()
     except BrokenPipeError:
         raise StdoutGone from None
 

@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 
 import pytest
 
@@ -60,6 +61,22 @@ def test_lines_come_in_order_and_none_is_made_up():
         assert p.line(0.05) is None           # nothing more was printed
     finally:
         p.stop()
+
+
+def test_a_stopped_program_s_reader_has_ended_and_the_next_program_s_line_comes_whole():
+    first = Program(ECHO)
+    assert first.line(10) == "ready"
+    first.read_in_background()
+    first.stop()
+    assert f"exec-{first.process.pid}" not in {t.name for t in threading.enumerate()}
+    # the next program's descriptors may take the numbers the first one's had: nothing
+    # of the first one reads them, so a line written in two pieces comes whole
+    pieces = [sys.executable, "-c", "import os\nos.write(1, b'/dev/pts/')\nos.write(1, b'7\\n')"]
+    second = Program(pieces)
+    try:
+        assert second.line(10) == "/dev/pts/7"
+    finally:
+        second.stop()
 
 
 def test_a_program_deaf_to_quit_and_sigterm_is_killed(quick):
