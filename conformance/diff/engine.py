@@ -172,7 +172,7 @@ class Pair:
         if not self._begin(out):
             return out
         self._last = list(steps)
-        self._teller = Teller(self.target, steps, self._refer) if ahead else None
+        self._teller = Teller(self.target, steps, self._refer, self.awaited) if ahead else None
         earlier: set[str] = set()          # what the sequence did before (labels read it)
         try:
             for place, step in enumerate(steps):
@@ -548,12 +548,20 @@ class Pair:
                                     if image.defaults.get(a, image.erased) != v}
         self.reference.write_eeprom(self._eeprom_changes)
 
+    def awaited(self, step: Step, data: bytes) -> float:
+        """How long both sides await a frame's answer: the longer of their two guards'
+        estimates (in virtual time a side that stopped listening sooner would run on
+        from another instant than the other, and every reading after it would differ)."""
+        return max(side.awaited(data, step.body, step.answer)
+                   for side in (self.target, self.reference))
+
     def _refer(self, step: Step, data: bytes) -> tuple[RoundTrip, str]:
         """The frame to the reference: its exchange, and why the sequence ends there
         ("": it goes on)."""
         try:
             return self.reference.exchange(data, lines=step.lines, answer=step.answer,
-                                           stall=step.stall, body=step.body), ""
+                                           stall=step.stall, body=step.body,
+                                           timeout=self.awaited(step, data)), ""
         except TargetNotResponding as err:
             return RoundTrip(data, b"", 0, 0, None, step.lines), str(err)
 
@@ -587,7 +595,8 @@ class Pair:
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
                                               stall=step.stall, body=step.body,
-                                              meanwhile=reference if told is None else None)
+                                              meanwhile=reference if told is None else None,
+                                              timeout=self.awaited(step, data))
         except SafetyStop as err:
             why = str(err)
             out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")

@@ -63,13 +63,16 @@ def tellable(step: Step) -> bool:
 
 class Teller:
     """One example's frames told ahead, for the target ``side``; ``refer`` runs a step's
-    frame on the reference (its exchange, and why the sequence ends there: "" to go on)."""
+    frame on the reference (its exchange, and why the sequence ends there: "" to go on);
+    ``awaited`` says how long both sides await a frame's answer."""
 
     def __init__(self, side: Side, steps: list[Step],
-                 refer: Callable[[Step, bytes], tuple[RoundTrip, str]]) -> None:
+                 refer: Callable[[Step, bytes], tuple[RoundTrip, str]],
+                 awaited: Callable[[Step, bytes], float]) -> None:
         self.side = side
         self.steps = steps
         self.refer = refer
+        self.awaited = awaited
         self.queue: deque[Told] = deque()
         #: the target answered alike at another instant than the reference within frames
         #: told ahead: this run's comparisons after it are not the sequence's
@@ -88,7 +91,7 @@ class Teller:
             if not tellable(step):
                 break
             data = step.frame_bytes(address, link.checksums)
-            if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
+            if not ahead.admit(data, self.awaited(step, data)):
                 break
             reference, ended = self.refer(step, data)
             if step.answer and reference.answer:
@@ -151,7 +154,7 @@ class Teller:
                 continue
             try:
                 self.side.exchange(told.data, lines=told.step.lines, answer=told.step.answer,
-                                   body=told.step.body)
+                                   body=told.step.body, timeout=self.awaited(told.step, told.data))
             except SafetyStop:
                 self.forget([told])
                 return

@@ -219,6 +219,25 @@ def test_a_kept_power_on_restored_finds_the_same_with_fewer_commands(mutant):
     assert sent == plain_sent and fewer < sent - 3 * seen[0][1]
 
 
+def test_both_sides_await_an_unanswered_w_alike_and_run_on_from_the_same_instant():
+    # a W in a packet goes unanswered; the co-simulator's guard (an envelope) and the
+    # reference's (none) estimate its run differently, yet both listen as long
+    p = pair(cosim())
+    p.ahead = False
+    steps = [Step(FRAME, body="*S", answer=False), Step(FRAME, body="WX,1,900,1,900"),
+             Step(FRAME, body="P")]
+    try:
+        out = p.run(steps)
+        assert out.disagreement is None and not out.ended, out.disagreement
+        w = out.records[1]
+        assert w.target.answer == w.reference.answer == b""
+        assert w.target.received_at - w.target.sent_at == \
+            w.reference.received_at - w.reference.sent_at
+    finally:
+        p.target.session.finish()
+        p.target.target.close()
+
+
 @pytest.mark.xfail(strict=True, raises=(AssertionError, TargetNotResponding), reason=(
     "a correct co-simulator is taken for one not responding: after `>` sent with a bad "
     "checksum (answered 0 on both sides), the packet's members *S, B, VL and C count as "
