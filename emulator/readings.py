@@ -192,6 +192,9 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                          "SW6 writing STOP (bit 0, \"žádost o zastavení\") as 1 is a stop "
                          "request the unit accepts: INTA is set and a motion stops on its "
                          "ramp, as writing INTA does"),
+    "accel-byte-range": (("10.cmd.accel-range",),
+                         "A takes 1..255 (thousands of pulses/s², one byte) and answers "
+                         "5 above: the manuals state A20 at reset and no range"),
 }.items()}
 
 #: readings whose behaviour lives in the stepper core

@@ -9,6 +9,7 @@ raises :class:`CommandError` and changes nothing (spec 4).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 from emulator.motion.interface import EMPTY_SAVE, KeepSave
 from emulator.protocol.device import MS, Device
@@ -17,6 +18,9 @@ from emulator.protocol.reply import Answer, Deferred, Reply
 from emulator.protocol.session import Session
 from emulator.protocol.state import INTA, INTCOM, Saved
 from gve_fixtures.protocol import SECOND, ErrorCode
+
+#: the reading accel-byte-range: the largest A a unit taking it as one byte accepts
+ACCEL_BYTE = 255
 
 Handler = Callable[[Device, Session, str, int], Reply]
 
@@ -91,6 +95,8 @@ def modal(key: str, attr: str) -> Handler:
     """T, $, A, V, B: one decimal within the profile's range, kept for later vectors."""
     def handler(dev: Device, ses: Session, p: str, t: int) -> Reply:
         r = dev.profile.ranges[key]
+        if key == "A" and dev.readings.active("accel-byte-range"):
+            r = replace(r, hi=min(r.hi, ACCEL_BYTE))
         head = plain(p.split(",")[0])
         if key == "V" and "," in p and head is not None and r.lo <= head <= r.hi \
                 and dev.mutant.active("velocity-syntax-refused-stored"):

@@ -20,6 +20,8 @@ EMULATOR = Path(__file__).resolve().parents[1].parent / "emulator"
 Step = bytes | tuple[int, int] | float
 POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "plus-sign": ([b"!0V+100\r"], b"4\r", b"0\r"),
+    # one byte: 255 taken, 256 beyond it
+    "accel-byte-range": ([b"!0A255\r", b"!0A256\r"], b"0\r0\r", b"0\r5\r"),
     "long-version": ([b"!0?\r"], b"0,IP84 v3 27.1.2010\r",
                      b"0,IP84 v3 27.1.2010 (c) Gravos (P.Borovsky)\r"),
     "go-nothing-queued": ([b"!0H\r", b"!0G\r"], b"8\r0\r", b"8\rE\r"),

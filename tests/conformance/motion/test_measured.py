@@ -34,6 +34,16 @@ def test_virtual_time_judges_every_reading_with_zero_tolerance(profile: str) -> 
             assert "ms line" not in c["what"] and "±" not in c["what"], c["what"]
 
 
+def test_an_acceleration_refused_beyond_a_range_no_manual_states_is_measured_at_reset():
+    """A unit that takes A as one byte refuses A10000 (5): the scenario is measured at
+    the reset value the manual states (A20) and judged, not left untested."""
+    results = run([parse_target("emu:GVE54?reading=accel-byte-range")],
+                  select(["10.2.measured.cruise-at-v", "10.2.measured.dwell"])).results
+    assert [r.verdict for r in results] == [PASS, PASS], [(r.id, r.notes) for r in results]
+    for r in results:
+        assert any("A10000 answered 5" in n and "with A20" in n for n in r.notes), r.notes
+
+
 @pytest.mark.slow
 @pytest.mark.pty
 @pytest.mark.parametrize("profile", ["GVE84-100", "GVE54", "GVE114-500"])

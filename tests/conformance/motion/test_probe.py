@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.motion.probe import _split
+from conformance.motion.probe import _split, _stated_instead
+from conformance.protocol.wire import parse_response
+from gve_fixtures.profile import load_profile
 
 
 @pytest.mark.parametrize(("body", "read"), [
@@ -15,3 +17,16 @@ from conformance.motion.probe import _split
 ])
 def test_a_frame_is_read_as_its_command_and_the_rest(body, read):
     assert _split(body) == read
+
+
+@pytest.mark.parametrize(("body", "answer", "instead"), [
+    ("A10000", b"5\r", "A20"),       # A's range is ours [D]: measured at reset
+    ("A10000", b"0\r", None),        # taken
+    ("A10000", b"4\r", None),        # another refusal: the case cannot judge
+    ("A20", b"5\r", None),           # the reset value itself refused: nothing to fall back to
+    ("V60000", b"5\r", None),        # V's range the manual states [M]
+    ("L10,0,0", b"5\r", None),       # not a modal value
+])
+def test_only_a_range_no_manual_states_falls_back_to_the_reset_value(body, answer, instead):
+    r = parse_response(answer, summed=False)
+    assert _stated_instead(body, r, load_profile("GVE54")) == instead
