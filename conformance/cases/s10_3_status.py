@@ -22,14 +22,21 @@ from gve_fixtures.protocol import ErrorCode
 IN0_ACTIVE = 0xFE          # IN0 grounded: active at the reset polarity 0 (spec 10.3)
 
 
-def _interrupted_by_input(ctx: CaseContext) -> None:
-    """Setup: IN0 enabled and active, so the unit is interrupted (INTA, ST4 bit 0)."""
+def _interrupted_by_input(ctx: CaseContext) -> bool:
+    """IN0 enabled while it is active: the unit is interrupted (INTA, ST4 bit 0) at once
+    under the level reading [D]. A unit may see the level only after it has answered
+    the write, so SR6 asks; one that never does reads interrupts as edges (False)."""
     r = ctx.link.send("SW0,01")
-    ctx.require(r is not None and r.ok and r.inta, f"SW0,01 answered {show(r)}")
+    ctx.require(r is not None and r.ok, f"SW0,01 answered {show(r)}")
+    if not r.inta:
+        r = ctx.link.send("SR6")
+    return ctx.expect(r is not None and r.inta, "enabling IN0 while it is active interrupts",
+                      observed=show(r), expected="INTA set", rule="10.3.inputs.level-triggered")
 
 
 def _after_clearing(ctx: CaseContext, body: str) -> None:
-    _interrupted_by_input(ctx)
+    if not _interrupted_by_input(ctx):
+        return                            # edges, not levels: what follows is moot
     r = ctx.link.send(body)
     if body == "R":
         # nothing was kept: what R answers then is the restore rule's reading, the INTA

@@ -7,8 +7,9 @@ from __future__ import annotations
 import pytest
 
 from conformance.cases.s11_golden import envelope_needed
-from conformance.run.runner import run_case
+from conformance.run.runner import run, run_case
 from conformance.run.selection import select
+from conformance.targets import parse_target
 from conformance.verdicts.verdict import COULD_NOT_TEST, PASS
 from gve_fixtures import golden_transcripts
 from gve_fixtures.profile import available_profiles, load_profile
@@ -57,3 +58,12 @@ def test_a_d_record_takes_the_extra_lines_of_a_unit_reading_it_otherwise():
     assert r.verdict == NON_STRICT, r.notes
     (failed,) = [ch for ch in r.checks if not ch["ok"]]
     assert failed["observed"] == "!0@\\r0,0\\r" and failed["tag"] == "D"
+
+
+@pytest.mark.parametrize("reading", ["go-clears-then-nothing", "go-nothing-queued"])
+def test_the_interrupted_golden_s_clean_up_takes_either_answer_to_g_with_nothing_queued(
+        reading):
+    # G4d's G only cleans up: 0, or 6 with nothing to start (spec 5 allows both)
+    result = run([parse_target(f"emu:GVE84-100?reading={reading}")],
+                 select(["11.golden.g4d-interrupted"]))
+    assert [r.verdict for r in result.results] == [PASS]
