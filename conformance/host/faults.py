@@ -21,6 +21,9 @@ from conformance.host.recording import Exchange, show
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode
 
+#: frames `>` never shows (spec 8): the last one remembered stays what it was
+_FORGOTTEN = classes(remembered=False)
+
 #: how late a late answer is: longer than a host's least patience (checks.PATIENCE)
 LATE_S = 0.4
 #: noise before an answer: bytes no response can contain (spec 4), so a careful host can
@@ -182,7 +185,8 @@ class QueueFull(Fault):
     """For a while from the target on, the unit answers `1` to every vector and `*E`
     (spec 5, 10.1: try again later). The vector does not reach the unit; the unit gets
     `F` instead, so that its index counts the frame as a full queue's would (spec 8), and
-    a packet's `*E` reaches it with a wrong count, so that it drops the packet."""
+    a packet's `*E` reaches it with a wrong count, so that it drops the packet. A `>`
+    after it shows the host's frame and the `1` it got, as a full queue's unit would."""
 
     kind = "queue-full"
 
@@ -191,6 +195,10 @@ class QueueFull(Fault):
         self.target = target
         self.until: int | None = None
         self._faked: set[int] = set()
+        #: per address, what `>` shows while a faked frame is the last one remembered:
+        #: the host's frame as sent (through its checksum) and the answer it got
+        self._remembered: dict[int, tuple[bytes, bytes]] = {}
+        self._repeats: set[int] = set()
 
     def describe(self) -> str:
         return f"the queue is full for {QUEUE_FULL_S:g} s from {self.target}"
@@ -206,6 +214,10 @@ class QueueFull(Fault):
     def frame(self, ex: Exchange, ctx: Context) -> bytes | None:
         raw = ex.frame.raw + b"\r"
         f = ex.parsed
+        if f.command == ">" and f.address in self._remembered:
+            self._repeats.add(ex.n)
+        elif f.command is not None and f.command not in _FORGOTTEN:
+            self._remembered.pop(f.address, None)
         if not self._active(ctx) or f.command is None:
             return raw
         packet = ctx.in_packet(f.address)
@@ -227,6 +239,11 @@ class QueueFull(Fault):
 
     def answer(self, ex: Exchange, ctx: Context) -> Delivery:
         data = b"".join(ex.answer)
+        if ex.n in self._repeats and ex.answer:
+            frame, answer = self._remembered[ex.parsed.address]
+            ctx.note_fault(self.kind, f"`>` answered {show(data)}; the host gets the frame "
+                                      f"it sent and the 1 it got")
+            return Delivery(frame + b"\r" + answer + b"\r")
         if ex.n not in self._faked or not ex.answer:
             return Delivery(data)
         line = ex.answer[-1].rstrip(b"\r")
@@ -242,6 +259,7 @@ class QueueFull(Fault):
             out += b",%02X" % byte_sum(out + b",")
         ctx.note_fault(self.kind, f"the unit answered {show(data)}; the host gets "
                                   f"{show(out)}\\r")
+        self._remembered[ex.parsed.address] = (ex.frame.raw, out)
         return Delivery(out + b"\r")
 
 
