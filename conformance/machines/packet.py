@@ -28,7 +28,6 @@ class PacketMachine(UnitMachine):
         if summed:
             r = self.send("%+", checksum=False)
             holds(r is not None and r.ok, "6.checksum.mode-commands", f"%+ answered {r}")
-            self.model.checksums = True
 
     @rule()
     def start(self) -> None:
@@ -67,7 +66,7 @@ class PacketMachine(UnitMachine):
         r = self.send("@")
         holds(r is not None and r.ok, "7.packet.breakers",
               f"@ inside a packet answered {r}")
-        self.model.packet = None
+        self.model.open_packet()          # answered, `@` ended it: no member is expected
         self.pending = []
 
     def teardown(self) -> None:

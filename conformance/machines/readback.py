@@ -502,7 +502,6 @@ class ReadBackMachine(UnitMachine):
             self.model.open_packet()
             for m in members:
                 self.send(m, answer=False)
-            self.model.packet = None
             r = self.send(f"*E{n}")
             holds(r is not None and r.code == want, "7.packet.codes",
                   f"{', '.join(members)}, *E{n} answered {r}, expected code {want}")
