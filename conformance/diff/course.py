@@ -1,7 +1,8 @@
 """What the reference has been given so far in an example, as far as a difference
 reads it: the dwell a frame may have met, the fastest its axes can have stepped, the
-last vector it queued and whether a packet is open. One tracker, fed every accepted
-frame and every step."""
+last vector it queued. One tracker, fed every accepted frame; whether a packet is open
+is the one view of the wire's (conformance/protocol/view.py), fed every frame and the
+reference's answer to it."""
 
 from __future__ import annotations
 
@@ -12,11 +13,10 @@ from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes, eeprom_read_width, eeprom_width
+from conformance.protocol.view import View, observe
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
-#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
-_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 #: a vector that moves nothing (and so waits no dwell)
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
@@ -46,7 +46,9 @@ class Course:
       the cruise; B lowers a rate, it never raises one).
     - The last vector it queued: ``C+C`` when a C followed a C (the two meet at a
       junction, spec 10.2); a D empties the queue.
-    - Whether a packet is open (`*S` to the unit's own address, until a breaker).
+    - The reference as the wire shows it (:attr:`wire`): whether a packet is open, as
+      the link and the guard read it (an answered `*S` opens none, a frame answered
+      inside one ends it).
     - How far from where the example began each axis can be (the counter units of every
       vector it took, in the micro-step mode of its time; unknown after anything else
       that moves or sets a counter): a position beyond is not a matter of *when* (a rate)
@@ -81,7 +83,9 @@ class Course:
         #: a reading, 10.2.motion.junction-reversal): everything after it is timed by it
         self.reversal = False
         self._last_c: list[int] | None = None
-        self.in_packet = False
+        #: the frames to the unit (and its spindle's address) and the reference's answers
+        self.wire = View()
+        self.spindle = profile.spindle.address if profile.spindle is not None else None
         self.factors = dict(profile.microstep.factors) if profile.microstep else {}
         self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
         #: the smallest acceleration it took (commanded steps/s²): the longest last step
@@ -146,12 +150,19 @@ class Course:
                 value = _first_number(params.partition(",")[2], 16)
                 self.mpg_byte = value if value is not None else self.mpg_byte
 
-    def stepped(self, command: str, step: Step) -> None:
-        """A step's frames all went: a packet opens or closes."""
-        if command == "*S" and step.address is None:
-            self.in_packet = True
-        elif command in _PACKET_BREAKERS:
-            self.in_packet = False
+    def exchanged(self, step: Step, reference: RoundTrip) -> None:
+        """A frame of ``step`` went to the reference, which answered ``reference``
+        (frames to another unit's address tell nothing of it)."""
+        if step.address is None or step.address == self.spindle:
+            self.wire = observe(self.wire, step.body, reference.response)
+
+    def powered_on(self) -> None:
+        """The reference restarted (a rig's power-on): the reset state (spec 9)."""
+        self.wire = self.wire.restarted()
+
+    @property
+    def in_packet(self) -> bool:
+        return self.wire.packet_open
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
         answer = reference.response

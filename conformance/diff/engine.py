@@ -333,6 +333,7 @@ class Pair:
             out.records.append(StepRecord(step, place=place))
             earlier.add(step.body.split()[0])
             if step.body == "power-on":
+                self.course.powered_on()
                 self._index = IndexBase(0)
                 self.judge = replace(self.judge, index_offset=0)
 
@@ -387,6 +388,7 @@ class Pair:
                 return True
             if (rec.reference.code or 0) & 7:
                 self._index.refused_frame(command, self._context(step, self.course.in_packet))
+            self.course.exchanged(step, rec.reference)
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
@@ -408,7 +410,6 @@ class Pair:
                 earlier.add(f"{command}-refused")
             if code == ErrorCode.QUEUE_FULL:
                 earlier.add(f"{command}-no-room")
-        self.course.stepped(command, step)
         return False
 
     def _disagreement(self, step: Step, command: str, kind: str, out: ExampleRun,

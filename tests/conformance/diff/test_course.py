@@ -62,14 +62,33 @@ def test_two_c_meet_at_a_junction_until_d():
     assert not c.junction
 
 
+def silent(at_ms: int = 0) -> RoundTrip:
+    """The reference answered nothing."""
+    return RoundTrip(b"", b"", at_ms * MS, at_ms * MS, None)
+
+
 def test_a_packet_opens_on_the_units_own_star_s_and_closes_on_a_breaker():
     c = course()
-    c.stepped("*S", Step(FRAME, "*S", address=3))
+    c.exchanged(Step(FRAME, "*S", address=3), silent())
     assert not c.in_packet
-    c.stepped("*S", Step(FRAME, "*S"))
-    c.stepped("C", Step(FRAME, "C1,0,0"))
-    assert c.in_packet
-    c.stepped("@", Step(FRAME, "@"))
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.exchanged(Step(FRAME, "C1,0,0"), silent())
+    assert c.in_packet and c.wire.packet == ("C1,0,0",)
+    c.exchanged(Step(FRAME, "@"), ok())
+    assert not c.in_packet
+
+
+def test_the_open_packet_is_the_one_view_s_of_the_reference_s_answers():
+    """Decided (docs/decisions.md, "one view of the unit"): an `*S` the reference
+    answered opened nothing, and a frame it answered inside a packet ended it."""
+    c = course()
+    c.exchanged(Step(FRAME, "*S"), ok(code=4))
+    assert not c.in_packet
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.exchanged(Step(FRAME, "V100"), ok())
+    assert not c.in_packet
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.powered_on()
     assert not c.in_packet
 
 
