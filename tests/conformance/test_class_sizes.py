@@ -18,7 +18,6 @@ OVER: dict[tuple[str, str], int] = {
     ("link/link.py", "Link"): 665,
     ("link/safety.py", "Guard"): 649,
     ("diff/engine.py", "Pair"): 543,
-    ("diff/grammar.py", "Grammar"): 473,
 }
 
 
