@@ -11,6 +11,7 @@ import re
 
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
+from conformance.motion.tolerance import profile_reach
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes, eeprom_read_width, eeprom_width
 from conformance.protocol.view import View, observe
@@ -237,6 +238,27 @@ class Course:
             self.reach = None
 
     # -- what a difference reads ---------------------------------------------------------
+    def context(self, t: int, command: str, body: str, position: list[str] | None
+                ) -> set[str]:
+        """The labels' context flags the course gives a difference at ``t`` on the frame
+        ``body`` (``position``: the target's values where it is a position's)."""
+        dwell = self.within_dwell(t)
+        shipped = self.unwritten(command, body)
+        flags = {
+            "in-dwell": dwell,
+            "c-from-rest": dwell and self.c_from_rest,
+            "after-zero-vector": self.after_zero_vector(t),
+            "reversal": self.reversal,
+            "beyond-reach": position is not None and self.beyond_reach(position),
+            "capped-elsewhere": self.capped_elsewhere,
+            "kept": self.kept,
+            "nothing-kept": not self.kept,
+            shipped: bool(shipped),
+            "mpg-on": self.mpg_on,
+            "mode-over-held": self.mode_over_held,
+        }
+        return {flag for flag, on in flags.items() if on}
+
     def within_dwell(self, t: int) -> bool:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
 
@@ -266,6 +288,18 @@ class Course:
         (raised by XM and XU) at the smallest A."""
         cruise = min(self.top, self.cruise * self.override * self.up)
         return math.ceil(cruise * 1_000_000_000 / self.accel)
+
+    def reading_ns(self, changes: int, command: str = "", body: str = "") -> tuple[int, int]:
+        """How much earlier and later a unit of somebody else's may place the example's
+        motion than the reference (tolerance.py's profile_reach), ``changes``: the frames
+        that changed its course, the run of the frame ``body`` (a W's, answered when it
+        ends) included."""
+        moves, ramps = self.own_run(command, body)
+        sooner, later = self.dwell_reach
+        return profile_reach(starts=self.starts + moves, changes=changes,
+                             sooner_ns=sooner, later_ns=later,
+                             ramp_ns=self.ramp_ns if self.path else 0,
+                             run_ramps_ns=self.run_ramps_ns + ramps)
 
     def own_run(self, command: str, body: str) -> tuple[int, int]:
         """A run at a speed of its own (`W<axis>,n2,n3,n4,n5`): its moves from rest (to
