@@ -7,7 +7,7 @@ and judges the host's traffic on the wire, under the faults a real line and unit
                 the host's bytes are framed by conformance/protocol/framer.py)
     relay.py    host <-> units, answers paired with frames, faults applied: only what
                 the line needs while it runs
-    ledger.py   the frames read and the units' views booked in the relay's order, when
+    booking.py   the frames read and the units' views booked in the relay's order, when
                 a fault or the end of the run asks
     faults.py   lost, damaged, late and noisy answers, lost and cut frames, a full queue,
                 an interrupt, a restart

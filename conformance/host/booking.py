@@ -5,7 +5,7 @@ Reading a frame against the grammar (grammar.py) and booking an exchange on the 
 views (unitview.py) take longer than a 921,600-baud line leaves the relay for a frame,
 and the line needs neither: the relay only passes bytes, pairs answers with frames and
 delivers them with their faults. So the relay notes, in its own order, what happened —
-a frame came, an exchange was answered, a unit restarted — and the ledger reads and
+a frame came, an exchange was answered, a unit restarted — and the booking reads and
 books them when someone asks: a fault that needs the count of accepted vectors, a
 unit's checksum mode or open packet, an exchange's reading, or the end of the run. A
 frame is read in the checksum mode its unit was in when the frame came, as it would have
@@ -24,7 +24,7 @@ from conformance.host.unitview import UnitView, by_address, profiles_by_address
 FRAME, ANSWERED, POWER_ON = "frame", "answered", "power-on"
 
 
-class Ledger:
+class Booking:
     def __init__(self, views: list[UnitView]) -> None:
         self.views = views
         self.view_at = by_address(views)
