@@ -3,7 +3,7 @@ and judges the host's traffic on the wire, under the faults a real line and unit
 
     ports/      where the host meets the relay (pty, TCP, serial device)
     units.py    the emulated units behind the relay (gve://, its rig and its clock)
-    grammar.py  one frame judged against spec 3 and 10 (the command catalogue's parameters;
+    frame_rules.py  one frame judged against spec 3 and 10 (the command catalogue's parameters;
                 the host's bytes are framed by conformance/protocol/framer.py)
     relay.py    host <-> units, answers paired with frames, faults applied: only what
                 the line needs while it runs

@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from conformance.host.grammar import ParsedFrame
+from conformance.host.frame_rules import ParsedFrame
 from conformance.protocol.framer import Fragment, HostFrame
 from gve_fixtures.transcript import ACTION, HOST, UNIT, Record, escape
 

@@ -31,7 +31,7 @@ import serial
 
 from conformance.host.booking import Booking
 from conformance.host.faults import Fault
-from conformance.host.grammar import command_of
+from conformance.host.frame_rules import command_of
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView

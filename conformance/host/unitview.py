@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from conformance.host.grammar import ParsedFrame, parse_frame
+from conformance.host.frame_rules import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
 from conformance.protocol.catalogue import classes
 from conformance.protocol.view import View, observe

@@ -4,7 +4,7 @@ the same readings and the same executed motion as reading and booking each at on
 from __future__ import annotations
 
 from conformance.host.booking import Booking
-from conformance.host.grammar import byte_sum, parse_frame
+from conformance.host.frame_rules import byte_sum, parse_frame
 from conformance.host.recording import Exchange
 from conformance.host.unitview import line_views
 from conformance.protocol.framer import HostFrame
