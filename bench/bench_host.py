@@ -22,7 +22,7 @@ from pathlib import Path
 
 import gve_host
 from conformance.host.certify import Plan, certify
-from conformance.host.faults import Fault
+from conformance.host.line_faults import Fault
 from conformance.host.ports.silent import SilentPort
 from conformance.host.relay import Relay
 from conformance.host.scenarios import SCENARIOS

@@ -9,7 +9,7 @@ and judges the host's traffic on the wire, under the faults a real line and unit
                 the line needs while it runs
     booking.py   the frames read and the units' views booked in the relay's order, when
                 a fault or the end of the run asks
-    faults.py   lost, damaged, late and noisy answers, lost and cut frames, a full queue,
+    line_faults.py   lost, damaged, late and noisy answers, lost and cut frames, a full queue,
                 an interrupt, a restart
     recording.py, unitview.py   what was seen both ways; what the units executed
     checks.py   the host rules judged on the wire (WIRE_CHECKS: rule ID -> check)

@@ -25,7 +25,7 @@ from typing import TextIO
 
 from conformance.host import oracle, probe
 from conformance.host.checks import LineFacts, judge
-from conformance.host.faults import Fault
+from conformance.host.line_faults import Fault
 from conformance.host.oracle import HostResult, HostRun
 from conformance.host.ports import HostPort, open_port
 from conformance.host.relay import Relay

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
-from conformance.host.faults import Fault
+from conformance.host.line_faults import Fault
 from conformance.host.probe import Final
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario

@@ -5,7 +5,7 @@ passed on at once to emulated units; the units' answers go back to the host. The
 line keeps virtual time, which the relay brings up to the wall clock before every move:
 the units act in real time, yet the relay never sleeps on them, and an answer is given to
 the host no sooner than the line could have carried it at its baud rate. Between the two
-a fault may act at one point of the job (faults.py). Every byte both ways is recorded
+a fault may act at one point of the job (line_faults.py). Every byte both ways is recorded
 with its instant (recording.py), and each frame is paired with the answer the unit gave
 it, so that the host rules (checks.py) and the motion the unit executed (unitview.py) can
 be judged from the wire alone. The relay does only what the line needs while it runs;
@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import serial
 
 from conformance.host.booking import Booking
-from conformance.host.faults import Fault
 from conformance.host.frame_rules import command_of
+from conformance.host.line_faults import Fault
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
@@ -84,7 +84,7 @@ class Relay:
         self._settings: str | None = None
         self._turn_end: int | None = None       # when the relay's last turn ended
 
-    # -- what faults may use (faults.Context) -------------------------------------------------
+    # -- what faults may use (line_faults.Context) --------------------------------------------
     def now(self) -> int:
         return now()
 

@@ -13,7 +13,7 @@ import fnmatch
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from conformance.host.faults import (
+from conformance.host.line_faults import (
     DAMAGE,
     AnswerFault,
     Fault,
