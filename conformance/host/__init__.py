@@ -15,6 +15,6 @@ and judges the host's traffic on the wire, under the faults a real line and unit
     checks.py   the host rules judged on the wire (WIRE_CHECKS: rule ID -> check)
     scenarios.py, oracle.py     the scenarios; the executed motion against the clean run
                 (oracle.HOST_CHECKS: every host rule -> the check that judges it)
-    probe.py    where the motion ended, asked over the wire after the host left
+    final_state.py    where the motion ended, asked over the wire after the host left
     certify.py  a whole certification, launched or attended
 """
