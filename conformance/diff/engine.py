@@ -20,7 +20,7 @@ from hypothesis.errors import Flaky, NoSuchExample
 from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.course import Course
 from conformance.diff.grammar import Grammar, Options
-from conformance.diff.index import QUERIES, IndexBase
+from conformance.diff.index_base import QUERIES, IndexBase
 from conformance.diff.labels import allowed, command_of, label, verdict_of
 from conformance.diff.matrix import Cell, cells
 from conformance.diff.reach import Reach
@@ -399,7 +399,7 @@ class Pair:
         return self.course.reading_ns(self._course_changes, command, body)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
-        """The index is compared from each side's first reading of it (index.py)."""
+        """The index is compared from each side's first reading of it (index_base.py)."""
         self._index.note(command, context, _values(rec.target), _values(rec.reference))
         self.judge = replace(self.judge, index_offset=self._index.offset or 0)
 

@@ -2,11 +2,11 @@
 session's, the reference a fresh unit given the target's history), or both from the
 reset state where the target is a co-simulator in virtual time; and, for a unit that
 lives on between sequences, the prelude both are sent first and the index each reads
-there, which the sequence's index is compared from (index.py)."""
+there, which the sequence's index is compared from (index_base.py)."""
 
 from __future__ import annotations
 
-from conformance.diff.index import IndexBase
+from conformance.diff.index_base import IndexBase
 from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME, RIG, Step
 from conformance.diff.timing import Timing

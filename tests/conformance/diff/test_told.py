@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 import conformance.diff.told as told_module
 from conformance.diff.engine import ExampleRun, Pair
 from conformance.diff.grammar import Options, sequences
-from conformance.diff.index import QUERIES
+from conformance.diff.index_base import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import Side
 from conformance.diff.start import Start
