@@ -14,8 +14,8 @@ from conformance.case.context import CaseContext, CouldNotTest
 from conformance.case.settings import example_database
 from conformance.machines.base import UnitMachine, index_invariant
 from conformance.machines.checksum import ChecksumMachine
-from conformance.machines.index import RecoveryMachine
 from conformance.machines.keep import KeepMachine
+from conformance.machines.recovery import RecoveryMachine
 from conformance.machines.runner import Factory, run_machine
 from conformance.run.selection import select
 from conformance.targets import parse_target
