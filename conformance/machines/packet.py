@@ -6,8 +6,8 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
-from conformance.machines.base import UnitMachine, holds, index_invariant
 from conformance.machines.runner import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from gve_fixtures.protocol import ErrorCode
 
 # member frame -> (kind, code it fails the packet with, steps it commits)
