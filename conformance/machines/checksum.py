@@ -7,7 +7,7 @@ from hypothesis.stateful import rule
 
 from conformance.case.context import CaseContext, case
 from conformance.link.framing import byte_sum
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
 from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from gve_fixtures.protocol import ErrorCode
 

@@ -22,7 +22,7 @@ from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
 from conformance.machines.unit_machine import UnitMachine, holds
 from gve_fixtures.protocol import ErrorCode, St6
 

@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
 from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from gve_fixtures.protocol import ErrorCode
 

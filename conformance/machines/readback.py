@@ -24,7 +24,7 @@ from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
 from conformance.link.line_band import line_band
 from conformance.link.link import idle_st6
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
 from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from conformance.protocol.catalogue import catalogue, classes
 from conformance.protocol.parse import parse
