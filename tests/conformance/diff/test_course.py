@@ -1,11 +1,16 @@
 """The reference's course through an example: the dwell a frame may meet, the fastest
 rate its axes can have stepped at, the junction of two C and the open packet."""
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from conformance.diff.course import Course
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import FRAME, Step
 from conformance.link.framing import parse_response
+from conformance.protocol.view import View, observe
 from conformance.targets import parse_target
+from tests.conformance.protocol.test_view import ANSWERS, FRAMES
 
 MS = 1_000_000
 
@@ -115,3 +120,19 @@ def test_vl_capping_only_axes_never_moved_below_the_rate_is_capped_elsewhere():
     c.took("VL", "VL1000,1000,1000", ok())
     c.took("L", "L0,300,0", ok())
     assert not c.capped_elsewhere                              # no cap below the rate
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(FRAMES), st.sampled_from(ANSWERS),
+                          st.sampled_from([None, 3, 7])), max_size=20))
+def test_the_course_keeps_no_packet_of_its_own(exchanges):
+    """Whatever the reference answered, the course's open packet is that of the one view
+    fed the frames to the unit and its spindle's address (protocol/view.py)."""
+    c = Course(parse_target("emu:GVE114-500").profile)          # the spindle at 7
+    wire = View(addresses=frozenset({0, 7}))
+    for body, raw, address in exchanges:
+        answer = None if raw is None else parse_response(raw, summed=False)
+        c.exchanged(Step(FRAME, body, address=address), RoundTrip(b"", raw or b"", 0, 0,
+                                                                  answer))
+        wire = observe(wire, body, answer, address)
+    assert c.in_packet == wire.packet_open
