@@ -138,7 +138,7 @@ class Pair:
         #: it could); no sequence is sent to it after that
         self.lost = ""
         self._last: list[Step] = []            # the steps of the latest sequence begun
-        #: the latest sequence began at the target's power-on (_power_on_start)
+        #: the latest sequence began at the target's power-on (Start.powered)
         self.started_at_power_on = False
         self.led_there: list[Step] = []        # the sequence after which it was lost
 
@@ -210,8 +210,8 @@ class Pair:
 
     def _begin(self, out: ExampleRun) -> bool:
         """Both sides in the known state, or both from power-on where the target is a
-        co-simulator in virtual time (start.py); False when the guard
-        refused it, or when the target could not be brought there (:attr:`lost`)."""
+        co-simulator in virtual time (start.py); False when the guard refused it, or when
+        the target could not be brought there (:attr:`lost`)."""
         if self.lost:
             out.ended = self.lost
             return False
