@@ -215,7 +215,7 @@ class Grammar:
         self.profile = profile
         self.options = options
         self.names = command_names(profile, options)
-        #: the names an idiom's frame may have (catalogue and known-as names, SW6)
+        #: the steps written in the grammar's data (frames of the run's names, SW6)
         self.written = Written(profile, options.rig, set(self.names) | {"SW6"} | {
             n for n, c in commands().items() if c.known_as in self.names}, g)
         self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
