@@ -66,8 +66,7 @@ class PacketMachine(UnitMachine):
         r = self.send("@")
         holds(r is not None and r.ok, "7.packet.breakers",
               f"@ inside a packet answered {r}")
-        self.model.open_packet()          # answered, `@` ended it: no member is expected
-        self.pending = []
+        self.pending = []                 # answered, `@` ended the packet on the wire
 
     def teardown(self) -> None:
         if self.model.packet is None:
