@@ -6,7 +6,7 @@
    behind its pyserial port. Two streams, every frame different: simplex exchanges (a
    setting or a vector, its answer) and packets of 50 members (no answers) and `*E`.
    Reading the frames and booking the units' views waits until after the run
-   (ledger.py): its time is printed beside, not counted against the line.
+   (host/booking.py): its time is printed beside, not counted against the line.
 2. A full certification of the reference host on one profile against the budget
    "the job's time × (scenarios + 1) + 10 %" (≥ 1: within budget).
 
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import gve_host
 from conformance.host.certify import Plan, certify
-from conformance.host.faults import Fault
+from conformance.host.line_faults import Fault
 from conformance.host.ports.silent import SilentPort
 from conformance.host.relay import Relay
 from conformance.host.scenarios import SCENARIOS
@@ -64,7 +64,7 @@ def relay_ratio(kind: str, n: int) -> tuple[float, float, float]:
         relay.deliver()
     took = time.perf_counter() - start
     start = time.perf_counter()
-    relay.ledger.settle()
+    relay.booking.settle()
     after = time.perf_counter() - start
     line.close()
     port.close()

@@ -1,7 +1,9 @@
 """`gve-conformance diff`: differential fuzzing. Sequences drawn from a grammar of spec 10
 go to the target and to a reference (the embedded emulator) alike; every disagreement is
 shrunk to a minimal transcript, kept once, labelled with the rule it touches and graded
-by its tag, in the usual reports. docs/diff.md."""
+by its tag, in the usual reports. docs/diff.md.
+
+The command line of conformance/diff/ (one meaning under one name)."""
 
 from __future__ import annotations
 

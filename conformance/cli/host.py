@@ -8,6 +8,8 @@ port to open (a pseudo-terminal path, or `socket://HOST:PORT` with --port tcp:..
 Attended (no command): the port is printed first; the operator runs the host for each
 scenario and types `done`, `failed` or `hung` when its job has ended.
 Exit status: 0 when nothing FAILs, 1 otherwise, 2 for usage errors.
+
+The command line of conformance/host/ (one meaning under one name).
 """
 
 from __future__ import annotations

@@ -132,7 +132,7 @@ def missing(profile: Profile, all_cells: list[Cell]) -> tuple[list[Clause], list
     reads = observers(profile)
     every = Grammar(profile, Options(destructive=True, rig=True))
     has = {name for name, setup in states(profile)
-           if setup is not None and every._can(setup)}
+           if setup is not None and every.written.can(setup)}
     lacking, meaningless = [], []
     for c in clauses():
         if not rules[c.rule].applies_to(profile.name, profile.family) or \

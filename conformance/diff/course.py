@@ -1,7 +1,8 @@
 """What the reference has been given so far in an example, as far as a difference
 reads it: the dwell a frame may have met, the fastest its axes can have stepped, the
-last vector it queued and whether a packet is open. One tracker, fed every accepted
-frame and every step."""
+last vector it queued. One tracker, fed every accepted frame; whether a packet is open
+is the one view of the wire's (conformance/protocol/view.py), fed every frame and the
+reference's answer to it."""
 
 from __future__ import annotations
 
@@ -10,13 +11,13 @@ import re
 
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import Step
+from conformance.motion.tolerance import profile_reach
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes, eeprom_read_width, eeprom_width
+from conformance.protocol.view import View, observe
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import ErrorCode
 
-#: frames that end an open packet: `*E` closes it, the breakers discard it (spec 7)
-_PACKET_BREAKERS = classes(packet="closes") | classes(packet="breaker")
 #: a vector that moves nothing (and so waits no dwell)
 _ZERO_VECTOR = re.compile(r"[LC][-+0,]*")
 #: frames that change the course of a motion: a difference after them is theirs
@@ -46,7 +47,9 @@ class Course:
       the cruise; B lowers a rate, it never raises one).
     - The last vector it queued: ``C+C`` when a C followed a C (the two meet at a
       junction, spec 10.2); a D empties the queue.
-    - Whether a packet is open (`*S` to the unit's own address, until a breaker).
+    - The reference as the wire shows it (:attr:`wire`): whether a packet is open, as
+      the link and the guard read it (an answered `*S` opens none, a frame answered
+      inside one ends it).
     - How far from where the example began each axis can be (the counter units of every
       vector it took, in the micro-step mode of its time; unknown after anything else
       that moves or sets a counter): a position beyond is not a matter of *when* (a rate)
@@ -81,7 +84,9 @@ class Course:
         #: a reading, 10.2.motion.junction-reversal): everything after it is timed by it
         self.reversal = False
         self._last_c: list[int] | None = None
-        self.in_packet = False
+        #: the frames to the unit (and its spindle's address) and the reference's answers
+        self.wire = View()
+        self.spindle = profile.spindle.address if profile.spindle is not None else None
         self.factors = dict(profile.microstep.factors) if profile.microstep else {}
         self.factor = self.factors[profile.microstep.reset_mode] if profile.microstep else 1
         #: the smallest acceleration it took (commanded steps/s²): the longest last step
@@ -146,12 +151,19 @@ class Course:
                 value = _first_number(params.partition(",")[2], 16)
                 self.mpg_byte = value if value is not None else self.mpg_byte
 
-    def stepped(self, command: str, step: Step) -> None:
-        """A step's frames all went: a packet opens or closes."""
-        if command == "*S" and step.address is None:
-            self.in_packet = True
-        elif command in _PACKET_BREAKERS:
-            self.in_packet = False
+    def exchanged(self, step: Step, reference: RoundTrip) -> None:
+        """A frame of ``step`` went to the reference, which answered ``reference``
+        (frames to another unit's address tell nothing of it)."""
+        if step.address is None or step.address == self.spindle:
+            self.wire = observe(self.wire, step.body, reference.response)
+
+    def powered_on(self) -> None:
+        """The reference restarted (a rig's power-on): the reset state (spec 9)."""
+        self.wire = self.wire.restarted()
+
+    @property
+    def in_packet(self) -> bool:
+        return self.wire.packet_open
 
     def _dwell(self, command: str, body: str, reference: RoundTrip) -> None:
         answer = reference.response
@@ -226,6 +238,27 @@ class Course:
             self.reach = None
 
     # -- what a difference reads ---------------------------------------------------------
+    def context(self, t: int, command: str, body: str, position: list[str] | None
+                ) -> set[str]:
+        """The labels' context flags the course gives a difference at ``t`` on the frame
+        ``body`` (``position``: the target's values where it is a position's)."""
+        dwell = self.within_dwell(t)
+        shipped = self.unwritten(command, body)
+        flags = {
+            "in-dwell": dwell,
+            "c-from-rest": dwell and self.c_from_rest,
+            "after-zero-vector": self.after_zero_vector(t),
+            "reversal": self.reversal,
+            "beyond-reach": position is not None and self.beyond_reach(position),
+            "capped-elsewhere": self.capped_elsewhere,
+            "kept": self.kept,
+            "nothing-kept": not self.kept,
+            shipped: bool(shipped),
+            "mpg-on": self.mpg_on,
+            "mode-over-held": self.mode_over_held,
+        }
+        return {flag for flag, on in flags.items() if on}
+
     def within_dwell(self, t: int) -> bool:
         return self.vector_at is not None and t - self.vector_at < self.t_ns
 
@@ -255,6 +288,18 @@ class Course:
         (raised by XM and XU) at the smallest A."""
         cruise = min(self.top, self.cruise * self.override * self.up)
         return math.ceil(cruise * 1_000_000_000 / self.accel)
+
+    def reading_ns(self, changes: int, command: str = "", body: str = "") -> tuple[int, int]:
+        """How much earlier and later a unit of somebody else's may place the example's
+        motion than the reference (tolerance.py's profile_reach), ``changes``: the frames
+        that changed its course, the run of the frame ``body`` (a W's, answered when it
+        ends) included."""
+        moves, ramps = self.own_run(command, body)
+        sooner, later = self.dwell_reach
+        return profile_reach(starts=self.starts + moves, changes=changes,
+                             sooner_ns=sooner, later_ns=later,
+                             ramp_ns=self.ramp_ns if self.path else 0,
+                             run_ramps_ns=self.run_ramps_ns + ramps)
 
     def own_run(self, command: str, body: str) -> tuple[int, int]:
         """A run at a speed of its own (`W<axis>,n2,n3,n4,n5`): its moves from rest (to

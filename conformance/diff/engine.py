@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import contextlib
 import random
-import re
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
@@ -20,13 +19,15 @@ from hypothesis.errors import Flaky, NoSuchExample
 
 from conformance.diff.compare import Judge, alike_because, difference
 from conformance.diff.course import Course
-from conformance.diff.grammar import Grammar, Options, load_grammar
-from conformance.diff.index import QUERIES, IndexBase
+from conformance.diff.grammar import Grammar, Options
+from conformance.diff.index_base import QUERIES, IndexBase
 from conformance.diff.labels import allowed, command_of, label, verdict_of
 from conformance.diff.matrix import Cell, cells
 from conformance.diff.reach import Reach
 from conformance.diff.rigstate import observed, response
 from conformance.diff.sides import RoundTrip, Side
+from conformance.diff.start import Start, left_summing
+from conformance.diff.step_flags import step_flags
 from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
@@ -35,26 +36,16 @@ from conformance.motion.tolerance import (
     PLACEMENT_STEPS,
     TICK_NS,
     byte_ns,
-    profile_reach,
     step_period,
 )
-from conformance.protocol.catalogue import catalogue, classes
-from conformance.protocol.parse import parse, read_int
+from conformance.protocol.catalogue import classes
 from conformance.targets.session import StepFailed
 from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import SECOND, ErrorCode, St6
+from gve_fixtures.protocol import ErrorCode, St6
 
-_LONG_DECIMAL = re.compile(r"\d{13,}")
-#: W with a comma after its axis letter (the format line's form, not M114's example's)
-_AXIS_COMMA = re.compile(r"W[A-Za-z],")
 #: the frames that change a running motion's course (H, G, XA...)
 _COURSE = classes(retimes=True)
-#: real time: how long the fresh reference stands before a sequence
-AGE_SECONDS = 1.0
-#: a unit that lives on between sequences: what both sides are sent first (the index read
-#: between two `SR0`, the same history for `>`); told ahead with the known state's last
-PRELUDE = ("SR0", "@", "SR0")
 
 
 @dataclass
@@ -125,9 +116,8 @@ class Pair:
         #: the frames of the example that changed a motion's course (H, G, XA...): a unit
         #: of somebody else's may take each at its own next step
         self._course_changes = 0
-        self._eeprom_changes: dict[int, int] | None = None   # real target: see _prelude
+        self.start = Start(target, reference, profile, self.timing)
         self._index = IndexBase()
-        self._reference_index = 0          # the reference's index read in the prelude
         #: real time: disagreements seen once that their sequence did not show again
         self.unconfirmed: list[Finding] = []
         #: a co-simulator is told each sequence's frames ahead where the guard can judge
@@ -148,7 +138,7 @@ class Pair:
         #: it could); no sequence is sent to it after that
         self.lost = ""
         self._last: list[Step] = []            # the steps of the latest sequence begun
-        #: the latest sequence began at the target's power-on (_power_on_start)
+        #: the latest sequence began at the target's power-on (Start.powered)
         self.started_at_power_on = False
         self.led_there: list[Step] = []        # the sequence after which it was lost
 
@@ -206,49 +196,35 @@ class Pair:
         return self._end(out)
 
     def _left_summing(self, out: ExampleRun) -> None:
-        """A sequence begun at power-on (or a rig's power-on in it) whose first frame's
-        answers after it differ: whether the power-on left the checksum mode on is asked
-        as a session asks a unit it finds (`?` without its checksum refused 4, with it
-        taken: spec 6); if it did, the disagreement is the reset state's (context
-        `summing-after-power-on`: checksums off after power-on, 9.reset.state [M])."""
+        """A disagreement whose sequence a power-on left summing (start.py's
+        left_summing) is the reset state's (context `summing-after-power-on`: checksums
+        off after power-on, 9.reset.state [M])."""
         d = out.disagreement
-        if d is None:
+        if d is None or not left_summing([r.step for r in out.records[:d.index]],
+                                         self.started_at_power_on, self.target.link):
             return
-        before = out.records[:d.index]
-        # the frames since the latest power-on: the sequence's start at one, or the rig's
-        powered = [i for i, r in enumerate(before) if r.step.kind == RIG
-                   and r.step.body == "power-on"]
-        since = before[powered[-1] + 1:] if powered else before
-        if not (powered or self.started_at_power_on) or any(
-                r.step.kind in (FRAME, FILL) for r in since):
-            return
-        link = self.target.link
-        try:
-            plain = link.send("?", checksum=False)
-            summed = plain is not None and plain.code == ErrorCode.SYNTAX and \
-                link.send("?", checksum=True)
-        except (SafetyStop, TargetNotResponding):
-            return
-        if not (summed and summed.ok):
-            return
-        family = self.profile.family
         d.context = d.context | {"summing-after-power-on"}
         d.rule = label(d.command, d.kind, set(d.context), set(d.earlier), _code(d.reference),
-                       _code(d.target), family)
+                       _code(d.target), self.profile.family)
         d.verdict, d.tag = verdict_of(d.rule, self.target.target.info.strict)
 
     def _begin(self, out: ExampleRun) -> bool:
         """Both sides in the known state, or both from power-on where the target is a
-        co-simulator in virtual time (:meth:`_power_on_start`); False when the guard
-        refused it, or when the target could not be brought there (:attr:`lost`)."""
+        co-simulator in virtual time (start.py); False when the guard refused it, or when
+        the target could not be brought there (:attr:`lost`)."""
         if self.lost:
             out.ended = self.lost
             return False
         try:
             self._course_changes = 0
-            self.started_at_power_on = self.target.real and self._power_on_start()
-            if not self.started_at_power_on:
-                self._known_start()
+            self.started_at_power_on = self.target.real and self.start.powered(self.restores)
+            if self.started_at_power_on:
+                self._index = IndexBase()
+                self.judge = replace(self.judge, index_offset=0)
+            else:
+                self._index = self.start.known()
+                if self.target.real:
+                    self.judge = replace(self.judge, index_offset=self._index.offset)
         except SafetyStop as err:
             # the known state or the reads after it were refused (a minimiser's candidate
             # left the unit where the guard cannot bring it back, or the guard saw the
@@ -265,40 +241,6 @@ class Pair:
             return False
         self.course = Course(self.profile)
         out.begun = True
-        return True
-
-    def _known_start(self) -> None:
-        """Both sides in the known state: the target's session's (its proof read back on
-        a unit that lives on), the reference a fresh unit given the target's history."""
-        real = self.target.real
-        # the reference's beginning needs nothing more of the target's (its EEPROM as
-        # found is known): done while a co-simulator runs the known state's frames
-        alone = real and self.target.session is not None and self._same_eeprom_known()
-        self.target.open(tell=PRELUDE if real else (),
-                         meanwhile=self._begin_reference if alone else None)
-        if not alone:
-            self._begin_reference()
-        self.timing.begin()
-        self._index = IndexBase()
-        if real:
-            self._prelude()
-
-    def _power_on_start(self) -> bool:
-        """Both sides from the reset state the manuals state (spec 9 [M]): a co-simulator
-        in virtual time powered on through its rig (its restart waited out on the suite's
-        clock: no wall time; RealSession.open_powered), the reference a fresh unit standing
-        as long since its start, given the target's EEPROM as found. Nothing is read back:
-        a power-on that left something behind shows in the sequence's first answers, a
-        finding of its own. False where the target is not begun so (a real unit, a
-        real-time simulator, a rig that refuses `power-on`): the known state then."""
-        if self.target.open_powered(kept=self.restores) is None:
-            return False
-        self.reference.open()
-        self._same_eeprom()
-        self.reference.age(self.target.session.since_power_on / SECOND)
-        self.timing.begin()
-        self._index = IndexBase()
-        self.judge = replace(self.judge, index_offset=0)
         return True
 
     def _input(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> None:
@@ -333,6 +275,7 @@ class Pair:
             out.records.append(StepRecord(step, place=place))
             earlier.add(step.body.split()[0])
             if step.body == "power-on":
+                self.course.powered_on()
                 self._index = IndexBase(0)
                 self.judge = replace(self.judge, index_offset=0)
 
@@ -387,6 +330,7 @@ class Pair:
                 return True
             if (rec.reference.code or 0) & 7:
                 self._index.refused_frame(command, self._context(step, self.course.in_packet))
+            self.course.exchanged(step, rec.reference)
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:
                 earlier.add("junction")
@@ -408,7 +352,6 @@ class Pair:
                 earlier.add(f"{command}-refused")
             if code == ErrorCode.QUEUE_FULL:
                 earlier.add(f"{command}-no-room")
-        self.course.stepped(command, step)
         return False
 
     def _disagreement(self, step: Step, command: str, kind: str, out: ExampleRun,
@@ -417,46 +360,22 @@ class Pair:
         spec allows both answers, and the example ends there)."""
         rec = out.records[-1]
         context = self._context(step, self.course.in_packet)
-        if self.course.within_dwell(rec.reference.sent_at):
-            context.add("in-dwell")
-            if self.course.c_from_rest:
-                context.add("c-from-rest")
-        if self.course.after_zero_vector(rec.reference.sent_at):
-            context.add("after-zero-vector")
-        if self.course.reversal:
-            context.add("reversal")
-        if kind == "position" and self.course.beyond_reach(_values(rec.target)):
-            context.add("beyond-reach")
-        if kind == "position" and self._placed(rec):
+        context |= self.course.context(rec.reference.sent_at, command, step.body,
+                                       _values(rec.target) if kind == "position" else None)
+        if kind == "position" and _placed(rec, self.judge.placement, self._course_changes):
             context.add("placement")
         elif "beyond-reach" not in context and self.timing.within(
                 command, step.body, kind, rec.target, rec.reference,
                 self.course.rate * self.course.factor, self.course.heading,
                 self._reading_ns(command, step.body)):
             context.add("profile")
-        if self.course.capped_elsewhere:
-            context.add("capped-elsewhere")
         if _ran(rec.reference, self.reference.link.baud):
             context.add("after-run")
-        context.add("kept" if self.course.kept else "nothing-kept")
-        shipped = self.course.unwritten(command, step.body)
-        if shipped:
-            context.add(shipped)
-        if self.course.mpg_on:
-            context.add("mpg-on")
-        if self.course.mode_over_held:
-            context.add("mode-over-held")
         context |= _st6_differs(step.body, rec)
         if _released(out):
             context.add("released")
-        if command == "@" and self._index.counts_queries(_values(rec.target),
-                                                         _values(rec.reference)):
-            context.add("queries-counted")
-        if command == "@" and self._index.skips_refused(_values(rec.target),
-                                                         _values(rec.reference)):
-            context.add("refused-uncounted")
-        if command == "@" and self._index.in_hex(_values(rec.target), _values(rec.reference)):
-            context.add("index-hex")
+        if command == "@":
+            context |= self._index.context(_values(rec.target), _values(rec.reference))
         family = self.profile.family
         why = allowed(command, kind, context, earlier, _code(rec.reference), _code(rec.target),
                       family)
@@ -476,77 +395,13 @@ class Pair:
                 side.close_example()
         return out
 
-    def _begin_reference(self) -> None:
-        """The reference in its known state, a fresh unit; where the target lives on
-        between examples, the reference's part of the prelude (:meth:`_prelude`)."""
-        self.reference.open()
-        if self.target.real:
-            self._same_eeprom()
-            self.reference.age(AGE_SECONDS)
-            self._reference_index = _index_read(self.reference)
-
-    def _prelude(self) -> None:
-        """A unit that lives on between examples (a real one, a co-simulator) is not
-        reset by the known state: its index is read on both sides and compared from
-        there; and give `>` the same history on both (`SR0`, answered 0,00 by both). The
-        reference, a fresh unit, first stands a while: the real one's last motion ended
-        long ago (a vector right away would otherwise wait the dwell T on one side only),
-        and the target's too: the known state may have moved its axes back just before,
-        so the sequence begins once the longest dwell T after that has passed (waited
-        after the reads, which the known state told a co-simulator ahead with its last).
-        The reference's part is done as it begins (:meth:`_begin_reference`)."""
-        index = _index_read(self.target)
-        self.target.wait(self.profile.range("T").hi / 1000)
-        self._index = IndexBase((index - self._reference_index) % 256)
-        self.judge = replace(self.judge, index_offset=self._index.offset)
-
-    def _placed(self, rec: StepRecord) -> bool:
-        """Whether a target of somebody else's reads within another placement of the same
-        steps: one step of placement, and one more for each frame of the example that
-        changed the motion's course, which it may take at its own next step."""
-        if not self.judge.placement:
-            return False
-        a, b = _values(rec.target), _values(rec.reference)
-        try:
-            apart = [abs(int(x) - int(y)) for x, y in zip(a, b, strict=True)]
-        except ValueError:
-            return False
-        return max(apart, default=0) <= self.judge.placement * (1 + self._course_changes)
-
     def _reading_ns(self, command: str = "", body: str = "") -> tuple[int, int]:
-        """How much earlier and later a unit of somebody else's may place the example's
-        motion than the reference (tolerance.py's profile_reach), the run of the frame
-        ``body`` (a W's, answered when it ends) included."""
-        c = self.course
-        moves, ramps = c.own_run(command, body)
-        sooner, later = c.dwell_reach
-        return profile_reach(starts=c.starts + moves, changes=self._course_changes,
-                             sooner_ns=sooner, later_ns=later,
-                             ramp_ns=c.ramp_ns if c.path else 0,
-                             run_ramps_ns=c.run_ramps_ns + ramps)
+        return self.course.reading_ns(self._course_changes, command, body)
 
     def _base_index(self, command: str, context: set[str], rec: StepRecord) -> None:
-        """The index is compared from each side's first reading of it (index.py)."""
+        """The index is compared from each side's first reading of it (index_base.py)."""
         self._index.note(command, context, _values(rec.target), _values(rec.reference))
         self.judge = replace(self.judge, index_offset=self._index.offset or 0)
-
-    def _same_eeprom_known(self) -> bool:
-        """Whether :meth:`_same_eeprom` sends nothing to the target (its bytes as found
-        are read already, or it has none)."""
-        return self._eeprom_changes is not None or "ER" not in self.profile.commands
-
-    def _same_eeprom(self) -> None:
-        """A real unit's EEPROM holds its own bytes, not a fresh unit's: the reference
-        gets the bytes the target was found with (read once; the session puts back what
-        an example wrote) where they differ from its own."""
-        if self.target.session is None or "ER" not in self.profile.commands:
-            return
-        if self._eeprom_changes is None:
-            found = self.target.session.eeprom_as_found()
-            image = self.profile.eeprom          # a fresh unit's: erased, with defaults
-            self._eeprom_changes = {a: v for a, v in found.items()
-                                    if image.defaults.get(a, image.erased) != v}
-        self.reference.write_eeprom(self._eeprom_changes)
 
     def awaited(self, step: Step, data: bytes) -> float:
         """How long both sides await a frame's answer: the longer of their two guards'
@@ -621,6 +476,10 @@ class Pair:
             return None
         return rec
 
+    def _context(self, step: Step, in_packet: bool) -> set[str]:
+        return step_flags(step, self.profile, in_packet=in_packet,
+                          summing=self.target.link.checksums)
+
     def _difference(self, command: str, rec: StepRecord) -> str | None:
         moving, late = self.timing.allowance(command, rec.target, rec.reference)
         judge = replace(self.judge, rate=self.course.rate * self._factor, slack_ns=late,
@@ -631,63 +490,24 @@ class Pair:
             rec.alike = alike_because(command, rec.target, rec.reference, judge, moving=moving)
         return kind
 
-    def _context(self, step: Step, in_packet: bool) -> set[str]:
-        g = load_grammar()["command"]
-        name = command_of(step.body)
-        entry = g.get(name, g.get(name + "0", {}))
-        spindle = self.profile.spindle
-        to_spindle = spindle is not None and step.address == spindle.address
-        flags = {
-            "other-address": step.address is not None and not to_spindle,
-            "to-spindle": to_spindle,
-            "stalled": step.stall is not None,
-            "lower": _has_lower(step.body[:len(name)] if name else step.body),
-            "lower-param": bool(name) and _has_lower(step.body[len(name):]),
-            # the parameters after the wire name (SW6's is SW: `SW+6,00` has a plus)
-            "plus": name != "%" and "+" in parse(step.body).params,
-            "bad-checksum": step.checksum == "bad" and self.target.link.checksums,
-            "no-checksum": step.checksum == "none" and self.target.link.checksums,
-            "in-packet": in_packet,
-            "extra-param": bool(name) and not entry.get("params") and name not in ("SW6",)
-            and step.body.upper() != name,
-            "long-decimal": bool(_LONG_DECIMAL.search(step.body)),
-            "long-hex": _long_hex(name, parse(step.body).fields),
-            "axis-comma": name == "W" and _axis_comma(step.body),
-            "enables": name == "SW" and step.body[2:4] in ("0,", "1,"),
-        }
-        return {k for k, on in flags.items() if on}
-
-
-def _long_hex(name: str, fields: tuple[str, ...]) -> bool:
-    """Whether a hex field of the frame has more than the two digits the manuals write
-    (00..FF)."""
-    command = catalogue().get(name)
-    # a frame may carry more or fewer fields than the command takes
-    return command is not None and any(
-        f.kind == "hex" and len(v.strip()) > 2
-        for f, v in zip(command.fields, fields, strict=False))
-
-
-def _axis_comma(body: str) -> bool:
-    """Whether ``body`` is a W with a comma after its axis letter and every number within
-    the catalogue's ranges: where the reference answers 5 it found no switch (a field out
-    of range is the range's rule, whatever the form)."""
-    if not _AXIS_COMMA.match(body):
-        return False
-    fields = parse(body).fields
-    command = catalogue()["W"]
-    if len(fields) != len(command.fields):
-        return False
-    for f, text in zip(command.fields, fields, strict=True):
-        value = read_int(text, strict=True) if f.kind == "dec" else 0
-        lo, hi = f.range if isinstance(f.range, tuple) else (value, value)
-        if value is None or not lo <= value <= hi:
-            return False
-    return True
 
 
 #: the frames whose answer's value is ST6 (F's with its queue bit)
 _ST6_READS = ("SR6", "F")
+
+
+def _placed(rec: StepRecord, placement: int, changes: int) -> bool:
+    """Whether a target of somebody else's reads within another placement of the same
+    steps: ``placement`` steps, and as many more for each of the ``changes`` of the
+    motion's course in the example, which it may take at its own next step."""
+    if not placement:
+        return False
+    a, b = _values(rec.target), _values(rec.reference)
+    try:
+        apart = [abs(int(x) - int(y)) for x, y in zip(a, b, strict=True)]
+    except ValueError:
+        return False
+    return max(apart, default=0) <= placement * (1 + changes)
 
 
 def _ran(reference: RoundTrip, baud: int) -> bool:
@@ -721,25 +541,6 @@ def _released(out: ExampleRun) -> bool:
     is active, so nothing interrupts again after a clear."""
     return bool(out.inputs) and all(v == 0xFF for v in out.inputs.values()) and not any(
         r.step.kind == FRAME and r.step.body.startswith(_POLARITY) for r in out.records)
-
-
-def _has_lower(text: str) -> bool:
-    return any("a" <= ch <= "z" for ch in text)
-
-
-def _index_values(side: Side) -> list[str]:
-    """What a side's `@` answers in the prelude (its second frame), as written."""
-    r = side.link.send_each(PRELUDE)[1]
-    return [] if r is None else list(r.values)
-
-
-def _index_read(side: Side) -> int:
-    """The index a side reads in the prelude (0 when unread or not a decimal number)."""
-    values = _index_values(side)
-    try:
-        return int(values[0]) if len(values) == 1 else 0
-    except ValueError:
-        return 0
 
 
 def _values(exchange: RoundTrip) -> list[str]:

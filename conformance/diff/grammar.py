@@ -6,7 +6,6 @@ destructive commands only when allowed."""
 
 from __future__ import annotations
 
-import re
 import tomllib
 from dataclasses import dataclass, replace
 from functools import cache
@@ -15,25 +14,13 @@ from pathlib import Path
 from hypothesis import strategies as st
 
 from conformance.diff.labels import command_of
-from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, INPUT, RIG, WAIT, Step
+from conformance.diff.written import Written, tabled
 from conformance.protocol.catalogue import Command, Field, classes, commands
 from gve_fixtures.profile import Profile
 
 GRAMMAR_FILE = Path(__file__).with_name("grammar.toml")
-PROBES_FILE = Path(__file__).with_name("probes.toml")
 _DEFAULTS = {"weight": 1, "answer": True, "lines": 1, "destructive": False}
-#: an idiom's vector along the first axis only
-_ONE_COMPONENT = re.compile(r"[LC]-?\d+")
-#: how an idiom's frame is sent, written before its body, and what that changes of the step
-_SENT = {
-    "bad": lambda profile: {"checksum": "bad"},
-    "stalled": lambda profile: {"stall": (2, (profile.watchdog_ms + 50) / 1000)},
-    "other": lambda profile: {"address": (profile.address + 1) % 8, "answer": False},
-    "spindle": lambda profile: {"address": profile.spindle.address},
-}
-_PREFIX = re.compile(r"^(%s):" % "|".join(_SENT))
-#: the rig's acts besides an input, written as its control channel's words (docs/rig.md)
-_SWITCH = re.compile(r"switch ([XYZA]) (-?\d+|none)")
 #: commands never drawn at the spindle's address among those it does not serve: motion
 #: there would be another unit's for the run's guard
 _MOTION = classes(motion=True)
@@ -94,11 +81,6 @@ def _kind(f: Field) -> str:
         return f"range:{f.range}"
     assert f.range is not None
     return f"{f.kind}:{f.range[0]}:{f.range[1]}"
-
-
-@cache
-def load_probes(path: Path = PROBES_FILE) -> tuple[dict, ...]:
-    return tuple(tomllib.loads(path.read_text(encoding="utf-8"))["probe"])
 
 
 def _range_of(profile: Profile, kind: str) -> tuple[int, int] | None:
@@ -233,9 +215,9 @@ class Grammar:
         self.profile = profile
         self.options = options
         self.names = command_names(profile, options)
-        #: the names an idiom's frame may have (catalogue and known-as names, SW6)
-        self._allowed = set(self.names) | {"SW6"} | {
-            n for n, c in commands().items() if c.known_as in self.names}
+        #: the steps written in the grammar's data (frames of the run's names, SW6)
+        self.written = Written(profile, options.rig, set(self.names) | {"SW6"} | {
+            n for n, c in commands().items() if c.known_as in self.names}, g)
         self.weighted = [n for n in self.names for _ in range(g["command"][n].get("weight", 1))]
         kinds = {k for n in self.names for k in g["command"][n].get("params", [])} | {"vector"}
         self.invalid = {k: _invalid(profile, k, g) for k in kinds}
@@ -282,11 +264,11 @@ class Grammar:
                           if w in self.names and r in self.names]
         if self.readbacks:
             self.kinds += ["readback"] * g["readback"]["weight"]
-        self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self._can(s)]
+        self.scenarios = [tuple(s) for s in g["scenarios"]["list"] if self.written.can(s)]
         if self.scenarios:
             self.kinds += ["scenario"] * g["scenarios"]["weight"]
-        self.tables = [s for idiom in g["tables"]["list"] for s in _tabled(profile, idiom)
-                       if self._can(s)]
+        self.tables = [s for idiom in g["tables"]["list"] for s in tabled(profile, idiom)
+                       if self.written.can(s)]
         # every table value of every command, each a frame of its own
         self.tables += [(body,) for body in value_frames(profile, self.names)]
         if self.tables:
@@ -298,26 +280,6 @@ class Grammar:
         self.member_names = [n for n, c in commands().items()
                              if c.packet == "member" and n in profile.commands]
         self.other_members = [n for n in g["packet"]["others"] if n in profile.commands]
-
-    def _can(self, idiom: list[str]) -> bool:
-        """Whether every step of an idiom can be sent on this profile and run."""
-        allowed = self._allowed
-        for f in idiom:
-            if f.startswith("input "):
-                if not (self.options.rig and int(f.split()[1]) in self.profile.input_ports):
-                    return False
-            elif f.startswith("fill "):
-                if command_of(f.split()[2]) not in allowed:
-                    return False
-            elif f.startswith("wait "):
-                continue
-            elif f == "state" or f == "power-on" or _SWITCH.fullmatch(f):
-                if not self.options.rig:
-                    return False
-            elif (command_of(_PREFIX.sub("", f)) not in allowed
-                  or (f.startswith("spindle:") and self.profile.spindle is None)):
-                return False
-        return True
 
     # -- pieces ----------------------------------------------------------------------------
     def pick(self, draw, choices) -> object:
@@ -374,7 +336,7 @@ class Grammar:
         answer = entry.get("answer", True) and address is None
         out = [Step(FRAME, body, checksum, address, answer, entry.get("lines", 1), stall)]
         if entry.get("then_wait") == "restart":
-            out.append(self.restart_wait())
+            out.append(self.written.restart_wait())
         return out
 
     def packet(self, draw) -> list[Step]:
@@ -490,7 +452,7 @@ class Grammar:
                 # moved, then read: whether it runs (RUN) shows an axis no read shows
                 out.append(Step(FRAME, body))
                 if self.states:
-                    out.append(self.fixed(self.pick(draw, self.states)))
+                    out.append(self.written.fixed(self.pick(draw, self.states)))
                 continue
             elif roll < (m["alone"] + m["zero"]) * 100:
                 count = self.pick(draw, self.vector_counts)
@@ -513,9 +475,9 @@ class Grammar:
             elif what == 1:
                 out.append(Step(WAIT, seconds=self.pick(draw, waits)))
             elif what == 2 and self.events:
-                out.append(self.fixed(self.pick(draw, self.events)))
+                out.append(self.written.fixed(self.pick(draw, self.events)))
             elif what == 3 and self.states:
-                out.append(self.fixed(self.pick(draw, self.states)))
+                out.append(self.written.fixed(self.pick(draw, self.states)))
         return out
 
     def group(self, draw) -> list[Step]:
@@ -535,13 +497,13 @@ class Grammar:
         if kind == "scenario":
             return self.scenario(draw)
         if kind == "power-on":
-            return [Step(RIG, "power-on"), self.restart_wait()]
+            return [Step(RIG, "power-on"), self.written.restart_wait()]
         if kind == "switch":
             return self.switch(draw)
         if kind == "spindle":
             return self.spindle(draw)
         if kind == "tables":
-            return self.idiom(self.pick(draw, self.tables))
+            return self.written.idiom(self.pick(draw, self.tables))
         return self.fill(draw)
 
     def input(self, draw) -> list[Step]:
@@ -549,7 +511,7 @@ class Grammar:
         port = self.pick(draw, self.ports)
         out = [Step(INPUT, port=port, value=draw(self.input_values))]
         if f"I{port}" in self.names and self.number(draw, 0, 1):
-            out.append(self.fixed(f"I{port}"))
+            out.append(self.written.fixed(f"I{port}"))
         return out
 
     def switch(self, draw) -> list[Step]:
@@ -562,7 +524,7 @@ class Grammar:
         entry = self.g["command"]["W"]
         kinds = entry["params"][1:]
         w = _body("W", entry, [axis, *(draw(self.valid[k]) for k in kinds)])
-        out = [Step(RIG, f"switch {axis} {where}"), self.fixed(w)]
+        out = [Step(RIG, f"switch {axis} {where}"), self.written.fixed(w)]
         if self.number(draw, 0, 1):
             out.append(Step(RIG, f"switch {axis} none"))
         return out
@@ -581,17 +543,17 @@ class Grammar:
             body = "V" + draw(self.spindle_values)
         else:
             body = self.body(draw, name)
-        out = [replace(self.fixed(body), address=at)]
+        out = [replace(self.written.fixed(body), address=at)]
         if self.g["command"][name].get("then_wait") == "restart":
-            out.append(self.restart_wait())
+            out.append(self.written.restart_wait())
         reader = dict(self.readbacks).get(name)
         if reader is not None:
             text = self.g["command"][name].get("text", name)
             place = body[len(text):].split(",")[0]
-            read = self.fixed(self.g["command"][reader].get("text", reader) + place)
+            read = self.written.fixed(self.g["command"][reader].get("text", reader) + place)
             out.append(replace(read, address=at) if self.number(draw, 0, 1) else read)
         elif self.number(draw, 0, 1):
-            out.append(self.fixed(self.pick(draw, [n for n in sp["after"]
+            out.append(self.written.fixed(self.pick(draw, [n for n in sp["after"]
                                                   if n in self.profile.commands])))
         return out
 
@@ -601,80 +563,26 @@ class Grammar:
         out = []
         if self.vectors and self.number(draw, 0, 1):
             out.append(Step(FRAME, self.body(draw, self.pick(draw, self.vectors), valid=True)))
-        out += self.idiom(self.pick(draw, self.scenarios))
+        out += self.written.idiom(self.pick(draw, self.scenarios))
         return out + (self.reads(draw) if self.number(draw, 0, 1) else [])
 
     def idiom(self, lines: list[str] | tuple[str, ...]) -> list[Step]:
-        """The steps an idiom (or a probe) is written as: `wait S`, `input P XX`, `state`,
-        `fill N BODY`, `bad:BODY` (a wrong checksum in checksum mode), `stalled:BODY` (a
-        pause longer than the watchdog after its second byte), `other:BODY` (to another
-        address), `spindle:BODY` (to the GVE114's spindle address), else a frame; `J` is
-        followed by its restart's wait."""
-        out = []
-        for f in lines:
-            word, _, rest = f.partition(" ")
-            if word == "wait":
-                out.append(Step(WAIT, seconds=float(rest)))
-            elif f == "state":
-                out.append(Step(STATE))
-            elif f == "power-on":
-                out += [Step(RIG, f), self.restart_wait()]
-            elif _SWITCH.fullmatch(f):
-                out.append(Step(RIG, f))
-            elif word == "input":
-                port, value = rest.split()
-                out.append(Step(INPUT, port=int(port), value=int(value, 16)))
-            elif word == "fill":
-                times, body = rest.split()
-                out.append(Step(FILL, self._padded(body), times=int(times)))
-            elif m := _PREFIX.match(f):
-                step = self.fixed(self._padded(f[m.end():]))
-                out.append(replace(step, **_SENT[m.group(1)](self.profile)))
-            else:
-                out.append(self.fixed(self._padded(f)))
-                if self.g["command"].get(command_of(f), {}).get("then_wait") == "restart":
-                    out.append(self.restart_wait())
-        return _silent_in_packets(out)
-
-    def fixed(self, body: str, checksum: str = "auto") -> Step:
-        """A frame written in the grammar (an event, an idiom's step), answered as its
-        command is: `>`'s two lines (the frame it repeats, then the answer), none after
-        `*S`."""
-        entry = self.g["command"].get(command_of(body), {})
-        return Step(FRAME, body, checksum, answer=entry.get("answer", True),
-                    lines=entry.get("lines", 1))
-
-    def _padded(self, body: str) -> str:
-        """An idiom's one-component vector (`C100`) with the profile's other axes 0."""
-        if _ONE_COMPONENT.fullmatch(body):
-            return body + ",0" * (len(self.profile.axes) - 1)
-        return body
+        """The steps of an idiom (written.py)."""
+        return self.written.idiom(lines)
 
     def probes(self) -> list[tuple[dict, list[Step]]]:
-        """The probes of ``probes.toml`` this profile and run can send, with their steps."""
-        return [(p, self.idiom(p["steps"])) for p in load_probes()
-                if self.profile.family in p.get("families", [self.profile.family])
-                and self._can(p["steps"])]
+        """The probes this profile and run can send, with their steps (written.py)."""
+        return self.written.probes()
 
     def sweep(self) -> list[list[Step]]:
-        """The tables run whole once, after the probes: every table value of a command in
-        one sequence (its frames one after the other), then each idiom of the profile's
-        tables, so that the default budget reaches every value whatever the draw."""
-        single = [t[0] for t in self.tables if len(t) == 1]
-        by_command: dict[str, list[str]] = {}
-        for body in single:
-            by_command.setdefault(command_of(body), []).append(body)
-        return ([self.idiom(bodies) for bodies in by_command.values()]
-                + [self.idiom(t) for t in self.tables if len(t) > 1])
+        """The grammar's tables run whole once (written.py)."""
+        return self.written.sweep(self.tables)
 
     def sequences(self) -> st.SearchStrategy[list[Step]]:
         """A sequence of steps for one example (groups flattened)."""
         group = st.composite(lambda draw: self.group(draw))()
         return st.lists(group, min_size=1, max_size=self.g["steps"]["max"]).map(
             lambda gs: [s for grp in gs for s in grp])
-
-    def restart_wait(self) -> Step:
-        return Step(WAIT, seconds=self.profile.restart_ms / 1000 + 0.05)
 
     def readback(self, draw) -> list[Step]:
         """A write read back at once: the place written, and now and then another place
@@ -742,75 +650,6 @@ def value_frames(profile: Profile, names: list[str]) -> list[str]:
             for value in table_values(profile, kind):
                 out.append(_body(name, entry, [*plain[:i], value, *plain[i + 1:]]))
     return list(dict.fromkeys(out))
-
-
-def _tabled(profile: Profile, idiom: list[str]) -> list[tuple[str, ...]]:
-    """An idiom of `[tables]` once per value of the profile's table its placeholder
-    names (none where the profile has no such table)."""
-    tables: dict[str, list[str]] = {}
-    if profile.mpg is not None:
-        listed = sorted(profile.mpg.enabling_values)
-        beside = sorted({(v + d) & 0xFF for v in listed for d in (-1, 1)} - set(listed))
-        tables["mpg"] = ["%02X" % v for v in listed + beside]
-        tables["mpg_address"] = ["%02X" % profile.mpg.enable_address]
-    if profile.spindle is not None:
-        r = profile.spindle.range
-        tables["spindle"] = [str(v) for v in (r.lo + 1, r.hi)]
-    if profile.microstep is not None:
-        tables["microstep"] = [*profile.microstep.factors, *profile.microstep.currents]
-    axes = len(profile.axes)
-    tables["axis_alone"] = [",".join("100" if j == i else "0" for j in range(axes))
-                            for i in range(axes)]
-    tables["port"] = [str(port) for port in profile.input_ports]
-    # the interrupt inputs behind each status word with several of them: enabled, grounded
-    # at once, the cause word read (ST0/2/4 are I1's, ST1/3/5 I2's)
-    tables["sources"] = [{"enable": str(word), "mask": "%02X" % mask, "port": str(word + 1),
-                          "cause": str(word + 4), "one": "%02X" % (mask & -mask)}
-                         for word, mask in enumerate((profile.low_mask, profile.high_mask))
-                         if bin(mask).count("1") > 1 and word + 1 in profile.input_ports]
-    wanted = sorted({m.group(1) for m in _PLACEHOLDER.finditer(" ".join(idiom))})
-    if any(not tables.get(name) for name in wanted):
-        return []
-    out: list[tuple[str, ...]] = [tuple(idiom)]
-    for name in wanted:
-        out = [tuple(_filled(line, name, value) for line in lines)
-               for lines in out for value in tables[name]]
-    return out
-
-
-#: `{name}`, or `{name.key}` for one of a table's values that are several together
-_PLACEHOLDER = re.compile(r"\{([a-z_]+)(?:\.([a-z_]+))?\}")
-
-
-def _filled(line: str, name: str, value: str | dict[str, str]) -> str:
-    if isinstance(value, dict):
-        for key, part in value.items():
-            line = line.replace("{%s.%s}" % (name, key), part)
-        return line
-    return line.replace("{%s}" % name, value)
-
-
-@cache
-def _commands() -> dict[str, Command]:
-    """The catalogue's commands, read once (every idiom's frames look theirs up)."""
-    return commands()
-
-
-def _silent_in_packets(steps: list[Step]) -> list[Step]:
-    """The frames of an open packet are answered by nothing until one ends it (`*E`, a
-    breaker: spec 7), as a drawn packet's members are sent: a frame that waited for an
-    answer would time out and make the line keep quiet after it."""
-    out, open_packet = [], False
-    for step in steps:
-        if step.kind == FRAME:
-            command = _commands().get(command_of(step.body))
-            ends = command is not None and command.ends_packet
-            if open_packet and not ends:
-                step = replace(step, answer=False)
-            open_packet = ((command is not None and command.packet == "opens")
-                           or (open_packet and not ends))
-        out.append(step)
-    return out
 
 
 def probes(profile: Profile, options: Options) -> list[tuple[dict, list[Step]]]:

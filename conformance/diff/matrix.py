@@ -133,10 +133,10 @@ def cells(profile: Profile, options: Options, *, built: bool = True) -> list[Cel
     m = load_matrix()
     grammar = Grammar(profile, options)
     every = Grammar(profile, Options(destructive=True, rig=True))
-    observers = [o for o in m["observers"]["now"] if grammar._can([o])]
-    rest = [o for o in m["observers"]["rest"] if grammar._can([o])]
-    held = [o for o in m["observers"]["held"] if grammar._can([o])]
-    move = [o for o in m["observers"]["move"] if grammar._can([o])]
+    observers = [o for o in m["observers"]["now"] if grammar.written.can([o])]
+    rest = [o for o in m["observers"]["rest"] if grammar.written.can([o])]
+    held = [o for o in m["observers"]["held"] if grammar.written.can([o])]
+    move = [o for o in m["observers"]["move"] if grammar.written.can([o])]
     spindle = profile.spindle
     out = []
     for state, setup in states(profile):
@@ -153,12 +153,12 @@ def cells(profile: Profile, options: Options, *, built: bool = True) -> list[Cel
 
 def _cell(grammar: Grammar, every: Grammar, state: str, setup: list[str] | None, form: str,
           after: list[str], built: bool = True) -> Cell:
-    if setup is None or not every._can(setup):
+    if setup is None or not every.written.can(setup):
         return Cell(state, form, left_out=f"the {every.profile.family} has no such state")
     lines = [*setup, form, *after]
-    if not every._can(lines):
+    if not every.written.can(lines):
         return Cell(state, form, left_out=f"the {every.profile.family} cannot send it")
-    if not grammar._can(lines):
+    if not grammar.written.can(lines):
         why = ("needs a test rig" if any(x.startswith("input ") for x in setup)
                else "needs --allow-destructive")
         return Cell(state, form, left_out=why)
@@ -169,7 +169,7 @@ def observers(profile: Profile) -> list[str]:
     """The observers the matrix reads at once after each command on ``profile`` (the rig's
     `state` among them)."""
     every = Grammar(profile, Options(destructive=True, rig=True))
-    return [o for o in load_matrix()["observers"]["now"] if every._can([o])]
+    return [o for o in load_matrix()["observers"]["now"] if every.written.can([o])]
 
 
 def summary(all_cells: list[Cell]) -> str:

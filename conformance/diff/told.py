@@ -24,7 +24,7 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from conformance.diff.index import QUERIES
+from conformance.diff.index_base import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, Step

@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
-from conformance.host import oracle, probe
+from conformance.host import oracle
 from conformance.host.checks import LineFacts, judge
-from conformance.host.faults import Fault
+from conformance.host.final_state import final_state
+from conformance.host.line_faults import Fault
 from conformance.host.oracle import HostResult, HostRun
 from conformance.host.ports import HostPort, open_port
 from conformance.host.relay import Relay
@@ -141,7 +142,7 @@ def run_once(plan: Plan, fault: Fault, port: HostPort, *,
             ended, code, output = _launched_run(relay, plan, port, limit)
         seconds = time.monotonic() - start
         relay.finish()
-        finals = {v.address: probe.final_state(line, v, relay.rec) for v in views}
+        finals = {v.address: final_state(line, v, relay.rec) for v in views}
     finally:
         line.close()
     return HostRun(relay.rec, views, finals, code, ended, seconds, fault, output)

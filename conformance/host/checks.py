@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 from conformance.host.examples import worked_frames
-from conformance.host.grammar import UNSUMMED
+from conformance.host.frame_rules import UNSUMMED
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited, show
 from conformance.host.unitview import VECTORS, UnitView
 from conformance.protocol.catalogue import classes
@@ -78,7 +78,7 @@ def _at(t: int, line: LineFacts) -> int:
 
 def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """Each frame on its own: grammar, address, command, parameters, checksum, length
-    (grammar.py), and a member of a packet carrying its own checksum (spec 7)."""
+    (frame_rules.py), and a member of a packet carrying its own checksum (spec 7)."""
     for ex in rec.exchanges:
         out.judged |= ex.parsed.judged
         for p in ex.parsed.problems:

@@ -22,8 +22,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from conformance.host.checks import WIRE_CHECKS, Judgement, findings_by_rule
-from conformance.host.faults import Fault
-from conformance.host.probe import Final
+from conformance.host.final_state import Final
+from conformance.host.line_faults import Fault
 from conformance.host.recording import Recording
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.unitview import VECTORS, Executed, UnitView

@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from conformance.host.grammar import ParsedFrame
+from conformance.host.frame_rules import ParsedFrame
 from conformance.protocol.framer import Fragment, HostFrame
 from gve_fixtures.transcript import ACTION, HOST, UNIT, Record, escape
 
@@ -21,8 +21,8 @@ STALL_NS = 20_000_000
 class Exchange:
     """One host frame and what became of it.
 
-    ``reading``: the frame as the judge reads it (None until the ledger has read it,
-    ledger.py; :attr:`parsed` reads it when asked). ``to_unit``: the bytes the unit got
+    ``reading``: the frame as the judge reads it (None until the booking has read it,
+    booking.py; :attr:`parsed` reads it when asked). ``to_unit``: the bytes the unit got
     for it (the frame itself, or what a fault made of it; None: nothing). ``answer``: the
     lines the unit answered (CR included; empty: none). ``delivered``: the bytes the host
     got (None: nothing, the answer was lost).
@@ -44,7 +44,7 @@ class Exchange:
     def parsed(self) -> ParsedFrame:
         if self.reading is None and self.settle is not None:
             self.settle()
-        assert self.reading is not None, "an exchange the ledger never read"
+        assert self.reading is not None, "an exchange the booking never read"
         return self.reading
 
     @property

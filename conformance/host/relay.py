@@ -5,11 +5,11 @@ passed on at once to emulated units; the units' answers go back to the host. The
 line keeps virtual time, which the relay brings up to the wall clock before every move:
 the units act in real time, yet the relay never sleeps on them, and an answer is given to
 the host no sooner than the line could have carried it at its baud rate. Between the two
-a fault may act at one point of the job (faults.py). Every byte both ways is recorded
+a fault may act at one point of the job (line_faults.py). Every byte both ways is recorded
 with its instant (recording.py), and each frame is paired with the answer the unit gave
 it, so that the host rules (checks.py) and the motion the unit executed (unitview.py) can
 be judged from the wire alone. The relay does only what the line needs while it runs;
-reading the frames and booking the units' views waits in the ledger (ledger.py) until a
+reading the frames and booking the units' views waits in the booking (booking.py) until a
 fault or the end of the run asks for them.
 
 Answers are paired by time: a unit answers at once (spec 2), so an answer's first byte
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import serial
 
-from conformance.host.faults import Fault
-from conformance.host.grammar import command_of
-from conformance.host.ledger import Ledger
+from conformance.host.booking import Booking
+from conformance.host.frame_rules import command_of
+from conformance.host.line_faults import Fault
 from conformance.host.ports import HostPort
 from conformance.host.recording import STALL_NS, Exchange, Recording, Unsolicited
 from conformance.host.unitview import UnitView
@@ -70,8 +70,8 @@ class Relay:
                  fault: Fault, baud: int) -> None:
         self.port, self.unit, self.views, self.fault = port, unit, views, fault
         self.line = line_of(unit)                  # the gve:// rig and clock
-        self.ledger = Ledger(views)
-        self.units = self.ledger.units
+        self.booking = Booking(views)
+        self.units = self.booking.units
         self.byte_ns = round(10 * SECOND / baud)
         self.rec = Recording(now())
         self.framer = HostFramer()
@@ -84,19 +84,19 @@ class Relay:
         self._settings: str | None = None
         self._turn_end: int | None = None       # when the relay's last turn ended
 
-    # -- what faults may use (faults.Context) -------------------------------------------------
+    # -- what faults may use (line_faults.Context) --------------------------------------------
     def now(self) -> int:
         return now()
 
     def vectors(self) -> int:
-        return self.ledger.vectors()
+        return self.booking.vectors()
 
     def in_packet(self, address: int | None) -> bool:
-        view = self.ledger.view(address)
+        view = self.booking.view(address)
         return view is not None and view.packet is not None
 
     def checksums(self, address: int | None) -> bool:
-        view = self.ledger.view(address)
+        view = self.booking.view(address)
         return view is not None and view.checksums
 
     def note_fault(self, kind: str, detail: str) -> None:
@@ -105,7 +105,7 @@ class Relay:
     def power_on(self, address: int) -> None:
         self._sync()
         self.line.power_on(address)
-        self.ledger.power_on(address, now())
+        self.booking.power_on(address, now())
 
     def set_input(self, port: int, value: int, address: int) -> None:
         self._sync()
@@ -160,7 +160,7 @@ class Relay:
         self.take_unit()
         for frag in self.framer.finish(now()):
             self.rec.fragments.append(frag)
-        self.ledger.settle()
+        self.booking.settle()
 
     # -- host -> units ---------------------------------------------------------------------
     def take_host(self, data: bytes, t: int) -> None:
@@ -197,7 +197,7 @@ class Relay:
     def _complete(self, frame: HostFrame) -> None:
         command = command_of(frame.raw, self.units)
         ex = Exchange(len(self.rec.exchanges), frame)
-        self.ledger.frame(ex)
+        self.booking.frame(ex)
         self.rec.exchanges.append(ex)
         held, self.held = bytes(self.held), bytearray()
         whole = held.endswith(frame.raw + b"\r")
@@ -251,7 +251,7 @@ class Relay:
     def _answered(self, ex: Exchange, lines: list[bytes]) -> None:
         ex.answer = lines
         ex.answered_at = self._on_line() if lines else None
-        self.ledger.answered(ex)
+        self.booking.answered(ex)
         if lines:
             out = self.fault.answer(ex, self)
             if out.data is not None:

@@ -13,7 +13,8 @@ import fnmatch
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from conformance.host.faults import (
+from conformance.host.final_state import Final
+from conformance.host.line_faults import (
     DAMAGE,
     AnswerFault,
     Fault,
@@ -23,7 +24,6 @@ from conformance.host.faults import (
     QueueFull,
     Restart,
 )
-from conformance.host.probe import Final
 from conformance.host.recording import Exchange
 from conformance.host.unitview import SETTINGS, VECTORS, Executed
 from gve_fixtures.protocol import ErrorCode

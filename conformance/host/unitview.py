@@ -1,6 +1,11 @@
-"""What each unit on the line did, read from the wire (spec 6, 7, 8, 9, 10.1): its checksum
-mode, its open packet, its modal settings, its status words as the host wrote them, and
-the motion it accepted — the oracle of the fault scenarios.
+"""What each unit on the line did, read from the wire (spec 6, 7, 8, 9, 10.1): the motion
+it accepted, with the settings each vector runs under — the oracle of the fault scenarios.
+
+The checksum mode and the open packet are the one view of the unit from the wire
+(conformance/protocol/view.py), fed each exchange as the unit got it and answered it;
+what is the oracle's own is kept here: the packet's members as the judge read them (to
+execute on their `*E`), the settings typed from the profile's reset state, whether a
+restart turned the mode off under the host, and what was executed.
 
 A vector is executed when the unit answered it `0` (or `8`: OK while interrupted), a
 packet's members when its `*E` answered `0,k` (spec 7: all or nothing). Each executed
@@ -13,11 +18,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from conformance.host.grammar import ParsedFrame, parse_frame
+from conformance.host.frame_rules import ParsedFrame, parse_frame
 from conformance.host.recording import Exchange
 from conformance.protocol.catalogue import classes
+from conformance.protocol.view import View, observe
+from conformance.protocol.wire import Response, parse_response
 from gve_fixtures.profile import Profile
-from gve_fixtures.protocol import ErrorCode
 
 #: commands that set modal parameters captured with each vector (spec 10.1)
 MODAL = classes(modal=True)
@@ -25,8 +31,6 @@ MODAL = classes(modal=True)
 SETTINGS = MODAL | classes(setting=True)
 #: commands that change the motion or the counters: kept in the executed sequence
 MARKERS = classes(marks=True)
-#: inside an open packet these are executed at once and discard it (spec 7)
-BREAKERS = classes(packet="breaker")
 VECTORS = classes(vector=True)
 SWITCHES = classes(switch=True)
 
@@ -55,11 +59,13 @@ class UnitView:
     profile: Profile
     address: int
     addresses: frozenset[int] = frozenset()
-    checksums: bool = False
+    #: the unit as the wire shows it: its checksum mode, its open packet
+    wire: View = field(default_factory=View)
     #: checksum mode was on when the unit last restarted, and no `%` since: a restart
     #: turned it off under the host (spec 6)
     lapsed: bool = False
-    packet: list[ParsedFrame] | None = None
+    #: the open packet's members as the judge read them (the view's packet, parsed)
+    members: list[ParsedFrame] = field(default_factory=list)
     modal: dict[str, object] = field(default_factory=dict)
     status: list[int] = field(default_factory=lambda: [0] * 7)
     executed: list[Executed] = field(default_factory=list)
@@ -70,20 +76,31 @@ class UnitView:
         spindle = self.profile.spindle
         extra = {spindle.address} if spindle is not None and self.address == 0 else set()
         self.addresses = frozenset({self.address, *extra})
-        self._reset()
+        self.wire = View(addresses=self.addresses, checksums=self.profile.reset.checksums)
+        self._reset(summing=False)
 
-    def _reset(self) -> None:
+    @property
+    def checksums(self) -> bool:
+        return self.wire.checksums
+
+    @property
+    def packet(self) -> list[ParsedFrame] | None:
+        """The open packet's members (None: none open, as the view reads the wire)."""
+        return self.members if self.wire.packet_open else None
+
+    def _reset(self, *, summing: bool) -> None:
+        """The reset state; ``summing``: the checksum mode was on just before."""
         r = self.profile.reset
-        self.lapsed = self.checksums and not r.checksums
-        self.checksums = r.checksums
-        self.packet = None
+        self.lapsed = summing and not r.checksums
+        self.wire = self.wire.restarted().assume(checksums=r.checksums)
+        self.members = []
         self.modal = {"V": r.V, "A": r.A, "B": r.B, "$": r.dollar, "T": r.T,
                       "VK": r.VK, "VL": tuple(r.VL), "XM": r.XM}
         self.status = list(r.status)
 
     def power_on(self, t: int) -> None:
         """The unit restarted (the rig's power cycle): reset state, deaf for a while."""
-        self._reset()
+        self._reset(summing=self.checksums)
         self.executed.append(Executed("power-on"))
         self.deaf_until = t + self.profile.restart_ms * 1_000_000
 
@@ -93,35 +110,36 @@ class UnitView:
             return
         f = (ex.parsed if ex.to_unit[:-1] == ex.parsed.raw
              else parse_frame(ex.to_unit[:-1], units, self.checksums))
-        if f.address not in self.addresses or f.command is None:
+        if f.address not in self.addresses:
             return
+        before = self.wire
+        answer = self._answer(ex, f.body)
+        self.wire = observe(before, f.body, answer, f.address)
+        if self.wire.packet is not None and self.wire.packet != before.packet:
+            # a member joined the packet, or an `*S` opened a new one
+            self.members = [*self.members, f] if self.wire.packet else []
         name = f.command
-        if self.packet is not None and not ex.answer:
-            if name == "*S":
-                self.packet = []
-            else:
-                self.packet.append(f)
+        if name is None or answer is None or answer.code is None:
             return
-        if name == "*S" and not ex.answer:
-            self.packet = []
-            return
-        if name in BREAKERS:
-            self.packet = None
-        code = ex.code
-        if code is None:
-            return
-        if name == "*E":
-            members, self.packet = self.packet or [], None
-            if code == ErrorCode.OK:
+        if name == "*E" and before.packet is not None:
+            members, self.members = self.members, []
+            if answer.ok:
                 for member in members:
                     self._accept(member)
             return
-        if code == ErrorCode.OK:
+        if answer.ok and name != "*E":
             self._accept(f)
             if name == "J":
                 t = ex.answered_at or 0
-                self._reset()
+                self._reset(summing=before.checksums)
                 self.deaf_until = t + self.profile.restart_ms * 1_000_000
+
+    def _answer(self, ex: Exchange, body: str) -> Response | None:
+        """The unit's answer to ``body`` as the view reads it (None: none)."""
+        if not ex.answer:
+            return None
+        return parse_response(b"".join(ex.answer), summed=self.wire.summed_after(body),
+                              lines=len(ex.answer))
 
     def _accept(self, f: ParsedFrame) -> None:
         name, params = f.command or "", f.params
@@ -132,7 +150,7 @@ class UnitView:
                 self.executed.append(Executed("spindle", (int(params[0]),)))
             return
         if name == "%":
-            self.checksums, self.lapsed = params[:1] == ["+"], False
+            self.lapsed = False                 # the mode is the view's
         elif name in VECTORS:
             values = tuple(int(p) for p in params)
             values += (0,) * (len(self.profile.axes) - len(values))

@@ -22,8 +22,8 @@ from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
-from conformance.machines.base import UnitMachine, holds
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds
 from gve_fixtures.protocol import ErrorCode, St6
 
 RELEASED = 0xFF                 # an unconnected input reads 1 (spec 10.3)

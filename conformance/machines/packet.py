@@ -6,8 +6,8 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
-from conformance.machines.base import UnitMachine, holds, index_invariant
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from gve_fixtures.protocol import ErrorCode
 
 # member frame -> (kind, code it fails the packet with, steps it commits)
@@ -28,7 +28,6 @@ class PacketMachine(UnitMachine):
         if summed:
             r = self.send("%+", checksum=False)
             holds(r is not None and r.ok, "6.checksum.mode-commands", f"%+ answered {r}")
-            self.model.checksums = True
 
     @rule()
     def start(self) -> None:
@@ -67,8 +66,7 @@ class PacketMachine(UnitMachine):
         r = self.send("@")
         holds(r is not None and r.ok, "7.packet.breakers",
               f"@ inside a packet answered {r}")
-        self.model.packet = None
-        self.pending = []
+        self.pending = []                 # answered, `@` ended the packet on the wire
 
     def teardown(self) -> None:
         if self.model.packet is None:

@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from hypothesis.stateful import initialize, rule
 
 from conformance.case.context import CaseContext, case
-from conformance.machines.base import UnitMachine, holds, index_invariant
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from gve_fixtures.protocol import ErrorCode, St6
 
 WAITING = "10.1.queue.wait-for-go"

@@ -24,8 +24,8 @@ from conformance.case.context import CaseContext, case
 from conformance.link.framing import Response
 from conformance.link.line_band import line_band
 from conformance.link.link import idle_st6
-from conformance.machines.base import UnitMachine, holds, index_invariant
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from conformance.protocol.catalogue import catalogue, classes
 from conformance.protocol.parse import parse
 from gve_fixtures.profile import Profile
@@ -502,7 +502,6 @@ class ReadBackMachine(UnitMachine):
             self.model.open_packet()
             for m in members:
                 self.send(m, answer=False)
-            self.model.packet = None
             r = self.send(f"*E{n}")
             holds(r is not None and r.code == want, "7.packet.codes",
                   f"{', '.join(members)}, *E{n} answered {r}, expected code {want}")

@@ -3,10 +3,10 @@
 from conformance.machines import (  # noqa: F401
     checksum,
     errors,
-    index,
     interrupts,
     keep,
     packet,
     queue,
     readback,
+    recovery,
 )

@@ -2,13 +2,21 @@
 
 It does not simulate motion; it books what the unit must have accepted, so that the
 machines can check the index, the checksum mode, packets and position bookkeeping.
+
+The checksum mode and whether a packet is open are not the model's: they are the one
+view of the unit from the wire (conformance/protocol/view.py) that the machine's link
+feeds with every frame it sends. The model keeps what it expects: the index by its
+counting rules, the codes the open packet's members must fail it with, the motion
+committed.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from conformance.protocol.catalogue import classes
+from conformance.protocol.view import View
 from gve_fixtures.protocol import ErrorCode
 
 UNCOUNTED = tuple(sorted(classes(indexed=False)))       # spec 8
@@ -19,10 +27,12 @@ PACKET_MEMBERS = classes(packet="member")               # spec 7
 class ModelUnit:
     axes: int = 3
     buffer: int = 64
-    checksums: bool = False
+    #: the unit as the wire shows it now (a machine's: its link's view)
+    wire: Callable[[], View] = View
     index: int = 0
     inta: bool = False
-    packet: list[tuple[str, ErrorCode]] | None = None     # (member kind, its code)
+    #: the open packet's members as expected: (member kind, the code it fails it with)
+    members: list[tuple[str, ErrorCode]] = field(default_factory=list)
     committed: list[int] = field(default_factory=lambda: [0, 0, 0])
     #: frames that do not advance the index: @ and > by our reading [D]; a unit whose @
     #: counts itself (measured by the machines) has none
@@ -30,6 +40,16 @@ class ModelUnit:
     #: whether a refused frame advances the index, as we read it [D]; a unit that counts
     #: only what it takes (measured by the machines) does not
     refused_counted: bool = True
+
+    @property
+    def checksums(self) -> bool:
+        """The checksum mode, as the wire shows it (spec 6)."""
+        return self.wire().checksums
+
+    @property
+    def packet(self) -> list[tuple[str, ErrorCode]] | None:
+        """The open packet's expected members (None: none open, as the wire shows)."""
+        return self.members if self.wire().packet_open else None
 
     # -- section 8 ------------------------------------------------------------------------
     def frame_arrived(self, name: str, checksum_ok: bool = True,
@@ -50,17 +70,17 @@ class ModelUnit:
 
     # -- section 7 ------------------------------------------------------------------------
     def open_packet(self) -> None:
-        self.packet = []
+        """An `*S` went: the packet it opens (on the wire) expects no member yet."""
+        self.members = []
 
     def member(self, kind: str, code: ErrorCode) -> None:
-        assert self.packet is not None
-        self.packet.append((kind, code))
+        self.members.append((kind, code))
 
     def end_packet(self, n: int, room: int) -> tuple[ErrorCode, int]:
         """(code, k) of *E<n> (spec 7), and commit when OK."""
         if self.packet is None:
             return ErrorCode.SYNTAX, 0
-        members, self.packet = self.packet, None
+        members, self.members = self.members, []
         k = len(members)
         if k != n:
             return ErrorCode.COUNT_MISMATCH, k

@@ -7,7 +7,7 @@ never class one frame two ways. Two modes:
   of either case, ``+6`` or `` 6`` for 6. It is how a frame is *classed*: the guard must
   judge what a frame could do, and diff and the host role class it the same way.
 - strict reads it as spec 3 writes it: upper-case command letters only; whether the
-  fields are well formed is left to the judge of the host role (host/grammar.py).
+  fields are well formed is left to the judge of the host role (host/frame_rules.py).
 
 A frame whose command is ``SW`` and whose first field reads 6 writes ST6 and is classed
 ``SW6`` (spec 10.3: writing ST6 can stop or resume motion).

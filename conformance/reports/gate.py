@@ -4,7 +4,8 @@ time (a mutant hunted, a reading tried, an implementation judged) rather than ca
 testsuite named after the gate, one testcase per item: a ``failure`` where the item failed
 the gate, ``skipped`` where the job ended before it (its time limit, a signal), and the
 lines the console showed for it as its ``system-out``; the gate's last line is the
-suite's ``system-out`` and its ``verdict`` property, as a run's is."""
+suite's ``system-out`` and its ``verdict`` property, as a run's is. The same gate
+cli/gate.py ends (one meaning under one name)."""
 
 from __future__ import annotations
 

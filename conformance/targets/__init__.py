@@ -8,9 +8,9 @@ run-wide session (session.py) opens links and keeps the unit safe."""
 from __future__ import annotations
 
 from conformance.targets import emu, port, process
-from conformance.targets.base import DEFAULT_MAX_TRAVEL, Target, TargetError
 from conformance.targets.info import EMULATOR
 from conformance.targets.session import Session, SessionError, SessionReport
+from conformance.targets.target import DEFAULT_MAX_TRAVEL, Target, TargetError
 from gve_fixtures.profile import Profile
 
 __all__ = ["DEFAULT_MAX_TRAVEL", "SCHEMES", "Session", "SessionError", "SessionReport",

@@ -12,8 +12,8 @@ from urllib.parse import parse_qs, urlsplit
 import serial
 
 from conformance.link.virtual import line_of
-from conformance.targets.base import Target, TargetError, known_settings
 from conformance.targets.info import EMULATOR, TargetInfo
+from conformance.targets.target import Target, TargetError, known_settings
 from gve_fixtures.profile import load_profile
 
 #: the settings an ``emu:`` target takes

@@ -18,7 +18,7 @@ import serial
 
 from conformance.link.exclusive import LeftAlone, open_serial, settings_kept
 from conformance.link.framing import frame, parse_response
-from conformance.targets.base import Target
+from conformance.targets.target import Target
 from conformance.verdicts.quoting import escaped, shown
 from gve_fixtures.profile import Profile, available_profiles, load_profile
 from gve_fixtures.protocol import ErrorCode

@@ -10,9 +10,9 @@ from urllib.parse import parse_qs, urlencode, urlsplit
 import serial
 
 from conformance.link.exclusive import open_serial
-from conformance.targets.base import Target, TargetError, known_settings
 from conformance.targets.emu import register_url_scheme, url_settings
 from conformance.targets.info import TargetInfo
+from conformance.targets.target import Target, TargetError, known_settings
 from conformance.targets.targetport import TargetPort
 from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.profile import Profile, available_profiles, load_profile

@@ -26,7 +26,6 @@ from typing import NoReturn
 
 from conformance.link.signals import Interrupts
 from conformance.protocol.bounded import decimal
-from conformance.targets.base import Target, TargetError
 from conformance.targets.cosim import (
     VERSION,
     CosimLine,
@@ -40,6 +39,7 @@ from conformance.targets.port import PortTarget, open_port, real_profile
 from conformance.targets.program import Program, ProgramError
 from conformance.targets.rig import ControlRig
 from conformance.targets.session import Session, SessionError
+from conformance.targets.target import Target, TargetError
 from conformance.targets.targetport import ENDING_SECONDS, TargetPort
 from conformance.verdicts.quoting import shown
 from gve_fixtures.profile import available_profiles

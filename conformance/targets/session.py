@@ -48,7 +48,7 @@ from gve_fixtures.protocol import ErrorCode, St6
 
 
 class Reachable(Protocol):
-    """What a session needs of its target (conformance.targets.base.Target)."""
+    """What a session needs of its target (conformance.targets.target.Target)."""
 
     info: TargetInfo
     profile: Profile

@@ -11,8 +11,8 @@ import serial
 
 import emulator  # noqa: F401  (registers gve://)
 from conformance.case.context import TargetInfo
-from conformance.targets.base import DEFAULT_MAX_TRAVEL
 from conformance.targets.port import PortTarget
+from conformance.targets.target import DEFAULT_MAX_TRAVEL
 from gve_fixtures.profile import load_profile
 
 #: the owner's EEPROM bytes (address: byte), none as shipped

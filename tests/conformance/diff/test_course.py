@@ -1,11 +1,16 @@
 """The reference's course through an example: the dwell a frame may meet, the fastest
 rate its axes can have stepped at, the junction of two C and the open packet."""
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from conformance.diff.course import Course
 from conformance.diff.sides import RoundTrip
 from conformance.diff.steps import FRAME, Step
 from conformance.link.framing import parse_response
+from conformance.protocol.view import View, observe
 from conformance.targets import parse_target
+from tests.conformance.protocol.test_view import ANSWERS, FRAMES
 
 MS = 1_000_000
 
@@ -62,14 +67,33 @@ def test_two_c_meet_at_a_junction_until_d():
     assert not c.junction
 
 
+def silent(at_ms: int = 0) -> RoundTrip:
+    """The reference answered nothing."""
+    return RoundTrip(b"", b"", at_ms * MS, at_ms * MS, None)
+
+
 def test_a_packet_opens_on_the_units_own_star_s_and_closes_on_a_breaker():
     c = course()
-    c.stepped("*S", Step(FRAME, "*S", address=3))
+    c.exchanged(Step(FRAME, "*S", address=3), silent())
     assert not c.in_packet
-    c.stepped("*S", Step(FRAME, "*S"))
-    c.stepped("C", Step(FRAME, "C1,0,0"))
-    assert c.in_packet
-    c.stepped("@", Step(FRAME, "@"))
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.exchanged(Step(FRAME, "C1,0,0"), silent())
+    assert c.in_packet and c.wire.packet == ("C1,0,0",)
+    c.exchanged(Step(FRAME, "@"), ok())
+    assert not c.in_packet
+
+
+def test_the_open_packet_is_the_one_view_s_of_the_reference_s_answers():
+    """Decided (docs/decisions.md, "one view of the unit"): an `*S` the reference
+    answered opened nothing, and a frame it answered inside a packet ended it."""
+    c = course()
+    c.exchanged(Step(FRAME, "*S"), ok(code=4))
+    assert not c.in_packet
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.exchanged(Step(FRAME, "V100"), ok())
+    assert not c.in_packet
+    c.exchanged(Step(FRAME, "*S"), silent())
+    c.powered_on()
     assert not c.in_packet
 
 
@@ -96,3 +120,19 @@ def test_vl_capping_only_axes_never_moved_below_the_rate_is_capped_elsewhere():
     c.took("VL", "VL1000,1000,1000", ok())
     c.took("L", "L0,300,0", ok())
     assert not c.capped_elsewhere                              # no cap below the rate
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(FRAMES), st.sampled_from(ANSWERS),
+                          st.sampled_from([None, 3, 7])), max_size=20))
+def test_the_course_keeps_no_packet_of_its_own(exchanges):
+    """Whatever the reference answered, the course's open packet is that of the one view
+    fed the frames to the unit and its spindle's address (protocol/view.py)."""
+    c = Course(parse_target("emu:GVE114-500").profile)          # the spindle at 7
+    wire = View(addresses=frozenset({0, 7}))
+    for body, raw, address in exchanges:
+        answer = None if raw is None else parse_response(raw, summed=False)
+        c.exchanged(Step(FRAME, body, address=address), RoundTrip(b"", raw or b"", 0, 0,
+                                                                  answer))
+        wire = observe(wire, body, answer, address)
+    assert c.in_packet == wire.packet_open

@@ -294,29 +294,13 @@ def test_a_restart_seen_in_the_reads_after_the_known_state_ends_only_that_sequen
         preludes.append(1)
         raise UnitRestarted("the unit restarted by itself: PF read 0,0,0 at rest")
 
-    monkeypatch.setattr(p, "_prelude", restarted)
+    monkeypatch.setattr(p.start, "prelude", restarted)
     out = p.run(Grammar(p.profile, EVERYTHING).idiom(["L10,0,0", "PF"]))
     assert out.disagreement is None and out.frames == 0 and preludes
     assert out.refused == ["the known state: the unit restarted by itself: PF read 0,0,0 "
                            "at rest"]
 
 
-@pytest.mark.parametrize(("body", "long"), [("SW2,1A5", True), ("ER00D", True),
-                                           ("EW100,00", True), ("O0,100", True),
-                                           ("SW2,FF", False), ("ERD", False),
-                                           ("V1000", False), ("NA100", False)])
-def test_a_hex_field_longer_than_the_manuals_two_digits_is_its_context(body, long):
-    from conformance.diff.labels import command_of
-    from conformance.protocol.parse import parse as parse_frame
-    assert engine._long_hex(command_of(body), parse_frame(body).fields) is long
-
-
-def test_a_w_with_a_comma_after_its_axis_and_its_numbers_in_range_is_its_context():
-    assert engine._axis_comma("WX,-100,1000,50,1000")
-    assert not engine._axis_comma("WX-100,1000,50,1000")
-    # a field out of range: the reference's 5 is the range's, the target's 4 its bug
-    assert not engine._axis_comma("WX,1,900,-1,900")
-    assert not engine._axis_comma("WX,1,900,1")
 def _refusing(monkeypatch, refuse) -> list[engine.ExampleRun]:
     """Pair's start refused by the guard where ``refuse(n)`` (n: the sequences begun so
     far): the sequence then sends nothing. The outcomes of every sequence run."""

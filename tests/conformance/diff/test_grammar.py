@@ -7,16 +7,13 @@ from conformance.diff.grammar import (
     Grammar,
     Options,
     command_names,
-    load_probes,
-    probes,
     sequences,
     table_values,
     value_frames,
 )
 from conformance.diff.labels import command_of
-from conformance.diff.steps import FILL, FRAME, INPUT, WAIT
+from conformance.diff.steps import FILL, FRAME, INPUT
 from gve_fixtures.profile import load_profile
-from gve_fixtures.rules import load_rules
 
 GVE54 = load_profile("GVE54")
 GVE84 = load_profile("GVE84-100")
@@ -46,12 +43,6 @@ def test_sequences_stay_inside_the_profile(data):
         assert s.kind != INPUT                       # no rig asked for
 
 
-def test_an_idiom_vector_gets_the_profile_axes():
-    assert Grammar(GVE84, Options())._padded("C100") == "C100,0,0"
-    assert Grammar(GVE54, Options())._padded("L-5") == "L-5" + ",0" * (len(GVE54.axes) - 1)
-    assert Grammar(GVE84, Options())._padded("C1,2,3") == "C1,2,3"
-
-
 def test_idioms_that_show_the_dwell_and_an_eeprom_write_are_drawn():
     everything = Grammar(GVE84, Options(destructive=True)).scenarios
     assert ("EW10,5A", "ER10") in everything
@@ -73,12 +64,6 @@ def test_every_repeat_awaits_its_two_lines(data):
             assert not s.answer, s
 
 
-def test_an_event_repeat_is_read_whole():
-    g = Grammar(GVE84, Options())
-    assert g.fixed(">").lines == 2 and g.fixed("H").lines == 1
-    assert not g.fixed("*S").answer
-
-
 @settings(max_examples=200, deadline=None)
 @given(st.data())
 def test_a_reference_run_lasts_a_fraction_of_a_second(data):
@@ -95,38 +80,6 @@ def test_a_reference_run_lasts_a_fraction_of_a_second(data):
             n2, n3, n4, n5 = (int(f) for f in fields)
             if max(abs(n2), abs(n4)) <= 300 and all(v.lo <= n <= v.hi for n in (n3, n5)):
                 assert (abs(n2) + abs(n4)) / min(n3, n5) <= 2 / 3, s
-
-
-def test_an_idiom_is_written_as_steps_on_the_profile():
-    g = Grammar(GVE84, Options(destructive=True, rig=True))
-    steps = g.idiom(["wait 0.5", "input 1 FE", "fill 9 C2", "bad:V100", "stalled:?",
-                     "other:?", "L300", "J"])
-    assert [s.kind for s in steps] == [WAIT, INPUT, FILL, FRAME, FRAME, FRAME, FRAME, FRAME,
-                                       WAIT]
-    wait, inp, fill, bad, stalled, other, line, _, restart = steps
-    assert (wait.seconds, inp.port, inp.value) == (0.5, 1, 0xFE)
-    assert (fill.body, fill.times) == ("C2,0,0", 9)
-    assert bad.checksum == "bad" and stalled.stall[1] > GVE84.watchdog_ms / 1000
-    assert other.address != GVE84.address and not other.answer
-    assert line.body == "L300,0,0" and restart.seconds >= GVE84.restart_ms / 1000
-
-
-def test_probes_name_rules_and_are_left_out_where_they_cannot_be_sent():
-    rules = load_rules()
-    assert all(p["rule"] in rules for p in load_probes())
-    on_gve54 = [p["rule"] for p, _ in probes(GVE54, Options(destructive=True))]
-    assert "10.2.motion.path-rate" not in on_gve54           # no VK on the GVE54
-    safe = [p["steps"] for p, _ in probes(GVE84, Options())]
-    assert ["EW10,5A", "ER10"] not in safe
-    assert ["EW10,5A", "ER10"] in [p["steps"] for p, _ in probes(GVE84, Options(True))]
-
-
-def test_a_written_packets_frames_await_no_answer_until_one_ends_it():
-    g = Grammar(load_profile("GVE84-100"), Options(destructive=True))
-    steps = g.idiom(["*S", "B10", "v10", "*E2", "C200", "*S", "C10", "H", "*E1", "F"])
-    assert [(s.body, s.answer) for s in steps] == [
-        ("*S", False), ("B10", False), ("v10", False), ("*E2", True), ("C200,0,0", True),
-        ("*S", False), ("C10,0,0", False), ("H", True), ("*E1", True), ("F", True)]
 
 
 def test_a_fields_table_values_are_its_ranges_ends_each_word_and_each_axis():
@@ -163,14 +116,3 @@ def test_the_tables_move_each_axis_alone_and_ground_several_inputs_at_once():
     # without a rig no input is set: the idioms that need one are left out
     plain = Grammar(GVE114, Options(destructive=True)).tables
     assert not any(line.startswith("input ") for t in plain for line in t)
-
-
-def test_the_sweep_runs_each_commands_values_together_then_each_idiom():
-    g = Grammar(GVE84, Options(destructive=True, rig=True))
-    swept = g.sweep()
-    singles = [t[0] for t in g.tables if len(t) == 1]
-    bodies = [s.body for seq in swept for s in seq if s.kind == FRAME]
-    assert all(b in bodies for b in singles)
-    # a command's values in one sequence
-    v = next(seq for seq in swept if command_of(seq[0].body) == "V")
-    assert {s.body for s in v} == {b for b in singles if command_of(b) == "V"}

@@ -38,7 +38,7 @@ def test_every_state_holds_the_bits_it_declares(name):
     declared = {s["name"]: set(s.get("bits", [])) for s in load_matrix()["state"]}
     checked = 0
     for state, setup in states(profile):
-        if state not in declared or setup is None or not grammar._can(setup):
+        if state not in declared or setup is None or not grammar.written.can(setup):
             continue
         side = Side(parse_target(f"emu:{name}"))
         link = side.open()

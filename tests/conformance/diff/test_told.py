@@ -19,9 +19,10 @@ from hypothesis import strategies as st
 import conformance.diff.told as told_module
 from conformance.diff.engine import ExampleRun, Pair
 from conformance.diff.grammar import Options, sequences
-from conformance.diff.index import QUERIES
+from conformance.diff.index_base import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import Side
+from conformance.diff.start import Start
 from conformance.diff.steps import FRAME, Step
 from conformance.link.virtual import line_of
 from conformance.targets import parse_target
@@ -224,16 +225,16 @@ def test_the_reference_begins_while_the_co_simulator_runs_the_known_state(pairs,
     pair = pairs["clean"]
     steps = [Step(FRAME, body=body) for body in ("V400", "L100,0,0", "SR6", "@", "PF")]
     pair.run(steps)                        # the EEPROM as found read: nothing waits for it
-    begin_reference = Pair._begin_reference
+    begin_reference = Start.begin_reference
     seen: list[bool] = []
 
     def begins(self):
         seen.append(line_of(self.target.link.port)._told is not None)
         begin_reference(self)
 
-    monkeypatch.setattr(Pair, "_begin_reference", begins)
+    monkeypatch.setattr(Start, "begin_reference", begins)
     overlapped = pair.run(steps)
-    monkeypatch.setattr(Pair, "_same_eeprom_known", lambda self: False)
+    monkeypatch.setattr(Start, "eeprom_known", lambda self: False)
     after = pair.run(steps)
     assert seen == [True, False]
     assert outcome(overlapped) == outcome(after)

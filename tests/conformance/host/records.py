@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from conformance.host.checks import LineFacts, judge
-from conformance.host.grammar import parse_frame
+from conformance.host.frame_rules import parse_frame
 from conformance.host.recording import Exchange, Recording
 from conformance.host.unitview import line_views
 from conformance.protocol.framer import HostFrame

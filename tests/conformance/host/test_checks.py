@@ -4,7 +4,7 @@ is and kept where it is not."""
 from __future__ import annotations
 
 from conformance.host.checks import MS, PATIENCE_MS
-from conformance.host.grammar import byte_sum
+from conformance.host.frame_rules import byte_sum
 from conformance.host.oracle import HOST_CHECKS
 from gve_fixtures.rules import load_rules
 from tests.conformance.host.records import Wire, broken

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.host import relay as relay_module
-from conformance.host.faults import Fault, JobPoint, QueueFull
+from conformance.host.line_faults import Fault, JobPoint, QueueFull
 from conformance.host.ports.silent import SilentPort
 from conformance.host.recording import STALL_NS
 from conformance.host.relay import Relay

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from conformance.host.unitview import UnitView
+from conformance.protocol.view import View, observe
+from conformance.protocol.wire import parse_response
 from tests.conformance.host.records import PROFILE, UNITS, Wire
+from tests.conformance.protocol.test_view import ANSWERS, FRAMES
 
 
 def booked(w: Wire) -> UnitView:
@@ -67,9 +73,45 @@ def test_the_interrupt_input_the_host_enabled():
 
 
 def test_a_restart_in_checksum_mode_leaves_the_mode_lapsed_until_the_host_sets_it():
-    view = UnitView(PROFILE, 0)
-    view.checksums = True
+    w = Wire()
+    w.frame(b"!0%+", 0, answer=b"0,5C\r")
+    view = booked(w)
+    assert view.checksums
     view.power_on(0)
     assert not view.checksums and view.lapsed
     view.power_on(0)                  # off already: nothing lapses a second time
     assert not view.lapsed
+
+
+def test_the_open_packet_and_the_mode_are_the_view_s_of_the_wire():
+    """Decided (docs/decisions.md, "one view of the unit"): an answered `*S` opens no
+    packet, and a frame answered inside one ends it; the oracle reads both from the view."""
+    w = Wire()
+    w.frame(b"!0*S", 0, answer=b"4\r")
+    assert booked(w).packet is None
+    w.frame(b"!0*S", 10, answer=None)
+    w.frame(b"!0C1,0,0", 20, answer=None)
+    view = booked(w)
+    assert [f.body for f in view.packet or []] == ["C1,0,0"] == list(view.wire.packet or ())
+    w.frame(b"!0V100", 30)                             # answered: the unit took no member
+    view = booked(w)
+    assert view.packet is None and not view.wire.packet_open
+    w.frame(b"!0*E1", 40, answer=b"4,0\r")
+    assert booked(w).executed == []
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(FRAMES), st.sampled_from(ANSWERS)), max_size=20))
+def test_the_oracle_keeps_no_packet_or_mode_of_its_own(exchanges):
+    """Whatever the wire, the oracle's open packet and checksum mode are those of the one
+    view fed the same frames and answers (protocol/view.py)."""
+    w = Wire()
+    wire = View()
+    for i, (body, raw) in enumerate(exchanges):
+        w.frame(b"!0" + body.encode(), 10 * i, answer=raw)
+        wire = observe(wire, body, None if raw is None else
+                       parse_response(raw, summed=wire.summed_after(body)))
+    view = booked(w)
+    assert (view.packet is not None) == wire.packet_open
+    assert view.checksums == wire.checksums
+    assert len(view.packet or []) == len(wire.packet or ())

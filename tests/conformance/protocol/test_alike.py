@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from conformance.diff.grammar import load_grammar
 from conformance.diff.labels import command_of
-from conformance.host.grammar import parse_frame
+from conformance.host.frame_rules import parse_frame
 from conformance.link.safety import Body
 from conformance.protocol.catalogue import catalogue, commands
 from conformance.protocol.framer import HostFramer

@@ -59,7 +59,8 @@ def host_packet(is_open: bool, name: str, r: Response | None) -> bool:
 
 
 def course_packet(is_open: bool, name: str, r: Response | None) -> bool:
-    """diff's course: `*S` opens, `*E` and the breakers close, as they are sent."""
+    """diff's course, and the machines' model (as its machines booked what they sent):
+    `*S` opens, `*E` and the breakers close, as they are sent."""
     if name == "*S":
         return True
     if name == "*E" or name in _BREAKERS:
@@ -71,7 +72,8 @@ PACKET_TRACKERS = (link_packet, guard_packet, host_packet, course_packet)
 
 
 def link_mode(on: bool, body: str, r: Response | None) -> bool:
-    """The link's (and host certification's): `%+`, `%-` and `J` taken set the mode."""
+    """The link's (and host certification's, and the model's: a machine set it once the
+    unit took `%+` or `%-`): `%+`, `%-` and `J` taken set the mode."""
     if r is None or not r.ok:
         return on
     return {"%+": True, "%-": False, "J": False}.get(body, on)

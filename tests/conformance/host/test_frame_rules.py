@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conformance.host.grammar import command_of, parse_frame
+from conformance.host.frame_rules import command_of, parse_frame
 from gve_fixtures.profile import load_profile
 
 GVE84 = {0: load_profile("GVE84-100")}
@@ -133,13 +133,13 @@ def test_a_host_s_hostile_field_is_a_problem_of_its_frame_shown_escaped(raw):
 
 
 def test_a_frame_summed_after_a_restart_turned_the_mode_off_names_that_cause():
-    from conformance.host.grammar import LineGrammar
-    grammar = LineGrammar(GVE84)
-    f = grammar.parse(b"!0@,BD", False, lapsed=True)
+    from conformance.host.frame_rules import LineRules
+    line = LineRules(GVE84)
+    f = line.parse(b"!0@,BD", False, lapsed=True)
     assert [p.rule for p in f.problems] == ["6.checksum.off-after-reset"]
     assert f.command == "@" and not f.params
     # without a restart behind it the same frame is read as the unit reads it
     assert "3.params.none-expected" in rules(b"!0@,BD")
     # a last field that is no sum of the frame is a parameter still
     assert "6.checksum.off-after-reset" not in [
-        p.rule for p in grammar.parse(b"!0SW2,00", False, lapsed=True).problems]
+        p.rule for p in line.parse(b"!0SW2,00", False, lapsed=True).problems]

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from conformance.host.grammar import byte_sum
+from conformance.host.frame_rules import byte_sum
 from conformance.host.recording import Exchange, show
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import INTA_BIT, SECOND, ErrorCode

@@ -2,7 +2,7 @@
 counts itself agrees; one off later by exactly the queries since is the counting reading;
 one off by anything else miscounts."""
 
-from conformance.diff.index import IndexBase
+from conformance.diff.index_base import IndexBase
 
 
 def test_the_first_reading_sets_the_base():

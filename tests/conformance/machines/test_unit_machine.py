@@ -12,11 +12,11 @@ from hypothesis.stateful import rule
 from conformance.case import settings as settings_profiles
 from conformance.case.context import CaseContext, CouldNotTest
 from conformance.case.settings import example_database
-from conformance.machines.base import UnitMachine, index_invariant
+from conformance.machines.as_case import Factory, run_machine
 from conformance.machines.checksum import ChecksumMachine
-from conformance.machines.index import RecoveryMachine
 from conformance.machines.keep import KeepMachine
-from conformance.machines.runner import Factory, run_machine
+from conformance.machines.recovery import RecoveryMachine
+from conformance.machines.unit_machine import UnitMachine, index_invariant
 from conformance.run.selection import select
 from conformance.targets import parse_target
 

@@ -1,10 +1,10 @@
-"""The ledger reads frames and books the units' views when asked, in the relay's order:
+"""The booking reads frames and books the units' views when asked, in the relay's order:
 the same readings and the same executed motion as reading and booking each at once."""
 
 from __future__ import annotations
 
-from conformance.host.grammar import byte_sum, parse_frame
-from conformance.host.ledger import Ledger
+from conformance.host.booking import Booking
+from conformance.host.frame_rules import byte_sum, parse_frame
 from conformance.host.recording import Exchange
 from conformance.host.unitview import line_views
 from conformance.protocol.framer import HostFrame
@@ -41,16 +41,16 @@ def exchanges() -> list[Exchange | str]:
     return out
 
 
-def lazily() -> tuple[Ledger, list[Exchange]]:
-    ledger, done = Ledger(line_views([(PROFILE, 0)])), []
+def lazily() -> tuple[Booking, list[Exchange]]:
+    booking, done = Booking(line_views([(PROFILE, 0)])), []
     for item in exchanges():
         if isinstance(item, str):
-            ledger.power_on(0, 0)
+            booking.power_on(0, 0)
         else:
-            ledger.frame(item)
-            ledger.answered(item)
+            booking.frame(item)
+            booking.answered(item)
             done.append(item)
-    return ledger, done
+    return booking, done
 
 
 def test_nothing_is_read_until_asked():
@@ -61,16 +61,16 @@ def test_nothing_is_read_until_asked():
 
 
 def test_a_frame_is_read_in_the_checksum_mode_of_its_time():
-    ledger, done = lazily()
-    ledger.settle()
+    booking, done = lazily()
+    booking.settle()
     in_mode, after_restart = done[1].parsed, done[-1].parsed
     assert "6.checksum.sum" in in_mode.judged and not in_mode.problems
     assert "6.checksum.sum" not in after_restart.judged and not after_restart.problems
 
 
 def test_the_accepted_vectors_as_each_frame_came():
-    ledger, done = lazily()
-    assert ledger.vectors() == 3
+    booking, done = lazily()
+    assert booking.vectors() == 3
     assert [ex.vectors_before for ex in done] == [0, 0, 1, 1, 1, 2]
 
 
@@ -84,8 +84,8 @@ def test_the_same_books_as_reading_and_booking_at_once():
         item.reading = parse_frame(item.frame.raw, UNITS, view.checksums)
         readings.append(item.reading)
         view.apply(item, UNITS)
-    ledger, done = lazily()
-    ledger.settle()
+    booking, done = lazily()
+    booking.settle()
     assert [ex.parsed for ex in done] == readings
-    assert ledger.views[0].executed == view.executed
-    assert (ledger.views[0].checksums, ledger.views[0].packet) == (view.checksums, view.packet)
+    assert booking.views[0].executed == view.executed
+    assert (booking.views[0].checksums, booking.views[0].packet) == (view.checksums, view.packet)

@@ -1,11 +1,11 @@
 """The judge's reading of each frame and the units' views, kept from the wire when asked
 (the host benchmark and the reports ask).
 
-Reading a frame against the grammar (grammar.py) and booking an exchange on the units'
+Reading a frame against the rules (frame_rules.py) and booking an exchange on the units'
 views (unitview.py) take longer than a 921,600-baud line leaves the relay for a frame,
 and the line needs neither: the relay only passes bytes, pairs answers with frames and
 delivers them with their faults. So the relay notes, in its own order, what happened —
-a frame came, an exchange was answered, a unit restarted — and the ledger reads and
+a frame came, an exchange was answered, a unit restarted — and the booking reads and
 books them when someone asks: a fault that needs the count of accepted vectors, a
 unit's checksum mode or open packet, an exchange's reading, or the end of the run. A
 frame is read in the checksum mode its unit was in when the frame came, as it would have
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections import deque
 
-from conformance.host.grammar import LineGrammar
+from conformance.host.frame_rules import LineRules
 from conformance.host.recording import Exchange
 from conformance.host.unitview import UnitView, by_address, profiles_by_address
 
@@ -24,12 +24,12 @@ from conformance.host.unitview import UnitView, by_address, profiles_by_address
 FRAME, ANSWERED, POWER_ON = "frame", "answered", "power-on"
 
 
-class Ledger:
+class Booking:
     def __init__(self, views: list[UnitView]) -> None:
         self.views = views
         self.view_at = by_address(views)
         self.units = profiles_by_address(views)
-        self.grammar = LineGrammar(self.units)
+        self.rules = LineRules(self.units)
         # (what, the exchange or None, the address and instant of a restart)
         self._due: deque[tuple[str, Exchange | None, int, int]] = deque()
 
@@ -56,7 +56,7 @@ class Ledger:
             if kind == FRAME:
                 assert ex is not None
                 view = self.view_at.get(_address(ex.frame.raw))
-                ex.reading = self.grammar.parse(ex.frame.raw, view is not None
+                ex.reading = self.rules.parse(ex.frame.raw, view is not None
                                                 and view.checksums,
                                                 lapsed=view is not None and view.lapsed)
                 ex.vectors_before = self._vectors()

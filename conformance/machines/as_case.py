@@ -11,7 +11,7 @@ from hypothesis.stateful import run_state_machine_as_test
 from conformance.case import settings as settings_profiles
 from conformance.case.context import CaseContext, CouldNotTest
 from conformance.link.framing import UnitDataError
-from conformance.machines.base import UnitMachine
+from conformance.machines.unit_machine import UnitMachine
 from conformance.verdicts.verdict import ALWAYS, UNREADABLE
 
 

@@ -54,7 +54,8 @@ class UnitMachine(RuleBasedStateMachine):
         self.link = ctx.fresh_link()
         p = ctx.profile
         # PF reports X, Y, Z on every profile (spec 10: GVE114 PF also 3 values)
-        self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0])
+        self.model = ModelUnit(axes=len(p.axes), buffer=p.buffer, committed=[0, 0, 0],
+                               wire=lambda: self.link.view)
         # a real unit is not fresh: start the bookkeeping from where it is
         self.model.committed = self.position()
         self.link.read_index()          # the form the unit writes the index in, measured

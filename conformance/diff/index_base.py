@@ -74,7 +74,6 @@ class IndexBase:
                 and self.queries % 256 != 0
                 and (a - b - self.offset) % 256 == self.queries % 256)
 
-
     def in_hex(self, target: list[str], reference: list[str]) -> bool:
         """Whether the target's `@` differs from the reference's only by being written in
         hex: read as hex, from the base read as hex (0 before any), it is the
@@ -82,6 +81,14 @@ class IndexBase:
         a, b = _hex(target), _number(reference)
         return (a is not None and b is not None and target != reference
                 and (a - (self.hex_offset or 0)) % 256 == b % 256)
+
+    def context(self, target: list[str], reference: list[str]) -> set[str]:
+        """The labels' context flags of two `@` answers that differ: the readings of the
+        index they are (queries counted, refused frames not, written in hex)."""
+        flags = {"queries-counted": self.counts_queries(target, reference),
+                 "refused-uncounted": self.skips_refused(target, reference),
+                 "index-hex": self.in_hex(target, reference)}
+        return {flag for flag, on in flags.items() if on}
 
 
 def _hex(values: list[str]) -> int | None:

@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from hypothesis.stateful import rule
 
 from conformance.case.context import CaseContext, case
-from conformance.machines.base import UnitMachine, holds
-from conformance.machines.runner import run_machine
+from conformance.machines.as_case import run_machine
+from conformance.machines.unit_machine import UnitMachine, holds
 
 FAULTS = {"none": None, "lost-command": ("host", "drop", {}),
           "lost-response": ("unit", "drop", {}),

@@ -95,7 +95,7 @@ def command_of(raw: bytes, units: dict[int, Profile]) -> str | None:
     return parse(raw[2:].decode("latin-1"), strict=True).name
 
 
-class LineGrammar:
+class LineRules:
     """:func:`parse_frame` for one line, remembering its answers: hosts repeat frames
     (polls, retries). A parsed frame is shared between equal frames: do not change it."""
 
