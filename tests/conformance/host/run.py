@@ -20,7 +20,9 @@ def certify(tmp_path: Path, profile: str, *host: str, scenarios: tuple[str, ...]
     """The exit status and the results of certifying ``command`` (default: the reference
     host on the sample job, with ``host`` options)."""
     command = command or [sys.executable, "-m", "gve_host", "{port}", "--job", str(JOB), *host]
-    argv = ["--profile", profile, "--report-dir", str(tmp_path), "--host-timeout", "2",
+    # a host silent this long hangs: long enough for the reference host on a machine
+    # loaded by the other tests (it stalled 2 s there once), short for the one that hangs
+    argv = ["--profile", profile, "--report-dir", str(tmp_path), "--host-timeout", "4",
             *[a for s in scenarios for a in ("--scenarios", s)], *options, "--", *command]
     status = main(argv)
     (folder,) = [p for p in tmp_path.iterdir() if p.is_dir()]
