@@ -57,6 +57,7 @@ from conformance.link.framing import (
     readable,
     shown_bytes,
 )
+from conformance.link.liveness import Booked, Exchange, tell_followers
 from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.signals import Interrupted
 from conformance.link.virtual import Rig, line_of
@@ -122,6 +123,7 @@ class Link:
         self.baud = baud
         self.virtual = virtual
         self.guard = guard
+        self._followers = guard.followers()      # who is told each exchange
         self.rig = rig
         #: the unit as the wire shows it (protocol/view.py), fed once per exchange: the
         #: checksum mode, the open packet, the index's form...; the unit's addresses
@@ -234,7 +236,7 @@ class Link:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
         the frame's and an answer's bytes, a margin, what the command itself takes when it
         answers at its end, and what the line adds (:meth:`line_seconds`)."""
-        return self._timeout(self.guard.answer_seconds(body), size)
+        return self._timeout(self.guard.times.answer_seconds(body), size)
 
     def _timeout(self, slow: float | None, size: int) -> float:
         return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
@@ -333,9 +335,8 @@ class Link:
         self.log.append(Record("=", f"note {text}".encode("ascii", "replace"), self.now))
 
     def _transmit(self, data: bytes, summed: bool | None) -> list[HostFrame]:
-        """Write ``data`` (host faults apply) once the guard has judged every frame it
-        completes (once, :meth:`Guard.admit`: a frame told a co-simulator ahead was
-        judged when told); returns those frames."""
+        """Write ``data`` (host faults apply) once the guard judged each frame it completes
+        (once, :meth:`Guard.admit`; one told a co-simulator ahead, when told): those frames."""
         self._book_unbooked(None)
         fault = self._fault("host")
         pieces = fault.apply(data) if fault else [(data, 0.0)]
@@ -486,18 +487,19 @@ class Link:
               awaited: bool = True, heard: bool = False) -> None:
         """Book frames with the answer to the last one (the others got none; with
         ``awaited`` false none was waited for, and one may come later): the view observes
-        each frame once, and the guard books them with the views they left in one call
-        (``heard``: with what was read for the last one, Guard.answered)."""
-        exchanges = []
+        each frame once, then those who follow the unit (Guard.followers) are told the
+        exchange once (``heard``: with what was read for the last one)."""
+        booked = []
         for i, f in enumerate(frames):
             last = i == len(frames) - 1
             r = answer if last else None
             body = f.bodies(self.checksums)[0]
             address = self.address if f.address is None else f.address
             self.view = observe(self.view, body, r, address, awaited=awaited and last)
-            exchanges.append((body, r, address, self.view))
-        if exchanges or heard:
-            self.guard.book(exchanges, answer, self._origin + self.wrote_at, heard=heard)
+            booked.append(Booked(body, r, address, self.view))
+        if booked or heard:
+            tell_followers(Exchange(tuple(booked), answer, self._origin + self.wrote_at, heard,
+                                    self._admitted.own, self._admitted.urgent), *self._followers)
 
     def _answers_late(self, data: bytes) -> bytes:
         """Give each whole line of ``data`` that came after its frame to the frame it
@@ -532,8 +534,7 @@ class Link:
 
     def _book_unbooked(self, answer: Response | None, *, awaited: bool = False,
                        heard: bool = False) -> None:
-        """Book the raw frames sent with ``answer`` (None: none read), the last one's
-        answer ``awaited`` (else one may come later), ``heard`` as :meth:`_book`."""
+        """Book the raw frames sent (:meth:`_book`) with ``answer`` (None: none read)."""
         frames, self._unbooked = self._unbooked, []
         self._book(frames, answer, awaited=awaited, heard=heard)
 

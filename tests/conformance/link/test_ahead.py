@@ -20,6 +20,7 @@ from conformance.link.link import Link
 from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding, UnitRestarted
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import load_profile
+from tests.conformance.link.told import told
 
 MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
                        eeprom=0)
@@ -62,11 +63,10 @@ def sent(g: Guard, body: str, text: str | None) -> bool:
     its answer ended the case (a read that shows a restart)."""
     g.check(body)
     r = response(text)
-    g.accepted(body, r)
     try:
-        g.answered(r)
+        told(g, body, r)
     except TargetNotResponding:
-        g.dead, g.silences = False, 0        # the silence count is not the envelope's
+        g.liveness.dead, g.liveness.silences = False, 0   # the silence count is not the envelope's
     except UnitRestarted:
         return False
     return True
