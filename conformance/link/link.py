@@ -375,7 +375,7 @@ class Link:
             self._put(data)
             return
         interrupts = self.guard.interrupts
-        with interrupts.held():
+        with interrupts.writing():
             if not self._admitted.urgent and interrupts.bars(own=self._admitted.own):
                 raise Interrupted
             self._put(data)

@@ -48,7 +48,7 @@ from conformance.link.ledger import EepromLedger
 from conformance.link.liveness import SILENCE_LIMIT as SILENCE_LIMIT
 from conformance.link.liveness import Liveness
 from conformance.link.liveness import TargetNotResponding as TargetNotResponding
-from conformance.link.signals import Interrupted, Interrupts
+from conformance.link.signals import Interrupted, StopSignals
 from conformance.link.stops import SafetyStop
 from conformance.link.stops import UnitRestarted as UnitRestarted
 from conformance.protocol.catalogue import catalogue, classes, eeprom_width
@@ -76,7 +76,7 @@ class Admitted:
     """What the guard said of frames it let out: how long the last one's answer may
     take (None: at once), and whether they are the session's own frames or its `H` and
     `D` after Ctrl-C (``own``, ``urgent``), which a signal that comes before they are
-    written keeps off the line or not (:meth:`Interrupts.bars`)."""
+    written keeps off the line or not (:meth:`StopSignals.bars`)."""
 
     answer_seconds: float | None = None
     own: bool = False
@@ -101,12 +101,12 @@ class Guard:
     knows of the unit's safety: the envelope, the EEPROM ledger, the run's Ctrl-C."""
 
     def __init__(self, profile: Profile, address: int, *, max_travel: int,
-                 allow_destructive: bool, interrupts: Interrupts | None = None) -> None:
+                 allow_destructive: bool, interrupts: StopSignals | None = None) -> None:
         self.profile = profile
         self.address = address
         self.max_travel = max_travel
         self.allow_destructive = allow_destructive
-        self.interrupts = interrupts or Interrupts()
+        self.interrupts = interrupts or StopSignals()
         micro = profile.microstep
         self.scale = profile.position_scale               # counter units per full step
         envelope = Envelope(
@@ -368,7 +368,7 @@ class EmulatorGuard(Guard):
     unit that stopped answering."""
 
     def __init__(self, profile: Profile, address: int,
-                 interrupts: Interrupts | None = None) -> None:
+                 interrupts: StopSignals | None = None) -> None:
         super().__init__(profile, address, max_travel=0, allow_destructive=True,
                          interrupts=interrupts)
 

@@ -8,13 +8,13 @@ import pytest
 from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
-from conformance.link.signals import Interrupted, Interrupts
+from conformance.link.signals import Interrupted, StopSignals
 from gve_fixtures.profile import load_profile
 from tests.conformance.link.told import told
 
 
 def guard(profile: str = "GVE84-100", *, destructive: bool = False, travel: int = 500,
-          interrupts: Interrupts | None = None) -> Guard:
+          interrupts: StopSignals | None = None) -> Guard:
     return Guard(load_profile(profile), 0, max_travel=travel,
                  allow_destructive=destructive, interrupts=interrupts)
 
@@ -81,7 +81,7 @@ def test_in_checksum_mode_a_members_last_field_is_its_checksum_on_every_profile(
 
 
 def test_after_ctrl_c_only_the_sessions_own_frames_go_and_never_motion():
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     g = guard(interrupts=interrupts)
     interrupts.signal()
     with pytest.raises(Interrupted):
