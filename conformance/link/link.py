@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 from conformance.link.account import Spent, TimeAccount
@@ -57,6 +57,8 @@ from conformance.link.framing import (
     readable,
     shown_bytes,
 )
+from conformance.link.line_time import MARGIN as MARGIN
+from conformance.link.line_time import LineTime
 from conformance.link.liveness import Booked, Exchange, tell_followers
 from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.signals import Interrupted
@@ -69,17 +71,12 @@ from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-#: processing margin on top of the bytes' own transmission time
-MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next
 #: frame (an answer later than this after its timeout could still be misread)
 QUIET = 2.5
 #: real time: how long after its timeout an answer is still taken as its frame's, noted
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
-#: real time: at the end of a case, the longest it listens for bytes still on their way
-#: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
-END_QUIET = 0.05
 
 # what the last frame left on the line
 _ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
@@ -118,10 +115,9 @@ class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
                  virtual: bool = False, rig: Rig | None = None) -> None:
         self.port = port
-        self.line = line_of(port) if virtual else None   # the clock in virtual time
+        #: the link's clock and time account (the virtual line's clock in virtual time)
+        self.time = LineTime(line_of(port) if virtual else None, baud)
         self.address = address
-        self.baud = baud
-        self.virtual = virtual
         self.guard = guard
         self._followers = guard.followers()      # who is told each exchange
         self.rig = rig
@@ -129,9 +125,6 @@ class Link:
         #: checksum mode, the open packet, the index's form...; the unit's addresses
         #: share it
         self.view = View(addresses=frozenset(guard.addresses))
-        #: real time: the line's round trip as the session measured it at its start
-        #: (``SessionReport.line``; empty when it was not), for the timing bands
-        self.round_trip: dict[str, float] = {}
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[Stray] = []
@@ -152,19 +145,11 @@ class Link:
         #: a later link of the case took over: what this one left went to a unit that
         #: has heard other frames since (or, on the emulator, is gone)
         self.superseded = False
-        #: where the link's time went (its session's account, shared by its links)
-        self.account = TimeAccount()
-        #: the exchange whose bytes are going out: the clock when its first byte was
-        #: written, its bytes, the time paused in it (booked apart); what follows its
-        #: answer, or its absence, is booked with it
-        self._exchange: list[int] | None = None
-        self._answered_as = Spent.ANSWERS
         #: what the guard said of the frames written last (Guard.admit)
         self._admitted = Admitted()
         #: work of the caller's done once, while the port runs the next frames told
         #: ahead (:meth:`tell`), or by the caller when none are told
         self.meanwhile: Callable[[], None] | None = None
-        self._origin = self._clock()
 
     # -- what the view holds -------------------------------------------------------------
     @property
@@ -185,74 +170,36 @@ class Link:
     def index_form(self, form: Form | None) -> None:
         self.view = self.view.assume(index_form=form)
 
-    # -- time ------------------------------------------------------------------------------
-    def _clock(self) -> int:
-        if self.line is not None:
-            return self.line.now
-        return time.monotonic_ns()
+    # -- time (the link's LineTime) ------------------------------------------------------
+    virtual = property(lambda self: self.time.virtual)
+    line = property(lambda self: self.time.line)
+    baud = property(lambda self: self.time.baud)
+    now = property(lambda self: self.time.now)
+    account = property(lambda self: self.time.account)
 
     @property
-    def now(self) -> int:
-        return self._clock() - self._origin
+    def round_trip(self) -> dict[str, float]:
+        """Real time: the line's round trip as the session measured it (LineTime)."""
+        return self.time.round_trip
+
+    @round_trip.setter
+    def round_trip(self, measured: dict[str, float]) -> None:
+        self.time.round_trip = measured
 
     def keep_account(self, account: TimeAccount) -> None:
-        """Book this link's time in ``account`` (its session's); in virtual time the
-        account's wall time follows this link's clock from now on."""
-        self.account = account
-        if self.virtual:
-            account.follow(lambda: self.now / SECOND)
+        self.time.keep_account(account)
 
-    @contextlib.contextmanager
-    def spending(self, spent: Spent) -> Iterator[None]:
-        """Book the time the block takes under ``spent`` (e.g. a technician's step)."""
-        began = self._clock()
-        try:
-            yield
-        finally:
-            self.account.book(spent, (self._clock() - began) / SECOND)
-
-    def _book_exchange(self, received: int, rest: Spent, began: int) -> None:
-        """Book the exchange under way (else what was read since ``began``): its bytes
-        and the ``received`` ones at the baud rate as line time, the rest under ``rest``."""
-        if self._exchange is not None:
-            began, sent, paused = self._exchange
-        else:
-            sent = paused = 0
-        self._exchange = None
-        seconds = (self._clock() - began - paused) / SECOND
-        line = min(seconds, self.byte_seconds(sent + received))
-        self.account.book(Spent.LINE, line)
-        self.account.book(rest, seconds - line)
-
-    def _close_exchange(self) -> None:
-        """Frames sent that nothing will read an answer to: their bytes are booked now."""
-        if self._exchange is not None:
-            self._book_exchange(0, Spent.WAITS, 0)
+    def spending(self, spent: Spent) -> contextlib.AbstractContextManager[None]:
+        return self.time.spending(spent)
 
     def byte_seconds(self, n: int) -> float:
-        return n * 10 / self.baud
+        return self.time.byte_seconds(n)
 
     def answer_timeout(self, body: str, size: int) -> float:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
         the frame's and an answer's bytes, a margin, what the command itself takes when it
         answers at its end, and what the line adds (:meth:`line_seconds`)."""
-        return self._timeout(self.guard.times.answer_seconds(body), size)
-
-    def _timeout(self, slow: float | None, size: int) -> float:
-        return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
-
-    def line_seconds(self) -> float:
-        """Real time: twice the slowest round trip the session measured (a USB adapter
-        holds an answer's bytes up to its latency timer, and may hold its last piece
-        that long again); nothing in virtual time or when the line was not measured."""
-        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
-
-    def end_quiet(self) -> float:
-        """Real time: how long the end of a case listens for bytes still on their way (a
-        second answer follows the first at once): the line's round trip as measured
-        (:meth:`line_seconds`), at most :data:`END_QUIET`."""
-        measured = self.line_seconds()
-        return min(END_QUIET, measured) if measured else END_QUIET
+        return self.time.timeout(self.guard.times.answer_seconds(body), size)
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
@@ -263,7 +210,7 @@ class Link:
         """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
         suite's own wait unless it says otherwise); returns whatever arrived meanwhile."""
         self.guard.check_idle()
-        self._close_exchange()
+        self.time.close_exchange()
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
@@ -302,19 +249,18 @@ class Link:
         as a second or a late answer."""
         if not data or data.endswith(CR) or self.guard.interrupts.pending:
             return data
-        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
         return data + self.port.read_until(CR)
 
     def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
-        began = self._clock()
+        began = self.time.clock()
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
             else:
                 time.sleep(seconds)  # real serial/TCP time: the fault is a pause on the wire
-        if self._exchange is not None:
-            self._exchange[2] += self._clock() - began
+        self.time.paused(self.time.clock() - began)
 
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
@@ -382,9 +328,7 @@ class Link:
 
     def _put(self, data: bytes) -> None:
         self._record(HOST, data)
-        if self._exchange is None:
-            self._exchange = [self._clock(), 0, 0]
-        self._exchange[1] += len(data)
+        self.time.wrote(len(data))
         self.port.write(data)
 
     def send_raw(self, data: bytes) -> None:
@@ -410,11 +354,11 @@ class Link:
         if self._dropped:
             timeout = 0.0            # an injected fault dropped it: no answer can come
         elif timeout is None:
-            timeout = self._timeout(self._admitted.answer_seconds, len(data))
+            timeout = self.time.timeout(self._admitted.answer_seconds, len(data))
             late = 0.0 if self.virtual else LATE
         self._unbooked = sent
         # H and W answer when their motion ends: the wait for them is the motion's
-        self._answered_as = (Spent.MOTION if self._admitted.answer_seconds
+        self.time.answered_as = (Spent.MOTION if self._admitted.answer_seconds
                              else Spent.ANSWERS)
         r = self.read_response(timeout, lines, summed=self.summed_after(body), late=late)
         if r is not None:
@@ -498,7 +442,7 @@ class Link:
             self.view = observe(self.view, body, r, address, awaited=awaited and last)
             booked.append(Booked(body, r, address, self.view))
         if booked or heard:
-            tell_followers(Exchange(tuple(booked), answer, self._origin + self.wrote_at, heard,
+            tell_followers(Exchange(tuple(booked), answer, self.time.origin + self.wrote_at, heard,
                                     self._admitted.own, self._admitted.urgent), *self._followers)
 
     def _answers_late(self, data: bytes) -> bytes:
@@ -589,8 +533,8 @@ class Link:
         self.port.timeout = timeout
         self._quiet = 0.0
         asked = time.monotonic()
-        began = self._clock()
-        answered_as, self._answered_as = self._answered_as, Spent.ANSWERS
+        began = self.time.clock()
+        answered_as, self.time.answered_as = self.time.answered_as, Spent.ANSWERS
         for i in range(lines):
             # an answer that began in time is read to its end before it is judged
             chunk = self._whole_line(self.port.read_until(CR))
@@ -607,10 +551,10 @@ class Link:
             raw += chunk
             if not chunk.endswith(CR):
                 break
-            self.port.timeout = MARGIN + self.line_seconds()
+            self.port.timeout = MARGIN + self.time.line_seconds()
         data = self._behind_late(bytes(raw), lines)
         # an answer that did not come (or not whole) was waited for to the suite's deadline
-        self._book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
+        self.time.book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
                             began)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None
@@ -644,7 +588,7 @@ class Link:
         (:meth:`_answers_late`)."""
         while (lines == 1 and data.endswith(CR) and self.view.answerable
                and not self.guard.interrupts.pending):
-            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
             behind = self._whole_line(self.port.read_until(CR))
             if not behind.endswith(CR) or self._answers_late(data):
                 return data + behind
@@ -657,14 +601,14 @@ class Link:
         more lines than expected (`>` after `@`, if `@` is remembered)."""
         raw = bytearray()
         self.port.timeout = seconds
-        began = self._clock()
+        began = self.time.clock()
         while True:
             chunk = self.port.read_until(CR)
             raw += chunk
             if not chunk.endswith(CR):
                 break
             self.port.timeout = self.byte_seconds(64)
-        self._book_exchange(len(raw), Spent.WAITS, began)
+        self.time.book_exchange(len(raw), Spent.WAITS, began)
         if raw:
             self._record(UNIT, bytes(raw), "the rest of the answer")
         return bytes(raw)
@@ -675,7 +619,7 @@ class Link:
         (a violation), after a timeout a late one (a violation), else unsolicited. In
         real time, after a timeout, wait until the line is quiet first."""
         state = self._last[0]
-        self._close_exchange()
+        self.time.close_exchange()
         data = self._outwait(final)
         kept_quiet = False
         if not self.virtual:
@@ -685,7 +629,7 @@ class Link:
                 kept_quiet = not self.guard.interrupts.pending
             elif final:
                 with self.spending(Spent.WAITS):
-                    data += self._listen(self.end_quiet(), stop_early=True)
+                    data += self._listen(self.time.end_quiet(), stop_early=True)
         self._quiet = 0.0
         waiting = self.port.in_waiting
         if waiting:
