@@ -42,7 +42,6 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Sequence
-from typing import NamedTuple
 
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.faults import FrameFault
@@ -51,24 +50,31 @@ from conformance.link.framing import (
     HostFrame,
     HostFramer,
     Response,
-    UnitDataError,
     frame,
     parse_response,
     readable,
-    shown_bytes,
 )
+from conformance.link.index_read import index_value, read_index
 from conformance.link.line_time import MARGIN as MARGIN
 from conformance.link.line_time import LineTime
 from conformance.link.liveness import Booked, Exchange, tell_followers
 from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
 from conformance.link.signals import Interrupted
+from conformance.link.strays import (
+    ANSWERED,
+    OPEN_PACKET,
+    TIMED_OUT,
+    UNASKED,
+    Stray,
+    judge,
+    left_open,
+)
 from conformance.link.virtual import Rig, line_of
-from conformance.protocol import index
 from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
 from conformance.protocol.view import View, answered_late, late, observe
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
+from gve_fixtures.protocol import MAX_FRAME, SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
 #: real time: after a frame timed out, how long the line must stay quiet before the next
@@ -78,38 +84,11 @@ QUIET = 2.5
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
 
-# what the last frame left on the line
-_ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
-
-# what the suite's bytes left unfinished for a watchdog to end
-LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an open packet"
-#: the rule an answer of each one's watchdog is judged by (our reading: a lone `!` is
-#: dropped without an answer, a frame answered 2, a packet never closed by time)
-WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
-                  OPEN_PACKET: "7.packet.open-until-end"}
 #: frames that set no axis moving, whatever the unit is, and those whose answer tells
 #: where the axes are
 _MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
                         eeprom=0)
 _POSITION_READS = classes(position=True)
-
-#: the rule a second answer breaks (the unit answers every complete frame once), and one
-#: after its frame's timeout (it answers as soon as possible)
-TWICE, LATE_RULE = "2.link.simplex", "2.link.answer-promptly"
-
-
-class Stray(NamedTuple):
-    """Bytes that did not belong to the frame just sent: what they were, the rule they
-    break, and whether they FAIL whatever that rule's tag (a second answer no watchdog
-    explains; a watchdog's answer is graded by its rule's tag)."""
-
-    text: str
-    rule: str
-    always: bool = True
-
-    def __str__(self) -> str:
-        return f"{self.text} [{self.rule}]"
-
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
@@ -138,7 +117,7 @@ class Link:
         self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
-        self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
+        self._last: tuple[str, bytes, bytes] = (UNASKED, b"", b"")   # state, frame, answer
         self._dropped = False
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
@@ -226,7 +205,7 @@ class Link:
         if rest:
             self._record(UNIT, rest)
             self._after_answer(rest, "during a wait", judged=True)
-        self._last = (_UNASKED, b"", b"")
+        self._last = (UNASKED, b"", b"")
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool, already: float = 0.0) -> bytes:
@@ -306,7 +285,7 @@ class Link:
                 self._write(piece)
         self._sent_until, self._waited_out = self.now, False
         if frames:
-            self._last = (_UNASKED, frames[-1].wire, b"")
+            self._last = (UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -469,12 +448,7 @@ class Link:
     def left_open(self) -> str:
         """What the suite's bytes so far leave for a watchdog to end (LONE_BANG,
         OPEN_FRAME, OPEN_PACKET), "" when nothing."""
-        partial = self._framer.partial
-        if partial == b"!":
-            return LONE_BANG
-        if partial:
-            return OPEN_FRAME
-        return OPEN_PACKET if self.view.packet_open else ""
+        return left_open(self._framer.partial, self.view.packet_open)
 
     def _book_unbooked(self, answer: Response | None, *, awaited: bool = False,
                        heard: bool = False) -> None:
@@ -483,42 +457,17 @@ class Link:
         self._book(frames, answer, awaited=awaited, heard=heard)
 
     def read_index(self, address: int | None = None) -> int | None:
-        """The index `@` answers (None: no answer, or a refusal), read in the form the
-        unit writes it: the first read whose text does not show its form measures it
-        first (frames that count move the index: protocol/index.py), so the value
-        returned is read after them. Raises UnitDataError for text no form reads."""
+        """The index `@` answers in the form the unit writes it (conformance/link/
+        index_read.py; None: no answer, or a refusal)."""
         where = self.address if address is None else address
-        r = self.send("@", address=where)
-        if r is None or not r.ok or not r.values:
-            return None
-        if self.index_form is None:
-            form = index.evident(r.values[0])
-            if form is None:
-                form = index.measure(lambda: self._index_text(where),
-                                     lambda: self._move_index(where))
-                r = self.send("@", address=where)
-                if r is None or not r.ok or not r.values:
-                    return None
+        value, form = read_index(lambda body: self.send(body, address=where), self.index_form)
+        if form is not None:
             self.index_form = form
-        return self.index_value(r)
+        return value
 
     def index_value(self, r: Response) -> int:
-        """Value 0 of ``r`` (an answer to `@`) as the index, in the form the unit writes it
-        (decimal before it is known)."""
-        text = r.values[0]
-        got = index.value(text, self.index_form or Form.DECIMAL)
-        if got is None:
-            raise UnitDataError(f"the answer {shown_bytes(r.raw)} has "
-                                f"{shown_bytes(text.encode('latin-1'), 80)} where the "
-                                f"index belongs (a number 0..255, decimal or hex)")
-        return got
-
-    def _move_index(self, address: int) -> None:
-        self.send("SR6", address=address)     # a read: it moves nothing but the index
-
-    def _index_text(self, address: int) -> str | None:
-        r = self.send("@", address=address)
-        return r.values[0] if r is not None and r.ok and r.values else None
+        """Value 0 of ``r`` (an answer to `@`) as the index, in the form the unit writes it."""
+        return index_value(r, self.index_form)
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
                       summed: bool | None = None, settle: bool = True,
@@ -563,7 +512,7 @@ class Link:
             real.received_at = self.now
         answered = real is not None and real.code is not None
         # a frame an injected fault dropped cannot be answered late
-        self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
+        self._last = (ANSWERED if answered else UNASKED if self._dropped else TIMED_OUT,
                       self._last[1], data)
         if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
@@ -623,7 +572,7 @@ class Link:
         data = self._outwait(final)
         kept_quiet = False
         if not self.virtual:
-            if state == _TIMED_OUT and not self.guard.interrupts.pending:
+            if state == TIMED_OUT and not self.guard.interrupts.pending:
                 with self.spending(Spent.WAITS):
                     data += self._listen(QUIET, stop_early=True, already=self._quiet)
                 kept_quiet = not self.guard.interrupts.pending
@@ -638,11 +587,11 @@ class Link:
         rest = self._answers_late(data)
         if not rest:
             if kept_quiet or data:       # the timed-out frame's answer can come no more
-                self._last = (_UNASKED, b"", b"")
+                self._last = (UNASKED, b"", b"")
             return data
         self._record(UNIT, rest, "unsolicited")
         self._after_answer(rest, "after")
-        self._last = (_UNASKED, b"", b"")
+        self._last = (UNASKED, b"", b"")
         return data
 
     def _outwait(self, final: bool) -> bytes:
@@ -658,7 +607,7 @@ class Link:
         profile = self.guard.profile
         idle = self.now - self._sent_until
         let_go = idle >= profile.watchdog_ms * 1_000_000 and kind != OPEN_PACKET
-        if not (final or let_go or self._last[0] == _TIMED_OUT):
+        if not (final or let_go or self._last[0] == TIMED_OUT):
             return b""
         self._waited_out = True
         left = (profile.watchdog_longest_ms * 1_000_000 - idle) / SECOND + MARGIN
@@ -671,33 +620,14 @@ class Link:
             return self._listen(left, stop_early=False)
 
     def _after_answer(self, data: bytes, when: str, *, judged: bool = False) -> None:
-        """Bytes no frame asked for: a watchdog's answer to what the suite left
-        unfinished (judged by the watchdog's rule; not when the case reads them itself,
-        ``judged``), else a second answer or a late one (a violation)."""
+        """Bytes no frame asked for, judged (conformance/link/strays.py): a watchdog's
+        answer that ends what the suite left open, else a second answer or a late one."""
         kind = self.left_open()
-        if kind and _watchdog_answer(data, kind, self.checksums):
-            self._ended_by_watchdog(kind, data, judged)
-            return
-        state, sent, answer = self._last
-        frame_text = readable(sent) or "the last frame"
-        if state == _ANSWERED:
-            self.violations.append(Stray(f"answered twice: {frame_text} got "
-                                         f"{readable(answer)}, then {readable(data)} {when}",
-                                         TWICE))
-        elif state == _TIMED_OUT:
-            self.violations.append(Stray(f"answered after its timeout: {frame_text} got "
-                                         f"{readable(data)} late", LATE_RULE))
-
-    def _ended_by_watchdog(self, kind: str, data: bytes, judged: bool) -> None:
-        """A watchdog answered what was left unfinished: our reading answers a frame so
-        too (its time is the watchdog-time rule's, which the watchdog case judges); a
-        lone `!` answered, or a packet closed by time, is a reading of its rule."""
-        if kind == OPEN_PACKET:
+        ended, stray = judge(data, when, kind, self.checksums, self._last, judged=judged)
+        if ended and kind == OPEN_PACKET:
             self.view = self.view.assume(packet=None)
-        if kind == OPEN_FRAME or judged:
-            return
-        self.violations.append(Stray(f"{kind} was ended by a watchdog answering "
-                                     f"{readable(data)}", WATCHDOG_RULES[kind], always=False))
+        if stray is not None:
+            self.violations.append(stray)
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05, *, send: Callable[[str], Response | None] | None = None,
@@ -723,21 +653,6 @@ class Link:
 
     def transcript_lines(self) -> list[str]:
         return [rec.line() for rec in self.log]
-
-
-def _watchdog_answer(data: bytes, kind: str, summed: bool) -> bool:
-    """Whether ``data`` is nothing but answers a watchdog gives (code 2, with INTA as it
-    stands; after a packet its count of members too, spec 7's `2,k`)."""
-    lines = [line for line in data.split(CR) if line]
-    if not lines or not data.endswith(CR):
-        return False
-    for line in lines:
-        r = parse_response(line + CR, summed=summed)
-        if r is None or r.code is None or r.code & 7 != ErrorCode.WATCHDOG:
-            return False
-        if len(r.values) > (1 if kind == OPEN_PACKET else 0):
-            return False
-    return True
 
 
 def idle_st6(r: Response) -> bool:
