@@ -58,7 +58,7 @@ from conformance.link.index_read import index_value, read_index
 from conformance.link.line_time import MARGIN as MARGIN
 from conformance.link.line_time import LineTime
 from conformance.link.liveness import Booked, Exchange, tell_followers
-from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
+from conformance.link.safety import Admitted, Guard
 from conformance.link.signals import Interrupted
 from conformance.link.strays import (
     ANSWERED,
@@ -70,7 +70,6 @@ from conformance.link.strays import (
     left_open,
 )
 from conformance.link.virtual import Rig, line_of
-from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
 from conformance.protocol.view import View, answered_late, late, observe
 from conformance.protocol.wire import is_hex_byte
@@ -83,12 +82,6 @@ QUIET = 2.5
 #: real time: how long after its timeout an answer is still taken as its frame's, noted
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
-
-#: frames that set no axis moving, whatever the unit is, and those whose answer tells
-#: where the axes are
-_MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
-                        eeprom=0)
-_POSITION_READS = classes(position=True)
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
@@ -361,7 +354,7 @@ class Link:
         expect = getattr(self.port, "expect", None)
         if expect is None or self._faults or not getattr(self.port, "tells", True):
             return
-        bodies = self._judged_ahead(bodies)
+        bodies = self.guard.told_ahead(bodies, self.address)
         if not bodies:
             return
         framed = [frame(body, self.address, self.checksums) for body in bodies]
@@ -375,28 +368,6 @@ class Link:
         elif getattr(self.port, "tell", expect)(told):
             self.meanwhile = None
             work()
-
-    def _judged_ahead(self, bodies: Sequence[str]) -> list[str]:
-        """The first of ``bodies`` that may be told ahead: a port told them runs them before
-        the run's guard judges any, so each is judged first on a copy of the guard as
-        though the ones before got any answer (Guard.ahead). The first refused ends them,
-        and after a position read, whose answer may move the axes anywhere in the guard's
-        eyes, only frames that set nothing moving follow."""
-        trial = self.guard.ahead()
-        admitted: list[str] = []
-        read = False
-        for body in bodies:
-            name = Body.parse(body).name            # SW6 apart from the other SW
-            if read and name not in _MOVE_NOTHING:
-                break
-            try:
-                trial.check(body, self.address)
-            except (SafetyStop, Interrupted, TargetNotResponding):
-                break
-            trial.book_any(body, self.address)
-            read = read or name in _POSITION_READS
-            admitted.append(body)
-        return admitted
 
     @property
     def takes_ahead(self) -> bool:

@@ -32,7 +32,7 @@ Public interface (docs/suite.md, "The session and its guard")::
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 from conformance.link.answer_time import LONGEST_ANSWER_S as LONGEST_ANSWER_S
@@ -67,6 +67,11 @@ MOTION = classes(motion=True)
 DESTRUCTIVE = classes(destructive=True)
 #: frames that set the checksum mode, and so how the unit reads the frames after them
 _SUMMING = classes(summing=True)
+#: frames that set no axis moving, whatever the unit is, and those whose answer tells
+#: where the axes are
+_MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
+                        eeprom=0)
+_POSITION_READS = classes(position=True)
 #: what a command sets moving again, by name: "queue" or "save"
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 
@@ -347,6 +352,29 @@ class Guard:
             raise SafetyStop(f"{body}: motion was not confirmed")
 
     # -- frames told ahead ------------------------------------------------------------------
+    def told_ahead(self, bodies: Sequence[str], address: int) -> list[str]:
+        """The first of ``bodies`` that may be told a port ahead (a co-simulator's
+        `batch`): a port told them runs them before the run's guard judges any, so each is
+        judged first on a copy (:meth:`ahead`) as though the ones before got any answer.
+        The first refused ends them, and after a position read, whose answer may move the
+        axes anywhere in the bookkeeping's eyes, only frames that set nothing moving
+        follow."""
+        trial = self.ahead()
+        admitted: list[str] = []
+        read = False
+        for body in bodies:
+            name = Body.parse(body).name            # SW6 apart from the other SW
+            if read and name not in _MOVE_NOTHING:
+                break
+            try:
+                trial.check(body, address)
+            except (SafetyStop, Interrupted, TargetNotResponding):
+                break
+            trial.book_any(body, address)
+            read = read or name in _POSITION_READS
+            admitted.append(body)
+        return admitted
+
     def ahead(self) -> Guard:
         """A copy of this guard on which frames told ahead of their sending (a
         co-simulator's `batch`) are judged one after the other, each booked with

@@ -16,7 +16,6 @@ from hypothesis import strategies as st
 
 from conformance.link.ahead import Ahead
 from conformance.link.framing import frame, parse_response
-from conformance.link.link import Link
 from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding, UnitRestarted
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import load_profile
@@ -155,8 +154,7 @@ def test_the_frames_a_link_tells_are_let_through_whatever_the_answers_before_the
     for body, text in before:
         with contextlib.suppress(SafetyStop):
             sent(g, body, text)
-    bodies_told = Link._judged_ahead(SimpleNamespace(guard=g, address=0),
-                                     [body for body, _ in told])
+    bodies_told = g.told_ahead([body for body, _ in told], 0)
     admitted = told[:len(bodies_told)]
     assert [body for body, _ in admitted] == bodies_told
     read = False
