@@ -392,8 +392,9 @@ class Link:
             self.view = observe(self.view, body, r, address, awaited=awaited and last)
             booked.append(Booked(body, r, address, self.view))
         if booked or heard:
-            tell_followers(Exchange(tuple(booked), answer, self.time.origin + self.wrote_at, heard,
-                                    self._admitted.own, self._admitted.urgent), *self._followers)
+            at, admitted = self.time.origin + self.wrote_at, self._admitted
+            tell_followers(Exchange(tuple(booked), self.view, answer, at, heard, admitted.own,
+                                    admitted.urgent), *self._followers)
 
     def _answers_late(self, data: bytes) -> bytes:
         """Give each whole line of ``data`` that came after its frame to the frame it

@@ -54,13 +54,15 @@ class Booked:
 
 @dataclass(frozen=True)
 class Exchange:
-    """What one exchange left, told once to those who follow the unit: its frames, what
-    was read for the last one (``answer``; only when ``heard``: an answer was awaited and
-    read for, else one may still come), the instant the frames went out (ns on the line's
-    clock), and whether the guard let them out as the session's `H` and `D` after Ctrl-C
-    (``urgent``) or as its own frames (``own``)."""
+    """What one exchange left, told once to those who follow the unit: its frames, the
+    view of the unit the link holds after it, what was read for the last one (``answer``;
+    only when ``heard``: an answer was awaited and read for, else one may still come),
+    the instant the frames went out (ns on the line's clock), and whether the guard let
+    them out as the session's `H` and `D` after Ctrl-C (``urgent``) or as its own frames
+    (``own``)."""
 
     frames: tuple[Booked, ...]
+    view: View | None = None
     answer: Response | None = None
     at: int | None = None
     heard: bool = False
@@ -140,7 +142,7 @@ class Liveness:
         self._sent(exchange.frames)
         if not exchange.heard:
             return
-        view = exchange.frames[-1].view if exchange.frames else None
+        view = exchange.view
         answer = answer_in(exchange.answer, bool(view and view.checksums))
         if answer is not None:
             self._answered(answer)

@@ -15,8 +15,10 @@ def told(g: Guard, body: str | None, r: Response | None, at: int | None = None, 
     and its answer ``r`` (None: none read) heard, ``at`` the instant it went out."""
     bookkeeping, liveness = g.followers()
     frames: tuple[Booked, ...] = ()
+    view = bookkeeping.view
     if body is not None:
         where = g.address if address is None else address
-        frames = (Booked(body, r, where, observe(bookkeeping.view, body, r, where)),)
-    tell_followers(Exchange(frames, r, at, heard=True, own=bool(g.own_frames()),
+        view = observe(view, body, r, where)
+        frames = (Booked(body, r, where, view),)
+    tell_followers(Exchange(frames, view, r, at, heard=True, own=bool(g.own_frames()),
                   urgent=bool(g.emergency())), bookkeeping, liveness)
