@@ -379,10 +379,9 @@ class Link:
 
     def _book(self, frames: list[HostFrame], answer: Response | None, *,
               awaited: bool = True, heard: bool = False) -> None:
-        """Book frames with the answer to the last one (the others got none; with
-        ``awaited`` false none was waited for, and one may come later): the view observes
-        each frame once, then those who follow the unit (Guard.followers) are told the
-        exchange once (``heard``: with what was read for the last one)."""
+        """Book frames with the answer to the last one (the others got none; ``awaited``
+        false: one may come later): the view observes each frame once, then the unit's
+        followers (Guard.followers) are told the exchange once (``heard``: its answer)."""
         booked = []
         for i, f in enumerate(frames):
             last = i == len(frames) - 1
