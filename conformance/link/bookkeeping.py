@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from conformance.link.body import Body, number, outcome_of
 from conformance.link.envelope import UNKNOWN, Envelope, Outcome, Read, Span, point
 from conformance.link.framing import Response
-from conformance.link.liveness import Exchange, Liveness
+from conformance.link.liveness import Liveness, Observed
 from conformance.link.stops import UnitRestarted
 from conformance.protocol.bounded import decimal
 from conformance.protocol.catalogue import classes
@@ -136,7 +136,7 @@ class Bookkeeping:
         """Whether a packet may be open (the view's): its members go unanswered."""
         return self.view.packet_open
 
-    def book(self, exchange: Exchange) -> None:
+    def book(self, exchange: Observed) -> None:
         """Book the frames of one exchange, each with its answer and the view it left
         (:meth:`accepted`); once the last one's answer was read (``heard``), a restart
         seen ends the case (:meth:`tell_restart`)."""

@@ -57,7 +57,7 @@ from conformance.link.framing import (
 from conformance.link.index_read import index_value, read_index
 from conformance.link.line_time import MARGIN as MARGIN
 from conformance.link.line_time import LineTime
-from conformance.link.liveness import Booked, Exchange, tell_followers
+from conformance.link.liveness import Booked, Observed, tell_followers
 from conformance.link.safety import Admitted, Guard
 from conformance.link.signals import Interrupted
 from conformance.link.strays import (
@@ -145,7 +145,6 @@ class Link:
     # -- time (the link's LineTime) ------------------------------------------------------
     virtual = property(lambda self: self.time.virtual)
     line = property(lambda self: self.time.line)
-    baud = property(lambda self: self.time.baud)
     now = property(lambda self: self.time.now)
     account = property(lambda self: self.time.account)
 
@@ -157,6 +156,15 @@ class Link:
     @round_trip.setter
     def round_trip(self, measured: dict[str, float]) -> None:
         self.time.round_trip = measured
+
+    @property
+    def baud(self) -> int:
+        """The line's rate (a case that changes it tells the link: LineTime)."""
+        return self.time.baud
+
+    @baud.setter
+    def baud(self, rate: int) -> None:
+        self.time.baud = rate
 
     def keep_account(self, account: TimeAccount) -> None:
         self.time.keep_account(account)
@@ -392,7 +400,7 @@ class Link:
             booked.append(Booked(body, r, address, self.view))
         if booked or heard:
             at, admitted = self.time.origin + self.wrote_at, self._admitted
-            tell_followers(Exchange(tuple(booked), self.view, answer, at, heard, admitted.own,
+            tell_followers(Observed(tuple(booked), self.view, answer, at, heard, admitted.own,
                                     admitted.urgent), *self._followers)
 
     def _answers_late(self, data: bytes) -> bytes:

@@ -53,7 +53,7 @@ class Booked:
 
 
 @dataclass(frozen=True)
-class Exchange:
+class Observed:
     """What one exchange left, told once to those who follow the unit: its frames, the
     view of the unit the link holds after it, what was read for the last one (``answer``;
     only when ``heard``: an answer was awaited and read for, else one may still come),
@@ -73,10 +73,10 @@ class Exchange:
 class Follower(Protocol):
     """What follows the unit from the exchanges a link tells it (Guard.followers)."""
 
-    def book(self, exchange: Exchange) -> None: ...
+    def book(self, exchange: Observed) -> None: ...
 
 
-def tell_followers(exchange: Exchange, bookkeeping: Follower, liveness: Liveness) -> None:
+def tell_followers(exchange: Observed, bookkeeping: Follower, liveness: Liveness) -> None:
     """Tell one exchange to those who follow the unit, once each: the bookkeeping books
     its frames (and ends the case once a restart was seen: UnitRestarted), then the
     liveness counts its answer (TargetNotResponding once the unit is given up)."""
@@ -135,7 +135,7 @@ class Liveness:
         lost before it are weighed no more."""
         self.unanswered = 0
 
-    def heard(self, exchange: Exchange) -> None:
+    def heard(self, exchange: Observed) -> None:
         """Count what one exchange showed: its frames, and (``heard``) the answer read
         for the last one; raises :class:`TargetNotResponding` when the target is given up
         (not for the session's `H` and `D` after Ctrl-C)."""

@@ -102,8 +102,9 @@ def _readings(frames: list[HostFrame], summed: bool | None,
 
 
 class Guard:
-    """One real unit's run-wide guard (see the module's docstring). It owns what the run
-    knows of the unit's safety: the envelope, the EEPROM ledger, the run's Ctrl-C."""
+    """One real unit's run-wide guard (see the module's docstring). It judges frames and
+    owns the EEPROM ledger and the run's stop signals; it reads its followers (the
+    bookkeeping, which owns the envelope, and the liveness) and the answer times."""
 
     def __init__(self, profile: Profile, address: int, *, max_travel: int,
                  allow_destructive: bool, interrupts: StopSignals | None = None) -> None:

@@ -3,7 +3,7 @@ without a link."""
 
 from __future__ import annotations
 
-from conformance.link.liveness import Booked, Exchange, tell_followers
+from conformance.link.liveness import Booked, Observed, tell_followers
 from conformance.link.safety import Guard
 from conformance.protocol.view import observe
 from conformance.protocol.wire import Response
@@ -20,5 +20,5 @@ def told(g: Guard, body: str | None, r: Response | None, at: int | None = None, 
         where = g.address if address is None else address
         view = observe(view, body, r, where)
         frames = (Booked(body, r, where, view),)
-    tell_followers(Exchange(frames, view, r, at, heard=True, own=bool(g.own_frames()),
+    tell_followers(Observed(frames, view, r, at, heard=True, own=bool(g.own_frames()),
                   urgent=bool(g.emergency())), bookkeeping, liveness)
