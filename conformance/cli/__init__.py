@@ -16,14 +16,14 @@ import sys
 
 from conformance.cli.commands import SUBCOMMANDS
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     # SIGINT, SIGTERM and SIGHUP alike; a job that was stopped before its own handling
     # began (or after it ended) still ends with one line, not a traceback
-    with Interrupts.alike():
+    with StopSignals.alike():
         try:
             if args and args[0] in SUBCOMMANDS:
                 module = importlib.import_module(SUBCOMMANDS[args[0]][0])

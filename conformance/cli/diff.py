@@ -32,7 +32,7 @@ from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
 from conformance.link.safety import SafetyStop, TargetNotResponding
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.operator.console import Console
 from conformance.reports.files import release
 from conformance.run.metadata import RunMeta, now_iso
@@ -174,7 +174,7 @@ def main(argv: list[str] | None = None) -> int:
     seed = args.seed if args.seed is not None else fresh_seed()
     run_id = (args.run_id or new_run_id()) if folder is None else folder.name
     meta = meta_of(args, argv, target, reference, seed)
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     try:
         session = target.begin(interrupts)
     except (CouldNotTest, SessionError) as err:

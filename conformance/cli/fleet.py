@@ -42,7 +42,7 @@ from pathlib import Path
 from conformance.cli.ending import recap, say_all, written
 from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import INTERRUPTED, verdict_status
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.reports.files import ReportNotWritten, write_text
 from conformance.run.runner import CaseResult, RunResult
 from conformance.targets import Target
@@ -136,7 +136,7 @@ def run_fleet(args: argparse.Namespace, argv: list[str], targets: list[Target], 
         accept_incomplete=args.accept_incomplete)
 
 
-class _Fleet(Interrupts):
+class _Fleet(StopSignals):
     """The fleet's signals: counted as a run counts them, each passed on at once, from
     the handler, as SIGINT to every running target (the third ends them at once too)."""
 
@@ -193,7 +193,7 @@ def _run_members(members: list[Member], folder: Path, jobs: int, start: float,
                     m = pending.popleft()
                     # a signal now waits until the member is running and known to the
                     # handler, which passes it on: none is started and then forgotten
-                    with Interrupts.held():
+                    with StopSignals.held():
                         _start(m, folder, start, wake, out_lock, shown)
                         running.append(m)
                 with contextlib.suppress(queue.Empty):

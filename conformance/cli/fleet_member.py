@@ -19,7 +19,7 @@ import threading
 from pathlib import Path
 
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 
 
 def _fleet_gone() -> None:
@@ -37,7 +37,7 @@ def _fleet_gone() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    with Interrupts.alike():
+    with StopSignals.alike():
         try:
             job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
             if stat.S_ISFIFO(os.fstat(0).st_mode):          # the fleet's pipe

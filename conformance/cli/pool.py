@@ -33,7 +33,7 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from conformance.cli.usage import INTERRUPTED
-from conformance.link.signals import STOPPING, Interrupts
+from conformance.link.signals import STOPPING, StopSignals
 
 #: how long the workers may take to end once stopped, before they are killed
 ENDING_SECONDS = 10.0
@@ -82,7 +82,7 @@ def _redelivered(which: Callable[[], int]) -> Iterator[None]:
         sys.unraisablehook = before
 
 
-class _Stopping(Interrupts):
+class _Stopping(StopSignals):
     """This process's signals while the jobs run: counted, and each passed on at once to
     every worker (from the handler itself: no frame of theirs waits for a loop here)."""
 
@@ -183,7 +183,7 @@ class Workers:
             raise WorkerFailed(self.failed)
 
     def _run(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]],
-             stopping: Interrupts) -> Iterator[Any]:
+             stopping: StopSignals) -> Iterator[Any]:
         context = multiprocessing.get_context()
         idle: list[Connection] = []
         busy: dict[Connection, int] = {}
@@ -192,7 +192,7 @@ class Workers:
             here, there = context.Pipe()
             process = context.Process(target=_serve, args=(there,), daemon=True)
             # started with the signals held: a worker exists before one is passed on
-            with Interrupts.held():
+            with StopSignals.held():
                 process.start()
                 self._processes.append(process)
             there.close()
@@ -271,7 +271,7 @@ def _serve(conn: Connection) -> None:
         except Exception:
             reply = ("failed", traceback.format_exc())
         try:
-            with Interrupts.held():            # a reply goes out whole or not at all
+            with StopSignals.held():            # a reply goes out whole or not at all
                 conn.send(reply)
         except OSError:
             return                             # the parent is gone: nobody to tell

@@ -25,7 +25,7 @@ from conformance.diff.gvt import expected_of, steps_of
 from conformance.diff.replayed import Verdict, frame_lines, header, verdict
 from conformance.diff.sides import Side
 from conformance.link.safety import TargetNotResponding
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.targets import SessionError, TargetError
 from conformance.verdicts.verdict import FAIL, FAILED, PASSED
 from gve_fixtures.transcript import TranscriptError, load
@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {one_line(err)}", file=sys.stderr)
         return 2
     expected = expected_of(t)
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     session = target.begin(interrupts)
     ask_first(args, target)
     for line in [] if args.quiet else header(args.file, target.info.spec, reference.info.spec,

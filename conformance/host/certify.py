@@ -33,7 +33,7 @@ from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
 from conformance.host.units import open_line
 from conformance.host.unitview import line_views, profiles_by_address
-from conformance.link.signals import STOPPING, Interrupts
+from conformance.link.signals import STOPPING, StopSignals
 from conformance.run.metadata import now_iso
 from conformance.run.runner import RunResult
 from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING
@@ -86,7 +86,7 @@ def _stop(proc: subprocess.Popen) -> None:
     """End the host program and everything it started (its process group): SIGTERM, then
     SIGKILL for what is still there after a grace period. A signal to the suite meanwhile
     waits until the host is gone, so that nothing is left behind."""
-    with Interrupts.held():
+    with StopSignals.held():
         for sig, grace in ((signal.SIGTERM, TERM_GRACE_S), (signal.SIGKILL, None)):
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(proc.pid, sig)
@@ -169,7 +169,7 @@ def _launched_run(relay: Relay, plan: Plan, port: HostPort,
     with tempfile.TemporaryFile() as log:
         try:
             # a signal waits until the host is known, so that it is stopped, never orphaned
-            with Interrupts.held():
+            with StopSignals.held():
                 try:
                     proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log,
                                             stderr=subprocess.STDOUT, start_new_session=True)

@@ -41,8 +41,7 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Callable, Iterator, Sequence
-from typing import NamedTuple
+from collections.abc import Callable, Sequence
 
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.faults import FrameFault
@@ -51,85 +50,53 @@ from conformance.link.framing import (
     HostFrame,
     HostFramer,
     Response,
-    UnitDataError,
     frame,
     parse_response,
     readable,
-    shown_bytes,
 )
-from conformance.link.safety import Admitted, Body, Guard, SafetyStop, TargetNotResponding
+from conformance.link.index_read import index_value, read_index
+from conformance.link.line_time import MARGIN as MARGIN
+from conformance.link.line_time import LineTime
+from conformance.link.liveness import Booked, Observed, tell_followers
+from conformance.link.safety import Admitted, Guard
 from conformance.link.signals import Interrupted
+from conformance.link.strays import (
+    ANSWERED,
+    OPEN_PACKET,
+    TIMED_OUT,
+    UNASKED,
+    Stray,
+    judge,
+    left_open,
+)
 from conformance.link.virtual import Rig, line_of
-from conformance.protocol import index
-from conformance.protocol.catalogue import classes
 from conformance.protocol.index import Form
 from conformance.protocol.view import View, answered_late, late, observe
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import MAX_FRAME, SECOND, ErrorCode, St6
+from gve_fixtures.protocol import MAX_FRAME, SECOND, St6
 from gve_fixtures.transcript import HOST, UNIT, Record
 
-#: processing margin on top of the bytes' own transmission time
-MARGIN = 0.25
 #: real time: after a frame timed out, how long the line must stay quiet before the next
 #: frame (an answer later than this after its timeout could still be misread)
 QUIET = 2.5
 #: real time: how long after its timeout an answer is still taken as its frame's, noted
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
-#: real time: at the end of a case, the longest it listens for bytes still on their way
-#: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
-END_QUIET = 0.05
-
-# what the last frame left on the line
-_ANSWERED, _TIMED_OUT, _UNASKED = "answered", "timed out", "unasked"
-
-# what the suite's bytes left unfinished for a watchdog to end
-LONE_BANG, OPEN_FRAME, OPEN_PACKET = "a lone '!'", "a frame without its CR", "an open packet"
-#: the rule an answer of each one's watchdog is judged by (our reading: a lone `!` is
-#: dropped without an answer, a frame answered 2, a packet never closed by time)
-WATCHDOG_RULES = {LONE_BANG: "3.frame.watchdog-lone-bang", OPEN_FRAME: "3.frame.watchdog",
-                  OPEN_PACKET: "7.packet.open-until-end"}
-#: frames that set no axis moving, whatever the unit is, and those whose answer tells
-#: where the axes are
-_MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
-                        eeprom=0)
-_POSITION_READS = classes(position=True)
-
-#: the rule a second answer breaks (the unit answers every complete frame once), and one
-#: after its frame's timeout (it answers as soon as possible)
-TWICE, LATE_RULE = "2.link.simplex", "2.link.answer-promptly"
-
-
-class Stray(NamedTuple):
-    """Bytes that did not belong to the frame just sent: what they were, the rule they
-    break, and whether they FAIL whatever that rule's tag (a second answer no watchdog
-    explains; a watchdog's answer is graded by its rule's tag)."""
-
-    text: str
-    rule: str
-    always: bool = True
-
-    def __str__(self) -> str:
-        return f"{self.text} [{self.rule}]"
-
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
                  virtual: bool = False, rig: Rig | None = None) -> None:
         self.port = port
-        self.line = line_of(port) if virtual else None   # the clock in virtual time
+        #: the link's clock and time account (the virtual line's clock in virtual time)
+        self.time = LineTime(line_of(port) if virtual else None, baud)
         self.address = address
-        self.baud = baud
-        self.virtual = virtual
         self.guard = guard
+        self._followers = guard.followers()      # who is told each exchange
         self.rig = rig
         #: the unit as the wire shows it (protocol/view.py), fed once per exchange: the
         #: checksum mode, the open packet, the index's form...; the unit's addresses
         #: share it
         self.view = View(addresses=frozenset(guard.addresses))
-        #: real time: the line's round trip as the session measured it at its start
-        #: (``SessionReport.line``; empty when it was not), for the timing bands
-        self.round_trip: dict[str, float] = {}
         self.log: list[Record] = []
         self.frames = 0
         self.violations: list[Stray] = []
@@ -143,26 +110,18 @@ class Link:
         self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
-        self._last: tuple[str, bytes, bytes] = (_UNASKED, b"", b"")   # state, frame, answer
+        self._last: tuple[str, bytes, bytes] = (UNASKED, b"", b"")   # state, frame, answer
         self._dropped = False
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
         #: a later link of the case took over: what this one left went to a unit that
         #: has heard other frames since (or, on the emulator, is gone)
         self.superseded = False
-        #: where the link's time went (its session's account, shared by its links)
-        self.account = TimeAccount()
-        #: the exchange whose bytes are going out: the clock when its first byte was
-        #: written, its bytes, the time paused in it (booked apart); what follows its
-        #: answer, or its absence, is booked with it
-        self._exchange: list[int] | None = None
-        self._answered_as = Spent.ANSWERS
         #: what the guard said of the frames written last (Guard.admit)
         self._admitted = Admitted()
         #: work of the caller's done once, while the port runs the next frames told
         #: ahead (:meth:`tell`), or by the caller when none are told
         self.meanwhile: Callable[[], None] | None = None
-        self._origin = self._clock()
 
     # -- what the view holds -------------------------------------------------------------
     @property
@@ -183,74 +142,44 @@ class Link:
     def index_form(self, form: Form | None) -> None:
         self.view = self.view.assume(index_form=form)
 
-    # -- time ------------------------------------------------------------------------------
-    def _clock(self) -> int:
-        if self.line is not None:
-            return self.line.now
-        return time.monotonic_ns()
+    # -- time (the link's LineTime) ------------------------------------------------------
+    virtual = property(lambda self: self.time.virtual)
+    line = property(lambda self: self.time.line)
+    now = property(lambda self: self.time.now)
+    account = property(lambda self: self.time.account)
 
     @property
-    def now(self) -> int:
-        return self._clock() - self._origin
+    def round_trip(self) -> dict[str, float]:
+        """Real time: the line's round trip as the session measured it (LineTime)."""
+        return self.time.round_trip
+
+    @round_trip.setter
+    def round_trip(self, measured: dict[str, float]) -> None:
+        self.time.round_trip = measured
+
+    @property
+    def baud(self) -> int:
+        """The line's rate (a case that changes it tells the link: LineTime)."""
+        return self.time.baud
+
+    @baud.setter
+    def baud(self, rate: int) -> None:
+        self.time.baud = rate
 
     def keep_account(self, account: TimeAccount) -> None:
-        """Book this link's time in ``account`` (its session's); in virtual time the
-        account's wall time follows this link's clock from now on."""
-        self.account = account
-        if self.virtual:
-            account.follow(lambda: self.now / SECOND)
+        self.time.keep_account(account)
 
-    @contextlib.contextmanager
-    def spending(self, spent: Spent) -> Iterator[None]:
-        """Book the time the block takes under ``spent`` (e.g. a technician's step)."""
-        began = self._clock()
-        try:
-            yield
-        finally:
-            self.account.book(spent, (self._clock() - began) / SECOND)
-
-    def _book_exchange(self, received: int, rest: Spent, began: int) -> None:
-        """Book the exchange under way (else what was read since ``began``): its bytes
-        and the ``received`` ones at the baud rate as line time, the rest under ``rest``."""
-        if self._exchange is not None:
-            began, sent, paused = self._exchange
-        else:
-            sent = paused = 0
-        self._exchange = None
-        seconds = (self._clock() - began - paused) / SECOND
-        line = min(seconds, self.byte_seconds(sent + received))
-        self.account.book(Spent.LINE, line)
-        self.account.book(rest, seconds - line)
-
-    def _close_exchange(self) -> None:
-        """Frames sent that nothing will read an answer to: their bytes are booked now."""
-        if self._exchange is not None:
-            self._book_exchange(0, Spent.WAITS, 0)
+    def spending(self, spent: Spent) -> contextlib.AbstractContextManager[None]:
+        return self.time.spending(spent)
 
     def byte_seconds(self, n: int) -> float:
-        return n * 10 / self.baud
+        return self.time.byte_seconds(n)
 
     def answer_timeout(self, body: str, size: int) -> float:
         """How long the answer to a frame of ``size`` bytes carrying ``body`` may take:
         the frame's and an answer's bytes, a margin, what the command itself takes when it
         answers at its end, and what the line adds (:meth:`line_seconds`)."""
-        return self._timeout(self.guard.answer_seconds(body), size)
-
-    def _timeout(self, slow: float | None, size: int) -> float:
-        return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
-
-    def line_seconds(self) -> float:
-        """Real time: twice the slowest round trip the session measured (a USB adapter
-        holds an answer's bytes up to its latency timer, and may hold its last piece
-        that long again); nothing in virtual time or when the line was not measured."""
-        return 0.0 if self.virtual else 2 * self.round_trip.get("max_ms", 0.0) / 1e3
-
-    def end_quiet(self) -> float:
-        """Real time: how long the end of a case listens for bytes still on their way (a
-        second answer follows the first at once): the line's round trip as measured
-        (:meth:`line_seconds`), at most :data:`END_QUIET`."""
-        measured = self.line_seconds()
-        return min(END_QUIET, measured) if measured else END_QUIET
+        return self.time.timeout(self.guard.times.answer_seconds(body), size)
 
     def summed_after(self, body: str) -> bool:
         """Whether the answer to ``body`` carries a checksum: iff the mode is on after
@@ -261,7 +190,7 @@ class Link:
         """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
         suite's own wait unless it says otherwise); returns whatever arrived meanwhile."""
         self.guard.check_idle()
-        self._close_exchange()
+        self.time.close_exchange()
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
@@ -277,7 +206,7 @@ class Link:
         if rest:
             self._record(UNIT, rest)
             self._after_answer(rest, "during a wait", judged=True)
-        self._last = (_UNASKED, b"", b"")
+        self._last = (UNASKED, b"", b"")
         return data
 
     def _listen(self, seconds: float, *, stop_early: bool, already: float = 0.0) -> bytes:
@@ -300,19 +229,18 @@ class Link:
         as a second or a late answer."""
         if not data or data.endswith(CR) or self.guard.interrupts.pending:
             return data
-        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
         return data + self.port.read_until(CR)
 
     def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
-        began = self._clock()
+        began = self.time.clock()
         with self.spending(spent):
             if self.line is not None:
                 self.line.advance(seconds)
             else:
                 time.sleep(seconds)  # real serial/TCP time: the fault is a pause on the wire
-        if self._exchange is not None:
-            self._exchange[2] += self._clock() - began
+        self.time.paused(self.time.clock() - began)
 
     # -- faults ---------------------------------------------------------------------------
     def inject(self, direction: str, kind: str, **params) -> None:
@@ -333,9 +261,8 @@ class Link:
         self.log.append(Record("=", f"note {text}".encode("ascii", "replace"), self.now))
 
     def _transmit(self, data: bytes, summed: bool | None) -> list[HostFrame]:
-        """Write ``data`` (host faults apply) once the guard has judged every frame it
-        completes (once, :meth:`Guard.admit`: a frame told a co-simulator ahead was
-        judged when told); returns those frames."""
+        """Write ``data`` (host faults apply) once the guard judged each frame it completes
+        (once, :meth:`Guard.admit`; one told a co-simulator ahead, when told): those frames."""
         self._book_unbooked(None)
         fault = self._fault("host")
         pieces = fault.apply(data) if fault else [(data, 0.0)]
@@ -359,7 +286,7 @@ class Link:
                 self._write(piece)
         self._sent_until, self._waited_out = self.now, False
         if frames:
-            self._last = (_UNASKED, frames[-1].wire, b"")
+            self._last = (UNASKED, frames[-1].wire, b"")
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -374,16 +301,14 @@ class Link:
             self._put(data)
             return
         interrupts = self.guard.interrupts
-        with interrupts.held():
+        with interrupts.writing():
             if not self._admitted.urgent and interrupts.bars(own=self._admitted.own):
                 raise Interrupted
             self._put(data)
 
     def _put(self, data: bytes) -> None:
         self._record(HOST, data)
-        if self._exchange is None:
-            self._exchange = [self._clock(), 0, 0]
-        self._exchange[1] += len(data)
+        self.time.wrote(len(data))
         self.port.write(data)
 
     def send_raw(self, data: bytes) -> None:
@@ -409,11 +334,11 @@ class Link:
         if self._dropped:
             timeout = 0.0            # an injected fault dropped it: no answer can come
         elif timeout is None:
-            timeout = self._timeout(self._admitted.answer_seconds, len(data))
+            timeout = self.time.timeout(self._admitted.answer_seconds, len(data))
             late = 0.0 if self.virtual else LATE
         self._unbooked = sent
         # H and W answer when their motion ends: the wait for them is the motion's
-        self._answered_as = (Spent.MOTION if self._admitted.answer_seconds
+        self.time.answered_as = (Spent.MOTION if self._admitted.answer_seconds
                              else Spent.ANSWERS)
         r = self.read_response(timeout, lines, summed=self.summed_after(body), late=late)
         if r is not None:
@@ -437,7 +362,7 @@ class Link:
         expect = getattr(self.port, "expect", None)
         if expect is None or self._faults or not getattr(self.port, "tells", True):
             return
-        bodies = self._judged_ahead(bodies)
+        bodies = self.guard.told_ahead(bodies, self.address)
         if not bodies:
             return
         framed = [frame(body, self.address, self.checksums) for body in bodies]
@@ -452,28 +377,6 @@ class Link:
             self.meanwhile = None
             work()
 
-    def _judged_ahead(self, bodies: Sequence[str]) -> list[str]:
-        """The first of ``bodies`` that may be told ahead: a port told them runs them before
-        the run's guard judges any, so each is judged first on a copy of the guard as
-        though the ones before got any answer (Guard.ahead). The first refused ends them,
-        and after a position read, whose answer may move the axes anywhere in the guard's
-        eyes, only frames that set nothing moving follow."""
-        trial = self.guard.ahead()
-        admitted: list[str] = []
-        read = False
-        for body in bodies:
-            name = Body.parse(body).name            # SW6 apart from the other SW
-            if read and name not in _MOVE_NOTHING:
-                break
-            try:
-                trial.check(body, self.address)
-            except (SafetyStop, Interrupted, TargetNotResponding):
-                break
-            trial.book_any(body, self.address)
-            read = read or name in _POSITION_READS
-            admitted.append(body)
-        return admitted
-
     @property
     def takes_ahead(self) -> bool:
         """Whether raw frames may be told ahead on this link now (conformance/link/
@@ -484,20 +387,21 @@ class Link:
 
     def _book(self, frames: list[HostFrame], answer: Response | None, *,
               awaited: bool = True, heard: bool = False) -> None:
-        """Book frames with the answer to the last one (the others got none; with
-        ``awaited`` false none was waited for, and one may come later): the view observes
-        each frame once, and the guard books them with the views they left in one call
-        (``heard``: with what was read for the last one, Guard.answered)."""
-        exchanges = []
+        """Book frames with the answer to the last one (the others got none; ``awaited``
+        false: one may come later): the view observes each frame once, then the unit's
+        followers (Guard.followers) are told the exchange once (``heard``: its answer)."""
+        booked = []
         for i, f in enumerate(frames):
             last = i == len(frames) - 1
             r = answer if last else None
             body = f.bodies(self.checksums)[0]
             address = self.address if f.address is None else f.address
             self.view = observe(self.view, body, r, address, awaited=awaited and last)
-            exchanges.append((body, r, address, self.view))
-        if exchanges or heard:
-            self.guard.book(exchanges, answer, self._origin + self.wrote_at, heard=heard)
+            booked.append(Booked(body, r, address, self.view))
+        if booked or heard:
+            at, admitted = self.time.origin + self.wrote_at, self._admitted
+            tell_followers(Observed(tuple(booked), self.view, answer, at, heard, admitted.own,
+                                    admitted.urgent), *self._followers)
 
     def _answers_late(self, data: bytes) -> bytes:
         """Give each whole line of ``data`` that came after its frame to the frame it
@@ -523,57 +427,26 @@ class Link:
     def left_open(self) -> str:
         """What the suite's bytes so far leave for a watchdog to end (LONE_BANG,
         OPEN_FRAME, OPEN_PACKET), "" when nothing."""
-        partial = self._framer.partial
-        if partial == b"!":
-            return LONE_BANG
-        if partial:
-            return OPEN_FRAME
-        return OPEN_PACKET if self.view.packet_open else ""
+        return left_open(self._framer.partial, self.view.packet_open)
 
     def _book_unbooked(self, answer: Response | None, *, awaited: bool = False,
                        heard: bool = False) -> None:
-        """Book the raw frames sent with ``answer`` (None: none read), the last one's
-        answer ``awaited`` (else one may come later), ``heard`` as :meth:`_book`."""
+        """Book the raw frames sent (:meth:`_book`) with ``answer`` (None: none read)."""
         frames, self._unbooked = self._unbooked, []
         self._book(frames, answer, awaited=awaited, heard=heard)
 
     def read_index(self, address: int | None = None) -> int | None:
-        """The index `@` answers (None: no answer, or a refusal), read in the form the
-        unit writes it: the first read whose text does not show its form measures it
-        first (frames that count move the index: protocol/index.py), so the value
-        returned is read after them. Raises UnitDataError for text no form reads."""
+        """The index `@` answers in the form the unit writes it (conformance/link/
+        index_read.py; None: no answer, or a refusal)."""
         where = self.address if address is None else address
-        r = self.send("@", address=where)
-        if r is None or not r.ok or not r.values:
-            return None
-        if self.index_form is None:
-            form = index.evident(r.values[0])
-            if form is None:
-                form = index.measure(lambda: self._index_text(where),
-                                     lambda: self._move_index(where))
-                r = self.send("@", address=where)
-                if r is None or not r.ok or not r.values:
-                    return None
+        value, form = read_index(lambda body: self.send(body, address=where), self.index_form)
+        if form is not None:
             self.index_form = form
-        return self.index_value(r)
+        return value
 
     def index_value(self, r: Response) -> int:
-        """Value 0 of ``r`` (an answer to `@`) as the index, in the form the unit writes it
-        (decimal before it is known)."""
-        text = r.values[0]
-        got = index.value(text, self.index_form or Form.DECIMAL)
-        if got is None:
-            raise UnitDataError(f"the answer {shown_bytes(r.raw)} has "
-                                f"{shown_bytes(text.encode('latin-1'), 80)} where the "
-                                f"index belongs (a number 0..255, decimal or hex)")
-        return got
-
-    def _move_index(self, address: int) -> None:
-        self.send("SR6", address=address)     # a read: it moves nothing but the index
-
-    def _index_text(self, address: int) -> str | None:
-        r = self.send("@", address=address)
-        return r.values[0] if r is not None and r.ok and r.values else None
+        """Value 0 of ``r`` (an answer to `@`) as the index, in the form the unit writes it."""
+        return index_value(r, self.index_form)
 
     def read_response(self, timeout: float | None = None, lines: int = 1, *,
                       summed: bool | None = None, settle: bool = True,
@@ -588,8 +461,8 @@ class Link:
         self.port.timeout = timeout
         self._quiet = 0.0
         asked = time.monotonic()
-        began = self._clock()
-        answered_as, self._answered_as = self._answered_as, Spent.ANSWERS
+        began = self.time.clock()
+        answered_as, self.time.answered_as = self.time.answered_as, Spent.ANSWERS
         for i in range(lines):
             # an answer that began in time is read to its end before it is judged
             chunk = self._whole_line(self.port.read_until(CR))
@@ -606,10 +479,10 @@ class Link:
             raw += chunk
             if not chunk.endswith(CR):
                 break
-            self.port.timeout = MARGIN + self.line_seconds()
+            self.port.timeout = MARGIN + self.time.line_seconds()
         data = self._behind_late(bytes(raw), lines)
         # an answer that did not come (or not whole) was waited for to the suite's deadline
-        self._book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
+        self.time.book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
                             began)
         summed = self.checksums if summed is None else summed
         real = parse_response(data, summed=summed, lines=lines) if data else None
@@ -618,7 +491,7 @@ class Link:
             real.received_at = self.now
         answered = real is not None and real.code is not None
         # a frame an injected fault dropped cannot be answered late
-        self._last = (_ANSWERED if answered else _UNASKED if self._dropped else _TIMED_OUT,
+        self._last = (ANSWERED if answered else UNASKED if self._dropped else TIMED_OUT,
                       self._last[1], data)
         if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
@@ -643,7 +516,7 @@ class Link:
         (:meth:`_answers_late`)."""
         while (lines == 1 and data.endswith(CR) and self.view.answerable
                and not self.guard.interrupts.pending):
-            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.line_seconds()
+            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
             behind = self._whole_line(self.port.read_until(CR))
             if not behind.endswith(CR) or self._answers_late(data):
                 return data + behind
@@ -656,14 +529,14 @@ class Link:
         more lines than expected (`>` after `@`, if `@` is remembered)."""
         raw = bytearray()
         self.port.timeout = seconds
-        began = self._clock()
+        began = self.time.clock()
         while True:
             chunk = self.port.read_until(CR)
             raw += chunk
             if not chunk.endswith(CR):
                 break
             self.port.timeout = self.byte_seconds(64)
-        self._book_exchange(len(raw), Spent.WAITS, began)
+        self.time.book_exchange(len(raw), Spent.WAITS, began)
         if raw:
             self._record(UNIT, bytes(raw), "the rest of the answer")
         return bytes(raw)
@@ -674,17 +547,17 @@ class Link:
         (a violation), after a timeout a late one (a violation), else unsolicited. In
         real time, after a timeout, wait until the line is quiet first."""
         state = self._last[0]
-        self._close_exchange()
+        self.time.close_exchange()
         data = self._outwait(final)
         kept_quiet = False
         if not self.virtual:
-            if state == _TIMED_OUT and not self.guard.interrupts.pending:
+            if state == TIMED_OUT and not self.guard.interrupts.pending:
                 with self.spending(Spent.WAITS):
                     data += self._listen(QUIET, stop_early=True, already=self._quiet)
                 kept_quiet = not self.guard.interrupts.pending
             elif final:
                 with self.spending(Spent.WAITS):
-                    data += self._listen(self.end_quiet(), stop_early=True)
+                    data += self._listen(self.time.end_quiet(), stop_early=True)
         self._quiet = 0.0
         waiting = self.port.in_waiting
         if waiting:
@@ -693,11 +566,11 @@ class Link:
         rest = self._answers_late(data)
         if not rest:
             if kept_quiet or data:       # the timed-out frame's answer can come no more
-                self._last = (_UNASKED, b"", b"")
+                self._last = (UNASKED, b"", b"")
             return data
         self._record(UNIT, rest, "unsolicited")
         self._after_answer(rest, "after")
-        self._last = (_UNASKED, b"", b"")
+        self._last = (UNASKED, b"", b"")
         return data
 
     def _outwait(self, final: bool) -> bytes:
@@ -713,7 +586,7 @@ class Link:
         profile = self.guard.profile
         idle = self.now - self._sent_until
         let_go = idle >= profile.watchdog_ms * 1_000_000 and kind != OPEN_PACKET
-        if not (final or let_go or self._last[0] == _TIMED_OUT):
+        if not (final or let_go or self._last[0] == TIMED_OUT):
             return b""
         self._waited_out = True
         left = (profile.watchdog_longest_ms * 1_000_000 - idle) / SECOND + MARGIN
@@ -726,33 +599,14 @@ class Link:
             return self._listen(left, stop_early=False)
 
     def _after_answer(self, data: bytes, when: str, *, judged: bool = False) -> None:
-        """Bytes no frame asked for: a watchdog's answer to what the suite left
-        unfinished (judged by the watchdog's rule; not when the case reads them itself,
-        ``judged``), else a second answer or a late one (a violation)."""
+        """Bytes no frame asked for, judged (conformance/link/strays.py): a watchdog's
+        answer that ends what the suite left open, else a second answer or a late one."""
         kind = self.left_open()
-        if kind and _watchdog_answer(data, kind, self.checksums):
-            self._ended_by_watchdog(kind, data, judged)
-            return
-        state, sent, answer = self._last
-        frame_text = readable(sent) or "the last frame"
-        if state == _ANSWERED:
-            self.violations.append(Stray(f"answered twice: {frame_text} got "
-                                         f"{readable(answer)}, then {readable(data)} {when}",
-                                         TWICE))
-        elif state == _TIMED_OUT:
-            self.violations.append(Stray(f"answered after its timeout: {frame_text} got "
-                                         f"{readable(data)} late", LATE_RULE))
-
-    def _ended_by_watchdog(self, kind: str, data: bytes, judged: bool) -> None:
-        """A watchdog answered what was left unfinished: our reading answers a frame so
-        too (its time is the watchdog-time rule's, which the watchdog case judges); a
-        lone `!` answered, or a packet closed by time, is a reading of its rule."""
-        if kind == OPEN_PACKET:
+        ended, stray = judge(data, when, kind, self.checksums, self._last, judged=judged)
+        if ended and kind == OPEN_PACKET:
             self.view = self.view.assume(packet=None)
-        if kind == OPEN_FRAME or judged:
-            return
-        self.violations.append(Stray(f"{kind} was ended by a watchdog answering "
-                                     f"{readable(data)}", WATCHDOG_RULES[kind], always=False))
+        if stray is not None:
+            self.violations.append(stray)
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05, *, send: Callable[[str], Response | None] | None = None,
@@ -778,21 +632,6 @@ class Link:
 
     def transcript_lines(self) -> list[str]:
         return [rec.line() for rec in self.log]
-
-
-def _watchdog_answer(data: bytes, kind: str, summed: bool) -> bool:
-    """Whether ``data`` is nothing but answers a watchdog gives (code 2, with INTA as it
-    stands; after a packet its count of members too, spec 7's `2,k`)."""
-    lines = [line for line in data.split(CR) if line]
-    if not lines or not data.endswith(CR):
-        return False
-    for line in lines:
-        r = parse_response(line + CR, summed=summed)
-        if r is None or r.code is None or r.code & 7 != ErrorCode.WATCHDOG:
-            return False
-        if len(r.values) > (1 if kind == OPEN_PACKET else 0):
-            return False
-    return True
 
 
 def idle_st6(r: Response) -> bool:

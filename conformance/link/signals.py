@@ -1,4 +1,4 @@
-"""Ctrl-C during a run.
+"""Ctrl-C (SIGINT), SIGTERM and SIGHUP during a run: the stop signals.
 
 The first SIGINT (or SIGTERM, SIGHUP) does not raise where it lands: it is counted, the
 frame in flight gets its answer (or times out), and the link raises
@@ -8,10 +8,15 @@ during the restorations that follow stops them the same way (`H`, `D` again, the
 skipped). A third signal raises KeyboardInterrupt at once.
 
 Outside a run (parsing the command line, opening ports, asking the operator) the three
-signals alike raise KeyboardInterrupt where they land (:meth:`Interrupts.alike`), so that
-a job ends the same way whichever of them came; a process that starts others (a program,
-a worker, a fleet's member) does so with the signals held (:meth:`Interrupts.held`), so
-that each signal finds it known and passes on to it.
+signals alike raise KeyboardInterrupt where they land (:meth:`StopSignals.alike`), so
+that a job ends the same way whichever of them came; a process that starts others (a
+program, a worker, a fleet's member) does so with the signals held
+(:meth:`StopSignals.held`), so that each signal finds it known and passes on to it.
+
+A link asks whether it may write and writes with the signals held back between the two
+(:meth:`StopSignals.writing`): while the run's own handler is installed
+(:meth:`StopSignals.catching`), that is a flag its handler reads, set once per write;
+only where another handler is installed are the handlers swapped around the write.
 """
 
 from __future__ import annotations
@@ -32,8 +37,9 @@ class Interrupted(KeyboardInterrupt):
 STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-class Interrupts:
-    """The run's Ctrl-C state, shared by every session of the run."""
+class StopSignals:
+    """The run's stop signals (Ctrl-C, SIGTERM, SIGHUP) as counted, shared by every
+    session of the run."""
 
     #: signals after which KeyboardInterrupt is raised wherever the program is
     HARD = 3
@@ -41,6 +47,10 @@ class Interrupts:
     def __init__(self) -> None:
         self.count = 0        # signals received
         self.handled = 0      # signals the sessions have answered with H and D
+        self._holding = False     # a write is under way: signals are counted after it
+        self._deferred = 0        # signals that came meanwhile
+        self._caught = False      # this object's handler installed (catching)
+        self._writing = _Writing(self)
 
     @property
     def pending(self) -> bool:
@@ -52,9 +62,27 @@ class Interrupts:
         return self.count > 0
 
     def signal(self, *_: object) -> None:
+        """The handler (:meth:`catching`): a signal counted, or, during a write, counted
+        once the write is over (:meth:`writing`)."""
+        if self._holding:
+            self._deferred += 1
+            return
+        self._count()
+
+    def _count(self) -> None:
         self.count += 1
         if self.count >= self.HARD:
             raise KeyboardInterrupt
+
+    def writing(self) -> contextlib.AbstractContextManager[object]:
+        """The block asks :meth:`bars` and writes: a signal that comes meanwhile lands
+        after it (before the question, nothing is written; after, the bytes went out).
+        While this object's handler is installed (:meth:`catching`), a flag its handler
+        reads; else the handlers are swapped for the block (:meth:`held`)."""
+        if self._caught and threading.current_thread() is threading.main_thread() \
+                and all(signal.getsignal(sig) == self.signal for sig in STOPPING):
+            return self._writing
+        return self.held()
 
     def bars(self, *, own: bool = False) -> bool:
         """Whether a frame may not go out now: a signal no `H` has answered yet, or any
@@ -111,22 +139,41 @@ class Interrupts:
                 signal.signal(sig, handler)
 
     @contextlib.contextmanager
-    def catching(self) -> Iterator[Interrupts]:
+    def catching(self) -> Iterator[StopSignals]:
         """SIGINT, SIGTERM and SIGHUP count here while the block runs (main thread only;
         elsewhere the default behaviour stays)."""
         if threading.current_thread() is not threading.main_thread():
             yield self
             return
         previous = {sig: signal.signal(sig, self.signal) for sig in STOPPING}
+        self._caught = True
         try:
             yield self
         finally:
+            self._caught = False
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
 
 
+class _Writing:
+    """The block of :meth:`StopSignals.writing` under the run's own handler: a flag."""
+
+    def __init__(self, stops: StopSignals) -> None:
+        self.stops = stops
+
+    def __enter__(self) -> None:
+        self.stops._holding = True
+
+    def __exit__(self, *exc: object) -> None:
+        stops = self.stops
+        stops._holding = False
+        deferred, stops._deferred = stops._deferred, 0
+        for _ in range(deferred):
+            stops._count()
+
+
 def _deliver(sig: int, handler: object) -> None:
-    """Hand a signal held back by :meth:`Interrupts.held` to the handler it was meant for."""
+    """Hand a signal held back by :meth:`StopSignals.held` to the handler it was meant for."""
     if callable(handler):
         handler(sig, None)
     elif handler == signal.SIG_DFL:

@@ -41,7 +41,7 @@ import pytest
 from conformance.case import settings as settings_profiles
 from conformance.case.context import Case
 from conformance.case.settings import PROFILES
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.operator.consent import Consent, NoConsent
 from conformance.operator.console import Console
 from conformance.pytest_plugin.stop import before_item, hold, interrupted
@@ -63,7 +63,7 @@ from conformance.verdicts.verdict import (
 )
 
 _TARGETS = pytest.StashKey[list[Target]]()
-_INTERRUPTS = pytest.StashKey[Interrupts]()
+_INTERRUPTS = pytest.StashKey[StopSignals]()
 _MOTION = pytest.StashKey[bool]()
 #: the controller's answer to "Move this machine?", given to an xdist worker
 MOTION_ALLOWED = "gve_motion_allowed"
@@ -375,7 +375,7 @@ def pytest_configure(config: pytest.Config) -> None:
     controller, worker = _xdist_controller(config), _on_xdist_worker(config)
     if controller and config.option.dist != "loadgroup":
         config.option.dist = "loadgroup"    # only groups keep a port on one worker
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     targets, opened = [], []
     consent = _consent(config, worker)
     try:

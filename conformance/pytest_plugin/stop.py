@@ -23,7 +23,7 @@ from typing import Any
 
 import pytest
 
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.verdicts.verdict import COULD_NOT_TEST
 
 #: why the session stopped, as pytest says it ("Interrupted: ...")
@@ -33,7 +33,7 @@ _OWN_GROUP = ("import os\ntry:\n    os.setpgid(0, 0)\nexcept OSError:\n    pass\
               "channel.send(os.getpid())")
 
 
-class Controller(Interrupts):
+class Controller(StopSignals):
     """An xdist controller's signals: counted, each passed on at once to every worker."""
 
     def __init__(self, config: pytest.Config) -> None:
@@ -60,7 +60,7 @@ class Controller(Interrupts):
         super().signal()
 
 
-def hold(config: pytest.Config, interrupts: Interrupts, *, controller: bool) -> None:
+def hold(config: pytest.Config, interrupts: StopSignals, *, controller: bool) -> None:
     """Take the stopping signals for the session (see the module's text): ``interrupts``
     counts them in a process that runs items; a controller passes them on."""
     stack = ExitStack()
@@ -80,7 +80,7 @@ def interrupted(session: pytest.Session) -> None:
     session.shouldstop = STOPPED
 
 
-def before_item(session: pytest.Session, interrupts: Interrupts) -> None:
+def before_item(session: pytest.Session, interrupts: StopSignals) -> None:
     """No item starts after a signal (one counted between items)."""
     if interrupts.stopped:
         interrupted(session)

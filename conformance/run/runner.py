@@ -14,7 +14,7 @@ from conformance.case.context import Case, CaseContext, CouldNotTest, Missing, S
 from conformance.link.framing import UnitDataError
 from conformance.link.link import Link
 from conformance.link.safety import TargetNotResponding
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.operator.console import Console
 from conformance.operator.hands import HandRig, Hands, cannot_by_hand
 from conformance.run.metadata import RunMeta
@@ -259,7 +259,7 @@ def run(targets: list[Target], cases: list[Case], *, settings_name: str | None =
     chosen = sorted({settings_for(t, settings_name) for t in targets})
     run = RunResult(run_id, targets=[t.info.spec for t in targets],
                     settings=", ".join(chosen) or (settings_name or "ci"))
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     start = time.perf_counter()
 
     def add(r: CaseResult) -> None:
@@ -279,7 +279,7 @@ def run(targets: list[Target], cases: list[Case], *, settings_name: str | None =
     return run
 
 
-def _run_target(target: Target, cases: list[Case], interrupts: Interrupts, settings: str,
+def _run_target(target: Target, cases: list[Case], interrupts: StopSignals, settings: str,
                 add: Callable[[CaseResult], None], run: RunResult, seed: int | None,
                 console: Console | None) -> None:
     session = target.begin(interrupts)

@@ -24,7 +24,7 @@ import shlex
 from dataclasses import dataclass, replace
 from typing import NoReturn
 
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.protocol.bounded import decimal
 from conformance.targets.cosim import (
     VERSION,
@@ -80,7 +80,7 @@ class ProcessTarget(PortTarget):
         except SessionError as err:
             raise TargetError(str(err)) from None
 
-    def begin(self, interrupts: Interrupts | None = None) -> Session:
+    def begin(self, interrupts: StopSignals | None = None) -> Session:
         session = super().begin(interrupts)
         if self.unserved:
             session.failed = self.unserved

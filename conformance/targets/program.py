@@ -25,7 +25,7 @@ import tempfile
 import threading
 import time
 
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.verdicts.quoting import shown
 
 #: how long the program may take to end after ``quit``, then after SIGTERM
@@ -52,7 +52,7 @@ class Program:
         try:
             # a signal waits until the program is known (and stopped at exit): never a
             # Popen lost as fork_exec returns, its program running on
-            with Interrupts.held():
+            with StopSignals.held():
                 self.process = subprocess.Popen(
                     command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                     stderr=self._stderr, process_group=0, close_fds=True)

@@ -37,7 +37,7 @@ from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response
 from conformance.link.link import MARGIN, Link
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
-from conformance.link.signals import Interrupted, Interrupts
+from conformance.link.signals import Interrupted, StopSignals
 from conformance.targets.as_found import AsFound, read_eeprom, round_trip
 from conformance.targets.info import TargetInfo
 from conformance.targets.restorations import Restorations
@@ -70,11 +70,11 @@ class Session:
     #: whether the unit outlives a link (and so is guarded, set and restored)
     real = False
 
-    def __init__(self, target: Reachable, interrupts: Interrupts | None = None) -> None:
+    def __init__(self, target: Reachable, interrupts: StopSignals | None = None) -> None:
         self.target = target
         self.profile = target.profile
         info = target.info
-        self.guard = self._guard(info, interrupts or Interrupts())
+        self.guard = self._guard(info, interrupts or StopSignals())
         self.report = SessionReport(info.spec, self.profile.name, list(self.profile.axes),
                                     self.real, max_travel=info.max_travel if self.real else None)
         self.started = False
@@ -85,15 +85,15 @@ class Session:
         self.book = Failures()
         self.account = TimeAccount()                # where the session's time goes
 
-    def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
+    def _guard(self, info: TargetInfo, interrupts: StopSignals) -> Guard:
         return EmulatorGuard(self.profile, self.target.address, interrupts)
 
     @property
-    def interrupts(self) -> Interrupts:
+    def interrupts(self) -> StopSignals:
         """The run's Ctrl-C, held by the guard (which stops every frame after it)."""
         return self.guard.interrupts
 
-    def share(self, interrupts: Interrupts) -> None:
+    def share(self, interrupts: StopSignals) -> None:
         """Take Ctrl-C from the run's ``interrupts``."""
         self.guard.interrupts = interrupts
 
@@ -202,7 +202,7 @@ class RealSession(Session):
 
     real = True
 
-    def __init__(self, target: Reachable, interrupts: Interrupts | None = None) -> None:
+    def __init__(self, target: Reachable, interrupts: StopSignals | None = None) -> None:
         super().__init__(target, interrupts)
         self.found = AsFound()
         self.known = KnownState(self.profile, self.guard, self.book, self.report.problems)
@@ -215,7 +215,7 @@ class RealSession(Session):
         self._kept_power_on: int | None = None
         self.restored = False       # the latest open_powered restored the unit kept
 
-    def _guard(self, info: TargetInfo, interrupts: Interrupts) -> Guard:
+    def _guard(self, info: TargetInfo, interrupts: StopSignals) -> Guard:
         return Guard(self.profile, self.target.address, max_travel=info.max_travel,
                      allow_destructive=info.allow_destructive, interrupts=interrupts)
 
@@ -438,6 +438,6 @@ class RealSession(Session):
             self.restorations.eeprom_back(link, sorted(self.guard.eeprom.written))
 
 
-def open_session(target: Reachable, interrupts: Interrupts | None = None) -> Session:
+def open_session(target: Reachable, interrupts: StopSignals | None = None) -> Session:
     """The session ``target`` needs: a real unit's, or the embedded emulator's."""
     return (RealSession if target.info.real else EmuSession)(target, interrupts)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import serial
 
 from conformance.link.link import Link
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.targets.info import TargetInfo
 from conformance.targets.session import Session, open_session
 from gve_fixtures.profile import Profile
@@ -58,7 +58,7 @@ class Target:
             self._session = open_session(self)
         return self._session
 
-    def begin(self, interrupts: Interrupts | None = None) -> Session:
+    def begin(self, interrupts: StopSignals | None = None) -> Session:
         """The session for a run, Ctrl-C shared through ``interrupts``: the one prepared
         before the run (an operator's prompt set, the identity read), else a new one."""
         if self._session is None or self._session.finished:

@@ -15,8 +15,7 @@ LIMIT = 400
 
 #: classes over the limit, by module and name: the most lines each may keep until cut
 OVER: dict[tuple[str, str], int] = {
-    ("link/link.py", "Link"): 665,
-    ("link/safety.py", "Guard"): 649,
+    ("link/link.py", "Link"): 549,
 }
 
 

@@ -9,7 +9,7 @@ import json
 import pytest
 
 from conformance.case.context import REGISTRY, Case, case
-from conformance.link.link import LONE_BANG, TWICE, WATCHDOG_RULES, Stray
+from conformance.link.strays import LONE_BANG, TWICE, WATCHDOG_RULES, Stray
 from conformance.run.runner import run_case
 from conformance.targets import parse_target
 from conformance.verdicts.verdict import ERROR, FAIL, INFO, NON_STRICT, PASS

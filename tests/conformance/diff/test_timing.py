@@ -8,7 +8,7 @@ from conformance.diff.grammar import Grammar, Options
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.timing import RealTime, Timing
 from conformance.link.framing import frame
-from conformance.link.signals import Interrupts
+from conformance.link.signals import StopSignals
 from conformance.targets import parse_target
 from tests.emulator.process import Emulator
 from tests.usb_relay import UsbRelay
@@ -114,7 +114,7 @@ def test_in_real_time_an_h_the_line_delivers_late_is_judged_by_its_own_answer():
     target = parse_target(f"serial:{relay.path}", profile="GVE84-100")
     try:
         target.preflight()
-        session = target.begin(Interrupts())
+        session = target.begin(StopSignals())
         pair = Pair(Side(target, session), Side(parse_target("emu:GVE84-100")),
                     target.profile)
         steps = Grammar(target.profile, Options()).idiom(

@@ -16,10 +16,10 @@ from hypothesis import strategies as st
 
 from conformance.link.ahead import Ahead
 from conformance.link.framing import frame, parse_response
-from conformance.link.link import Link
 from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding, UnitRestarted
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import load_profile
+from tests.conformance.link.told import told
 
 MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
                        eeprom=0)
@@ -62,11 +62,10 @@ def sent(g: Guard, body: str, text: str | None) -> bool:
     its answer ended the case (a read that shows a restart)."""
     g.check(body)
     r = response(text)
-    g.accepted(body, r)
     try:
-        g.answered(r)
+        told(g, body, r)
     except TargetNotResponding:
-        g.dead, g.silences = False, 0        # the silence count is not the envelope's
+        g.liveness.dead, g.liveness.silences = False, 0   # the silence count is not the envelope's
     except UnitRestarted:
         return False
     return True
@@ -155,8 +154,7 @@ def test_the_frames_a_link_tells_are_let_through_whatever_the_answers_before_the
     for body, text in before:
         with contextlib.suppress(SafetyStop):
             sent(g, body, text)
-    bodies_told = Link._judged_ahead(SimpleNamespace(guard=g, address=0),
-                                     [body for body, _ in told])
+    bodies_told = g.told_ahead([body for body, _ in told], 0)
     admitted = told[:len(bodies_told)]
     assert [body for body, _ in admitted] == bodies_told
     read = False

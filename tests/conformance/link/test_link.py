@@ -119,3 +119,13 @@ def test_the_quiet_after_a_timed_out_frame_is_kept_once(monkeypatch):
     kept = ln.now
     ln.settle()                                # the line is known quiet: no second wait
     assert kept - before >= 0.5 * SECOND > ln.now - kept
+
+
+def test_a_rate_the_case_sets_is_the_one_the_link_waits_by():
+    """A case that moves the line to another rate tells the link (its time is the
+    bytes' at that rate)."""
+    ln = link()
+    fast = ln.answer_timeout("V1000", 8)
+    ln.baud = 9600
+    assert ln.baud == 9600 and ln.byte_seconds(1) == pytest.approx(10 / 9600)
+    assert ln.answer_timeout("V1000", 8) > fast

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.case.context import REGISTRY
-from conformance.link.link import OPEN_FRAME, TWICE, WATCHDOG_RULES
+from conformance.link.strays import OPEN_FRAME, TWICE, WATCHDOG_RULES
 from conformance.run.runner import run_case
 from conformance.run.selection import select
 from conformance.targets import parse_target

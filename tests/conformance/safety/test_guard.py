@@ -8,12 +8,13 @@ import pytest
 from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
 from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
-from conformance.link.signals import Interrupted, Interrupts
+from conformance.link.signals import Interrupted, StopSignals
 from gve_fixtures.profile import load_profile
+from tests.conformance.link.told import told
 
 
 def guard(profile: str = "GVE84-100", *, destructive: bool = False, travel: int = 500,
-          interrupts: Interrupts | None = None) -> Guard:
+          interrupts: StopSignals | None = None) -> Guard:
     return Guard(load_profile(profile), 0, max_travel=travel,
                  allow_destructive=destructive, interrupts=interrupts)
 
@@ -80,7 +81,7 @@ def test_in_checksum_mode_a_members_last_field_is_its_checksum_on_every_profile(
 
 
 def test_after_ctrl_c_only_the_sessions_own_frames_go_and_never_motion():
-    interrupts = Interrupts()
+    interrupts = StopSignals()
     g = guard(interrupts=interrupts)
     interrupts.signal()
     with pytest.raises(Interrupted):
@@ -103,12 +104,12 @@ def test_consecutive_silences_give_the_target_up():
     g = guard()
     garbage = parse_response(b"\x00zz\r", summed=False)
     for r in (None, garbage, None):
-        g.answered(r)
-    g.answered(parse_response(b"0\r", summed=False))     # an answer: the count starts again
+        told(g, None, r)
+    told(g, None, parse_response(b"0\r", summed=False))   # an answer: the count starts again
     for r in (None, None, garbage):
-        g.answered(r)
+        told(g, None, r)
     with pytest.raises(TargetNotResponding, match="4 frames unanswered"):
-        g.answered(None)
+        told(g, None, None)
     with pytest.raises(TargetNotResponding):
         g.check("SR0")                      # nothing more goes out
 
@@ -179,16 +180,16 @@ def test_the_emulator_has_no_envelope():
 def test_silence_inside_an_open_packet_is_no_silence():
     g = guard()
     g.check("*S")
-    g.accepted("*S", None)
+    told(g, "*S", None)
     for _ in range(6):
-        g.answered(None)                    # members: the unit answers nothing until *E
+        told(g, "C1,0,0", None)             # members: the unit answers nothing until *E
     assert g.responding
     g.check("*E6")
-    g.accepted("*E6", None)
-    for _ in range(3):
-        g.answered(None)
+    told(g, "*E6", None)
+    for _ in range(2):
+        told(g, None, None)
     with pytest.raises(TargetNotResponding, match="4 frames unanswered"):
-        g.answered(None)
+        told(g, None, None)
 
 
 def test_an_unanswered_breaker_leaves_the_packet_open():
@@ -203,10 +204,10 @@ def test_an_unanswered_breaker_leaves_the_packet_open():
 
 def test_the_bytes_named_are_those_of_the_silence_that_gave_up():
     g = guard()
-    g.answered(parse_response(b"!0C1,0,167\r", summed=False))    # not an answer
-    g.answered(parse_response(b"0\r", summed=False))
+    told(g, None, parse_response(b"!0C1,0,167\r", summed=False))    # not an answer
+    told(g, None, parse_response(b"0\r", summed=False))
     for _ in range(3):
-        g.answered(None)
+        told(g, None, None)
     with pytest.raises(TargetNotResponding) as err:
-        g.answered(None)
+        told(g, None, None)
     assert "not an answer" not in str(err.value)

@@ -22,6 +22,7 @@ from conformance.link.safety import (
     UnitRestarted,
 )
 from gve_fixtures.profile import load_profile
+from tests.conformance.link.told import told
 
 MS = 1_000_000
 
@@ -41,8 +42,7 @@ def sent(g: Guard, body: str, reply: str | None = "0", *, summed: bool = False) 
     and counted as the link books and counts them."""
     g.check(body)
     r = answer(reply, summed)
-    g.accepted(body, r)
-    g.answered(r)
+    told(g, body, r)
 
 
 def out_to(g: Guard, x: int) -> None:
@@ -115,8 +115,7 @@ def test_bytes_that_are_no_readable_answer_are_no_restart_s_silence():
     sent(g, "L1000,0,0")
     sent(g, "L-1000,0,0", "7")
     g.check(">")
-    g.accepted(">", None)
-    g.answered(parse_response(b"A\r", summed=False, lines=2))   # not the two of `>`
+    told(g, ">", parse_response(b"\x00zz\r", summed=False, lines=2))   # not the two of `>`
     sent(g, "L-1000,0,0")
     sent(g, "SR6", "0,00")
     sent(g, "PF", "0,0,0,0")
@@ -265,15 +264,15 @@ def test_the_rigs_eyes_locate_the_axes_and_motion_may_go_on():
 def test_a_unit_that_restarts_is_heard_again_before_it_is_given_up():
     g = guard()
     for i in range(SILENCE_LIMIT + 2):  # frames 0.25 s apart in virtual time
-        g.answered(None, i * 250 * MS)
-    assert g.responding is False and not g.dead     # silent for 1.25 s: restarting
-    g.answered(answer("0"), 3500 * MS)
+        told(g, None, None, i * 250 * MS)
+    assert g.responding is False and not g.liveness.dead     # silent for 1.25 s: restarting
+    told(g, None, answer("0"), 3500 * MS)
     assert g.responding
     silent = []
     with pytest.raises(TargetNotResponding):
         for i in range(20):
             silent.append(i * 250)
-            g.answered(None, (4000 + i * 250) * MS)
+            told(g, None, None, (4000 + i * 250) * MS)
     assert silent[-1] == 2 * 2000          # twice the restart time (spec 2: about 2 s)
 
 
@@ -281,7 +280,7 @@ def test_the_emulators_guard_gives_up_after_the_frames_alone():
     g = EmulatorGuard(load_profile("GVE84-100"), 0)
     with pytest.raises(TargetNotResponding):
         for i in range(SILENCE_LIMIT):
-            g.answered(None, i * MS)
+            told(g, None, None, i * MS)
 
 
 def _refused(g: Guard, body: str) -> str:

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from conformance.cli import main
-from conformance.link import safety
+from conformance.link import bookkeeping
 from conformance.run.runner import run
 from conformance.run.selection import select
 from conformance.verdicts.verdict import FAILED, overall
@@ -62,13 +62,13 @@ def test_a_restart_anywhere_stays_within_the_envelope_and_is_named(place, eyes, 
     unit = virtual_unit(max_travel=TRAVEL, rig=eyes)
     restarts = arm(unit.unit, pattern, nth, 3500, condition(beyond, moving))
     lost_at: list[list[int]] = []       # where the axes physically were once the guard knew
-    read = safety.Guard._read
+    read = bookkeeping.Bookkeeping._read
 
     def watched(guard, name, counters, **kw):
         read(guard, name, counters, **kw)
         if guard.lost and not lost_at:
             lost_at.append(unit.state()["physical"])
-    monkeypatch.setattr(safety.Guard, "_read", watched)
+    monkeypatch.setattr(bookkeeping.Bookkeeping, "_read", watched)
     result = run([unit], select(globs))
     state = unit.state()
     assert len(restarts) == 1, "the restart never came"
