@@ -550,10 +550,13 @@ class Pair:
 
     def _refer(self, step: Step, data: bytes) -> tuple[RoundTrip, str]:
         """The frame to the reference: its exchange, and why the sequence ends there
-        ("": it goes on)."""
+        ("": it goes on). The reference is listened to as long as the target is (its
+        guard's window: a W's or H's may be shorter than the reference's own)."""
+        timeout = self.target.awaited(data, step.body, step.answer)
         try:
             return self.reference.exchange(data, lines=step.lines, answer=step.answer,
-                                           stall=step.stall, body=step.body), ""
+                                           stall=step.stall, body=step.body,
+                                           timeout=timeout), ""
         except TargetNotResponding as err:
             return RoundTrip(data, b"", 0, 0, None, step.lines), str(err)
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from conformance.diff.index import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import RoundTrip, Side
-from conformance.diff.steps import FILL, FRAME, Step
+from conformance.diff.steps import FILL, FRAME, STATE, Step
 from conformance.link.ahead import Ahead
 from conformance.link.safety import SafetyStop
 from conformance.protocol.catalogue import classes
@@ -80,9 +80,12 @@ class Teller:
         ``place`` on, and tell the target those the guard lets through (at least two)."""
         link = self.side.link
         if not (self._more(place, repeat) and link.takes_ahead):
+            if self._read_after(place):
+                self.side.state_next()
             return
         ahead, planned = Ahead(link), []
         address = self.side.target.address
+        last = place
         while place < len(self.steps) and len(planned) < MOST:
             step = self.steps[place]
             if not tellable(step):
@@ -90,6 +93,7 @@ class Teller:
             data = step.frame_bytes(address, link.checksums)
             if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
                 break
+            last = place
             reference, ended = self.refer(step, data)
             if step.answer and reference.answer:
                 # the target answers when the reference did, or differs: then its frames
@@ -102,6 +106,8 @@ class Teller:
                 repeat += 1
             else:
                 place, repeat = place + 1, 0
+        if planned and self._read_after(last):
+            self.side.state_next()
         try:
             ran = ahead.tell()
         except BaseException:
@@ -113,6 +119,13 @@ class Teller:
         for i, told in enumerate(planned):
             told.ran = i < ran
         self.queue.extend(planned)
+
+    def _read_after(self, place: int) -> bool:
+        """Whether the rig's state is read right after the frame of step ``place`` (a
+        rig read next, or the sequence's end: what the rig sees then)."""
+        if self.steps[place].kind != FRAME:
+            return False
+        return place + 1 == len(self.steps) or self.steps[place + 1].kind == STATE
 
     def _more(self, place: int, repeat: int) -> bool:
         """Whether a second frame may follow the one at ``place``: worth telling."""
