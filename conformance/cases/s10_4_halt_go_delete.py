@@ -14,6 +14,7 @@ from conformance.cases._kit import (
     position,
     setup,
     show,
+    still_seconds,
     vector,
 )
 from gve_fixtures.protocol import ErrorCode, St6
@@ -46,7 +47,7 @@ def delete(ctx: CaseContext) -> None:
     here = position(ctx)
     answers(ctx, ctx.link.send("D"), "0", "D after H")
     answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared")
-    ctx.link.wait(1.0)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), here, "position unchanged")
 
 
@@ -92,7 +93,7 @@ def halt(ctx: CaseContext) -> None:
     """H brakes on the ramp and answers (8) only once the motion has stopped."""
     halted_with_queue(ctx)
     first = position(ctx)
-    ctx.link.wait(0.5)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), first, "no motion after H's answer", rule="10.4.halt.ramp")
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 = INTA+RUN+INTCOM, STOP clear",

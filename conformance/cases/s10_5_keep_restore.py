@@ -15,6 +15,7 @@ from conformance.cases._kit import (
     position,
     setup,
     show,
+    still_seconds,
     vector,
 )
 from gve_fixtures.protocol import ErrorCode
@@ -128,5 +129,5 @@ def save_emptied(ctx: CaseContext) -> None:
     link.poll("SR6", lambda r: r.values == ["00"], 10)
     answers(ctx, link.send("R"), "0", "a second R restores the empty save")
     code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "nothing to resume: G → 6")
-    link.wait(1.0)
+    link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), [1000, 0, 0], "the remainder ran once")
