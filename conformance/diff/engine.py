@@ -549,14 +549,11 @@ class Pair:
         self.reference.write_eeprom(self._eeprom_changes)
 
     def _refer(self, step: Step, data: bytes) -> tuple[RoundTrip, str]:
-        """The frame to the reference: its exchange, and why the sequence ends there
-        ("": it goes on). The reference is listened to as long as the target is (its
-        guard's window: a W's or H's may be shorter than the reference's own)."""
-        timeout = self.target.awaited(data, step.body, step.answer)
+        """The frame to the reference, listened to as long as the target is: its exchange,
+        and why the sequence ends there ("": it goes on)."""
         try:
             return self.reference.exchange(data, lines=step.lines, answer=step.answer,
-                                           stall=step.stall, body=step.body,
-                                           timeout=timeout), ""
+                                           stall=step.stall, body=step.body, like=self.target), ""
         except TargetNotResponding as err:
             return RoundTrip(data, b"", 0, 0, None, step.lines), str(err)
 

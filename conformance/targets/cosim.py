@@ -179,7 +179,110 @@ class Conversation:
         return text
 
 
-class CosimLine:
+class SentAhead:
+    """The `pipeline` extension's part of :class:`CosimLine` (which it is mixed into):
+    commands whose words do not hang on the replies before them sent in one write, each
+    reply read when the suite comes to its command (:meth:`CosimLine.ask`, the `until`s
+    of :meth:`CosimLine.advance_to`), those it does not come to read before the next
+    command is sent (:meth:`_drain`)."""
+
+    talk: Conversation
+    extensions: frozenset[str]
+    now: int
+
+    @property
+    def pipelines(self) -> bool:
+        """Whether commands may be sent ahead of the replies before them."""
+        return "pipeline" in self.extensions
+
+    def untils(self, t: int) -> list[str]:
+        """The `until`s that take the clock from now to the instant ``t``, each as far
+        as one command may ask (:meth:`advance_to` sends them, one at a time)."""
+        out, at = [], self.now
+        while at < t:
+            at = min(t, at + STEP_NS)
+            out.append(f"until {at}")
+        return out
+
+    def send_ahead(self, commands: Sequence[str]) -> bool:
+        """Commands the suite is about to send one after the other, each in its turn as
+        it would (:meth:`ask`, :meth:`advance_to`), sent now in one write where the
+        simulator takes them so and more than one is to go (else each goes in its turn);
+        whether they were sent. The line must be quiet: nothing of its own under way."""
+        if not (self.pipelines and len(commands) > 1 and self._tx is None
+                and self._inflight is None and self._told is None and not self._ahead
+                and not self.talk.ahead):
+            return False
+        self.talk.send_ahead(commands)
+        return True
+
+    def power_on_ahead(self, seconds: float, *, state: bool) -> bool:
+        """A power-on through the rig, its restart waited out for ``seconds`` (on the
+        clock as :meth:`advance` waits) and, with ``state``, the rig's `state` after it,
+        sent in one write (:meth:`send_ahead`); whether they were."""
+        self._flush()
+        self._catch_up()
+        t = self.now + round(seconds * SECOND)
+        return self.send_ahead(["power-on", *self.untils(t), *(["state"] if state else [])])
+
+    def ask_next(self, command: str) -> None:
+        """A rig command (`state`) the suite will ask once the next command sent has
+        been answered (a frame's `tx`, a `batch`), sent in one write with it where the
+        simulator takes commands ahead; if the suite asks something else first, its
+        reply is read then and dropped."""
+        if self.pipelines:
+            self.talk.then = command
+
+    def _drain(self, but: str | None = None) -> None:
+        """The replies to the commands sent ahead that the suite did not come to in their
+        turn (a read that stopped early at a CR, another command first): read in order,
+        the clock where they took it, the rest of them dropped; up to ``but``, where it
+        is the next of them (its reply is the caller's)."""
+        talk = self.talk
+        while talk.ahead and talk.ahead[0] != but:
+            command = talk.ahead.popleft()
+            try:
+                if command.startswith("until "):
+                    goal = decimal(command.split()[1])
+                    self._moved(command, self.now, self.now,
+                                self.now if goal is None else goal)
+                else:
+                    talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
+            except BaseException:
+                talk.ahead.clear()
+                if not talk.broken:
+                    talk.broken = (f"the exchange {command!r} was cut off before its reply "
+                                   "was read: the co-simulation cannot go on")
+                raise
+
+
+class KeptState:
+    """The `snapshot` extension's part of :class:`CosimLine` (which it is mixed into): the
+    simulator keeps its whole state, and returns to it."""
+
+    extensions: frozenset[str]
+    now: int
+
+    def snapshot(self) -> bool:
+        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
+        False where it does not offer it, or refuses it (not used from then on)."""
+        if "snapshot" not in self.extensions:
+            return False
+        if self.ask("snapshot").strip().lower() != "ok":
+            self.extensions = self.extensions - {"snapshot"}
+            return False
+        return True
+
+    def restore(self) -> None:
+        """Back to the state the last `snapshot` kept, the clock not going back: the
+        unit has stood since then (its reply `now T` is the present instant)."""
+        self._flush()
+        self._catch_up()
+        self._drain()
+        self._move("restore", self.now, self.now, self.now)
+
+
+class CosimLine(SentAhead, KeptState):
     """The simulator's line, driven in virtual time (see the module's docstring)."""
 
     def __init__(self, program: Channel, baud: int, extensions: frozenset[str] = frozenset()
@@ -238,25 +341,6 @@ class CosimLine:
         if due is not None:
             return due
         self.talk.fail(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
-
-    # -- a state kept (the `snapshot` extension) --------------------------------------------------
-    def snapshot(self) -> bool:
-        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
-        False where it does not offer it, or refuses it (not used from then on)."""
-        if "snapshot" not in self.extensions:
-            return False
-        if self.ask("snapshot").strip().lower() != "ok":
-            self.extensions = self.extensions - {"snapshot"}
-            return False
-        return True
-
-    def restore(self) -> None:
-        """Back to the state the last `snapshot` kept, the clock not going back: the
-        unit has stood since then (its reply `now T` is the present instant)."""
-        self._flush()
-        self._catch_up()
-        self._drain()
-        self._move("restore", self.now, self.now, self.now)
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -522,72 +606,6 @@ class CosimLine:
 
     def advance(self, seconds: float) -> None:
         self.advance_to(self.now + round(seconds * SECOND))
-
-    # -- commands sent ahead (the `pipeline` extension) -----------------------------------------
-    @property
-    def pipelines(self) -> bool:
-        """Whether commands may be sent ahead of the replies before them."""
-        return "pipeline" in self.extensions
-
-    def untils(self, t: int) -> list[str]:
-        """The `until`s that take the clock from now to the instant ``t``, each as far
-        as one command may ask (:meth:`advance_to` sends them, one at a time)."""
-        out, at = [], self.now
-        while at < t:
-            at = min(t, at + STEP_NS)
-            out.append(f"until {at}")
-        return out
-
-    def send_ahead(self, commands: Sequence[str]) -> bool:
-        """Commands the suite is about to send one after the other, each in its turn as
-        it would (:meth:`ask`, :meth:`advance_to`), sent now in one write where the
-        simulator takes them so and more than one is to go (else each goes in its turn);
-        whether they were sent. The line must be quiet: nothing of its own under way."""
-        if not (self.pipelines and len(commands) > 1 and self._tx is None
-                and self._inflight is None and self._told is None and not self._ahead
-                and not self.talk.ahead):
-            return False
-        self.talk.send_ahead(commands)
-        return True
-
-    def power_on_ahead(self, seconds: float, *, state: bool) -> bool:
-        """A power-on through the rig, its restart waited out for ``seconds`` (on the
-        clock as :meth:`advance` waits) and, with ``state``, the rig's `state` after it,
-        sent in one write (:meth:`send_ahead`); whether they were."""
-        self._flush()
-        self._catch_up()
-        t = self.now + round(seconds * SECOND)
-        return self.send_ahead(["power-on", *self.untils(t), *(["state"] if state else [])])
-
-    def ask_next(self, command: str) -> None:
-        """A rig command (`state`) the suite will ask once the next command sent has
-        been answered (a frame's `tx`, a `batch`), sent in one write with it where the
-        simulator takes commands ahead; if the suite asks something else first, its
-        reply is read then and dropped."""
-        if self.pipelines:
-            self.talk.then = command
-
-    def _drain(self, but: str | None = None) -> None:
-        """The replies to the commands sent ahead that the suite did not come to in their
-        turn (a read that stopped early at a CR, another command first): read in order,
-        the clock where they took it, the rest of them dropped; up to ``but``, where it
-        is the next of them (its reply is the caller's)."""
-        talk = self.talk
-        while talk.ahead and talk.ahead[0] != but:
-            command = talk.ahead.popleft()
-            try:
-                if command.startswith("until "):
-                    goal = decimal(command.split()[1])
-                    self._moved(command, self.now, self.now,
-                                self.now if goal is None else goal)
-                else:
-                    talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
-            except BaseException:
-                talk.ahead.clear()
-                if not talk.broken:
-                    talk.broken = (f"the exchange {command!r} was cut off before its reply "
-                                   "was read: the co-simulation cannot go on")
-                raise
 
     def run_until_idle(self, max_seconds: float = 3600.0) -> bool:
         """Advance from event to event until none is due; False if ``max_seconds`` ran
