@@ -17,6 +17,7 @@ from conformance.cases._kit import (
     still_seconds,
     vector,
 )
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode, St6
 
 # id -> (rules (the first judges the readings), commands it requires, families, scenario)
@@ -56,7 +57,7 @@ def delete(ctx: CaseContext) -> None:
 def delete_moving(ctx: CaseContext) -> None:
     """D while moving answers 7."""
     setup(ctx, "C" + vector(ctx, 2000))
-    ctx.link.wait(0.2)
+    ctx.link.wait(0.2, Spent.MOTION)         # the vector under way
     code(ctx, ctx.link.send("D"), ErrorCode.BUSY, "D while moving → 7", rule="10.4.delete")
     ctx.link.send("H")
 

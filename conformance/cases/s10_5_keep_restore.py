@@ -18,6 +18,7 @@ from conformance.cases._kit import (
     still_seconds,
     vector,
 )
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
 
@@ -72,7 +73,7 @@ def partial(ctx: CaseContext) -> None:
 def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
-    ctx.link.wait(0.2)
+    ctx.link.wait(0.2, Spent.MOTION)         # the vector under way
     code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving", rule="5.code.busy-moving")
     code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving", rule="5.code.busy-moving")
     ctx.link.send("H")
