@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from conformance.case.context import CaseContext, case
@@ -113,8 +114,20 @@ def configured(ctx: CaseContext, name: str, *, required: bool = True) -> bool:
         # the manuals do not say when an EEPROM value takes effect: a reader may read its
         # settings at reset only (as M114 10.1 says of the switches), so J applies them
         setup(ctx, "J")
-        ctx.link.wait(ctx.profile.restart_ms / 1000 + 0.5)
+        # the unit is ready again after about 2 s (spec 2, M84 12.4)
+        ctx.link.wait(ctx.profile.restart_ms / 1000 + 0.5, Spent.MANUAL)
     return True
+
+
+def still_seconds(ctx: CaseContext) -> float:
+    """How long a case watches for a motion that must not happen (a vector refused,
+    deleted, held): a vector a unit took would begin within the longest dwell T (spec 10,
+    M84 12.5.2: at most 24 ms) and make its first step from rest within sqrt(2/A) at the
+    slowest acceleration the ranges allow (A in thousands of pulses/s^2: 45 ms at A1),
+    read after the line's margin."""
+    dwell = ctx.profile.range("T").hi / 1000
+    first_step = math.sqrt(2 / (ctx.profile.range("A").lo * 1000.0))
+    return dwell + first_step + MARGIN
 
 
 def halted_with_queue(ctx: CaseContext, vectors: int = 3, steps: int = 330) -> None:

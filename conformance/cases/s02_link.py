@@ -54,7 +54,7 @@ def restart(ctx: CaseContext) -> None:
     if summed:
         setup(ctx, "%+", checksum=False)
     answers(ctx, link.send("J"), "0", "J answers a plain 0 (no checksum)", rule="10.cmd.restart")
-    link.wait(0.5)
+    link.wait(0.5, Spent.MANUAL)             # into the restart (spec 2, M84 12.4)
     r = link.send("SW3,5A", checksum=False, timeout=1.0)
     ctx.expect(r is None, "a frame while the unit restarts gets no answer",
                observed=r, expected="nothing", rule="2.link.restart-deaf")

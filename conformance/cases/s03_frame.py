@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from conformance.case.context import CaseContext, case
 from conformance.cases._kit import answers, code, index, index_moved, setup, show
+from conformance.link.account import Spent
 from conformance.link.framing import Response
 from gve_fixtures.protocol import ErrorCode
 
@@ -71,7 +72,8 @@ def lf(ctx: CaseContext) -> None:
 def lone_bang(ctx: CaseContext) -> None:
     """If only '!' arrived before the watchdog time, nothing is answered."""
     ctx.link.send_raw(b"!")
-    got = ctx.link.wait(0.5)
+    # the watchdog's time as a unit takes it (M84 12.6, 100 ms), and a margin
+    got = ctx.link.wait(0.5, Spent.MANUAL)
     ctx.expect(got == b"", "no answer to a lone '!'", observed=got, expected=b"")
 
 

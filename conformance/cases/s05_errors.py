@@ -16,6 +16,7 @@ from conformance.cases._kit import (
     setup,
     vector,
 )
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
 
@@ -37,7 +38,7 @@ def busy(ctx: CaseContext) -> None:
     """D, K, R, N while a vector runs answer 7."""
     setup(ctx, "V1000")
     setup(ctx, "C" + vector(ctx, 1500))      # 1.5 s at V1000: moving for every probe
-    ctx.link.wait(0.3)
+    ctx.link.wait(0.3, Spent.MOTION)         # (the vector under way, as halted_line waits)
     for body, rule in (("D", "5.code.busy-moving"), ("K", "5.code.busy-moving"),
                        ("R", "5.code.busy-moving"), ("N", "5.code.busy-run")):
         code(ctx, ctx.link.send(body), ErrorCode.BUSY, f"{body} while moving → 7", rule=rule)

@@ -16,6 +16,7 @@ from conformance.cases._kit import (
     queries_counted,
     setup,
     show,
+    still_seconds,
     vector,
 )
 from conformance.link.framing import byte_sum
@@ -58,7 +59,7 @@ def corrupted_end(ctx: CaseContext) -> None:
             rule="7.packet.bad-checksum-member")
     index_moved(ctx, before, 3, "*S, the member and *E counted; the corrupted frame not",
                 rule="8.index.uncounted")
-    ctx.link.wait(0.5)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), [0, 0, 0], "nothing was committed",
                      rule="7.packet.bad-checksum-member")
 
@@ -84,7 +85,7 @@ def count(ctx: CaseContext) -> None:
     code(ctx, r, ErrorCode.COUNT_MISMATCH, "2 members, *E3 → 2", rule="5.code.watchdog")
     ctx.expect(r is not None and r.values[:1] == ["2"], "and the 2 members received",
                observed=show(r), expected="2,2", rule="7.packet.codes")
-    ctx.link.wait(1.0)
+    ctx.link.wait(still_seconds(ctx))
     # members committed as they arrive are another reading of the manual's packet [D]
     ctx.expect(position(ctx) == [0, 0, 0], "nothing moved", rule="7.packet.all-or-nothing")
 
@@ -149,7 +150,7 @@ def invalid(ctx: CaseContext) -> None:
     """A member other than C or B fails the packet with 4; nothing is committed."""
     r = _packet(ctx, ["C" + vector(ctx, 10), "V100", "C" + vector(ctx, 10)], 3)
     answers(ctx, r, "4,3", "V inside a packet → 4,3", rule="7.packet.codes")
-    ctx.link.wait(1.0)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), [0, 0, 0], "no member was committed",
                      rule="7.packet.all-or-nothing")
 

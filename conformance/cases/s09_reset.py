@@ -168,7 +168,7 @@ def mpg_values(ctx: CaseContext) -> None:
         answers(ctx, link.send("Y-"), "0,Y-", "Y- before the EEPROM write", rule="10.cmd.mpg")
         setup(ctx, f"EW{enable},{value:02X}")
         setup(ctx, "J")
-        link.wait(ctx.profile.restart_ms / 1000 + 0.5)
+        link.wait(ctx.profile.restart_ms / 1000 + 0.5, Spent.MANUAL)     # spec 2
         shown = f"EEPROM {enable} = {value:02X}"
         if enables:
             _mpg_on(ctx, f"{shown}: after J", "10.cmd.mpg")

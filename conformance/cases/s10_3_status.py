@@ -14,6 +14,7 @@ from conformance.cases._kit import (
     refused_beyond_ff,
     setup,
     show,
+    still_seconds,
     vector,
 )
 from conformance.link.account import Spent
@@ -56,7 +57,7 @@ def _after_clearing(ctx: CaseContext, body: str) -> None:
     code(ctx, ctx.link.send("L" + vector(ctx, 300)), ErrorCode.OK,
          f"after {body}: L is accepted and waits", inta=True,
          rule="10.3.inputs.level-triggered")
-    ctx.link.wait(0.5)
+    ctx.link.wait(still_seconds(ctx))
     here = position(ctx)
     ctx.expect(here == [0, 0, 0], f"after {body}: nothing moved while the input is active",
                observed=here, expected=[0, 0, 0], rule="10.3.inputs.level-triggered")
@@ -204,7 +205,7 @@ def sw6(ctx: CaseContext) -> None:
     code(ctx, r, ErrorCode.OK, "L is accepted while INTA = 1", rule="10.3.sw6.acts")
     ctx.expect(r is not None and bool(r.inta), "the answer after SW6,80 carries INTA",
                observed=show(r), expected="8", rule="4.response.inta-bit")
-    link.wait(0.5)
+    link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), [0, 0, 0], "the vector waits for G", rule="10.3.sw6.acts")
     link = ctx.fresh_link()
     halted_line(ctx, 300, 0.1)

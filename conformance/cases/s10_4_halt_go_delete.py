@@ -14,8 +14,10 @@ from conformance.cases._kit import (
     position,
     setup,
     show,
+    still_seconds,
     vector,
 )
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode, St6
 
 # id -> (rules (the first judges the readings), commands it requires, families, scenario)
@@ -46,7 +48,7 @@ def delete(ctx: CaseContext) -> None:
     here = position(ctx)
     answers(ctx, ctx.link.send("D"), "0", "D after H")
     answers(ctx, ctx.link.send("SR6"), "0,00", "ST6 cleared")
-    ctx.link.wait(1.0)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), here, "position unchanged")
 
 
@@ -55,7 +57,7 @@ def delete(ctx: CaseContext) -> None:
 def delete_moving(ctx: CaseContext) -> None:
     """D while moving answers 7."""
     setup(ctx, "C" + vector(ctx, 2000))
-    ctx.link.wait(0.2)
+    ctx.link.wait(0.2, Spent.MOTION)         # the vector under way
     code(ctx, ctx.link.send("D"), ErrorCode.BUSY, "D while moving → 7", rule="10.4.delete")
     ctx.link.send("H")
 
@@ -92,7 +94,7 @@ def halt(ctx: CaseContext) -> None:
     """H brakes on the ramp and answers (8) only once the motion has stopped."""
     halted_with_queue(ctx)
     first = position(ctx)
-    ctx.link.wait(0.5)
+    ctx.link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), first, "no motion after H's answer", rule="10.4.halt.ramp")
     r = ctx.link.send("SR6")
     ctx.expect(r is not None and r.values[:1] == ["D0"], "ST6 = INTA+RUN+INTCOM, STOP clear",

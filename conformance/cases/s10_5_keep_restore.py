@@ -15,8 +15,10 @@ from conformance.cases._kit import (
     position,
     setup,
     show,
+    still_seconds,
     vector,
 )
+from conformance.link.account import Spent
 from gve_fixtures.protocol import ErrorCode
 
 
@@ -71,7 +73,7 @@ def partial(ctx: CaseContext) -> None:
 def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
     setup(ctx, "C" + vector(ctx, 2000))
-    ctx.link.wait(0.2)
+    ctx.link.wait(0.2, Spent.MOTION)         # the vector under way
     code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving", rule="5.code.busy-moving")
     code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving", rule="5.code.busy-moving")
     ctx.link.send("H")
@@ -128,5 +130,5 @@ def save_emptied(ctx: CaseContext) -> None:
     link.poll("SR6", lambda r: r.values == ["00"], 10)
     answers(ctx, link.send("R"), "0", "a second R restores the empty save")
     code(ctx, link.send("G"), ErrorCode.NOTHING_TO_GO, "nothing to resume: G → 6")
-    link.wait(1.0)
+    link.wait(still_seconds(ctx))
     ctx.expect_equal(position(ctx), [1000, 0, 0], "the remainder ran once")

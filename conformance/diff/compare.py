@@ -69,6 +69,9 @@ def difference(command: str, target: RoundTrip, reference: RoundTrip, judge: Jud
     """The kind of difference between the two answers (None: alike)."""
     a, b = target.answer, reference.answer
     if a == b:
+        if not a:
+            # nothing came on either side: where each stopped listening is the suite's
+            return None
         late = (target.received_at - target.sent_at) - (reference.received_at
                                                          - reference.sent_at)
         if judge.exact and late and not (command in DEFERRED

@@ -162,7 +162,7 @@ class Pair:
         if not self._begin(out):
             return out
         self._last = list(steps)
-        self._teller = Teller(self.target, steps, self._refer, self.awaited) if ahead else None
+        self._teller = Teller(self.target, steps, self._refer) if ahead else None
         earlier: set[str] = set()          # what the sequence did before (labels read it)
         try:
             for place, step in enumerate(steps):
@@ -403,20 +403,13 @@ class Pair:
         self._index.note(command, context, _values(rec.target), _values(rec.reference))
         self.judge = replace(self.judge, index_offset=self._index.offset or 0)
 
-    def awaited(self, step: Step, data: bytes) -> float:
-        """How long both sides await a frame's answer: the longer of their two guards'
-        estimates (in virtual time a side that stopped listening sooner would run on
-        from another instant than the other, and every reading after it would differ)."""
-        return max(side.awaited(data, step.body, step.answer)
-                   for side in (self.target, self.reference))
-
     def _refer(self, step: Step, data: bytes) -> tuple[RoundTrip, str]:
-        """The frame to the reference: its exchange, and why the sequence ends there
-        ("": it goes on)."""
+        """The frame to the reference, listened to as long as the target is: its exchange,
+        and why the sequence ends there ("": it goes on)."""
         try:
             return self.reference.exchange(data, lines=step.lines, answer=step.answer,
                                            stall=step.stall, body=step.body,
-                                           timeout=self.awaited(step, data)), ""
+                                           like=self.target), ""
         except TargetNotResponding as err:
             return RoundTrip(data, b"", 0, 0, None, step.lines), str(err)
 
@@ -450,8 +443,7 @@ class Pair:
         try:
             rec.target = self.target.exchange(data, lines=step.lines, answer=step.answer,
                                               stall=step.stall, body=step.body,
-                                              meanwhile=reference if told is None else None,
-                                              timeout=self.awaited(step, data))
+                                              meanwhile=reference if told is None else None)
         except SafetyStop as err:
             why = str(err)
             out.refused.append(why if why.startswith(f"{step.body}:") else f"{step}: {why}")

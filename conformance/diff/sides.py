@@ -135,14 +135,17 @@ class Side:
     def exchange(self, data: bytes, *, lines: int = 1, answer: bool = True,
                  stall: tuple[int, float] | None = None, body: str | None = None,
                  meanwhile: Callable[[], None] | None = None,
-                 timeout: float | None = None) -> RoundTrip:
+                 like: Side | None = None) -> RoundTrip:
         """Send a frame's bytes (through the guard: SafetyStop when refused) and take
         what comes back: its answer (``answer``), else whatever arrives while the
         answer's bytes would have taken. ``body``: the frame's command, when known (it
         decides how long an answer may take). ``meanwhile``: work of the caller's that
         a port which sends a write before its read (a co-simulator's) does while the
         target runs the frame, between the two (any other port: not done here).
-        ``timeout``: how long the answer is awaited (None: :meth:`awaited`)."""
+        ``like``: the side whose window it is listened to for (the reference for the
+        target's: its guard's window for a W or an H may be shorter than the reference's
+        own, and two sides listened to for different times differ in when they went
+        quiet); else its own (:meth:`awaited`)."""
         link = self.link
         if body is None:
             body = _body(data, link.checksums)
@@ -150,8 +153,7 @@ class Side:
             link.inject("host", "delay", at=stall[0], seconds=stall[1])
         link.send_raw(data)
         sent_at = link.wrote_at - self._origin
-        if timeout is None:
-            timeout = self.awaited(data, body, answer)
+        timeout = (like or self).awaited(data, body, answer)
         if answer:
             launch = getattr(link.port, "launch", None)
             if meanwhile is not None and launch is not None:
@@ -212,6 +214,14 @@ class Side:
             return self._physical[axis]
         found = getattr(self.session, "_rig_origin", None) if self.real else None
         return found.get(axis, 0) if isinstance(found, dict) else 0
+
+    def state_next(self) -> None:
+        """The rig's `state` is read once the next frame is answered: a port that takes
+        commands ahead (a co-simulator's) sends it with that frame."""
+        ask_next = getattr(self.link.port, "ask_next", None) if self.has_rig else None
+        command = getattr(self.link.rig, "state_command", None) if ask_next else None
+        if command is not None:
+            ask_next(command())
 
     def rig_state(self) -> dict | None:
         """What the rig sees of the unit now (docs/rig.md `state`); None (and the rig

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from conformance.diff.index_base import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import RoundTrip, Side
-from conformance.diff.steps import FILL, FRAME, Step
+from conformance.diff.steps import FILL, FRAME, STATE, Step
 from conformance.link.ahead import Ahead
 from conformance.link.safety import SafetyStop
 from conformance.protocol.catalogue import classes
@@ -63,16 +63,13 @@ def tellable(step: Step) -> bool:
 
 class Teller:
     """One example's frames told ahead, for the target ``side``; ``refer`` runs a step's
-    frame on the reference (its exchange, and why the sequence ends there: "" to go on);
-    ``awaited`` says how long both sides await a frame's answer."""
+    frame on the reference (its exchange, and why the sequence ends there: "" to go on)."""
 
     def __init__(self, side: Side, steps: list[Step],
-                 refer: Callable[[Step, bytes], tuple[RoundTrip, str]],
-                 awaited: Callable[[Step, bytes], float]) -> None:
+                 refer: Callable[[Step, bytes], tuple[RoundTrip, str]]) -> None:
         self.side = side
         self.steps = steps
         self.refer = refer
-        self.awaited = awaited
         self.queue: deque[Told] = deque()
         #: the target answered alike at another instant than the reference within frames
         #: told ahead: this run's comparisons after it are not the sequence's
@@ -83,16 +80,20 @@ class Teller:
         ``place`` on, and tell the target those the guard lets through (at least two)."""
         link = self.side.link
         if not (self._more(place, repeat) and link.takes_ahead):
+            if self._read_after(place):
+                self.side.state_next()
             return
         ahead, planned = Ahead(link), []
         address = self.side.target.address
+        last = place
         while place < len(self.steps) and len(planned) < MOST:
             step = self.steps[place]
             if not tellable(step):
                 break
             data = step.frame_bytes(address, link.checksums)
-            if not ahead.admit(data, self.awaited(step, data)):
+            if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
                 break
+            last = place
             reference, ended = self.refer(step, data)
             if step.answer and reference.answer:
                 # the target answers when the reference did, or differs: then its frames
@@ -105,6 +106,8 @@ class Teller:
                 repeat += 1
             else:
                 place, repeat = place + 1, 0
+        if planned and self._read_after(last):
+            self.side.state_next()
         try:
             ran = ahead.tell()
         except BaseException:
@@ -116,6 +119,13 @@ class Teller:
         for i, told in enumerate(planned):
             told.ran = i < ran
         self.queue.extend(planned)
+
+    def _read_after(self, place: int) -> bool:
+        """Whether the rig's state is read right after the frame of step ``place`` (a
+        rig read next, or the sequence's end: what the rig sees then)."""
+        if self.steps[place].kind != FRAME:
+            return False
+        return place + 1 == len(self.steps) or self.steps[place + 1].kind == STATE
 
     def _more(self, place: int, repeat: int) -> bool:
         """Whether a second frame may follow the one at ``place``: worth telling."""
@@ -154,7 +164,7 @@ class Teller:
                 continue
             try:
                 self.side.exchange(told.data, lines=told.step.lines, answer=told.step.answer,
-                                   body=told.step.body, timeout=self.awaited(told.step, told.data))
+                                   body=told.step.body)
             except SafetyStop:
                 self.forget([told])
                 return

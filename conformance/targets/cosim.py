@@ -7,6 +7,9 @@ somebody else's; the emulator is one more such program).
 (``now``, ``advance``, ``advance_to``; reads that wait in virtual time), and
 :class:`CosimPort` the pyserial port on it that links write and read. A write is sent
 with the next operation (``tx HEX T`` when that is a read: one exchange per frame).
+Where the simulator takes commands ahead (`pipeline`), those whose words do not depend
+on the replies before them (a wait's `until`s, a power-on, its restart and the `state`
+after it) go in one write, each reply read when the suite comes to its command.
 
 Every reply is checked as it comes: a simulator that breaks the protocol — no reply or
 no ``now`` within :data:`REPLY_SECONDS`, time going backwards, a byte stamped before the
@@ -99,6 +102,11 @@ class Conversation:
         self.program = program
         self.broken = ""
         self.exchanges = 0                    # commands sent
+        self.writes = 0                       # writes they went in (one each, or ahead)
+        #: commands sent ahead (`pipeline`), their replies not read yet, in order
+        self.ahead: deque[str] = deque()
+        #: a command to go in one write with the next one sent (sent ahead with it)
+        self.then: str | None = None
 
     def fail(self, why: str) -> NoReturn:
         self.broken = self.broken or f"the co-simulator broke the protocol: {why}"
@@ -109,9 +117,30 @@ class Conversation:
             raise ProtocolBroken(self.broken)
 
     def send(self, command: str) -> None:
-        self.exchanges += 1
-        if not self.program.send(command):
+        if self.ahead:          # (the line reads their replies before it sends another)
+            self.fail(f"{command!r} was to be sent before the replies to "
+                      f"{self.ahead[0]!r} and the commands sent with it were read")
+        then, self.then = self.then, None
+        self.exchanges += 1 + (then is not None)
+        self.writes += 1
+        if not self.program.send(command if then is None else f"{command}\n{then}"):
             self.ended(command)
+        if then is not None:
+            self.ahead.append(then)
+
+    def send_ahead(self, commands: Sequence[str]) -> None:
+        """Commands in one write, their replies read as each is exchanged in turn
+        (:meth:`exchange`) or by the line when it needs another."""
+        self.usable()
+        if not commands:
+            return
+        if self.then is not None:
+            commands, self.then = [*commands, self.then], None
+        self.exchanges += len(commands)
+        self.writes += 1
+        if not self.program.send("\n".join(commands)):
+            self.ended(commands[0])
+        self.ahead.extend(commands)
 
     @contextlib.contextmanager
     def exchange(self, command: str) -> Iterator[None]:
@@ -121,7 +150,10 @@ class Conversation:
         self.usable()
         done = False
         try:
-            self.send(command)
+            if self.ahead and self.ahead[0] == command:
+                self.ahead.popleft()          # sent ahead: its reply is on its way
+            else:
+                self.send(command)
             yield
             done = True
         finally:
@@ -147,7 +179,110 @@ class Conversation:
         return text
 
 
-class CosimLine:
+class SentAhead:
+    """The `pipeline` extension's part of :class:`CosimLine` (which it is mixed into):
+    commands whose words do not hang on the replies before them sent in one write, each
+    reply read when the suite comes to its command (:meth:`CosimLine.ask`, the `until`s
+    of :meth:`CosimLine.advance_to`), those it does not come to read before the next
+    command is sent (:meth:`_drain`)."""
+
+    talk: Conversation
+    extensions: frozenset[str]
+    now: int
+
+    @property
+    def pipelines(self) -> bool:
+        """Whether commands may be sent ahead of the replies before them."""
+        return "pipeline" in self.extensions
+
+    def untils(self, t: int) -> list[str]:
+        """The `until`s that take the clock from now to the instant ``t``, each as far
+        as one command may ask (:meth:`advance_to` sends them, one at a time)."""
+        out, at = [], self.now
+        while at < t:
+            at = min(t, at + STEP_NS)
+            out.append(f"until {at}")
+        return out
+
+    def send_ahead(self, commands: Sequence[str]) -> bool:
+        """Commands the suite is about to send one after the other, each in its turn as
+        it would (:meth:`ask`, :meth:`advance_to`), sent now in one write where the
+        simulator takes them so and more than one is to go (else each goes in its turn);
+        whether they were sent. The line must be quiet: nothing of its own under way."""
+        if not (self.pipelines and len(commands) > 1 and self._tx is None
+                and self._inflight is None and self._told is None and not self._ahead
+                and not self.talk.ahead):
+            return False
+        self.talk.send_ahead(commands)
+        return True
+
+    def power_on_ahead(self, seconds: float, *, state: bool) -> bool:
+        """A power-on through the rig, its restart waited out for ``seconds`` (on the
+        clock as :meth:`advance` waits) and, with ``state``, the rig's `state` after it,
+        sent in one write (:meth:`send_ahead`); whether they were."""
+        self._flush()
+        self._catch_up()
+        t = self.now + round(seconds * SECOND)
+        return self.send_ahead(["power-on", *self.untils(t), *(["state"] if state else [])])
+
+    def ask_next(self, command: str) -> None:
+        """A rig command (`state`) the suite will ask once the next command sent has
+        been answered (a frame's `tx`, a `batch`), sent in one write with it where the
+        simulator takes commands ahead; if the suite asks something else first, its
+        reply is read then and dropped."""
+        if self.pipelines:
+            self.talk.then = command
+
+    def _drain(self, but: str | None = None) -> None:
+        """The replies to the commands sent ahead that the suite did not come to in their
+        turn (a read that stopped early at a CR, another command first): read in order,
+        the clock where they took it, the rest of them dropped; up to ``but``, where it
+        is the next of them (its reply is the caller's)."""
+        talk = self.talk
+        while talk.ahead and talk.ahead[0] != but:
+            command = talk.ahead.popleft()
+            try:
+                if command.startswith("until "):
+                    goal = decimal(command.split()[1])
+                    self._moved(command, self.now, self.now,
+                                self.now if goal is None else goal)
+                else:
+                    talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
+            except BaseException:
+                talk.ahead.clear()
+                if not talk.broken:
+                    talk.broken = (f"the exchange {command!r} was cut off before its reply "
+                                   "was read: the co-simulation cannot go on")
+                raise
+
+
+class KeptState:
+    """The `snapshot` extension's part of :class:`CosimLine` (which it is mixed into): the
+    simulator keeps its whole state, and returns to it."""
+
+    extensions: frozenset[str]
+    now: int
+
+    def snapshot(self) -> bool:
+        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
+        False where it does not offer it, or refuses it (not used from then on)."""
+        if "snapshot" not in self.extensions:
+            return False
+        if self.ask("snapshot").strip().lower() != "ok":
+            self.extensions = self.extensions - {"snapshot"}
+            return False
+        return True
+
+    def restore(self) -> None:
+        """Back to the state the last `snapshot` kept, the clock not going back: the
+        unit has stood since then (its reply `now T` is the present instant)."""
+        self._flush()
+        self._catch_up()
+        self._drain()
+        self._move("restore", self.now, self.now, self.now)
+
+
+class CosimLine(SentAhead, KeptState):
     """The simulator's line, driven in virtual time (see the module's docstring)."""
 
     def __init__(self, program: Channel, baud: int, extensions: frozenset[str] = frozenset()
@@ -186,6 +321,9 @@ class CosimLine:
         """A rig command (docs/rig.md) at the current instant: its one reply line."""
         self._flush()
         self._catch_up()
+        if self.talk.then == command:
+            self.talk.then = None             # asked now: it goes now, alone
+        self._drain(but=command)
         with self.talk.exchange(command):
             return self.talk.reply(command, time.monotonic() + REPLY_SECONDS, "")
 
@@ -203,24 +341,6 @@ class CosimLine:
         if due is not None:
             return due
         self.talk.fail(f"it answered 'next' with {shown(reply, 120)}, not next T or next none")
-
-    # -- a state kept (the `snapshot` extension) --------------------------------------------------
-    def snapshot(self) -> bool:
-        """The simulator keeps its whole state as it is now (`snapshot`, docs/cosim.md);
-        False where it does not offer it, or refuses it (not used from then on)."""
-        if "snapshot" not in self.extensions:
-            return False
-        if self.ask("snapshot").strip().lower() != "ok":
-            self.extensions = self.extensions - {"snapshot"}
-            return False
-        return True
-
-    def restore(self) -> None:
-        """Back to the state the last `snapshot` kept, the clock not going back: the
-        unit has stood since then (its reply `now T` is the present instant)."""
-        self._flush()
-        self._catch_up()
-        self._move("restore", self.now, self.now, self.now)
 
     # -- the clock -----------------------------------------------------------------------------
     def _move(self, command: str, start: int, end: int, goal: int) -> bool:
@@ -325,12 +445,18 @@ class CosimLine:
                 self._ahead.appendleft(head)
                 wait = goal - end
                 self._catch_up()                  # the bytes go out from where it is
+                self._drain()
                 start, end = self.now, self.now + len(data) * self.byte_ns
                 self.now, goal = end, end + wait
             command = f"tx {data.hex().upper()}" + (f" {goal}" if goal > end else "")
             return self._move(command, start, end, goal)
         self._catch_up()
         goal = max(self.now, min(t, self.now + STEP_NS))
+        if self.talk.ahead and self.talk.ahead[0] != f"until {goal}":
+            self._drain()                     # stopped early at a CR: they run on
+            if self.now >= t:
+                return False
+            goal = max(self.now, min(t, self.now + STEP_NS))
         return self._move(f"until {goal}", self.now, self.now, goal)
 
     # -- a write sent before its read ------------------------------------------------------------
@@ -342,7 +468,8 @@ class CosimLine:
         it: nothing waits to be read (bytes received already, say during an injected
         pause, may be the answer the read takes, and the write then waits)."""
         self._land_told()
-        if self._tx is None or self._ahead or self._rx or self.talk.broken:
+        if self._tx is None or self._ahead or self._rx or self.talk.broken \
+                or self.talk.ahead:
             return
         data, start = self._tx
         end = self.now
@@ -391,6 +518,9 @@ class CosimLine:
         if not self.tells:
             return False
         self.talk.usable()
+        self._drain()
+        if not self.tells:                   # (bytes came meanwhile: one at a time)
+            return False
         stops = "batch-stops" in self.extensions
         plan: list[tuple[bytes, int]] = []
         for data, timeout, *due in frames:
@@ -469,6 +599,8 @@ class CosimLine:
         if self._tx is not None:
             self._step(t)
         self._catch_up()
+        if not self.talk.ahead:
+            self.send_ahead(self.untils(t))
         while self.now < t:
             self._step(t)
 
@@ -494,6 +626,8 @@ class CosimLine:
         self.talk.usable()
         if self._ahead and (self._ahead[0].data, self._ahead[0].start) != (data, self.now):
             self._catch_up()
+        if not self._ahead:
+            self._drain()          # the bytes go out after the commands sent ahead
         if data:
             self._tx = (bytes(data), self.now)
             self.now += len(data) * self.byte_ns
@@ -608,6 +742,14 @@ class CosimPort:
     def restore(self) -> None:
         """Back to the state kept (CosimLine.restore)."""
         self.line.restore()
+
+    def power_on_ahead(self, seconds: float, *, state: bool) -> bool:
+        """A power-on, its restart and a `state` sent in one write (CosimLine.power_on_ahead)."""
+        return self.line.power_on_ahead(seconds, state=state)
+
+    def ask_next(self, command: str) -> None:
+        """``command`` sent with the next one (CosimLine.ask_next)."""
+        self.line.ask_next(command)
 
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""

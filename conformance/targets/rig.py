@@ -125,8 +125,12 @@ class ControlRig:
         self._do("power-on" + ("" if address is None else f" @{address}"))   # None: all
         self.on_power_on()
 
+    def state_command(self, address: int | None = None) -> str:
+        """The words of :meth:`state`'s command."""
+        return f"state{self._at(address)}"
+
     def state(self, address: int | None = None) -> dict:
-        reply = self._ask(f"state{self._at(address)}")
+        reply = self._ask(self.state_command(address))
         state = json_object(reply)
         if state is None:
             raise CouldNotTest(f"the rig's state is not one JSON object: {shown(reply)}")

@@ -294,15 +294,21 @@ class RealSession(Session):
             link.checksums = False
             self.since_power_on = self._kept_power_on
         else:
+            wait = self.profile.restart_ms / 1000 + MARGIN
             try:
                 rig.hands_off()
+                # a co-simulator that takes commands ahead gets the power-on, the restart
+                # and the rig's `state` read next (unless a snapshot comes first) at once
+                ahead = getattr(link.port, "power_on_ahead", None)
+                if ahead is not None:
+                    ahead(wait, state=not kept)
                 rig.power_on()
             except CouldNotTest as err:
                 self._power_on_refused = str(err)
                 return None
             link.checksums = False
             powered = link.now
-            link.wait(self.profile.restart_ms / 1000 + MARGIN, Spent.MANUAL)
+            link.wait(wait, Spent.MANUAL)
             self.since_power_on = link.now - powered
             snapshot = getattr(link.port, "snapshot", None)
             if kept and snapshot is not None and snapshot():

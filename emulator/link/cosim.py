@@ -17,14 +17,20 @@ in-process `gve://` line would give it.
                    from the snapshot's instant to now (`now T`, T the present instant)
     in, switch, power-on, state, quit, help: the test rig (docs/rig.md)
 
+Commands may come before the reply to the one before has been read (the extension
+`pipeline`): each is answered in turn, and the replies to those already waiting go out
+together.
+
 `tx` and `until` answer `rx T HEX` for the bytes that reached the host meanwhile, then
 `now T`; anything malformed answers one `error: ...` line and changes nothing.
 """
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
+import select
 import sys
 from collections.abc import Callable
 from typing import BinaryIO, NoReturn, TextIO
@@ -37,7 +43,7 @@ from emulator.link.words import decimal
 
 VERSION = 1
 #: the optional extensions this simulator speaks, named on its first line (docs/cosim.md)
-EXTENSIONS = ("batch", "batch-stops", "snapshot")
+EXTENSIONS = ("batch", "batch-stops", "pipeline", "snapshot")
 CR = b"\r"
 #: the fastest line `baud` takes: a byte must take at least a nanosecond
 MAX_BAUD = 10**9
@@ -280,7 +286,7 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
     `restore` (by fork: the process's own standard input and output only; each restore
     forks the next standby, which on a busy machine costs more than a power-on and its
     restart in virtual time, hence not offered unless asked)."""
-    stdin = stdin if stdin is not None else sys.stdin.buffer
+    commands = _Commands(stdin if stdin is not None else sys.stdin.buffer)
     stdout = stdout if stdout is not None else sys.stdout
     cosim = Cosim(line)
     kept = _Snapshots() if snapshots and hasattr(os, "fork") else None
@@ -290,25 +296,38 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
     def say(lines: list[str]) -> None:
         try:
             stdout.write("".join(f"{x}\n" for x in lines))
-            stdout.flush()
+            # the replies to commands already here go out with those to come: the
+            # driver that sent them ahead wakes once for all of them
+            if not commands.waiting():
+                stdout.flush()
         except BrokenPipeError:
             raise StdoutGone from None
 
     say([" ".join(("cosim", str(VERSION), *offered))])
+    try:
+        _serve(cosim, commands, say, kept, stdout.flush)
+    finally:
+        with contextlib.suppress(BrokenPipeError, ValueError):
+            stdout.flush()
+
+
+def _serve(cosim: Cosim, commands: _Commands, say: Callable[[list[str]], None],
+           kept: _Snapshots | None, flush: Callable[[], None]) -> None:
+    """Each command in turn, until `quit` or the end of input."""
     while True:
-        raw = stdin.readline(CONTROL_LIMIT + 1)
+        raw = commands.readline(CONTROL_LIMIT + 1)
         if not raw:
             return
         if len(raw) > CONTROL_LIMIT and not raw.endswith(b"\n"):
             while raw and not raw.endswith(b"\n"):          # the rest of that line
-                raw = stdin.readline(CONTROL_LIMIT + 1)
+                raw = commands.readline(CONTROL_LIMIT + 1)
             say([f"error: a command line longer than {CONTROL_LIMIT} bytes"])
             continue
         text = raw.decode("utf-8", "replace")
         words = text.split()
         verb = words[0].lower() if words else ""
         if verb in ("snapshot", "restore") and kept is not None:
-            say(_snapshot_or_restore(cosim, kept, verb, words[1:], stdout.flush))
+            say(_snapshot_or_restore(cosim, kept, verb, words[1:], flush))
             continue
         try:
             replies = cosim.handle(text)
@@ -316,6 +335,49 @@ def serve_cosim(line: Line, stdin: BinaryIO | None = None, stdout: TextIO | None
             return
         if replies:
             say(replies)
+
+
+class _Commands:
+    """The driver's command lines, read as they come (from a pipe or a terminal: its
+    descriptor; any other stream: its own lines), and whether another one is already
+    here."""
+
+    def __init__(self, stream: BinaryIO) -> None:
+        self.stream = stream
+        try:
+            self.fd: int | None = stream.fileno()
+        except (AttributeError, OSError, ValueError):
+            self.fd = None
+        self.pending = bytearray()
+
+    def readline(self, limit: int) -> bytes:
+        """The next line with its newline, at most ``limit`` bytes of it (b"": the end)."""
+        if self.fd is None:
+            return self.stream.readline(limit)
+        while True:
+            k = self.pending.find(b"\n", 0, limit)
+            if k >= 0 or len(self.pending) >= limit:
+                end = k + 1 if k >= 0 else limit
+                out = bytes(self.pending[:end])
+                del self.pending[:end]
+                return out
+            data = os.read(self.fd, 1 << 16)
+            if not data:
+                out = bytes(self.pending)
+                self.pending.clear()
+                return out
+            self.pending += data
+
+    def waiting(self) -> bool:
+        """Whether a whole command is here already, read or on the descriptor."""
+        if self.fd is None:
+            return False
+        if b"\n" in self.pending:
+            return True
+        try:
+            return bool(select.select([self.fd], [], [], 0)[0])
+        except (OSError, ValueError):
+            return False
 
 
 def _snapshot_or_restore(cosim: Cosim, kept: _Snapshots, verb: str, args: list[str],
@@ -326,6 +388,7 @@ def _snapshot_or_restore(cosim: Cosim, kept: _Snapshots, verb: str, args: list[s
     if verb == "restore":
         if kept.wake is None:
             return ["error: restore: no snapshot was taken"]
+        flush()                                # the replies before it go out first
         kept.restore(cosim.line.now)           # ends here; the keeper's child goes on
     # a child the keeper made after a `restore` comes back here, with the instant to
     # stand until

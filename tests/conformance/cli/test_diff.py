@@ -238,6 +238,35 @@ def test_a_known_state_that_cannot_be_had_ends_in_a_verdict(tmp_path, capsys, mo
     assert "reached: commands" in captured.out
 
 
+def test_a_clean_target_whose_known_state_is_lost_never_passes(tmp_path, capsys,
+                                                                monkeypatch):
+    """No disagreement in the sequences that ran, then the known state lost: the search
+    ended COULD-NOT-TEST, counting only the sequences that ran; no PASS, and the exit
+    status is not a success's."""
+    opened = [0]
+    real_open = Side.open
+
+    def open_(self, tell=(), meanwhile=None):
+        opened[0] += 1
+        if opened[0] > 40:
+            raise CouldNotTest("the known state: a KEEP is held and J needs consent")
+        return real_open(self, tell, meanwhile)
+
+    monkeypatch.setattr(Side, "open", open_)
+    status = main(["diff", "--target", "emu:GVE84-100", "--examples", "500",
+                   "--report-dir", str(tmp_path)])
+    captured = capsys.readouterr()
+    assert status != 0 and "Traceback" not in captured.err
+    last = captured.out.strip().splitlines()[-1]
+    assert not last.startswith(("PASS", "PASSED")), last
+    (folder,) = tmp_path.iterdir()
+    (result,) = json.loads((folder / "results.json").read_text())["results"]
+    assert (result["id"], result["verdict"]) == ("diff.search.agreement", "COULD-NOT-TEST")
+    assert "the search stopped after" in " ".join(result["notes"])
+    sequences = int(result["notes"][0].split("after ")[1].split()[0])
+    assert 0 < sequences < 40, result["notes"]
+
+
 def test_diff_prints_what_it_reached_beside_its_verdict(capsys):
     assert main(["diff", "--target", "emu:GVE54", "--examples", "30", "--no-reports",
                  "-v"]) == 0

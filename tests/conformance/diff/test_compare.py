@@ -22,6 +22,11 @@ def test_in_virtual_time_an_answer_at_another_instant_is_a_timing_difference():
     assert difference("H", ex(b"8\r", 0, MS), ex(b"8\r", 0, 5 * MS), Judge()) == "timing"
 
 
+def test_two_silences_are_alike_however_long_each_side_was_listened_to():
+    # where each stopped listening is the suite's, not the unit's
+    assert difference("W", ex(b"", 0, MS), ex(b"", 0, 400 * MS), Judge()) is None
+
+
 def test_a_timing_difference_shows_two_different_instants():
     assert delays(ex(b"8\r", 0, MS), ex(b"8\r", 0, 5 * MS)) == ("1.000 ms", "5.000 ms")
     # as many decimals as tell them apart, to the nanosecond

@@ -55,6 +55,23 @@ def test_the_comparison_is_exact_and_the_clean_emulator_agrees():
         p.target.target.close()
 
 
+def test_a_frame_neither_side_answers_is_listened_to_as_long_on_both():
+    """A W queued in a packet gets no answer: the target's guard awaits it for as long as
+    the envelope lets the move last, the reference's (no envelope) far longer; both are
+    listened to for the target's window, and two silences are alike."""
+    p = pair(cosim())
+    try:
+        out = p.run([Step(FRAME, body="*S", answer=False),
+                     Step(FRAME, body="WX,1,900,1,900")])
+        assert out.disagreement is None and out.frames == 2, out.ended
+        target, reference = out.records[1].target, out.records[1].reference
+        assert target.answer == reference.answer == b""
+        assert target.received_at == reference.received_at
+    finally:
+        p.target.session.finish()
+        p.target.target.close()
+
+
 def test_a_mutant_is_found_shrunk_and_replayed(tmp_path: Path, capsys):
     spec = cosim("--mutant", "velocity-ignored")
     status = diff_main(["--target", spec, "--profile", "GVE84-100", "--allow-destructive",

@@ -485,3 +485,76 @@ def test_frames_told_with_their_reply_read_later_are_sent_as_those_read_at_once(
     *at_once, _ = _told_then_sent(False)
     assert unread, "nothing read before the line's next use"
     assert later == at_once and all(later[0])
+
+
+def _writes(pipeline: bool, act):
+    """The writes to a co-simulated emulator (each its commands' first words), and what
+    ``act(line)`` gave, with the extension `pipeline` on or off."""
+    target = parse_target("exec:" + shlex.join(EMULATOR), profile="GVE84-100")
+    target.preflight()
+    try:
+        line = target.connect(None)[0].line
+        assert "pipeline" in line.extensions
+        if not pipeline:
+            line.extensions = line.extensions - {"pipeline"}
+        writes = []
+        send = line.program.send
+        line.program.send = lambda text: writes.append(
+            [c.split()[0] for c in text.splitlines()]) or send(text)
+        done = act(line)
+        return list(writes), done
+    finally:
+        target.close()
+
+
+def _wait_read(line):
+    """A `?` written, a wait of 2.5 s over its answer, what came and the clock."""
+    start = line.now
+    line.write(b"!0?\r")
+    line.advance(2.5)
+    return line.read(64, 0.0), line.now - start
+
+
+def test_the_untils_of_a_long_wait_go_in_one_write_where_the_simulator_takes_them():
+    one_by_one, seen = _writes(False, _wait_read)
+    ahead, seen_ahead = _writes(True, _wait_read)
+    # the answer stops the clock at its CR; the 2.5 s from there take three `until`s
+    assert seen == seen_ahead == (b"0,IP84 v3 27.1.2010\r", 2_500_000_000 + 4 * 86806)
+    assert one_by_one == [["tx"], ["until"], ["until"], ["until"]]
+    assert ahead == [["tx"], ["until", "until", "until"]]
+
+
+def _powered(line, then: str = "state"):
+    """A power-on sent ahead with its restart and `state`, taken in turn (or ``then``
+    asked first): what it answered and the clock."""
+    start = line.now
+    told = line.power_on_ahead(2.25, state=True)
+    ok = line.ask("power-on")
+    line.advance(2.25)
+    return told, ok, line.ask(then)[:12], line.now - start
+
+
+@pytest.mark.parametrize("then", ["state", "next"])
+def test_a_power_on_its_restart_and_the_state_after_it_go_in_one_write(then):
+    one_by_one, seen = _writes(False, lambda line: _powered(line, then))
+    ahead, seen_ahead = _writes(True, lambda line: _powered(line, then))
+    assert seen[1:] == seen_ahead[1:] and seen[0] is False and seen_ahead[0] is True
+    assert seen[1] == "ok" and seen[3] == 2_250_000_000
+    assert one_by_one == [["power-on"], ["until"], ["until"], ["until"], [then]]
+    if then == "state":
+        assert ahead == [["power-on", "until", "until", "until", "state"]]
+    else:
+        # asked something else first: the `state` sent ahead is read and dropped
+        assert ahead == [["power-on", "until", "until", "until", "state"], ["next"]]
+
+
+def test_commands_sent_ahead_and_not_come_to_leave_the_clock_where_they_took_it():
+    def act(line):
+        line.power_on_ahead(2.25, state=True)
+        line.write(b"!0SR6\r")          # the frame goes out after them, as sent
+        answer = line.read(64, 0.5, b"\r")
+        return answer, line.now
+
+    ahead, (answer, now) = _writes(True, act)
+    assert answer == b"0,00\r" and now > 2_250_000_000
+    assert ahead == [["power-on", "until", "until", "until", "state"], ["tx"]]

@@ -30,7 +30,7 @@ B = byte_time(BAUD)
 
 
 #: the first line: the version and the extensions the emulator speaks
-FIRST = "cosim 1 batch batch-stops"
+FIRST = "cosim 1 batch batch-stops pipeline"
 
 def cosim(model: str = "GVE84-100") -> Cosim:
     spec = LineSpec(units=[(model, None)])
@@ -392,7 +392,7 @@ def test_restore_brings_back_the_state_kept_and_the_clock_does_not_go_back():
                           "--snapshot"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                          text=True)
     try:
-        assert p.stdout.readline().split()[2:] == ["batch", "batch-stops", "snapshot"]
+        assert p.stdout.readline().split()[2:] == ["batch", "batch-stops", "pipeline", "snapshot"]
         assert _ask(p, "restore")[0].startswith("error: restore: no snapshot")
         assert _ask(p, "snapshot") == ["ok"]
         moved = _now(_ask(p, "tx " + b"!0L100,0,0\r".hex() + " 300000000"))
