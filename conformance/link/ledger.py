@@ -15,6 +15,11 @@ class EepromLedger:
     written: set[int] = field(default_factory=set)   # may differ now: not put back yet
     touched: set[int] = field(default_factory=set)   # written by the run, put back since
 
+    def copy(self) -> EepromLedger:
+        """A copy whose writes change nothing here (the originals, never changed in
+        place, are shared: a copy is made for every batch of frames told ahead)."""
+        return EepromLedger(self.originals, set(self.written), set(self.touched))
+
     def found(self, originals: dict[int, int]) -> None:
         """The bytes as the run found them (read before its first EEPROM write)."""
         self.originals = dict(originals)

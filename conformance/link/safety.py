@@ -385,7 +385,7 @@ class Guard:
         nothing here."""
         trial = copy.copy(self)
         trial.bookkeeping = self.bookkeeping.copy(self.liveness)
-        trial.eeprom = copy.deepcopy(self.eeprom)
+        trial.eeprom = self.eeprom.copy()
         trial.times = AnswerTime(self.profile, trial.envelope)
         if self.motion_confirmed is None and self.before_motion is not None:
             trial.before_motion = lambda: False
