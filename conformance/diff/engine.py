@@ -46,6 +46,8 @@ from gve_fixtures.protocol import ErrorCode, St6
 
 #: the frames that change a running motion's course (H, G, XA...)
 _COURSE = classes(retimes=True)
+#: frames that end an open packet before its *E (spec 7, our reading [D])
+_BREAKERS = classes(packet="breaker")
 
 
 @dataclass
@@ -330,6 +332,8 @@ class Pair:
                 return True
             if (rec.reference.code or 0) & 7:
                 self._index.refused_frame(command, self._context(step, self.course.in_packet))
+            if command in _BREAKERS and self.course.in_packet:
+                earlier.add("packet-broken")
             self.course.exchanged(step, rec.reference)
             self.course.took(command, step.body, rec.reference, first=i == 0)
             if self.course.junction:

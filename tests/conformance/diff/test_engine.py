@@ -351,3 +351,16 @@ def test_a_search_whose_sequences_send_nothing_ends_could_not_test(monkeypatch):
                        "the known state: refused for the test"):
         search(pair(None), EVERYTHING, budget, with_probes=False)
     assert budget.used == 3
+
+
+def test_what_a_packet_broken_by_h_shows_is_the_packet_rule_s_not_the_halt_s():
+    # a unit that applies a packet's members as they arrive has its C run after H broke
+    # the packet; the position then read is the packet's [D] reading, not H's ramp
+    p = Pair(Side(parse_target("emu:GVE84-100?reading=packet-committed-on-arrival")),
+             Side(parse_target("emu:GVE84-100")), load_profile("GVE84-100"))
+    out = p.run([Step(FRAME, body="*S", answer=False), Step(FRAME, body="C-1000,-1000,-1000"),
+                 Step(FRAME, body="H"), Step(FRAME, body="PF")])
+    d = out.disagreement
+    assert d is not None and (d.command, d.rule, d.tag) == ("PF", "7.packet.all-or-nothing",
+                                                            "D"), d
+    assert "packet-broken" in d.earlier
