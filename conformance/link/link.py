@@ -46,39 +46,27 @@ from collections.abc import Callable, Sequence
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.faults import FrameFault
 from conformance.link.framing import (
-    CR,
     HostFrame,
     HostFramer,
     Response,
     frame,
     parse_response,
-    readable,
 )
 from conformance.link.index_read import index_value, read_index
 from conformance.link.line_time import MARGIN as MARGIN
 from conformance.link.line_time import LineTime
 from conformance.link.liveness import Booked, Observed, tell_followers
+from conformance.link.receiver import Receiver
 from conformance.link.safety import Admitted, Guard
 from conformance.link.signals import Interrupted
-from conformance.link.strays import (
-    ANSWERED,
-    OPEN_PACKET,
-    TIMED_OUT,
-    UNASKED,
-    Stray,
-    judge,
-    left_open,
-)
+from conformance.link.strays import Stray, left_open
 from conformance.link.virtual import Rig, line_of
 from conformance.protocol.index import Form
-from conformance.protocol.view import View, answered_late, late, observe
+from conformance.protocol.view import View, observe
 from conformance.protocol.wire import is_hex_byte
-from gve_fixtures.protocol import MAX_FRAME, SECOND, St6
-from gve_fixtures.transcript import HOST, UNIT, Record
+from gve_fixtures.protocol import SECOND, St6
+from gve_fixtures.transcript import HOST, Record
 
-#: real time: after a frame timed out, how long the line must stay quiet before the next
-#: frame (an answer later than this after its timeout could still be misread)
-QUIET = 2.5
 #: real time: how long after its timeout an answer is still taken as its frame's, noted
 #: as late (a loaded USB adapter's line); later than that it is a hang's
 LATE = 1.0
@@ -99,21 +87,16 @@ class Link:
         self.view = View(addresses=frozenset(guard.addresses))
         self.log: list[Record] = []
         self.frames = 0
-        self.violations: list[Stray] = []
-        #: real time: answers that came after their timeout, within the quiet the line
-        #: keeps before the next frame, taken as their frame's (notes, not violations)
-        self.late: list[str] = []
-        self._quiet = 0.0        # seconds the line has been quiet since a timeout
+        #: the receiving side: answers read and given to whom they belong
+        self._receiver = Receiver(self)
         #: when the last frame's bytes began to go out (ns), after any quiet the line kept
         #: for the frame before it: the instant its round trip counts from
         self.wrote_at = 0
         self._faults: list[FrameFault] = []
         self._framer = HostFramer()
         self._unbooked: list[HostFrame] = []     # raw frames whose answer is not read yet
-        self._last: tuple[str, bytes, bytes] = (UNASKED, b"", b"")   # state, frame, answer
-        self._dropped = False
-        self._sent_until = 0      # when the last byte the suite wrote went out (ns)
-        self._waited_out = True   # what is left unfinished had its watchdog waited out
+        #: an injected fault dropped the last frame: no answer can come
+        self.dropped = False
         #: a later link of the case took over: what this one left went to a unit that
         #: has heard other frames since (or, on the emulator, is gone)
         self.superseded = False
@@ -122,6 +105,17 @@ class Link:
         #: work of the caller's done once, while the port runs the next frames told
         #: ahead (:meth:`tell`), or by the caller when none are told
         self.meanwhile: Callable[[], None] | None = None
+
+    @property
+    def violations(self) -> list[Stray]:
+        """Bytes no frame asked for that break a rule (the receiver's)."""
+        return self._receiver.violations
+
+    @property
+    def late(self) -> list[str]:
+        """Real time: answers that came after their timeout, within the quiet the line
+        keeps before the next frame, taken as their frame's (notes, not violations)."""
+        return self._receiver.late
 
     # -- what the view holds -------------------------------------------------------------
     @property
@@ -190,47 +184,13 @@ class Link:
         """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
         suite's own wait unless it says otherwise); returns whatever arrived meanwhile."""
         self.guard.check_idle()
-        self.time.close_exchange()
-        with self.spending(spent):
-            if self.line is not None:
-                self.line.advance(seconds)
-                data = self._whole_line(self.port.read(self.port.in_waiting))
-            else:
-                data = self._listen(seconds, stop_early=False)
+        data = self._receiver.during(seconds, spent)
         # raw frames not read for an answer: booked as unanswered now, not only when a
         # later frame goes out on this link (there may be none: a `*S` that ends an
         # example must still leave the guard knowing that a packet may be open)
         self._book_unbooked(None)
-        rest = self._answers_late(data)
-        self.view = self.view.listened()
-        if rest:
-            self._record(UNIT, rest)
-            self._after_answer(rest, "during a wait", judged=True)
-        self._last = (UNASKED, b"", b"")
+        self.view = self._receiver.waited(data, self.view)
         return data
-
-    def _listen(self, seconds: float, *, stop_early: bool, already: float = 0.0) -> bytes:
-        """Real time: read for ``seconds`` (``stop_early``: until the line has been quiet
-        that long, ``already`` of it before the call); Ctrl-C ends the wait."""
-        end = time.monotonic() + max(0.0, seconds - already)
-        data = bytearray()
-        while time.monotonic() < end and not self.guard.interrupts.pending:
-            self.port.timeout = min(0.05, max(0.0, end - time.monotonic()))
-            got = self.port.read(max(1, self.port.in_waiting))
-            data += got
-            if got and stop_early:
-                end = time.monotonic() + seconds
-        return self._whole_line(bytes(data))
-
-    def _whole_line(self, data: bytes) -> bytes:
-        """``data`` and the rest of the line it ends inside: a unit's bytes arrive one
-        after another, so a read that ends while a line is on its way has its beginning
-        only; what the unit wrote in one go is judged whole, as it came, never its tail
-        as a second or a late answer."""
-        if not data or data.endswith(CR) or self.guard.interrupts.pending:
-            return data
-        self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
-        return data + self.port.read_until(CR)
 
     def _pause(self, seconds: float, spent: Spent) -> None:
         """Hold back the next bytes (an injected delay); what arrives stays unread."""
@@ -254,7 +214,8 @@ class Link:
         return None
 
     # -- sending --------------------------------------------------------------------------
-    def _record(self, direction: str, data: bytes, comment: str = "") -> None:
+    def record(self, direction: str, data: bytes, comment: str = "") -> None:
+        """Log ``data`` sent or received now (the receiver logs what it reads here)."""
         self.log.append(Record(direction, data, self.now, comment))
 
     def note(self, text: str) -> None:
@@ -276,7 +237,7 @@ class Link:
         self._framer.frames(wire)
         if fault:
             self.note(f"fault host {fault.kind} {fault.params}")
-        self._dropped = not wire
+        self.dropped = not wire
         # a frame held back mid-way waits out the unit's watchdog (spec 3)
         paused = Spent.MANUAL if fault and fault.kind == "delay" else Spent.WAITS
         for piece, pause in pieces:
@@ -284,9 +245,7 @@ class Link:
                 self._pause(pause, paused)
             if piece:
                 self._write(piece)
-        self._sent_until, self._waited_out = self.now, False
-        if frames:
-            self._last = (UNASKED, frames[-1].wire, b"")
+        self._receiver.sent(frames[-1].wire if frames else None)
         return frames
 
     def _write(self, data: bytes) -> None:
@@ -307,7 +266,7 @@ class Link:
             self._put(data)
 
     def _put(self, data: bytes) -> None:
-        self._record(HOST, data)
+        self.record(HOST, data)
         self.time.wrote(len(data))
         self.port.write(data)
 
@@ -331,7 +290,7 @@ class Link:
             self._book(sent, None, awaited=False)
             return None
         late = 0.0
-        if self._dropped:
+        if self.dropped:
             timeout = 0.0            # an injected fault dropped it: no answer can come
         elif timeout is None:
             timeout = self.time.timeout(self._admitted.answer_seconds, len(data))
@@ -403,31 +362,12 @@ class Link:
             tell_followers(Observed(tuple(booked), self.view, answer, at, heard, admitted.own,
                                     admitted.urgent), *self._followers)
 
-    def _answers_late(self, data: bytes) -> bytes:
-        """Give each whole line of ``data`` that came after its frame to the frame it
-        answers: the first sent with no answer awaited that may have one (a frame the
-        unit did not take as a packet's member); returns the lines nobody's."""
-        lines = data.split(CR)
-        taken = 0
-        for line in lines[:-1]:
-            if not self.view.answerable:
-                break
-            r = parse_response(line + CR, summed=self.checksums)
-            after = late(self.view, r) if r is not None and r.code is not None else None
-            if after is None:
-                break
-            owner = answered_late(self.view)
-            assert owner is not None
-            frame_text = readable(frame(owner.body, owner.address, owner.before.checksums))
-            self._record(UNIT, line + CR, f"the answer to {frame_text}, sent before")
-            self.view = after
-            taken += len(line) + 1
-        return data[taken:]
-
-    def left_open(self) -> str:
+    def left_open(self, view: View | None = None) -> str:
         """What the suite's bytes so far leave for a watchdog to end (LONE_BANG,
-        OPEN_FRAME, OPEN_PACKET), "" when nothing."""
-        return left_open(self._framer.partial, self.view.packet_open)
+        OPEN_FRAME, OPEN_PACKET), "" when nothing; by ``view`` (the link's unless given)
+        whether a packet is open."""
+        view = self.view if view is None else view
+        return left_open(self._framer.partial, view.packet_open)
 
     def _book_unbooked(self, answer: Response | None, *, awaited: bool = False,
                        heard: bool = False) -> None:
@@ -456,157 +396,35 @@ class Link:
         :meth:`rest_of_answer`). ``late``: how long after ``timeout`` an answer is still
         taken as this frame's (the quiet the line must keep before the next frame anyway)
         and noted in :attr:`late` rather than lost."""
-        timeout = MARGIN if timeout is None else timeout
-        raw = bytearray()
-        self.port.timeout = timeout
-        self._quiet = 0.0
-        asked = time.monotonic()
-        began = self.time.clock()
-        answered_as, self.time.answered_as = self.time.answered_as, Spent.ANSWERS
-        for i in range(lines):
-            # an answer that began in time is read to its end before it is judged
-            chunk = self._whole_line(self.port.read_until(CR))
-            if i == 0 and late and not chunk.endswith(CR) \
-                    and not self.guard.interrupts.pending:
-                self.port.timeout = late
-                chunk += self.port.read_until(CR)
-                if chunk.endswith(CR):
-                    self.late.append(f"{readable(self._last[1]) or 'a frame'} answered "
-                                     f"{time.monotonic() - asked:.3f} s after it was sent, "
-                                     f"{timeout:.3f} s allowed")
-                elif not chunk:
-                    self._quiet = late       # of the quiet wait before the next frame
-            raw += chunk
-            if not chunk.endswith(CR):
-                break
-            self.port.timeout = MARGIN + self.time.line_seconds()
-        data = self._behind_late(bytes(raw), lines)
-        # an answer that did not come (or not whole) was waited for to the suite's deadline
-        self.time.book_exchange(len(data), answered_as if data.endswith(CR) else Spent.WAITS,
-                            began)
+        data, real, self.view = self._receiver.answer(timeout, lines, summed, late, self.view)
         summed = self.checksums if summed is None else summed
-        real = parse_response(data, summed=summed, lines=lines) if data else None
-        if data:
-            self._record(UNIT, data)
-            real.received_at = self.now
-        answered = real is not None and real.code is not None
-        # a frame an injected fault dropped cannot be answered late
-        self._last = (ANSWERED if answered else UNASKED if self._dropped else TIMED_OUT,
-                      self._last[1], data)
         if settle and not self.virtual and data and self.port.in_waiting:
             self.settle()                        # a second answer right behind the first
         # a frame an injected fault dropped is not a silence of the unit's
-        self._book_unbooked(real, awaited=True, heard=not self._dropped)
-        r = real
+        self._book_unbooked(real, awaited=True, heard=not self.dropped)
         fault = self._fault("unit")
-        if fault is not None:
-            self.note(f"fault unit {fault.kind} {fault.params}")
-            pieces = fault.apply(data) if data else []
-            faulted = b"".join(p for p, _ in pieces)
-            r = parse_response(faulted, summed=summed, lines=lines) if faulted else None
-            if r is not None:
-                r.received_at = self.now
+        if fault is None:
+            return real
+        self.note(f"fault unit {fault.kind} {fault.params}")
+        faulted = b"".join(p for p, _ in fault.apply(data)) if data else b""
+        r = parse_response(faulted, summed=summed, lines=lines) if faulted else None
+        if r is not None:
+            r.received_at = self.now
         return r
-
-    def _behind_late(self, data: bytes, lines: int) -> bytes:
-        """The answer to the frame just sent, when frames sent before it with no answer
-        awaited may have been answered all the same (a unit that did not take one as a
-        packet's member): answers keep the order of their frames, so while another
-        answer follows at once, the one before it is an earlier frame's
-        (:meth:`_answers_late`)."""
-        while (lines == 1 and data.endswith(CR) and self.view.answerable
-               and not self.guard.interrupts.pending):
-            self.port.timeout = MARGIN + self.byte_seconds(MAX_FRAME) + self.time.line_seconds()
-            behind = self._whole_line(self.port.read_until(CR))
-            if not behind.endswith(CR) or self._answers_late(data):
-                return data + behind
-            data = behind
-        return data
 
     def rest_of_answer(self, seconds: float = MARGIN) -> bytes:
         """The lines that follow an answer at once, taken as part of it (not as a
         second answer): a unit reading a [D] point otherwise may answer a frame with
         more lines than expected (`>` after `@`, if `@` is remembered)."""
-        raw = bytearray()
-        self.port.timeout = seconds
-        began = self.time.clock()
-        while True:
-            chunk = self.port.read_until(CR)
-            raw += chunk
-            if not chunk.endswith(CR):
-                break
-            self.port.timeout = self.byte_seconds(64)
-        self.time.book_exchange(len(raw), Spent.WAITS, began)
-        if raw:
-            self._record(UNIT, bytes(raw), "the rest of the answer")
-        return bytes(raw)
+        return self._receiver.rest_of_answer(seconds)
 
     def settle(self, *, final: bool = False) -> bytes:
         """Take what arrived although nothing was asked, before the next frame (or, with
         ``final``, at the end of a case): after a complete answer it is a second answer
         (a violation), after a timeout a late one (a violation), else unsolicited. In
         real time, after a timeout, wait until the line is quiet first."""
-        state = self._last[0]
-        self.time.close_exchange()
-        data = self._outwait(final)
-        kept_quiet = False
-        if not self.virtual:
-            if state == TIMED_OUT and not self.guard.interrupts.pending:
-                with self.spending(Spent.WAITS):
-                    data += self._listen(QUIET, stop_early=True, already=self._quiet)
-                kept_quiet = not self.guard.interrupts.pending
-            elif final:
-                with self.spending(Spent.WAITS):
-                    data += self._listen(self.time.end_quiet(), stop_early=True)
-        self._quiet = 0.0
-        waiting = self.port.in_waiting
-        if waiting:
-            data += self.port.read(waiting)
-        data = self._whole_line(data)
-        rest = self._answers_late(data)
-        if not rest:
-            if kept_quiet or data:       # the timed-out frame's answer can come no more
-                self._last = (UNASKED, b"", b"")
-            return data
-        self._record(UNIT, rest, "unsolicited")
-        self._after_answer(rest, "after")
-        self._last = (UNASKED, b"", b"")
+        data, self.view = self._receiver.settle(final, self.view)
         return data
-
-    def _outwait(self, final: bool) -> bytes:
-        """Wait out the longest watchdog a reader may choose since the last byte sent,
-        when the suite left something unfinished on purpose and then let it go: at the
-        end of a case, after a frame that timed out, or (a lone `!`, a frame without its
-        CR) once the unit's own watchdog time has passed without a byte. A packet the
-        next frame goes on with, and a frame the next `!` is meant to cut, are not
-        waited for. Returns what arrived meanwhile (real time)."""
-        kind = self.left_open()
-        if not kind or self._waited_out or (final and self.superseded):
-            return b""
-        profile = self.guard.profile
-        idle = self.now - self._sent_until
-        let_go = idle >= profile.watchdog_ms * 1_000_000 and kind != OPEN_PACKET
-        if not (final or let_go or self._last[0] == TIMED_OUT):
-            return b""
-        self._waited_out = True
-        left = (profile.watchdog_longest_ms * 1_000_000 - idle) / SECOND + MARGIN
-        if left <= 0:
-            return b""
-        with self.spending(Spent.MANUAL):          # the watchdog's time, as a unit may take it
-            if self.line is not None:
-                self.line.advance(left)
-                return b""
-            return self._listen(left, stop_early=False)
-
-    def _after_answer(self, data: bytes, when: str, *, judged: bool = False) -> None:
-        """Bytes no frame asked for, judged (conformance/link/strays.py): a watchdog's
-        answer that ends what the suite left open, else a second answer or a late one."""
-        kind = self.left_open()
-        ended, stray = judge(data, when, kind, self.checksums, self._last, judged=judged)
-        if ended and kind == OPEN_PACKET:
-            self.view = self.view.assume(packet=None)
-        if stray is not None:
-            self.violations.append(stray)
 
     def poll(self, body: str, until: Callable[[Response], bool], max_seconds: float = 30.0,
              every: float = 0.05, *, send: Callable[[str], Response | None] | None = None,

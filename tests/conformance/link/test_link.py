@@ -5,6 +5,7 @@ import pytest
 
 from conformance.diff.sides import Side
 from conformance.link import link as link_module
+from conformance.link import receiver as receiver_module
 from conformance.link.link import LATE, Link
 from conformance.targets import parse_target
 from gve_fixtures.protocol import SECOND
@@ -97,7 +98,7 @@ def test_a_frame_after_a_timed_out_one_counts_its_round_trip_from_the_quiet_line
         monkeypatch):
     # the quiet kept before it is the link's, not the line's: a round trip counted from
     # before it would widen every band read from the round trips by that much
-    monkeypatch.setattr(link_module, "QUIET", 0.5)
+    monkeypatch.setattr(receiver_module, "QUIET", 0.5)
     monkeypatch.setattr(link_module, "LATE", 0.0)
     port = _Line([b"", b"0,12\r"])           # V1000 unanswered, SR6 answered at once
     ln = real_link(port)
@@ -109,7 +110,7 @@ def test_a_frame_after_a_timed_out_one_counts_its_round_trip_from_the_quiet_line
 
 
 def test_the_quiet_after_a_timed_out_frame_is_kept_once(monkeypatch):
-    monkeypatch.setattr(link_module, "QUIET", 0.5)
+    monkeypatch.setattr(receiver_module, "QUIET", 0.5)
     monkeypatch.setattr(link_module, "LATE", 0.0)
     port = _Line([b""])
     ln = real_link(port)

@@ -2,7 +2,8 @@
 guard once per exchange, before the write (Guard.admit); after the read the link tells
 the exchange once to each of those who follow the unit (its bookkeeping, its liveness),
 never to the guard: traced with a profiler hook (sys.setprofile) that notes every call
-into each module from another module."""
+into each module from another module (the link's two, link.py and its receiving side
+receiver.py, as one)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import pytest
 from conformance.link import bookkeeping as bookkeeping_module
 from conformance.link import link as link_module
 from conformance.link import liveness as liveness_module
+from conformance.link import receiver as receiver_module
 from conformance.link import safety as safety_module
 from conformance.link.link import Link
 from conformance.link.safety import Guard
@@ -48,16 +50,17 @@ class _Port:
         return b""
 
 
-def entries(run: Callable[[], object], module: object) -> list[str]:
-    """The calls into ``module`` from code outside it while ``run`` runs, by name."""
-    room = str(Path(module.__file__))
+def entries(run: Callable[[], object], *modules: object) -> list[str]:
+    """The calls into ``modules`` (one room) from code outside them while ``run`` runs,
+    by name."""
+    room = {str(Path(module.__file__)) for module in modules}
     seen: list[str] = []
 
     def hook(frame, event, _arg) -> None:
-        if event != "call" or frame.f_code.co_filename != room:
+        if event != "call" or frame.f_code.co_filename not in room:
             return
         caller = frame.f_back
-        if caller is None or caller.f_code.co_filename != room:
+        if caller is None or caller.f_code.co_filename not in room:
             seen.append(frame.f_code.co_name)
 
     sys.setprofile(hook)
@@ -66,6 +69,10 @@ def entries(run: Callable[[], object], module: object) -> list[str]:
     finally:
         sys.setprofile(None)
     return seen
+
+
+#: the link's modules: the link and its receiving side
+LINK = (link_module, receiver_module)
 
 
 def _link() -> Link:
@@ -78,7 +85,7 @@ def _link() -> Link:
 def visits(run: Callable[[], object]) -> dict[str, list[str]]:
     """The calls the link makes into the guard and into those who follow the unit while
     ``run`` runs, by module (what the guard itself reads of them is its own)."""
-    link = str(Path(link_module.__file__))
+    link = {str(Path(m.__file__)) for m in LINK}
     rooms = {str(Path(m.__file__)): name for name, m in
              (("guard", safety_module), ("bookkeeping", bookkeeping_module),
               ("liveness", liveness_module))}
@@ -87,7 +94,7 @@ def visits(run: Callable[[], object]) -> dict[str, list[str]]:
     def hook(frame, event, _arg) -> None:
         room = rooms.get(frame.f_code.co_filename)
         if event == "call" and room and frame.f_back is not None \
-                and frame.f_back.f_code.co_filename == link:
+                and frame.f_back.f_code.co_filename in link:
             seen[room].append(frame.f_code.co_name)
 
     sys.setprofile(hook)
@@ -105,7 +112,7 @@ ONCE = {"guard": ["admit"], "bookkeeping": [], "liveness": ["tell_followers"]}
 
 def test_a_frame_sent_visits_the_link_once_and_the_guard_once():
     link = _link()
-    assert entries(lambda: link.send("V1000"), link_module) == ["send"]
+    assert entries(lambda: link.send("V1000"), *LINK) == ["send"]
     assert entries(lambda: link.send("V1000"), safety_module) == ["admit"]
     assert visits(lambda: link.send("V1000")) == ONCE
 
