@@ -14,15 +14,19 @@ from conformance.verdicts.verdict import FAIL, grade
 JOB = Path(gve_host.__file__).parent / "jobs" / "square.job"
 
 
+#: a host silent this long hangs: long enough for the reference host on a machine loaded
+#: by the other tests (it stalled 2 s there once), short for a host that does hang
+HOST_TIMEOUT = 4.0
+
+
 def certify(tmp_path: Path, profile: str, *host: str, scenarios: tuple[str, ...] = (),
             options: tuple[str, ...] = (), command: list[str] | None = None
             ) -> tuple[int, list[dict]]:
     """The exit status and the results of certifying ``command`` (default: the reference
     host on the sample job, with ``host`` options)."""
     command = command or [sys.executable, "-m", "gve_host", "{port}", "--job", str(JOB), *host]
-    # a host silent this long hangs: long enough for the reference host on a machine
-    # loaded by the other tests (it stalled 2 s there once), short for the one that hangs
-    argv = ["--profile", profile, "--report-dir", str(tmp_path), "--host-timeout", "4",
+    argv = ["--profile", profile, "--report-dir", str(tmp_path), "--host-timeout",
+            str(HOST_TIMEOUT),
             *[a for s in scenarios for a in ("--scenarios", s)], *options, "--", *command]
     status = main(argv)
     (folder,) = [p for p in tmp_path.iterdir() if p.is_dir()]

@@ -13,7 +13,7 @@ import pytest
 
 from conformance.cli.host import main
 from conformance.verdicts.verdict import FAIL, PASS
-from tests.conformance.host.run import certify, failing_rules
+from tests.conformance.host.run import HOST_TIMEOUT, certify, failing_rules
 
 pytestmark = pytest.mark.pty
 
@@ -65,7 +65,7 @@ def test_the_whole_job_executed_passes_with_the_verdict_line_and_metadata(tmp_pa
     assert meta["host_command"] == [SHELL, "{port}"]
     assert meta["command"][:3] == ["host", "--profile", "GVE84-100"]
     flags = meta["host_flags"]
-    assert flags["--expect-motion"] == SHELL_MOTION and flags["--host-timeout"] == 2.0
+    assert flags["--expect-motion"] == SHELL_MOTION and flags["--host-timeout"] == HOST_TIMEOUT
     assert flags["--profile"] == "GVE84-100@0" and flags["--scenarios"] == "clean"
     page = (folder / "report.html").read_text()
     assert "host command" in page and "shell_host.sh" in page
