@@ -23,10 +23,10 @@ from pathlib import Path
 import gve_host
 from conformance.host.certify import Plan, certify
 from conformance.host.line_faults import Fault
+from conformance.host.played_units import load_units, open_line
 from conformance.host.ports.silent import SilentPort
 from conformance.host.relay import Relay
 from conformance.host.scenarios import SCENARIOS
-from conformance.host.units import load_units, open_line
 from conformance.host.unitview import line_views
 
 BAUD = 921_600

@@ -13,8 +13,8 @@ import sys
 from conformance.case.settings import fresh_seed
 from conformance.cli.colour import wanted
 from conformance.cli.ending import claimed, counted, end, new_run_id
+from conformance.cli.preflight import consent, unattended
 from conformance.cli.progress import HEARTBEAT, Progress
-from conformance.cli.unit import consent, unattended
 from conformance.cli.usage import (
     Parser,
     UsageError,

@@ -31,9 +31,9 @@ from conformance.cli.usage import (
     writable_folder,
 )
 from conformance.host.certify import HostStartError, Plan, certify
+from conformance.host.played_units import load_units
 from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
-from conformance.host.units import load_units
 from conformance.operator.console import Console
 from conformance.reports.files import release
 from conformance.run.runner import CaseResult

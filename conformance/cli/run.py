@@ -19,8 +19,7 @@ from conformance.case.settings import DEFAULT_DATABASE, PROFILES, example_databa
 from conformance.cli.colour import wanted
 from conformance.cli.commands import subcommands_help
 from conformance.cli.ending import claimed, counted, end, new_run_id
-from conformance.cli.progress import Progress
-from conformance.cli.unit import (
+from conformance.cli.preflight import (
     confirmed,
     consent,
     record_identities,
@@ -28,6 +27,7 @@ from conformance.cli.unit import (
     unattended,
     unattended_specs,
 )
+from conformance.cli.progress import Progress
 from conformance.cli.usage import (
     INTERRUPTED,
     Parser,

@@ -28,10 +28,10 @@ from conformance.host.checks import LineFacts, judge
 from conformance.host.final_state import final_state
 from conformance.host.line_faults import Fault
 from conformance.host.oracle import HostResult, HostRun
+from conformance.host.played_units import open_line
 from conformance.host.ports import HostPort, open_port
 from conformance.host.relay import Relay
 from conformance.host.scenarios import Baseline, Scenario
-from conformance.host.units import open_line
 from conformance.host.unitview import line_views, profiles_by_address
 from conformance.link.signals import STOPPING, StopSignals
 from conformance.run.metadata import now_iso

@@ -29,7 +29,7 @@ from conformance.reports.failures import failures, natural
 from conformance.reports.logs import compact, compact_checks
 from conformance.reports.sections import section_key, section_title
 from conformance.reports.text import clean, rule_html
-from conformance.reports.units import units_view
+from conformance.reports.unit_rows import units_view
 from conformance.run.runner import CaseResult, RunResult
 from conformance.verdicts.quoting import quoted
 from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, ORDER, PASS

@@ -7,10 +7,10 @@ import pytest
 
 from conformance.host import relay as relay_module
 from conformance.host.line_faults import Fault, JobPoint, QueueFull
+from conformance.host.played_units import load_units, open_line
 from conformance.host.ports.silent import SilentPort
 from conformance.host.recording import STALL_NS
 from conformance.host.relay import Relay
-from conformance.host.units import load_units, open_line
 from conformance.host.unitview import line_views
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from conformance.cli import main, ports
-from conformance.cli.unit import resolve
+from conformance.cli.preflight import resolve
 from conformance.operator.console import Console
 from conformance.targets.identify import candidates, variant_of
 from gve_fixtures.profile import available_profiles, load_profile

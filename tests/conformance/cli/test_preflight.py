@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import io
 
-from conformance.cli.unit import confirmed
+from conformance.cli.preflight import confirmed
 from conformance.operator.console import Console
 from conformance.run.metadata import RunMeta
 from conformance.targets import parse_target
