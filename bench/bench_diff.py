@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.sides import Side
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.targets import parse_target
 
 BUDGET_FRAMES = 10_000

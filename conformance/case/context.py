@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from conformance.link.link import Link
-from conformance.link.safety import SafetyStop
+from conformance.link.stops import SafetyStop
 from conformance.targets.info import TargetInfo
 from conformance.verdicts.check import Check
 from conformance.verdicts.quoting import as_text

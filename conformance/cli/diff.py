@@ -31,8 +31,9 @@ from conformance.diff.reach import Reach
 from conformance.diff.results import agreement_result, rig_lost_result
 from conformance.diff.sides import Side
 from conformance.link.framing import readable
-from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.link.signals import StopSignals
+from conformance.link.stops import SafetyStop
 from conformance.operator.console import Console
 from conformance.reports.files import release
 from conformance.run.metadata import RunMeta, now_iso

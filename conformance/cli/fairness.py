@@ -115,7 +115,7 @@ def diff_trial(profile: str, readings: list[str], result: Trial) -> None:
     from conformance.diff.grammar import Grammar, Options
     from conformance.diff.matrix import cells
     from conformance.diff.sides import Side
-    from conformance.link.safety import TargetNotResponding
+    from conformance.link.liveness import TargetNotResponding
     from conformance.targets import SessionError, parse_target
     target = parse_target(f"emu:{profile}?reading={','.join(readings)}",
                           allow_destructive=True)

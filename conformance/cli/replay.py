@@ -24,7 +24,7 @@ from conformance.diff.engine import Pair
 from conformance.diff.gvt import expected_of, steps_of
 from conformance.diff.replayed import Verdict, frame_lines, header, verdict
 from conformance.diff.sides import Side
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.link.signals import StopSignals
 from conformance.targets import SessionError, TargetError
 from conformance.verdicts.verdict import FAIL, FAILED, PASSED

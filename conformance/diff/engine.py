@@ -31,7 +31,8 @@ from conformance.diff.step_flags import step_flags
 from conformance.diff.steps import FILL, FRAME, INPUT, RIG, STATE, WAIT, Step, frames_in
 from conformance.diff.timing import timing_for
 from conformance.diff.told import Teller
-from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.stops import SafetyStop
 from conformance.motion.tolerance import (
     PLACEMENT_STEPS,
     TICK_NS,

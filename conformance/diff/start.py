@@ -11,7 +11,8 @@ from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME, RIG, Step
 from conformance.diff.timing import Timing
 from conformance.link.link import Link
-from conformance.link.safety import SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.stops import SafetyStop
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, ErrorCode
 

@@ -29,7 +29,7 @@ from conformance.diff.labels import command_of
 from conformance.diff.sides import RoundTrip, Side
 from conformance.diff.steps import FILL, FRAME, STATE, Step
 from conformance.link.ahead import Ahead
-from conformance.link.safety import SafetyStop
+from conformance.link.stops import SafetyStop
 from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
 from gve_fixtures.protocol import ErrorCode

@@ -21,9 +21,10 @@ from conformance.known_state.answers import (
 from conformance.known_state.failed_steps import Failures, StepFailure
 from conformance.known_state.limits import known_axis_limits
 from conformance.link.account import Spent
+from conformance.link.answer_time import LONGEST_ANSWER_S
 from conformance.link.framing import Response
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import LONGEST_ANSWER_S, MOTION, Guard
+from conformance.link.safety import MOTION, Guard
 from conformance.protocol.parse import parse_text
 from gve_fixtures.profile import Profile
 from gve_fixtures.protocol import SECOND, ErrorCode, St6

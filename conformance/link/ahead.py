@@ -14,9 +14,11 @@ judged and booked by the run's guard as it is sent.
 
 from __future__ import annotations
 
+from conformance.link.body import Body
 from conformance.link.link import Link
-from conformance.link.safety import Body, SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.link.signals import Interrupted
+from conformance.link.stops import SafetyStop
 from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
 

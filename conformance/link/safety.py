@@ -35,22 +35,15 @@ import copy
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
-from conformance.link.answer_time import LONGEST_ANSWER_S as LONGEST_ANSWER_S
 from conformance.link.answer_time import AnswerTime
-from conformance.link.body import Body as Body
-from conformance.link.body import number
+from conformance.link.body import Body, number
 from conformance.link.bookkeeping import Bookkeeping, Depth, steps
-from conformance.link.bookkeeping import Restart as Restart
-from conformance.link.bookkeeping import Untracked as Untracked
 from conformance.link.envelope import EMPTY, INF, Envelope, Outcome, Span
 from conformance.link.framing import HostFrame, Response
 from conformance.link.ledger import EepromLedger
-from conformance.link.liveness import SILENCE_LIMIT as SILENCE_LIMIT
-from conformance.link.liveness import Liveness
-from conformance.link.liveness import TargetNotResponding as TargetNotResponding
+from conformance.link.liveness import Liveness, TargetNotResponding
 from conformance.link.signals import Interrupted, StopSignals
 from conformance.link.stops import SafetyStop
-from conformance.link.stops import UnitRestarted as UnitRestarted
 from conformance.protocol.catalogue import catalogue, classes, eeprom_width
 from conformance.protocol.view import View
 from gve_fixtures.profile import Profile

@@ -27,7 +27,7 @@ from typing import Any
 from conformance.link.account import Spent
 from conformance.link.framing import Response, UnitDataError
 from conformance.link.link import Link
-from conformance.link.safety import SILENCE_LIMIT
+from conformance.link.liveness import SILENCE_LIMIT
 from conformance.operator.console import Console, HandStep
 from conformance.verdicts.verdict import CouldNotTest
 from gve_fixtures.protocol import St6

@@ -13,7 +13,7 @@ from conformance.case import settings as settings_profiles
 from conformance.case.context import Case, CaseContext, CouldNotTest, Missing, SafetyStop
 from conformance.link.framing import UnitDataError
 from conformance.link.link import Link
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.link.signals import StopSignals
 from conformance.operator.console import Console
 from conformance.operator.hands import HandRig, Hands, cannot_by_hand

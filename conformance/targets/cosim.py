@@ -28,7 +28,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import NoReturn, Protocol
 
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.protocol.bounded import decimal
 from conformance.verdicts.quoting import shown
 from gve_fixtures.protocol import SECOND

@@ -11,7 +11,8 @@ from conformance.known_state.procedure import KnownState
 from conformance.link.account import Spent
 from conformance.link.framing import Response
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import Guard, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import Guard
 from conformance.targets.as_found import AsFound, read_eeprom
 from conformance.targets.session_report import SessionReport
 from conformance.verdicts.verdict import CouldNotTest

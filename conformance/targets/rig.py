@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.protocol.bounded import decimal, hexadecimal, json_object
 from conformance.targets.program import Program
 from conformance.verdicts.quoting import shown

@@ -36,8 +36,10 @@ from conformance.known_state.procedure import KnownState
 from conformance.link.account import Spent, TimeAccount
 from conformance.link.framing import HostFramer, Response
 from conformance.link.link import MARGIN, Link
-from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import EmulatorGuard, Guard
 from conformance.link.signals import Interrupted, StopSignals
+from conformance.link.stops import SafetyStop
 from conformance.targets.as_found import AsFound, read_eeprom, round_trip
 from conformance.targets.info import TargetInfo
 from conformance.targets.restorations import Restorations

@@ -11,7 +11,7 @@ from typing import NoReturn, Protocol
 
 import serial
 
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 
 #: after the port failed, how long a program may take to be seen ending
 ENDING_SECONDS = 1.0

@@ -15,7 +15,7 @@ from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.labels import label
 from conformance.diff.sides import Side
 from conformance.diff.steps import FILL, FRAME, WAIT, Step
-from conformance.link.safety import UnitRestarted
+from conformance.link.stops import UnitRestarted
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
 from gve_fixtures.profile import load_profile

@@ -15,8 +15,11 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from conformance.link.ahead import Ahead
+from conformance.link.body import Body
 from conformance.link.framing import frame, parse_response
-from conformance.link.safety import Body, Guard, SafetyStop, TargetNotResponding, UnitRestarted
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import Guard
+from conformance.link.stops import SafetyStop, UnitRestarted
 from conformance.protocol.catalogue import classes
 from gve_fixtures.profile import load_profile
 from tests.conformance.link.told import told

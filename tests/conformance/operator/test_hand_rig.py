@@ -14,7 +14,8 @@ import pytest
 import conformance.cases  # noqa: F401  (registers the cases)
 from conformance.case.context import REGISTRY, Case
 from conformance.link.framing import parse_response
-from conformance.link.safety import Guard, SafetyStop
+from conformance.link.safety import Guard
+from conformance.link.stops import SafetyStop
 from conformance.link.virtual import Rig
 from conformance.operator.console import Console, HandStep
 from conformance.operator.hands import HandRig, cannot_by_hand, wording

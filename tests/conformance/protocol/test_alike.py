@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from conformance.diff.grammar import load_grammar
 from conformance.diff.labels import command_of
 from conformance.host.frame_rules import parse_frame
-from conformance.link.safety import Body
+from conformance.link.body import Body
 from conformance.protocol.catalogue import catalogue, commands
 from conformance.protocol.framer import HostFramer
 from gve_fixtures.profile import load_profile

@@ -13,7 +13,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conformance.link.safety import Body, SafetyStop, TargetNotResponding
+from conformance.link.body import Body
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.stops import SafetyStop
 from emulator.readings import READINGS
 from gve_fixtures.profile import load_profile
 from tests.conformance.safety.units import virtual_unit

@@ -8,7 +8,8 @@ import pytest
 
 from conformance.link.envelope import Span
 from conformance.link.framing import parse_response
-from conformance.link.safety import Guard, SafetyStop
+from conformance.link.safety import Guard
+from conformance.link.stops import SafetyStop
 from gve_fixtures.profile import load_profile
 
 

@@ -7,8 +7,10 @@ import pytest
 
 from conformance.link.envelope import Outcome, point
 from conformance.link.framing import HostFramer, parse_response
-from conformance.link.safety import EmulatorGuard, Guard, SafetyStop, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import EmulatorGuard, Guard
 from conformance.link.signals import Interrupted, StopSignals
+from conformance.link.stops import SafetyStop
 from gve_fixtures.profile import load_profile
 from tests.conformance.link.told import told
 

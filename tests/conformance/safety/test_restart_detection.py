@@ -13,14 +13,9 @@ import pytest
 
 from conformance.link.envelope import Span
 from conformance.link.framing import parse_response
-from conformance.link.safety import (
-    SILENCE_LIMIT,
-    EmulatorGuard,
-    Guard,
-    SafetyStop,
-    TargetNotResponding,
-    UnitRestarted,
-)
+from conformance.link.liveness import SILENCE_LIMIT, TargetNotResponding
+from conformance.link.safety import EmulatorGuard, Guard
+from conformance.link.stops import SafetyStop, UnitRestarted
 from gve_fixtures.profile import load_profile
 from tests.conformance.link.told import told
 

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conformance.case.context import CouldNotTest
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.targets.cosim import CosimLine, announced
 from conformance.targets.process import port_url
 from conformance.targets.rig import ControlRig

@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from conformance.case.context import CouldNotTest
-from conformance.link.safety import TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
 from conformance.targets import rig as rig_module
 from conformance.targets.program import Program
 from conformance.targets.rig import ControlRig

@@ -13,7 +13,8 @@ import serial
 
 from conformance.link.exclusive import open_serial
 from conformance.link.link import Link
-from conformance.link.safety import EmulatorGuard, TargetNotResponding
+from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import EmulatorGuard
 from conformance.run.runner import run
 from conformance.run.selection import select
 from conformance.targets import parse_target
