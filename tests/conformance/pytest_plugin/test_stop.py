@@ -43,6 +43,9 @@ def test_a_signal_to_the_controller_halts_every_worker_s_unit(tmp_path, sig, wor
     for proxy in run.proxies:
         assert_halted_first(proxy.frames, run.instant)
     skipped = [s.get("message", "") for s in ET.parse(junit).getroot().iter("skipped")]
-    assert any("interrupted" in m and "H and D sent" in m for m in skipped), skipped
+    # the item in flight, where the signal came inside one (on a loaded machine it may
+    # come on the session's own frames between two items), is COULD-NOT-TEST saying so
+    assert any("interrupted" in m for m in skipped), skipped
+    assert all("H and D sent" in m for m in skipped if "interrupted by Ctrl-C" in m), skipped
     assert workers == "0" or len(run.started) >= 2, "both workers were running"
     assert not any(alive(p) for p in run.started)
