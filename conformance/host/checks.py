@@ -105,13 +105,13 @@ def probes(rec: Recording) -> set[int]:
 
 def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """Each frame on its own: grammar, address, command, parameters, checksum, length
-    (frame_rules.py), and a member of a packet carrying its own checksum (spec 7). A value
-    out of range in a probe (:func:`probes`) is graded by our reading."""
+    (frame_rules.py), and a member of a packet carrying its own checksum (spec 7). What a
+    probe (:func:`probes`) breaks is graded by our reading: the unit refused it."""
     probing = probes(rec)
     for ex in rec.exchanges:
         out.judged |= ex.parsed.judged
         for p in ex.parsed.problems:
-            if ex.n in probing and p.rule in ex.parsed.out_of_range:
+            if ex.n in probing:
                 out.add(p.rule, _at(ex.frame.start, line), ex.text, f"{p.what}: {PROBE}",
                         "D")
             else:

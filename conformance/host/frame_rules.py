@@ -62,7 +62,6 @@ class ParsedFrame:
     checksum: str | None = None
     problems: list[Problem] = field(default_factory=list)
     judged: set[str] = field(default_factory=set)      # every rule this frame was held to
-    out_of_range: set[str] = field(default_factory=set)  # rules broken by a value's range
 
     @property
     def text(self) -> str:
@@ -216,8 +215,7 @@ def _params(f: ParsedFrame, command: Command, text: str, profile: Profile,
     fields = [*command.fields, *[command.fields[-1]] * (len(parts) - len(command.fields))]
     for spec, value in zip(fields, parts, strict=True):
         rule, problem = _value(spec, value, command, profile, spindle)
-        if not f.check(problem is None, rule, problem or "") and rule in _ranged(command):
-            f.out_of_range.add(rule)
+        f.check(problem is None, rule, problem or "")
 
 
 def _counts(command: Command, profile: Profile) -> tuple[int, ...]:
@@ -261,11 +259,6 @@ def _bounds(spec: Field, profile: Profile, spindle: bool) -> tuple[int, int]:
         return -profile.vector_range, profile.vector_range
     r = profile.range(str(spec.range))
     return r.lo, r.hi
-
-
-def _ranged(command: Command) -> tuple[str, ...]:
-    """The rules a value of ``command`` breaks by its range alone."""
-    return (*command.rules, "12.spindle.speed", "5.code.range")
 
 
 @cache
