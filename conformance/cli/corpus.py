@@ -64,6 +64,8 @@ class Implementation:
     #: defect still fails the gate while a known one is being fixed
     open: dict[str, str] = field(default_factory=dict)
     diff_examples: int = 0
+    #: the suite's options a user gives for this implementation, as its comment says why
+    options: tuple[str, ...] = ()
 
     def argv(self) -> list[str]:
         """The command's words, `{python}` and `{dir}` filled in."""
@@ -96,7 +98,7 @@ def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
     except (OSError, tomllib.TOMLDecodeError) as err:
         raise UsageError(f"{path}: {err}") from None
     known = {"name", "kind", "folder", "command", "profiles", "departures", "written-from",
-             "diff-examples", "open"}
+             "diff-examples", "open", "options"}
     out = []
     for table in data.get("implementation", []):
         wrong = sorted(set(table) - known)
@@ -111,7 +113,8 @@ def load_manifest(path: Path = MANIFEST) -> list[Implementation]:
             departures=dict(table.get("departures", {})),
             open=dict(table.get("open", {})),
             written_from=table.get("written-from", ""),
-            diff_examples=int(table.get("diff-examples", 0))))
+            diff_examples=int(table.get("diff-examples", 0)),
+            options=tuple(table.get("options", ()))))
     return out
 
 
@@ -157,7 +160,7 @@ def jobs_of(impl: Implementation, reports: Path, seed: int) -> list[tuple[str, l
     out = []
     for profile in impl.profiles:
         common = ["--profile", profile, "--report-dir", str(reports / f"{profile}-{len(out)}"),
-                  "-q"]
+                  "-q", *impl.options]
         if impl.kind == "unit":
             target = "exec:" + shlex.join(impl.argv())
             out.append((f"catalogue {profile}",
@@ -165,7 +168,8 @@ def jobs_of(impl: Implementation, reports: Path, seed: int) -> list[tuple[str, l
                          "--allow-destructive"]))
             if impl.diff_examples:
                 common = ["--profile", profile,
-                          "--report-dir", str(reports / f"{profile}-{len(out)}"), "-q"]
+                          "--report-dir", str(reports / f"{profile}-{len(out)}"), "-q",
+                          *impl.options]
                 out.append((f"diff {profile}",
                             [*cli, "diff", "--target", target, *common, "--yes",
                              "--allow-destructive", "--examples", str(impl.diff_examples),

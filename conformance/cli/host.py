@@ -30,8 +30,8 @@ from conformance.cli.usage import (
     summary,
     writable_folder,
 )
-from conformance.host.certify import HostStartError, Plan, certify
-from conformance.host.played_units import load_units
+from conformance.host.certify import CLEAN_LIMIT_S, HostStartError, Plan, certify
+from conformance.host.played_units import check_readings, load_units
 from conformance.host.ports import open_port
 from conformance.host.scenarios import SCENARIOS, select
 from conformance.operator.console import Console
@@ -78,6 +78,14 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     ap.add_argument("--baud", type=positive, help="the line's baud rate (default: the profile's)")
     ap.add_argument("--host-timeout", type=seconds, default=5.0, metavar="S",
                     help="a host silent this long without exiting hangs (default 5)")
+    ap.add_argument("--clean-limit", type=seconds, default=CLEAN_LIMIT_S, metavar="S",
+                    help="the longest the host's job may take on the clean line (default "
+                         f"{CLEAN_LIMIT_S:.0f}); a fault run may take twice the clean "
+                         "run's length")
+    ap.add_argument("--reading", action="append", default=[], metavar="NAME",
+                    help="the played unit reads a silence of the manuals as NAME "
+                         "(repeatable; the readings of emulator/readings.py, listed when a "
+                         "name is unknown): play the reading the host was written for")
     ap.add_argument("--port", default="pty",
                     help="pty (default), tcp:HOST:PORT, or a serial device path")
     ap.add_argument("--strict", action="store_true",
@@ -116,9 +124,14 @@ def plan_of(args: argparse.Namespace) -> Plan:
         fnmatch.fnmatchcase(s.name, p) or fnmatch.fnmatchcase(s.id, p) for s in SCENARIOS)]
     if unmatched:
         raise UsageError(f"no scenario matches {' '.join(unmatched)} (see --list)")
+    try:
+        readings = check_readings(args.reading)
+    except ValueError as err:
+        raise UsageError(f"--reading: {err}") from None
     scenarios = select(args.scenarios)
     return Plan(units, baud, scenarios, args.command, args.port, args.host_timeout,
-                args.strict, args.jobs, expect_motion_of(args.expect_motion, units))
+                args.strict, args.jobs, expect_motion_of(args.expect_motion, units),
+                clean_limit=args.clean_limit, readings=readings)
 
 
 def expect_motion_of(given: list[str], units: list[tuple[Profile, int]]
@@ -151,7 +164,9 @@ def flags_of(args: argparse.Namespace, plan: Plan) -> dict[str, object]:
     return {"--profile" if args.profile else "--unit": plan.profile,
             "--baud": plan.baud, "--port": plan.port,
             "--scenarios": " ".join(args.scenarios) or "all",
-            "--host-timeout": plan.host_timeout, "--jobs": plan.jobs,
+            "--host-timeout": plan.host_timeout, "--clean-limit": plan.clean_limit,
+            "--reading": " ".join(plan.readings) or "none (the project's decisions)",
+            "--jobs": plan.jobs,
             "--strict": plan.strict,
             "--expect-motion": " ".join(args.expect_motion) or "none (not judged)",
             "wire logs": "whole, every scenario"}

@@ -39,7 +39,7 @@ from conformance.run.runner import RunResult
 from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING
 from gve_fixtures.profile import Profile
 
-#: the longest a clean run may take, and the slack a fault run gets over the clean one
+#: the longest a clean run may take unless the user says otherwise (--clean-limit)
 CLEAN_LIMIT_S = 120.0
 #: operator answers in attended mode -> the exit status they stand for
 OPERATOR = {"": 0, "done": 0, "ok": 0, "failed": 1, "fail": 1, "gave up": 1}
@@ -57,6 +57,10 @@ class Plan:
     jobs: int = 4
     #: address -> the full steps per axis the clean run must travel (--expect-motion)
     expect_motion: dict[int, tuple[int, ...]] | None = None
+    #: the longest the clean run may take (a fault run's limit follows from its length)
+    clean_limit: float = CLEAN_LIMIT_S
+    #: the emulator readings the played units take (none: the project's decisions)
+    readings: tuple[str, ...] = ()
     stop: threading.Event = field(default_factory=threading.Event)   # Ctrl-C
     baseline: Baseline | None = None      # what the clean run showed, once it has run
     started: set[str] = field(default_factory=set)   # scenarios whose host run has begun
@@ -130,7 +134,7 @@ def run_once(plan: Plan, fault: Fault, port: HostPort, *,
              limit: float = CLEAN_LIMIT_S) -> HostRun:
     """One run of the host's job under ``fault``: launched (``plan.command``), or until
     ``done()`` returns the exit status the operator reported."""
-    line = open_line(plan.units, plan.baud)
+    line = open_line(plan.units, plan.baud, plan.readings)
     views = line_views(plan.units)
     relay = Relay(port, line, views, fault, plan.baud)
     start = time.monotonic()
@@ -216,7 +220,7 @@ def grade(plan: Plan, sc: Scenario, out: HostRun) -> HostResult:
 def _fault_limit(plan: Plan) -> float:
     """How long a fault run may take: twice the clean one, and time to give up."""
     restart = max(p.restart_ms for p, _ in plan.units) / 1000
-    seconds = plan.baseline.seconds if plan.baseline is not None else CLEAN_LIMIT_S
+    seconds = plan.baseline.seconds if plan.baseline is not None else plan.clean_limit
     return 2 * seconds + 2 * plan.host_timeout + restart
 
 
@@ -232,7 +236,7 @@ def launched(plan: Plan, on_result: Callable[[HostResult], None]) -> None:
             port.close()
 
     clean, rest = plan.scenarios[0], plan.scenarios[1:]
-    out = run(clean, Fault(), CLEAN_LIMIT_S)
+    out = run(clean, Fault(), plan.clean_limit)
     plan.baseline = baseline_of(out)
     on_result(grade(plan, clean, out))
     made = [_build(sc, plan) for sc in rest]

@@ -9,6 +9,7 @@ says so (a hang is a FAIL whatever the tag).
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
@@ -76,13 +77,45 @@ def _at(t: int, line: LineFacts) -> int:
     return t - line.origin
 
 
+#: the refusals a host may provoke on purpose: unknown, syntax, range (spec 5)
+REFUSALS = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
+            ErrorCode.RANGE: "5.code.range"}
+#: why a probe is graded by our reading, not by the unit's rule
+PROBE = ("refused once and never sent again: a probe the host made and took the "
+         "refusal of (that a host sends only what the unit accepts is our reading, "
+         "spec 5 [D])")
+
+
+def probes(rec: Recording) -> set[int]:
+    """The exchanges (by ``n``) a host sent to learn how the unit answers: refused as
+    unknown, for syntax or for range with no fault of ours, their command refused nowhere
+    else in the run, the frame never sent again, and the host going on after it. No
+    sentence of the manuals forbids a host to send a frame the unit refuses; a host that
+    leans on refused frames repeats them, has more than one of a command refused, or
+    stops at the refusal."""
+    refused = [ex for ex in rec.exchanges
+               if ex.fault is None and ex.code in REFUSALS and not _lapsed(ex)]
+    commands = Counter(ex.parsed.command or ex.parsed.key for ex in refused)
+    sent = Counter(ex.frame.raw for ex in rec.exchanges)
+    last = rec.exchanges[-1].n if rec.exchanges else -1
+    return {ex.n for ex in refused
+            if commands[ex.parsed.command or ex.parsed.key] == 1 and sent[ex.frame.raw] == 1
+            and ex.n < last}
+
+
 def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
     """Each frame on its own: grammar, address, command, parameters, checksum, length
-    (frame_rules.py), and a member of a packet carrying its own checksum (spec 7)."""
+    (frame_rules.py), and a member of a packet carrying its own checksum (spec 7). What a
+    probe (:func:`probes`) breaks is graded by our reading: the unit refused it."""
+    probing = probes(rec)
     for ex in rec.exchanges:
         out.judged |= ex.parsed.judged
         for p in ex.parsed.problems:
-            out.add(p.rule, _at(ex.frame.start, line), ex.text, p.what)
+            if ex.n in probing:
+                out.add(p.rule, _at(ex.frame.start, line), ex.text, f"{p.what}: {PROBE}",
+                        "D")
+            else:
+                out.add(p.rule, _at(ex.frame.start, line), ex.text, p.what)
     for frag in rec.fragments:
         out.judged.add("3.frame.grammar")
         shown = show(frag.data)
@@ -104,18 +137,23 @@ def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
     A frame summed after a restart turned checksum mode off is refused for that cause,
     which its reading names (6.checksum.off-after-reset), not for its parameters. A `*E`
     refused after a packet was opened closes one the host could not know closed (spec 7:
-    only `*E` is sure to), as its answer or a fault left it unsure: no fault of the host's."""
-    rules = {ErrorCode.UNKNOWN: "5.code.unknown", ErrorCode.SYNTAX: "5.code.syntax",
-             ErrorCode.RANGE: "5.code.range", ErrorCode.BUSY: "10.1.queue.wait-idiom"}
+    only `*E` is sure to), as its answer or a fault left it unsure: no fault of the host's.
+    A probe (:func:`probes`) is graded by our reading."""
+    rules = {**REFUSALS, ErrorCode.BUSY: "10.1.queue.wait-idiom"}
     out.judged |= set(rules.values())
+    probing = probes(rec)
     opened = False
     for ex in rec.exchanges:
         closer = opened and ex.parsed.command == "*E"
         opened = opened or ex.parsed.command == "*S"
         if ex.fault is None and ex.code in rules and not _lapsed(ex) and not closer:
             answer = b"".join(ex.answer).decode("latin-1").strip()
-            out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
-                    f"the unit answered {answer}")
+            if ex.n in probing:
+                out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
+                        f"the unit answered {answer}; {PROBE}", "D")
+            else:
+                out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
+                        f"the unit answered {answer}")
 
 
 def _lapsed(ex: Exchange) -> bool:

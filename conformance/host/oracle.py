@@ -163,6 +163,12 @@ def driven_checks(g: Grader, out: HostRun, expect: dict[int, tuple[int, ...]] | 
                 f"it travelled {shown or 'nothing'} full steps", "always")
 
 
+#: what a clean run that did not finish may owe to the unit played, not to the host
+WRITTEN_FOR = ("a host written for a unit that reads a silence of the manuals otherwise "
+               "than the unit played (docs/decisions.md) may fail here: play that "
+               "reading with --reading NAME")
+
+
 def motion_checks(g: Grader, out: HostRun, baseline: Baseline | None,
                   expect: dict[int, tuple[int, ...]] | None = None) -> None:
     sc = g.scenario
@@ -170,6 +176,8 @@ def motion_checks(g: Grader, out: HostRun, baseline: Baseline | None,
     if sc.name == "clean":
         g.check(finished, "8.recovery.finishes", "the host finishes its own job on a "
                 "clean line", _ending(out), "always")
+        if not finished:
+            g.notes.append(WRITTEN_FOR)
         driven_checks(g, out, expect)
         return
     hung = out.ended in ("silent", "limit")
@@ -227,7 +235,8 @@ def _ending(out: HostRun) -> str:
     if out.ended == "silent":
         return f"silent for too long, not exited after {out.seconds:.1f} s"
     if out.ended == "limit":
-        return f"still running after {out.seconds:.1f} s"
+        return (f"still running after {out.seconds:.1f} s (the clean run's limit is "
+                "--clean-limit; a fault run's, twice the clean run's length)")
     return f"exit status {out.exit_code} after {out.seconds:.2f} s"
 
 

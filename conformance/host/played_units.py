@@ -26,9 +26,20 @@ def load_units(specs: list[str]) -> list[tuple[Profile, int]]:
     return units
 
 
-def open_line(units: list[tuple[Profile, int]], baud: int) -> serial.SerialBase:
-    """A line with these units at ``baud``, its clock at 0."""
+def open_line(units: list[tuple[Profile, int]], baud: int,
+              readings: tuple[str, ...] = ()) -> serial.SerialBase:
+    """A line with these units at ``baud``, its clock at 0, each unit taking ``readings``
+    (none: the project's decisions)."""
     import emulator  # noqa: F401  (registers the gve:// scheme with pyserial)
 
     query = "&".join(f"unit={p.name}@{a}" for p, a in units)
-    return serial.serial_for_url(f"gve://?{query}&baud={baud}", timeout=0)
+    taken = f"&reading={','.join(readings)}" if readings else ""
+    return serial.serial_for_url(f"gve://?{query}&baud={baud}{taken}", timeout=0)
+
+
+def check_readings(names: list[str]) -> tuple[str, ...]:
+    """The readings given to the played units, each one the emulator knows; raises
+    ValueError naming the unknown ones."""
+    from emulator.readings import parse_readings
+
+    return parse_readings(",".join(names))

@@ -128,3 +128,22 @@ def test_a_decided_check_beside_a_manual_one_is_not_a_fail_of_its_rule():
                            {"id": "e", "profile": "p", "verdict": "ERROR", "checks": []}]}
     assert failed_rules(results) == [("c [p]", "FAIL", ["10.cmd.axis-limits"]),
                                      ("e [p]", "ERROR", ["(no rule)"])]
+
+
+def test_an_implementations_options_reach_every_job_it_runs(tmp_path):
+    from conformance.cli.corpus import jobs_of
+
+    (tmp_path / "corpus.toml").write_text(
+        '[[implementation]]\nname = "h"\nkind = "host"\nfolder = "."\n'
+        'command = "{python} host.py {port}"\nprofiles = ["GVE54"]\n'
+        'options = ["--reading", "index-hex"]\n'
+        '[[implementation]]\nname = "u"\nkind = "unit"\nfolder = "."\n'
+        'command = "{python} sim.py --cosim"\nprofiles = ["GVE54"]\ndiff-examples = 5\n'
+        'options = ["--strict"]\n')
+    host, sim = load_manifest(tmp_path / "corpus.toml")
+    ((_, argv),) = jobs_of(host, tmp_path, seed=0)
+    assert argv[argv.index("--") - 2:argv.index("--")] == ["--reading", "index-hex"]
+    assert argv[argv.index("--") + 2:] == ["host.py", "{port}"]
+    jobs = jobs_of(sim, tmp_path, seed=0)
+    assert [what for what, _ in jobs] == ["catalogue GVE54", "diff GVE54"]
+    assert all("--strict" in argv for _, argv in jobs)

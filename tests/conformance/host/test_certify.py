@@ -5,10 +5,12 @@ The whole matrix (every profile, every mode, every scenario) is marked slow."""
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from conformance.host.scenarios import SCENARIOS
-from conformance.verdicts.verdict import INFO, MISSING, PASS
+from conformance.verdicts.verdict import FAIL, INFO, MISSING, PASS
 from gve_fixtures.profile import available_profiles, load_profile
 from tests.conformance.host.run import certify, verdicts
 
@@ -71,3 +73,27 @@ def test_the_whole_matrix(tmp_path, profile, mode):
     print(profile, mode, found)
     assert status == 0
     assert all(v in (PASS, MISSING) for name, v in found.items() if name != "restart")
+
+
+SLOW_HOST = """
+import sys, time, serial
+port = serial.serial_for_url(sys.argv[1], 115200, timeout=2)
+port.write(b"!0?\\r")
+port.read_until(b"\\r")
+time.sleep(1)
+"""
+
+
+def test_the_clean_runs_limit_is_the_users(tmp_path):
+    # a host whose job asks `?` and then takes a second: past a clean-run limit of 0.3 s
+    # it is still running, a FAIL; under the default limit it finishes
+    slow = [sys.executable, "-c", SLOW_HOST, "{port}"]
+    status, results = certify(tmp_path / "short", "GVE84-100", scenarios=("2.host.clean",),
+                              options=("--clean-limit", "0.3"), command=slow)
+    (clean,) = results
+    assert status == 1 and clean["verdict"] == FAIL
+    assert any("still running" in c["observed"] and "--clean-limit" in c["observed"]
+               for c in clean["checks"] if c["rule"] == "8.recovery.finishes")
+    status, results = certify(tmp_path / "default", "GVE84-100", scenarios=("2.host.clean",),
+                              command=slow)
+    assert status == 0 and [r["verdict"] for r in results] == [PASS]

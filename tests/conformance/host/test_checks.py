@@ -6,6 +6,7 @@ from __future__ import annotations
 from conformance.host.checks import MS, PATIENCE_MS
 from conformance.host.frame_rules import byte_sum
 from conformance.host.oracle import HOST_CHECKS
+from gve_fixtures.profile import load_profile
 from gve_fixtures.rules import load_rules
 from tests.conformance.host.records import Wire, broken
 
@@ -250,17 +251,56 @@ def test_a_host_that_gives_up_while_a_refused_vector_waits_did_not_ignore_the_re
     assert broken(w.judge(exit_code=0))["5.code.queue-full"] == ["!0L20,0,0"]
 
 
-def test_refusals_are_the_hosts_fault():
+def test_refusals_a_host_leans_on_are_its_fault():
+    # each command refused twice: a host that repeats what the unit refuses relies on it
     w = Wire()
-    w.frame(b"!0l100,0,0", 0, answer=b"3\r")
-    w.frame(b"!0V1000.0", 10, answer=b"4\r")
-    w.frame(b"!0SW8,F1", 20, answer=b"5\r")
-    w.frame(b"!0N", 30, answer=b"7\r")                # while moving (spec 5, 10.1)
+    for t in (0, 40):
+        w.frame(b"!0l100,0,0", t, answer=b"3\r")
+        w.frame(b"!0V1000.0", t + 10, answer=b"4\r")
+        w.frame(b"!0SW8,F1", t + 20, answer=b"5\r")
+        w.frame(b"!0N", t + 30, answer=b"7\r")           # while moving (spec 5, 10.1)
     found = broken(w.judge())
-    assert found["10.1.queue.wait-idiom"] == ["!0N"]
-    assert found["5.code.unknown"] == ["!0l100,0,0"]
-    assert found["5.code.syntax"] == ["!0V1000.0"]
-    assert found["5.code.range"] == ["!0SW8,F1"]
+    assert found["10.1.queue.wait-idiom"] == ["!0N", "!0N"]
+    assert found["5.code.unknown"] == ["!0l100,0,0"] * 2
+    assert found["5.code.syntax"] == ["!0V1000.0"] * 2
+    assert found["5.code.range"] == ["!0SW8,F1"] * 2
+
+
+def _graded(j, rule: str) -> list[tuple[str, str | None]]:
+    return [(f.frame, f.tag) for f in j.findings if f.rule == rule]
+
+
+def test_a_refusal_provoked_once_and_never_repeated_is_graded_by_our_reading():
+    # a host that sends V39 to learn how the GVE54 answers, takes the 5 and goes on with
+    # other values: no sentence of the manuals forbids the frame, so the refusal and the
+    # value's range are [D] (NON-STRICT), not the unit's [M] rule
+    w = Wire({0: load_profile("GVE54")})
+    w.frame(b"!0V39", 0, answer=b"5\r")
+    w.frame(b"!0@", 10, answer=b"0,1\r")
+    w.frame(b"!0V1000", 20)
+    j = w.judge()
+    assert _graded(j, "5.code.range") == [("!0V39", "D")]
+    assert _graded(j, "1.profile.v-b-range-gve54") == [("!0V39", "D")]
+    assert all("a probe" in f.what for f in j.findings if f.tag == "D")
+    # the same value sent again: the host leans on it, the unit's rule FAILs it
+    w.frame(b"!0V39", 30, answer=b"5\r")
+    j = w.judge()
+    assert _graded(j, "5.code.range") == [("!0V39", None), ("!0V39", None)]
+    assert _graded(j, "1.profile.v-b-range-gve54") == [("!0V39", None), ("!0V39", None)]
+
+
+def test_a_refusal_the_host_stopped_at_is_no_probe():
+    w = Wire({0: load_profile("GVE54")})
+    w.frame(b"!0V1000", 0)
+    w.frame(b"!0V39", 10, answer=b"5\r")
+    assert broken(w.judge(exit_code=1))["5.code.range"] == ["!0V39"]
+
+
+def test_a_second_refusal_of_the_same_command_is_no_probe():
+    w = Wire({0: load_profile("GVE54")})
+    w.frame(b"!0V39", 0, answer=b"5\r")
+    w.frame(b"!0V38", 10, answer=b"5\r")
+    assert broken(w.judge())["5.code.range"] == ["!0V39", "!0V38"]
 
 
 def test_nothing_is_sent_while_the_unit_restarts_after_j():

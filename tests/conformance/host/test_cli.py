@@ -28,6 +28,8 @@ HOST = ["--", "python", "-m", "gve_host", "{port}", "--job", "x.job"]
     (["host", "--unit", "GVE54@9", *HOST], "0..7"),
     (["host", "--profile", "GVE84-100", "--bogus", *HOST], "--bogus"),
     (["host", "--profile", "GVE84-100", "--host-timeout", "0", *HOST], "--host-timeout"),
+    (["host", "--profile", "GVE84-100", "--clean-limit", "0", *HOST], "--clean-limit"),
+    (["host", "--profile", "GVE84-100", "--reading", "index-hx", *HOST], "index-hx"),
 ])
 def test_usage_errors(capsys, argv, says):
     assert main(argv) == 2
