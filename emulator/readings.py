@@ -178,6 +178,10 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                             "zero-vector-dwells, and an H meanwhile sets INTA and leaves "
                             "the dwell to run out (ST6 RUN with INTA; D, K, R, M, N refused "
                             "with 7 and L with 1 until the T ms are over)"),
+    "accel-along-path": (("10.2.motion.path-accel",),
+                         "under VK, A is taken along the path |d| as V is (\"rychlosti jsou "
+                         "určeny podle d\"): the dominant axis accelerates and brakes at "
+                         "A·n/|d|"),
     "restore-refused-while-run": (("5.moving.after-halt",),
                                   "R is refused with 7 whenever RUN = 1, also while halted "
                                   "vectors hold it after H (\"Nelze použít za chodu\" read "
