@@ -24,6 +24,8 @@ from conformance.known_state.limits import known_axis_limits
 from conformance.link.account import Spent
 from conformance.link.framing import Response, frame
 from conformance.link.line_band import EXACT, LineBand, acted_within, line_band
+from conformance.link.line_time import MARGIN
+from conformance.link.link import Link
 from conformance.motion.model import DWELL_TICK, MotionModel
 from conformance.motion.plan import Params, dominant
 from conformance.motion.tolerance import (
@@ -149,6 +151,7 @@ class Probe:
             self.ctx.note(f"{body} answered {r.text} (a range the manuals do not state): "
                           f"measured with {stated}, the reset value")
             body, r = stated, self.link.send(stated)
+        r = _when_done(self.link, body, r, self.ctx.profile)
         self.ctx.require(r is not None and r.ok, f"{body} answered "
                          f"{'nothing' if r is None else r.text}, expected 0")
         self._book(body, *self._timing(body, r))
@@ -487,6 +490,21 @@ class Probe:
 def _within(tol: Tolerance) -> str:
     """The band a check used, for its text; none where the check is exact."""
     return "" if tol.exact else f" ({tol})"
+
+
+def _when_done(link: Link, body: str, r: Response | None, profile: Profile
+               ) -> Response | None:
+    """An `L` answered 1 ("Dokud není přijat, karta hlásí chybu 1, a tudíž fronta před ním
+    není hotová"): a unit may count the T dwell after the vector before it as part of the
+    queue. Sent again every tick until it is answered otherwise, for at most the longest
+    T and the line's margin; the model books it at the answer that took it. The last
+    answer."""
+    def busy(x: Response | None) -> bool:
+        return x is not None and x.code is not None and x.code & 7 == ErrorCode.QUEUE_FULL
+    if _split(body)[0] != "L" or not busy(r):
+        return r
+    limit = profile.range("T").hi / 1000 + 2 * MARGIN
+    return link.poll(body, lambda x: not busy(x), limit, TICK_NS / SECOND) or r
 
 
 def _along_path(d: tuple[int, ...], p: Params) -> Params:
