@@ -172,6 +172,16 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                            "continuous applies to it: answered 0 once everything before it "
                            "is done, it then holds RUN = 1 (moving: N, D, K, R, M, EW "
                            "refused with 7, L with 1) for T ms; H ends the dwell"),
+    "dwell-outlives-halt": (("5.moving.after-halt", "10.2.motion.zero-length"),
+                            "the T dwell after a vector counts as running (\"za chodu\") "
+                            "and H does not end it: `L0,0,0` holds RUN for its T as under "
+                            "zero-vector-dwells, and an H meanwhile sets INTA and leaves "
+                            "the dwell to run out (ST6 RUN with INTA; D, K, R, M, N refused "
+                            "with 7 and L with 1 until the T ms are over)"),
+    "accel-along-path": (("10.2.motion.path-accel",),
+                         "under VK, A is taken along the path |d| as V is (\"rychlosti jsou "
+                         "určeny podle d\"): the dominant axis accelerates and brakes at "
+                         "A·n/|d|"),
     "restore-refused-while-run": (("5.moving.after-halt",),
                                   "R is refused with 7 whenever RUN = 1, also while halted "
                                   "vectors hold it after H (\"Nelze použít za chodu\" read "

@@ -21,7 +21,7 @@ SCENARIOS: dict[str, tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...], li
         (), (), ["A10000", "V3000", "L600,-200,0", 0.25]),
     # VK: the speed along the path, the dominant rate V·n/|d| (10.2)
     "10.2.measured.path-rate": (
-        ("10.2.motion.path-rate", "10.cmd.vk-vn"), ("VK",), (),
+        ("10.2.motion.path-rate", "10.cmd.vk-vn", "10.2.motion.path-accel"), ("VK",), (),
         ["A10000", "VK", "V2000", "L300,400,0", 0.3]),
     # VL caps an axis's rate (10.2)
     "10.2.measured.axis-caps": (

@@ -241,7 +241,10 @@ class ToRest:
             # what the bookkeeping took for deleted may still be queued: no position read
             # tells where the axes rest until the unit shows rest
             self.guard.doubt_rest()
-            self.failures.book(link, self._not_deleted(link, halt, deleted, st6))
+            failure = self._not_deleted(link, halt, deleted, st6)
+            if failure is None:
+                return ""
+            self.failures.book(link, failure)
             if not self.guard.interrupts.stopped:
                 st6 = self._to_rest(link)
                 if rests(st6):
@@ -253,20 +256,31 @@ class ToRest:
             + left(st6)
 
     def _not_deleted(self, link: Link, halt: Response, deleted: Response | None,
-                     st6: Response) -> StepFailure:
-        """`D` after `H` left INTA. Refused as busy (7: "not while moving"), `PF` read
-        twice tells whether the axes still move: moving after `H` was answered, the frame
-        that answers only once they stopped (spec 2) did not — the `W` that last set them
+                     st6: Response) -> StepFailure | None:
+        """`D` after `H` left INTA. Refused as busy (7: "nelze použít za chodu"), the
+        unit may still be running in a sense the manuals allow: a reader may count the
+        T dwell after its last vector as running and let `H` leave it to end (M54 T:
+        "prodleva mezi nenavazujícími vektory", up to the longest T). So `SR6` is read
+        until RUN and STOP clear, for at most the longest T (:meth:`_dwell_seconds`: a
+        held remainder keeps RUN all along), and `D` is sent again: taken, and ST6 then
+        clear, the unit is at rest and nothing failed (None). `PF` read before and after
+        that wait tells whether the axes moved after `H` was answered: the frame that
+        answers only once they stopped (spec 2) did not — the `W` that last set them
         moving where one did (spec 10: under simplex `H` cannot meet a `W` run that
         answered when done; whether `H` stops one is the manuals' silence), else `H`.
-        At rest, `D` broke its own rule."""
+        At rest, `D` still refused once the longest T is over, or `D` not clearing ST6,
+        broke `D`'s own rule. The wait is for what ST6 shows, not a time of the suite's:
+        however short the suite's other waits, `D` is asked again only after it."""
         evidence = f"H {shown(halt)}, D {shown(deleted)}, SR6 {shown(st6)}"
         if deleted is not None and deleted.code is not None \
                 and deleted.code & 7 == ErrorCode.BUSY:
             first = self.position(link)
-            link.wait(RUN_OUT_POLL_S, Spent.MOTION)
+            waited = link.poll("SR6", lambda r: not hex_ok(r) or not bits(r) & (
+                St6.RUN | St6.STOP), self._dwell_seconds())
             then = self.position(link)
-            evidence += f", PF {shown_counters(first)} then {shown_counters(then)}"
+            evidence += (f", SR6 {'still RUN' if waited is None else shown(waited)} "
+                         f"within the longest T, PF {shown_counters(first)} then "
+                         f"{shown_counters(then)}")
             before = self.failures.before
             last = ("", False) if before is None else _last_motion(before.log)
             # a W whose answer never came: whether H stops its run is the manuals' silence
@@ -278,9 +292,22 @@ class ToRest:
                         "the axes at rest from W's answer on")
                 return StepFailure("10.4.halt.ramp", "halt", "H answers only when the unit "
                                    "has stopped", evidence, "the axes at rest from H's answer on")
+            again = link.send("D")
+            evidence += f", D again {shown(again)}"
+            if taken(again):
+                st6 = link.send("SR6")
+                if rests(st6):
+                    return None
+                evidence += f", SR6 {shown(st6)}"
         return StepFailure(
-            "10.4.delete", "delete", "D after H (the unit stopped) empties the queue and "
-            "clears ST6", evidence, "D 0, then SR6 with RUN, STOP and INTA clear")
+            "10.4.delete", "delete", "D after H (the unit stopped, the longest T dwell over) "
+            "empties the queue and clears ST6", evidence,
+            "D 0, then SR6 with RUN, STOP and INTA clear")
+
+    def _dwell_seconds(self) -> float:
+        """The longest a unit stopped by `H` may still count itself running: the longest
+        T dwell a reader may let run after its last vector, and the line's margin."""
+        return self.profile.range("T").hi / 1000 + 2 * MARGIN
 
     def _keep_not_given_back(self, link: Link) -> str:
         """A `K` the last case left whose save `R` would give back beyond the envelope:

@@ -51,7 +51,8 @@ def cmd_line(dev: Device, ses: Session, p: str, t: int) -> Reply:
             dev.push(steps, False, t)
         raise CommandError(ErrorCode.QUEUE_FULL, "L waits until nothing is queued or running")
     dev.push(steps, False, t)
-    if not any(steps) and not dev.state.inta and dev.readings.active("zero-vector-dwells"):
+    if not any(steps) and not dev.state.inta and (dev.readings.active("zero-vector-dwells")
+                                                  or dev.readings.active("dwell-outlives-halt")):
         # a normal vector with no motion: the T dwell after it holds RUN (the next
         # vector from rest waits it out in the stepper core too)
         dev.state.dwell_until = t + dev.state.modal.T * MS
@@ -239,7 +240,8 @@ def _reference_run(dev: Device, t: int, duration: int, moves: list[tuple[int, in
 
 def cmd_halt(dev: Device, ses: Session, p: str, t: int) -> Reply:
     rest = dev.motion.halt(t)
-    dev.state.dwell_until = min(dev.state.dwell_until, t)     # a dwell ends at once
+    if not dev.readings.active("dwell-outlives-halt"):
+        dev.state.dwell_until = min(dev.state.dwell_until, t)     # a dwell ends at once
     dev.state.status[6] |= INTA | INTCOM
     if rest > t and not dev.mutant.active("halt-answers-early"):
         return Deferred(dev.seen_at_rest(rest), lambda at: (ErrorCode.OK, []))

@@ -301,13 +301,19 @@ class Device:
         if act("a-axis-alone-ignored") and len(steps) == 4 and not any(steps[:3]):
             steps = (0, 0, 0, 0)
         self.last_vector = steps
+        accel *= 1000 * f
+        path2 = sum(s * s for s in steps[:3])
+        along = m.VK and not act("path-speed-ignored")
+        if along and path2 and self.readings.active("accel-along-path"):
+            # A along |d| as V is: the dominant axis accelerates at A·n/|d|
+            accel = max(1, math.isqrt((accel * max(map(abs, steps))) ** 2 // path2))
         self.motion.push(Vector(
             steps=tuple(s * step_f for s in steps), continuous=continuous,
-            velocity=min(v, mr) * rate_f, accel=accel * 1000 * f,
+            velocity=min(v, mr) * rate_f, accel=accel,
             brake=min(brake, mr) * rate_f,
             short=0 if act("short-vector-ignored") else m.dollar * f,
             dwell=0 if act("dwell-ignored") else m.T * MS,
-            path_speed=m.VK and not act("path-speed-ignored"),
+            path_speed=along,
             axis_limits=tuple(min(x, mr) * f for x in limits)), t)
 
     def exchange_velocity(self, t: int) -> None:

@@ -53,7 +53,8 @@ class DeviceState:
     mpg: str = ""
     spindle: int = 0
     reference_until: int = -1         # a W reference run in progress until then
-    #: the reading zero-vector-dwells: the T dwell of an `L0,0,0` holds RUN until then
+    #: the readings zero-vector-dwells and dwell-outlives-halt: the T dwell of an `L0,0,0`
+    #: holds RUN until then
     dwell_until: int = -1
 
     @property

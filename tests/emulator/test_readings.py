@@ -97,6 +97,14 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # 1 ms after L0,0,0 its T5 dwell still holds RUN: N refused, SR6 shows RUN
     "zero-vector-dwells": ([b"!0L0,0,0\r", 0.001, b"!0N\r", 0.001, b"!0SR6\r"],
                            b"0\r0\r0,00\r", b"0\r7\r0,40\r"),
+    # 1 ms after L0,0,0 an H at rest leaves its T5 dwell running: D refused, RUN with INTA
+    "dwell-outlives-halt": ([b"!0L0,0,0\r", 0.001, b"!0H\r", 0.001, b"!0D\r", 0.001,
+                             b"!0SR6\r"],
+                            b"0\r8\r0\r0,00\r", b"0\r8\rF\r8,D0\r"),
+    # 0.1 s into L300,400 under VK at V2000 and the reset's A: Y (n = 400 of |d| = 500)
+    # ramps at A, or at A·400/500 along the path
+    "accel-along-path": ([b"!0VK\r", 0.001, b"!0V2000\r", 0.001, b"!0L300,400,0\r", 0.1,
+                          b"!0PF\r"], b"0\r0\r0\r0,71,95,0\r", b"0\r0\r0\r0,59,79,0\r"),
     # a halted L holds RUN: R refused, where the clean unit restores an empty save
     "restore-refused-while-run": ([b"!0L1000,0,0\r", 0.01, b"!0H\r", b"!0R\r"],
                                   b"0\r8\r0\r", b"0\r8\rF\r"),

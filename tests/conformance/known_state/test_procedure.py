@@ -18,6 +18,7 @@ from conformance.run.runner import run
 from conformance.run.selection import select
 from conformance.targets import parse_target
 from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, PASS
+from gve_fixtures.profile import load_profile
 from tests.conformance.cases.used import UsedUnit, used_unit
 from tests.conformance.safety.units import Recorder
 
@@ -222,9 +223,35 @@ def test_a_d_refused_as_busy_after_h_names_what_still_moved_the_axes(mutant, fra
 def test_a_d_refused_as_busy_with_the_axes_at_rest_is_ds_own_rule():
     (failure,), after = _known_states("delete-refused", ["L300,0,0"], 0)
     assert failure.rule == "10.4.delete" and "D F" in failure.observed
-    first, then = failure.observed.split("PF ")[1].split(" then ")
-    assert first == then
+    # sent again once SR6 showed RUN clear or the longest T was over: refused all the same
+    read, again = failure.observed.split("PF ")[1].split(", D again ")
+    first, then = read.split(" then ")
+    assert first == then and again == "F"
     assert after == []                           # each rule once a run
+
+
+@pytest.mark.parametrize("profile", ["GVE84-100", "GVE54"])
+def test_a_d_refused_while_a_dwell_outlives_h_is_sent_again_once_st6_shows_it_over(profile):
+    """A reader counting the T dwell after a vector as running, which H does not end:
+    the known state's D is refused with 7 (RUN with INTA, as halted vectors show), then
+    sent again once SR6 shows RUN clear, and taken: no step failed, the unit at rest."""
+    u = used_unit(profile, allow_destructive=True, max_travel=4000,
+                  readings=("dwell-outlives-halt",))
+    u.port = Rewritten(u.port, {})
+    session = u.begin()
+    link = session.open_link()
+    assert session.take_failures() == []
+    longest = load_profile(profile).range("T").hi
+    assert link.send(f"T{longest}").ok and link.send("L0,0,0").ok
+    before = len(frames_sent(u))
+    link = session.open_link()                  # the known state: H within the dwell
+    assert session.take_failures() == []
+    assert link.send("SR6").raw == b"0,00\r"
+    session.finish()
+    sent = frames_sent(u)[before:]
+    halt = sent.index(b"!0H\r")
+    # D refused in the dwell, SR6 read until RUN cleared, D again
+    assert sent[halt:].count(b"!0D\r") >= 2 and b"!0SR6\r" in sent[halt:]
 
 
 def test_an_h_refused_is_a_fail_of_its_rule_and_the_stop_goes_on():
@@ -289,10 +316,12 @@ def test_an_r_refused_at_rest_with_a_k_held_is_still_a_fail_of_its_rule():
 
 
 #: readings of what the known state sends (profile, reading): L0,0,0 holding RUN for its
-#: T dwell (N after the return move, N<axis> and EW at the end), R refused while halted
-#: vectors hold RUN (a K a case left, given back after H), M refused likewise (the GVE54's
-#: reset frames)
+#: T dwell (N after the return move, N<axis> and EW at the end), that dwell outliving the
+#: known state's H (D refused with 7 until it is over), R refused while halted vectors
+#: hold RUN (a K a case left, given back after H), M refused likewise (the GVE54's reset
+#: frames)
 MACHINERY_READINGS = [("GVE84-100", "zero-vector-dwells"), ("GVE54", "zero-vector-dwells"),
+                      ("GVE84-100", "dwell-outlives-halt"), ("GVE54", "dwell-outlives-halt"),
                       ("GVE84-100", "restore-refused-while-run"),
                       ("GVE54", "restore-refused-while-run"),
                       ("GVE54", "motor-mode-refused-while-run")]

@@ -70,3 +70,23 @@ def test_a_motion_mutant_still_fails_through_another_placement(mutant: str) -> N
                 seen.append((c.id, profile, r.verdict, tags))
     assert seen and all(verdict == NON_STRICT and tags == {"D"}
                         for _, _, verdict, tags in seen), seen
+
+
+def test_a_along_the_path_under_vk_is_graded_by_its_own_rule_and_vk_ignored_still_fails():
+    """A unit taking A along |d| under VK (reading accel-along-path: M84 12.5.4 puts the
+    speeds along |d| and says nothing of A) runs path-rate's scenario behind the model's,
+    whose dominant axis ramps at A; with A taken as one byte (accel-byte-range: A10000
+    refused, the scenario measured at the reset's A20) the ramps show: every reading it
+    misses is graded by 10.2.motion.path-accel [D], as the whole scenario is the model's
+    with A along the path; VK ignored is faster, not slower, and still FAILs the path rate
+    [M] through it."""
+    case = REGISTRY["10.2.measured.path-rate"]
+    readings = "emu:GVE84-100?reading=accel-along-path,accel-byte-range"
+    r = run_case(case, parse_target(readings), "mutation")
+    assert r.verdict == NON_STRICT
+    assert {c["rule"] for c in r.checks if not c["ok"]} == {"10.2.motion.path-accel"}
+    assert run_case(case, parse_target(readings, strict=True), "mutation").verdict == FAIL
+    ignored = parse_target(f"{readings}&mutant=path-speed-ignored")
+    r = run_case(case, ignored, "mutation")
+    assert r.verdict == FAIL
+    assert "10.2.motion.path-rate" in {c["rule"] for c in r.checks if not c["ok"]}

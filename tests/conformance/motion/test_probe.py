@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.motion.probe import _split, _stated_instead
+from conformance.motion.probe import _split, _stated_instead, _when_done
 from conformance.protocol.wire import parse_response
 from gve_fixtures.profile import load_profile
+from tests.conformance.cases.used import used_unit
 
 
 @pytest.mark.parametrize(("body", "read"), [
@@ -30,3 +31,28 @@ def test_a_frame_is_read_as_its_command_and_the_rest(body, read):
 def test_only_a_range_no_manual_states_falls_back_to_the_reset_value(body, answer, instead):
     r = parse_response(answer, summed=False)
     assert _stated_instead(body, r, load_profile("GVE54")) == instead
+
+
+def test_an_l_refused_with_1_while_a_dwell_holds_the_queue_is_sent_again_until_taken():
+    """A unit holding RUN for the T dwell after `L0,0,0` (reading zero-vector-dwells)
+    refuses the scenario's next `L` with 1 ("fronta před ním není hotová") until the
+    dwell is over: sent again each tick, it is taken; an `L` refused while a vector still
+    runs past the longest T keeps its refusal (the case then cannot judge)."""
+    profile = load_profile("GVE84-100")
+    unit = used_unit("GVE84-100", max_travel=4000, readings=("zero-vector-dwells",))
+    session = unit.begin()
+    try:
+        link = session.open_link()
+        assert link.send("T24").ok and link.send("L0,0,0").ok
+        refused = link.send("L10,0,0")
+        assert refused.code == 1
+        began = link.now
+        taken = _when_done(link, "L10,0,0", refused, profile)
+        assert taken.ok and link.now - began < 0.03 * 1e9
+        assert link.send("V40").ok
+        # taken once the L10 and its dwell are over, then running for 1 s at V40
+        assert link.poll("L40,0,0", lambda r: r.ok, 1.0) is not None
+        refused = link.send("L10,0,0")
+        assert _when_done(link, "L10,0,0", refused, profile).code == 1
+    finally:
+        session.finish()
