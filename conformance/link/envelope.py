@@ -129,6 +129,9 @@ class Envelope:
         #: where the run of K's save may take each axis (None: no save held)
         self.saved: list[Span] | None = None
         self.save_moves = False                  # the save holds a vector
+        #: a K took (or may have taken) the save and no R gave it back: after R the save
+        #: may still be held (a reader may keep it, spec 10.5 [D]) but nothing asks for R
+        self.save_kept = False
         self.settled = True                      # nothing can be moving now
         self.offset = [UNKNOWN] * axes           # physical = counter + offset
         self.factor = Span(min(factors), max(factors))   # counter units per commanded step
@@ -220,11 +223,12 @@ class Envelope:
             else:
                 self.saved = [a.hull(b) for a, b in zip(self.saved, kept, strict=True)]
                 self.save_moves = self.save_moves or moves
+            self.save_kept = True
         else:
             self._cut()
         if restart:
             if sure:
-                self.saved = None
+                self.saved, self.save_kept = None, False
             self.offset = list(self.start) if sure else [
                 o.hull(s) for o, s in zip(self.offset, self.start, strict=True)]
             reset = point(self.reset_factor)
@@ -234,15 +238,20 @@ class Envelope:
     def restore(self, outcome: Outcome) -> None:
         """`R`: the saved queue replaces what is held and runs after `G` from where the
         axes stand: they may then be anywhere its run goes, and rest there once the unit
-        shows it ended (a read at rest tells where)."""
+        shows it ended (a read at rest tells where). A save `R` took is given back, yet
+        may still be held: that `R` empties it is a decision (spec 10.5 [D]), and a unit
+        that keeps it runs it again after another `R` and `G`."""
         if outcome is Outcome.REFUSED:
             return
         self._cut()
         moves = self.saved is not None and self.save_moves
         if moves:
-            self.start = [a.hull(b) for a, b in zip(self.start, self.saved, strict=True)]
+            before, self.start = self.start, [
+                a.hull(b) for a, b in zip(self.start, self.saved, strict=True)]
+            # kept, it runs again from where this run ends: as far once more
+            self.saved = [s.hull(s + (s - b)) for s, b in zip(self.saved, before, strict=True)]
         if outcome is Outcome.ACCEPTED:
-            self.saved, self.save_moves = None, False
+            self.save_kept = False
         self.settled = outcome is Outcome.ACCEPTED and not moves
         self._see()
 

@@ -235,3 +235,27 @@ def test_a_b_answered_while_a_packet_may_be_open_moves_nothing():
     sent(g, "L1,0,0")
     sent(g, "L0,0,0")
     assert g.envelope.position()[0] == 1
+
+
+def test_a_save_given_back_may_still_be_held_and_run_again():
+    """That `R` empties the save is a decision (spec 10.5 [D]): a unit that keeps it runs
+    the remainder again after a second `R` and `G`, from where the first run ended. The
+    envelope follows it; no `K` is then held that the known state must give back."""
+    g = guard()
+    sent(g, "C300,0,0")
+    sent(g, "H", "8")
+    sent(g, "K")                           # the save: what is left of 0..300
+    sent(g, "PF", "0,100,0,0")             # halted at 100: 200 are left
+    assert g.keep_held
+    sent(g, "R", "8")
+    sent(g, "G")
+    sent(g, "SR6", "0,00")
+    sent(g, "PF", "0,300,0,0")             # the save ran: 300
+    assert not g.keep_held
+    sent(g, "R", "8")                      # a unit that keeps its save: 200 more
+    sent(g, "G")
+    assert x(g)[1] >= 500
+    sent(g, "SR6", "0,00")
+    sent(g, "PF", "0,500,0,0")
+    assert x(g) == (500, 500) and not g.restarts and not g.untracked
+    assert "R" in refused(g, "R")          # a third run would leave the ±500 envelope
