@@ -19,6 +19,9 @@ from gve_fixtures.protocol import SECOND
 
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
+#: real time: how long after its timeout an answer is still taken as its frame's, noted
+#: as late (a loaded USB adapter's line); later than that it is a hang's
+LATE = 1.0
 #: real time: at the end of a case, the longest it listens for bytes still on their way
 #: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
 END_QUIET = 0.05
@@ -109,6 +112,20 @@ class LineTime:
         answer's bytes, a margin, ``slow`` (what the command itself takes when it answers
         at its end), and what the line adds (:meth:`line_seconds`)."""
         return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
+
+    def late(self) -> float:
+        """How long after the timeout :meth:`timeout` gives an answer is still its frame's,
+        noted as late (:data:`LATE`; nothing in virtual time, where no line delays it)."""
+        return 0.0 if self.virtual else LATE
+
+    def quiet(self) -> float:
+        """Real time: how long the line must have been silent since a frame's answer was
+        due before the next frame goes, once that frame timed out: the late grace
+        (:data:`LATE`) and the time any answer is given beyond its frame's bytes (the
+        margin, an answer's bytes at the baud rate, the line's delay: :meth:`timeout`), so
+        that an answer the unit began within the grace has come whole by then; a later one
+        is a hang's whichever frame it lands on (docs/decisions.md)."""
+        return LATE + self.timeout(None, 0)
 
     def line_seconds(self) -> float:
         """Real time: twice the slowest round trip the session measured (a USB adapter
