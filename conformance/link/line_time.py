@@ -135,7 +135,9 @@ class LineTime:
 
     def end_quiet(self) -> float:
         """Real time: how long the end of a case listens for bytes still on their way (a
-        second answer follows the first at once): the line's round trip as measured
-        (:meth:`line_seconds`), at most :data:`END_QUIET`."""
-        measured = self.line_seconds()
+        second answer follows the first at once): the line's slowest round trip as
+        measured, which holds a USB adapter's latency timer once, as the second answer's
+        first byte waits at most once behind the first's last (the rest of its line is
+        read whole); at most :data:`END_QUIET`, and that where nothing was measured."""
+        measured = self.round_trip.get("max_ms", 0.0) / 1e3
         return min(END_QUIET, measured) if measured else END_QUIET

@@ -64,6 +64,9 @@ class Receiver:
         #: real time: since when the line has been heard silent after the last frame timed
         #: out (its answer's due instant; None: not since it was due)
         self._silent_from: float | None = None
+        #: real time: until when the line was read (or the suite's last bytes went out):
+        #: anything the unit sent since is still in the port
+        self._read_to = 0.0
         self._last: tuple[str, bytes, bytes] = (UNASKED, b"", b"")   # state, frame, answer
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
@@ -72,6 +75,7 @@ class Receiver:
         """The link just wrote the suite's bytes (``wire``: the last frame they complete,
         None when they complete none)."""
         self._sent_until, self._waited_out = self.link.now, False
+        self._read_to = time.monotonic()
         if wire is not None:
             self._last = (UNASKED, wire, b"")
 
@@ -98,10 +102,12 @@ class Receiver:
         only; what the unit wrote in one go is judged whole, as it came, never its tail
         as a second or a late answer."""
         link = self.link
-        if not data or data.endswith(CR) or link.guard.interrupts.pending:
-            return data
-        link.port.timeout = MARGIN + link.byte_seconds(MAX_FRAME) + link.time.line_seconds()
-        return data + link.port.read_until(CR)
+        if data and not data.endswith(CR) and not link.guard.interrupts.pending:
+            link.port.timeout = (MARGIN + link.byte_seconds(MAX_FRAME)
+                                 + link.time.line_seconds())
+            data += link.port.read_until(CR)
+        self._read_to = time.monotonic()
+        return data
 
     def during(self, seconds: float, spent: Spent) -> bytes:
         """Let ``seconds`` pass, booked under ``spent``; what arrived meanwhile."""
@@ -226,6 +232,7 @@ class Receiver:
             if not chunk.endswith(CR):
                 break
             port.timeout = link.byte_seconds(64)
+        self._read_to = time.monotonic()
         link.time.book_exchange(len(raw), Spent.WAITS, began)
         if raw:
             link.record(UNIT, bytes(raw), "the rest of the answer")
@@ -250,8 +257,12 @@ class Receiver:
                     data += self.listen(link.time.quiet(), stop_early=True, already=silent)
                 kept_quiet = not link.guard.interrupts.pending
             elif final:
+                # the silence since the line was last read counts (what came since waits
+                # in the port, and is read first)
+                silent = 0.0 if data else time.monotonic() - self._read_to
                 with link.spending(Spent.WAITS):
-                    data += self.listen(link.time.end_quiet(), stop_early=True)
+                    data += self.listen(link.time.end_quiet(), stop_early=True,
+                                        already=silent)
         self._silent_from = None
         waiting = link.port.in_waiting
         if waiting:

@@ -2,7 +2,9 @@
 out, the next frame goes once the line has been silent for the late grace and an
 answer's time since the answer was due (not a fixed quiet); an answer within the grace
 is still its frame's, noted late; one after the grace, before the next frame, is the
-timed-out frame's late answer (a FAIL of its own), never the next frame's."""
+timed-out frame's late answer (a FAIL of its own), never the next frame's. The end of a
+case listens one slowest round trip, the silence since the line was last read counting,
+and still catches a second answer."""
 
 from __future__ import annotations
 
@@ -10,9 +12,9 @@ import pytest
 
 from conformance.link import line_time as line_time_module
 from conformance.link import receiver as receiver_module
-from conformance.link.line_time import LATE, MARGIN
+from conformance.link.line_time import END_QUIET, LATE, MARGIN
 from conformance.link.link import Link
-from conformance.link.strays import LATE_RULE
+from conformance.link.strays import LATE_RULE, TWICE
 from conformance.targets import parse_target
 
 CR = b"\r"
@@ -136,3 +138,36 @@ def test_an_answer_after_the_grace_is_the_timed_out_frames_late_answer_not_the_n
     r = ln.send("SR6")
     assert r is not None and r.raw == b"0,00\r"
     assert [v.rule for v in ln.violations] == [LATE_RULE]
+
+
+def test_the_end_of_a_case_listens_one_slowest_round_trip():
+    ln = _link(_Port(_Clock(), []))
+    ln.round_trip = {"max_ms": 12.0}
+    assert ln.time.end_quiet() == pytest.approx(0.012)
+    ln.round_trip = {"max_ms": 80.0}            # never more than END_QUIET
+    assert ln.time.end_quiet() == pytest.approx(END_QUIET)
+
+
+def test_the_end_of_a_case_counts_the_silence_since_the_line_was_last_read(clock):
+    port = _Port(clock, [], {b"SR6": b"0,00\r"})
+    ln = _link(port)
+    ln.round_trip = {"max_ms": 12.0}
+    assert ln.send("SR6").raw == b"0,00\r"
+    clock.t += 0.02                              # the case's own work after its last read
+    before = clock.t
+    ln.settle(final=True)
+    assert clock.t == before and ln.violations == []
+
+
+@pytest.mark.parametrize(("work", "after"), [(0.02, 0.004), (0.005, 0.01)])
+def test_a_second_answer_is_still_caught_at_the_end_of_a_case(clock, work, after):
+    """Right behind the first: while the case worked after its last read (waiting in
+    the port), or after that, within the round trip."""
+    port = _Port(clock, [], {b"SR6": b"0,00\r"})
+    ln = _link(port)
+    ln.round_trip = {"max_ms": 12.0}
+    assert ln.send("SR6").raw == b"0,00\r"
+    port.arrivals.append((clock.t - port.opened + after, b"0,00\r"))
+    clock.t += work
+    ln.settle(final=True)
+    assert [v.rule for v in ln.violations] == [TWICE]
