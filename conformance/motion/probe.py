@@ -112,7 +112,7 @@ class Probe:
         self.next_brake = False    # model the junctions at the next C's B (a [D] reading)
         self.start_delay = 0       # ns: a dwell before every start from rest (a reading)
         self.trips: list[int] = []          # ns: the round trips of frames answered at once
-        self.link.wait(SETTLE)
+        self.link.wait(SETTLE, Spent.MANUAL)      # the longest dwell T the manual allows
         start = self.read("start")
         if start is None:
             raise CouldNotTest("PF did not answer with positions before the motion")

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.motion.probe import _split, _stated_instead
+from conformance.link.account import Spent
+from conformance.motion.probe import SETTLE, _split, _stated_instead
 from conformance.protocol.wire import parse_response
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.targets import parse_target
 from gve_fixtures.profile import load_profile
 
 
@@ -30,3 +34,14 @@ def test_a_frame_is_read_as_its_command_and_the_rest(body, read):
 def test_only_a_range_no_manual_states_falls_back_to_the_reset_value(body, answer, instead):
     r = parse_response(answer, summed=False)
     assert _stated_instead(body, r, load_profile("GVE54")) == instead
+
+
+def test_the_rest_before_a_scenario_is_booked_as_the_manuals_dwell():
+    """The probe's rest before its first reading waits out the longest dwell T the
+    manual allows a vector: the manual's wait in the run's time account, not the
+    suite's own."""
+    result = run([parse_target("emu:GVE84-100")], select(["10.2.measured.path-rate"]))
+    (totals,) = [s["time"] for s in result.sessions.values()]
+    assert load_profile("GVE84-100").range("T").hi / 1000 <= SETTLE
+    assert totals[str(Spent.MANUAL)] == pytest.approx(SETTLE)
+    assert totals[str(Spent.WAITS)] == 0
