@@ -7,11 +7,11 @@ from hypothesis import strategies as st
 from hypothesis.stateful import rule
 
 from conformance.case.context import CaseContext, case
-from conformance.link.account import Spent
 from conformance.machines.as_case import run_machine
+from conformance.machines.running import Running
 from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from conformance.protocol.catalogue import classes
-from gve_fixtures.protocol import SECOND, ErrorCode, St6
+from gve_fixtures.protocol import ErrorCode, St6
 
 RUN, INTA = St6.RUN, St6.INTA
 
@@ -47,15 +47,8 @@ class ErrorMachine(UnitMachine):
     def __init__(self, ctx: CaseContext) -> None:
         super().__init__(ctx)
         reset = ctx.profile.reset
-        self.speed, self.accel = reset.V, reset.A * 1000.0      # pulses/s, pulses/s^2
-        #: until when (the link's clock, ns) the vectors the unit took may run: each at the
-        #: speed set, the ramps at the reset acceleration (a unit that takes longer makes
-        #: the rest the suite's); none once the unit was seen at rest or halted
-        self.runs_until = 0
-        self.halted_left = 0     # ns: what H left of them, for G to resume
-
-    def _motion_left(self) -> int:
-        return max(0, self.runs_until - self.link.now)
+        #: how long the vectors taken may run (the time account's motion)
+        self.running = Running(self.link, reset.V, reset.A * 1000.0)
 
     def observe(self) -> tuple[bool, bool, bool]:
         r = self.send("SR6")
@@ -67,7 +60,7 @@ class ErrorMachine(UnitMachine):
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
         moving = (run and not inta) or bool(st6 & St6.STOP)
         if not moving:
-            self.runs_until = 0
+            self.running.at_rest()
         return moving, run, inta
 
     @rule(steps=st.integers(500, 1500))
@@ -77,28 +70,18 @@ class ErrorMachine(UnitMachine):
         r = self.send(f"C{steps},0,0")
         holds(r is not None and r.code in (ErrorCode.OK, ErrorCode.QUEUE_FULL),
               "10.1.queue.cont-buffer", f"C answered {r}")
-        if r.ok and not r.inta:
-            # a C joins the one running without a stop: only the first ramps up and down
-            left = self._motion_left()
-            seconds = steps / self.speed + (0 if left else self.speed / self.accel)
-            self.runs_until = self.link.now + left + round(seconds * SECOND)
+        self.running.took(steps, r)
 
     @rule()
     def halt(self) -> None:
         r = self.send("H")
         holds(r is not None and r.ok and r.inta, "4.response.inta-bit",
               f"H answered {r}")
-        self.halted_left, self.runs_until = self._motion_left(), 0   # the axes stand
+        self.running.halted()
 
     @rule(seconds=st.sampled_from([0.01, 0.3, 1.5]))
     def wait(self, seconds: float) -> None:
-        # while the vectors taken may run, the wait is the unit's motion (as a case's
-        # wait while its vectors run); the rest is the suite's own
-        moving = min(seconds, self._motion_left() / SECOND)
-        if moving > 0:
-            self.link.wait(moving, Spent.MOTION)
-        if seconds > moving:
-            self.link.wait(seconds - moving)
+        self.running.wait(seconds)
 
     @rule(body=st.sampled_from(["V1000", "T99", "Z", "V+1", "SW8,F1", "F", "SR6", "C1,0,0",
                                 "A0", "T5,5", "N", "D", "G", "L0,0,0"]))
@@ -117,11 +100,11 @@ class ErrorMachine(UnitMachine):
               f"expected {want}")
         after = {"G": False, "D": False}.get(body, inta) if r.ok else inta
         if body == "V1000" and r.ok:
-            self.speed = 1000
+            self.running.speed = 1000
         elif body == "G" and r.ok:
-            self.runs_until = self.link.now + self.halted_left    # the halted vectors resume
+            self.running.resumed()
         elif body == "D" and r.ok:
-            self.halted_left = 0                                  # deleted
+            self.running.dropped()
         if r.code == ErrorCode.NOTHING_TO_GO and inta:
             self.send("D")                  # nothing started: clear INTA the manual's way
             after = r.inta
