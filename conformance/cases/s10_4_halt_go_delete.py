@@ -110,10 +110,10 @@ def halt_final(ctx: CaseContext) -> None:
     unit's own arithmetic lays the stop, the manuals do not say) [D], the step left held
     (RUN = 1); farther from the target, the ramp was not A's [M]."""
     link = ctx.link
-    link.wait(0.03)
+    link.wait(0.03, Spent.MANUAL)            # the longest dwell T over (as the probe's rest)
     setup(ctx, "V1500")
     setup(ctx, "L" + vector(ctx, 0, 0, 245))
-    link.wait(0.20)
+    link.wait(0.20, Spent.MOTION)            # the vector under way, into its deceleration
     answers(ctx, link.send("H"), "8", "H during the final deceleration", rule="10.4.halt.ramp")
     r = link.send("PF")
     short = r is not None and r.raw == b"8,0,0,244\r"
@@ -142,7 +142,7 @@ def halt_at_rest_on_the_rig(ctx: CaseContext) -> None:
     axes = len(ctx.profile.axes)
     setup(ctx, "V1500")
     setup(ctx, "L" + ",".join(["1500"] + ["-700"] * (axes - 1)))
-    link.wait(0.3)
+    link.wait(0.3, Spent.MOTION)             # the vector under way
     r = link.send("H")
     ctx.require(r is not None and r.inta, f"H answered {show(r)}")
     first = link.rig.state()

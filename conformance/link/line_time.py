@@ -19,6 +19,9 @@ from gve_fixtures.protocol import SECOND
 
 #: processing margin on top of the bytes' own transmission time
 MARGIN = 0.25
+#: real time: how long after its timeout an answer is still taken as its frame's, noted
+#: as late (a loaded USB adapter's line); later than that it is a hang's
+LATE = 1.0
 #: real time: at the end of a case, the longest it listens for bytes still on their way
 #: (a line whose round trip was measured is listened to for that long, :meth:`end_quiet`)
 END_QUIET = 0.05
@@ -110,6 +113,20 @@ class LineTime:
         at its end), and what the line adds (:meth:`line_seconds`)."""
         return MARGIN + self.byte_seconds(size + 64) + (slow or 0.0) + self.line_seconds()
 
+    def late(self) -> float:
+        """How long after the timeout :meth:`timeout` gives an answer is still its frame's,
+        noted as late (:data:`LATE`; nothing in virtual time, where no line delays it)."""
+        return 0.0 if self.virtual else LATE
+
+    def quiet(self) -> float:
+        """Real time: how long the line must have been silent since a frame's answer was
+        due before the next frame goes, once that frame timed out: the late grace
+        (:data:`LATE`) and the time any answer is given beyond its frame's bytes (the
+        margin, an answer's bytes at the baud rate, the line's delay: :meth:`timeout`), so
+        that an answer the unit began within the grace has come whole by then; a later one
+        is a hang's whichever frame it lands on (docs/decisions.md)."""
+        return LATE + self.timeout(None, 0)
+
     def line_seconds(self) -> float:
         """Real time: twice the slowest round trip the session measured (a USB adapter
         holds an answer's bytes up to its latency timer, and may hold its last piece
@@ -118,7 +135,9 @@ class LineTime:
 
     def end_quiet(self) -> float:
         """Real time: how long the end of a case listens for bytes still on their way (a
-        second answer follows the first at once): the line's round trip as measured
-        (:meth:`line_seconds`), at most :data:`END_QUIET`."""
-        measured = self.line_seconds()
+        second answer follows the first at once): the line's slowest round trip as
+        measured, which holds a USB adapter's latency timer once, as the second answer's
+        first byte waits at most once behind the first's last (the rest of its line is
+        read whole); at most :data:`END_QUIET`, and that where nothing was measured."""
+        measured = self.round_trip.get("max_ms", 0.0) / 1e3
         return min(END_QUIET, measured) if measured else END_QUIET

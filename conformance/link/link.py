@@ -13,10 +13,11 @@ fault alike.
 Answers belong to their frame: bytes that arrive before a frame is
 sent are logged as unsolicited and never read as its answer; after a frame timed out
 the link waits for a quiet line before the next one (real time), so a late answer is
-not taken for a later frame's. An answer up to :data:`LATE` after its timeout is
-still its frame's, noted as late (:attr:`Link.late`), not a failure: the spec sets no
-deadline, and a slow line (a USB adapter's latency timer under load) makes a correct
-unit late; later than that it is a hang's, and FAILs whatever the tag.
+not taken for a later frame's. An answer up to the late grace after its timeout
+(:data:`~conformance.link.line_time.LATE`) is still its frame's, noted as late
+(:attr:`Link.late`), not a failure: the spec sets no deadline, and a slow line (a USB
+adapter's latency timer under load) makes a correct unit late; later than that it is
+a hang's, and FAILs whatever the tag.
 Bytes after a complete answer are recorded in :attr:`Link.violations` ("answered
 twice"), which fail the case that sent the frame, each naming the rule it breaks.
 
@@ -67,9 +68,6 @@ from conformance.protocol.wire import is_hex_byte
 from gve_fixtures.protocol import SECOND, St6
 from gve_fixtures.transcript import HOST, Record
 
-#: real time: how long after its timeout an answer is still taken as its frame's, noted
-#: as late (a loaded USB adapter's line); later than that it is a hang's
-LATE = 1.0
 
 class Link:
     def __init__(self, port, guard: Guard, *, address: int = 0, baud: int = 115200,
@@ -294,7 +292,7 @@ class Link:
             timeout = 0.0            # an injected fault dropped it: no answer can come
         elif timeout is None:
             timeout = self.time.timeout(self._admitted.answer_seconds, len(data))
-            late = 0.0 if self.virtual else LATE
+            late = self.time.late()
         self._unbooked = sent
         # H and W answer when their motion ends: the wait for them is the motion's
         self.time.answered_as = (Spent.MOTION if self._admitted.answer_seconds

@@ -32,10 +32,6 @@ from conformance.protocol.view import View, answered_late, late
 from gve_fixtures.protocol import MAX_FRAME, SECOND
 from gve_fixtures.transcript import UNIT
 
-#: real time: after a frame timed out, how long the line must stay quiet before the next
-#: frame (an answer later than this after its timeout could still be misread)
-QUIET = 2.5
-
 
 class OwningLink(Protocol):
     """What the receiver reads of its link (conformance/link/link.py), which owns it."""
@@ -65,7 +61,12 @@ class Receiver:
         #: real time: answers that came after their timeout, within the quiet the line
         #: keeps before the next frame, taken as their frame's (notes, not violations)
         self.late: list[str] = []
-        self._quiet = 0.0        # seconds the line has been quiet since a timeout
+        #: real time: since when the line has been heard silent after the last frame timed
+        #: out (its answer's due instant; None: not since it was due)
+        self._silent_from: float | None = None
+        #: real time: until when the line was read (or the suite's last bytes went out):
+        #: anything the unit sent since is still in the port
+        self._read_to = 0.0
         self._last: tuple[str, bytes, bytes] = (UNASKED, b"", b"")   # state, frame, answer
         self._sent_until = 0      # when the last byte the suite wrote went out (ns)
         self._waited_out = True   # what is left unfinished had its watchdog waited out
@@ -74,6 +75,7 @@ class Receiver:
         """The link just wrote the suite's bytes (``wire``: the last frame they complete,
         None when they complete none)."""
         self._sent_until, self._waited_out = self.link.now, False
+        self._read_to = time.monotonic()
         if wire is not None:
             self._last = (UNASKED, wire, b"")
 
@@ -84,7 +86,9 @@ class Receiver:
         port, interrupts = self.link.port, self.link.guard.interrupts
         end = time.monotonic() + max(0.0, seconds - already)
         data = bytearray()
-        while time.monotonic() < end and not interrupts.pending:
+        first = True             # what waits is read even when the quiet has passed
+        while (first or time.monotonic() < end) and not interrupts.pending:
+            first = False
             port.timeout = min(0.05, max(0.0, end - time.monotonic()))
             got = port.read(max(1, port.in_waiting))
             data += got
@@ -98,10 +102,12 @@ class Receiver:
         only; what the unit wrote in one go is judged whole, as it came, never its tail
         as a second or a late answer."""
         link = self.link
-        if not data or data.endswith(CR) or link.guard.interrupts.pending:
-            return data
-        link.port.timeout = MARGIN + link.byte_seconds(MAX_FRAME) + link.time.line_seconds()
-        return data + link.port.read_until(CR)
+        if data and not data.endswith(CR) and not link.guard.interrupts.pending:
+            link.port.timeout = (MARGIN + link.byte_seconds(MAX_FRAME)
+                                 + link.time.line_seconds())
+            data += link.port.read_until(CR)
+        self._read_to = time.monotonic()
+        return data
 
     def during(self, seconds: float, spent: Spent) -> bytes:
         """Let ``seconds`` pass, booked under ``spent``; what arrived meanwhile."""
@@ -132,13 +138,15 @@ class Receiver:
         timeout = MARGIN if timeout is None else timeout
         raw = bytearray()
         port.timeout = timeout
-        self._quiet = 0.0
+        self._silent_from = None
         asked = time.monotonic()
         began = link.time.clock()
         answered_as, link.time.answered_as = link.time.answered_as, Spent.ANSWERS
         for i in range(lines):
             # an answer that began in time is read to its end before it is judged
             chunk = self.whole_line(port.read_until(CR))
+            if i == 0 and not chunk:
+                self._silent_from = time.monotonic()       # due, and nothing came
             if i == 0 and late and not chunk.endswith(CR) \
                     and not link.guard.interrupts.pending:
                 port.timeout = late
@@ -147,8 +155,8 @@ class Receiver:
                     self.late.append(f"{readable(self._last[1]) or 'a frame'} answered "
                                      f"{time.monotonic() - asked:.3f} s after it was sent, "
                                      f"{timeout:.3f} s allowed")
-                elif not chunk:
-                    self._quiet = late       # of the quiet wait before the next frame
+                elif chunk:
+                    self._silent_from = None
             raw += chunk
             if not chunk.endswith(CR):
                 break
@@ -224,6 +232,7 @@ class Receiver:
             if not chunk.endswith(CR):
                 break
             port.timeout = link.byte_seconds(64)
+        self._read_to = time.monotonic()
         link.time.book_exchange(len(raw), Spent.WAITS, began)
         if raw:
             link.record(UNIT, bytes(raw), "the rest of the answer")
@@ -240,13 +249,21 @@ class Receiver:
         kept_quiet = False
         if not link.virtual:
             if state == TIMED_OUT and not link.guard.interrupts.pending:
+                # the silence heard since the answer was due counts (the late grace, a
+                # watchdog waited out with nothing said)
+                silent = (time.monotonic() - self._silent_from
+                          if self._silent_from is not None and not data else 0.0)
                 with link.spending(Spent.WAITS):
-                    data += self.listen(QUIET, stop_early=True, already=self._quiet)
+                    data += self.listen(link.time.quiet(), stop_early=True, already=silent)
                 kept_quiet = not link.guard.interrupts.pending
             elif final:
+                # the silence since the line was last read counts (what came since waits
+                # in the port, and is read first)
+                silent = 0.0 if data else time.monotonic() - self._read_to
                 with link.spending(Spent.WAITS):
-                    data += self.listen(link.time.end_quiet(), stop_early=True)
-        self._quiet = 0.0
+                    data += self.listen(link.time.end_quiet(), stop_early=True,
+                                        already=silent)
+        self._silent_from = None
         waiting = link.port.in_waiting
         if waiting:
             data += link.port.read(waiting)

@@ -8,6 +8,7 @@ from hypothesis.stateful import rule
 
 from conformance.case.context import CaseContext, case
 from conformance.machines.as_case import run_machine
+from conformance.machines.running import Running
 from conformance.machines.unit_machine import UnitMachine, holds, index_invariant
 from conformance.protocol.catalogue import classes
 from gve_fixtures.protocol import ErrorCode, St6
@@ -43,6 +44,12 @@ CODE_RULES = {"V+1": "3.params.decimal", "A0": "10.cmd.accel-range", "N": "5.cod
 class ErrorMachine(UnitMachine):
     index_is_the_models = index_invariant()
 
+    def __init__(self, ctx: CaseContext) -> None:
+        super().__init__(ctx)
+        reset = ctx.profile.reset
+        #: how long the vectors taken may run (the time account's motion)
+        self.running = Running(self.link, reset.V, reset.A * 1000.0)
+
     def observe(self) -> tuple[bool, bool, bool]:
         r = self.send("SR6")
         holds(r is not None and r.ok and r.values, "10.cmd.status-words",
@@ -51,7 +58,10 @@ class ErrorMachine(UnitMachine):
         holds(r.inta == bool(st6 & INTA), "4.response.inta-bit",
               f"the INTA bit of {r.text} disagrees with ST6")
         inta, run = bool(st6 & INTA), bool(st6 & RUN)
-        return (run and not inta) or bool(st6 & St6.STOP), run, inta
+        moving = (run and not inta) or bool(st6 & St6.STOP)
+        if not moving:
+            self.running.at_rest()
+        return moving, run, inta
 
     @rule(steps=st.integers(500, 1500))
     def motion(self, steps: int) -> None:
@@ -60,16 +70,18 @@ class ErrorMachine(UnitMachine):
         r = self.send(f"C{steps},0,0")
         holds(r is not None and r.code in (ErrorCode.OK, ErrorCode.QUEUE_FULL),
               "10.1.queue.cont-buffer", f"C answered {r}")
+        self.running.took(steps, r)
 
     @rule()
     def halt(self) -> None:
         r = self.send("H")
         holds(r is not None and r.ok and r.inta, "4.response.inta-bit",
               f"H answered {r}")
+        self.running.halted()
 
     @rule(seconds=st.sampled_from([0.01, 0.3, 1.5]))
     def wait(self, seconds: float) -> None:
-        self.link.wait(seconds)
+        self.running.wait(seconds)
 
     @rule(body=st.sampled_from(["V1000", "T99", "Z", "V+1", "SW8,F1", "F", "SR6", "C1,0,0",
                                 "A0", "T5,5", "N", "D", "G", "L0,0,0"]))
@@ -87,6 +99,12 @@ class ErrorMachine(UnitMachine):
               f"{body} (moving={moving}, RUN={run}, INTA={inta}): code {r.code}, "
               f"expected {want}")
         after = {"G": False, "D": False}.get(body, inta) if r.ok else inta
+        if body == "V1000" and r.ok:
+            self.running.speed = 1000
+        elif body == "G" and r.ok:
+            self.running.resumed()
+        elif body == "D" and r.ok:
+            self.running.dropped()
         if r.code == ErrorCode.NOTHING_TO_GO and inta:
             self.send("D")                  # nothing started: clear INTA the manual's way
             after = r.inta

@@ -8,6 +8,7 @@ from hypothesis.stateful import initialize, precondition, rule
 
 from conformance.case.context import CaseContext, case
 from conformance.machines.as_case import run_machine
+from conformance.machines.running import Running
 from conformance.machines.unit_machine import UnitMachine, holds
 from gve_fixtures.protocol import ErrorCode
 
@@ -21,11 +22,14 @@ class KeepMachine(UnitMachine):
         self.halted = False
         self.kept = False
         self.booked = 0         # X steps of the vectors the unit accepted in this example
+        #: how long the vectors taken may run (the time account's motion)
+        self.running = Running(self.link, ctx.profile.reset.V, ctx.profile.reset.A * 1000.0)
 
     @initialize()
     def speed(self) -> None:
         r = self.send("V2000")
         holds(r is not None and r.ok, "10.cmd.modal", f"V2000 answered {r}")
+        self.running.speed = 2000
 
     @precondition(lambda self: not self.kept)
     @rule(steps=st.integers(200, 1500), count=st.integers(1, 3))
@@ -37,13 +41,14 @@ class KeepMachine(UnitMachine):
                 return
             r = self.send(f"C{steps},0,0")
             holds(r is not None, "10.1.queue.cont-buffer", "C got no answer")
+            self.running.took(steps, r)
             if r.ok:
                 self.model.book((steps, 0, 0))
                 self.booked += steps
 
     @rule(seconds=st.sampled_from([0.05, 0.2, 0.6]))
     def run(self, seconds: float) -> None:
-        self.link.wait(seconds)
+        self.running.wait(seconds)
 
     @precondition(lambda self: not self.kept)
     @rule()
@@ -51,6 +56,7 @@ class KeepMachine(UnitMachine):
         r = self.send("H")
         holds(r is not None and r.ok and r.inta, "10.4.halt.ramp", f"H answered {r}")
         self.halted = True
+        self.running.halted()
 
     @precondition(lambda self: self.halted and not self.kept)
     @rule(lift=st.integers(1, 300))
@@ -58,12 +64,14 @@ class KeepMachine(UnitMachine):
         r = self.send("K")
         holds(r is not None and r.ok and not r.inta, "10.5.keep.saves", f"K answered {r}")
         self.kept, self.halted = True, False
+        self.running.dropped()                # kept away from the queue
         for z in (-lift, lift):
             self.idle()
             r = self.send(f"L0,0,{z}")
             holds(r is not None and r.ok, "10.5.keep.single-l",
                   f"L0,0,{z} after K answered {r}")
         self.idle()
+        self.running.at_rest()
 
     @precondition(lambda self: self.kept)
     @rule(speed=st.sampled_from([500, 1000, 3000]))
@@ -84,6 +92,8 @@ class KeepMachine(UnitMachine):
               "10.4.go.resume", f"G answered {r}")
         if r.code == ErrorCode.NOTHING_TO_GO:
             self.send("D")
+        else:
+            self.running.resumed()            # a restored queue's time is not counted
         self.halted = False
 
     def teardown(self) -> None:

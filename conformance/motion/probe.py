@@ -118,7 +118,7 @@ class Probe:
         self.start_delay = 0       # ns: a dwell before every start from rest (a reading)
         self.accel_along_path = False   # VK vectors take A along |d| (a reading)
         self.trips: list[int] = []          # ns: the round trips of frames answered at once
-        self.link.wait(SETTLE)
+        self.link.wait(SETTLE, Spent.MANUAL)      # the longest dwell T the manual allows
         start = self.read("start")
         if start is None:
             raise CouldNotTest("PF did not answer with positions before the motion")

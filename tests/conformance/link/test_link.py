@@ -4,9 +4,9 @@ its own frames and for the raw frames the differential sides send."""
 import pytest
 
 from conformance.diff.sides import Side
-from conformance.link import link as link_module
-from conformance.link import receiver as receiver_module
-from conformance.link.link import LATE, Link
+from conformance.link import line_time as line_time_module
+from conformance.link.line_time import LATE
+from conformance.link.link import Link
 from conformance.targets import parse_target
 from gve_fixtures.protocol import SECOND
 
@@ -98,8 +98,7 @@ def test_a_frame_after_a_timed_out_one_counts_its_round_trip_from_the_quiet_line
         monkeypatch):
     # the quiet kept before it is the link's, not the line's: a round trip counted from
     # before it would widen every band read from the round trips by that much
-    monkeypatch.setattr(receiver_module, "QUIET", 0.5)
-    monkeypatch.setattr(link_module, "LATE", 0.0)
+    monkeypatch.setattr(line_time_module, "LATE", 0.0)
     port = _Line([b"", b"0,12\r"])           # V1000 unanswered, SR6 answered at once
     ln = real_link(port)
     assert ln.send("V1000") is None
@@ -110,16 +109,15 @@ def test_a_frame_after_a_timed_out_one_counts_its_round_trip_from_the_quiet_line
 
 
 def test_the_quiet_after_a_timed_out_frame_is_kept_once(monkeypatch):
-    monkeypatch.setattr(receiver_module, "QUIET", 0.5)
-    monkeypatch.setattr(link_module, "LATE", 0.0)
+    monkeypatch.setattr(line_time_module, "LATE", 0.0)
     port = _Line([b""])
     ln = real_link(port)
     assert ln.send("V1000") is None
-    before = ln.now
+    due = ln.now
     ln.settle()                                # waits for the quiet line
     kept = ln.now
     ln.settle()                                # the line is known quiet: no second wait
-    assert kept - before >= 0.5 * SECOND > ln.now - kept
+    assert kept - due >= ln.time.quiet() * SECOND > ln.now - kept
 
 
 def test_a_rate_the_case_sets_is_the_one_the_link_waits_by():

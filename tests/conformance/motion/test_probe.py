@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import pytest
 
-from conformance.motion.probe import _split, _stated_instead, _when_done
+from conformance.link.account import Spent
+from conformance.motion.probe import SETTLE, _split, _stated_instead, _when_done
 from conformance.protocol.wire import parse_response
+from conformance.run.runner import run
+from conformance.run.selection import select
+from conformance.targets import parse_target
 from gve_fixtures.profile import load_profile
 from tests.conformance.cases.used import used_unit
 
@@ -56,3 +60,14 @@ def test_an_l_refused_with_1_while_a_dwell_holds_the_queue_is_sent_again_until_t
         assert _when_done(link, "L10,0,0", refused, profile).code == 1
     finally:
         session.finish()
+
+
+def test_the_rest_before_a_scenario_is_booked_as_the_manuals_dwell():
+    """The probe's rest before its first reading waits out the longest dwell T the
+    manual allows a vector: the manual's wait in the run's time account, not the
+    suite's own."""
+    result = run([parse_target("emu:GVE84-100")], select(["10.2.measured.path-rate"]))
+    (totals,) = [s["time"] for s in result.sessions.values()]
+    assert load_profile("GVE84-100").range("T").hi / 1000 <= SETTLE
+    assert totals[str(Spent.MANUAL)] == pytest.approx(SETTLE)
+    assert totals[str(Spent.WAITS)] == 0
