@@ -72,7 +72,8 @@ def partial(ctx: CaseContext) -> None:
       rules=("5.code.busy-moving", "10.5.keep.saves"))
 def moving(ctx: CaseContext) -> None:
     """K and R are not possible while moving (7)"""
-    setup(ctx, "C" + vector(ctx, 2000))
+    # half the default envelope: a save an earlier case gave back may run again at R
+    setup(ctx, "C" + vector(ctx, 1000))
     ctx.link.wait(0.2, Spent.MOTION)         # the vector under way
     code(ctx, ctx.link.send("K"), ErrorCode.BUSY, "K while moving", rule="5.code.busy-moving")
     code(ctx, ctx.link.send("R"), ErrorCode.BUSY, "R while moving", rule="5.code.busy-moving")

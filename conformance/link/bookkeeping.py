@@ -480,7 +480,7 @@ class Bookkeeping:
     @property
     def keep_held(self) -> bool:
         """Whether a `K` the unit took (or may have) holds a save no `R` or `J` gave back."""
-        return self.envelope.saved is not None and self.envelope.save_kept
+        return self.envelope.saved is not None
 
     def excursion(self) -> list[tuple[float, float]]:
         """Per axis, the farthest the axis may have gone each way, in full steps."""

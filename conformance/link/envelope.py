@@ -129,9 +129,11 @@ class Envelope:
         #: where the run of K's save may take each axis (None: no save held)
         self.saved: list[Span] | None = None
         self.save_moves = False                  # the save holds a vector
-        #: a K took (or may have taken) the save and no R gave it back: after R the save
-        #: may still be held (a reader may keep it, spec 10.5 [D]) but nothing asks for R
-        self.save_kept = False
+        #: how far a save `R` gave back moves the axes should it run again: that `R`
+        #: empties the save is a decision (spec 10.5 [D]), and a unit that keeps it runs
+        #: it once more after another `R` and `G`, from wherever the axes then stand
+        #: (None: no save given back, or a `K` or restart since)
+        self.rerun: list[Span] | None = None
         self.settled = True                      # nothing can be moving now
         self.offset = [UNKNOWN] * axes           # physical = counter + offset
         self.factor = Span(min(factors), max(factors))   # counter units per commanded step
@@ -218,17 +220,18 @@ class Envelope:
             # the save's run goes wherever the queue could still go from here
             kept, moves = self.reach(), any(q != EMPTY for q in self.queue)
             self._cut()
+            if sure:
+                self.rerun = None
             if sure or self.saved is None:
                 self.saved, self.save_moves = kept, moves
             else:
                 self.saved = [a.hull(b) for a, b in zip(self.saved, kept, strict=True)]
                 self.save_moves = self.save_moves or moves
-            self.save_kept = True
         else:
             self._cut()
         if restart:
             if sure:
-                self.saved, self.save_kept = None, False
+                self.saved, self.rerun = None, None
             self.offset = list(self.start) if sure else [
                 o.hull(s) for o, s in zip(self.offset, self.start, strict=True)]
             reset = point(self.reset_factor)
@@ -238,20 +241,24 @@ class Envelope:
     def restore(self, outcome: Outcome) -> None:
         """`R`: the saved queue replaces what is held and runs after `G` from where the
         axes stand: they may then be anywhere its run goes, and rest there once the unit
-        shows it ended (a read at rest tells where). A save `R` took is given back, yet
-        may still be held: that `R` empties it is a decision (spec 10.5 [D]), and a unit
-        that keeps it runs it again after another `R` and `G`."""
+        shows it ended (a read at rest tells where). A save given back may run again
+        (:attr:`rerun`) from wherever the axes stand at a later `R`."""
         if outcome is Outcome.REFUSED:
             return
         self._cut()
+        before = self.start
+        if self.rerun is not None:
+            self.start = [a.hull(a + d) for a, d in zip(self.start, self.rerun, strict=True)]
         moves = self.saved is not None and self.save_moves
         if moves:
-            before, self.start = self.start, [
-                a.hull(b) for a, b in zip(self.start, self.saved, strict=True)]
-            # kept, it runs again from where this run ends: as far once more
-            self.saved = [s.hull(s + (s - b)) for s, b in zip(self.saved, before, strict=True)]
+            self.start = [a.hull(b) for a, b in zip(self.start, self.saved, strict=True)]
+            # run again, it goes as far from wherever it starts (its own run's reach)
+            ran = [s - b for s, b in zip(self.saved, before, strict=True)]
+            self.rerun = ran if self.rerun is None else [
+                a.hull(b) for a, b in zip(self.rerun, ran, strict=True)]
         if outcome is Outcome.ACCEPTED:
-            self.save_kept = False
+            self.saved, self.save_moves = None, False
+        moves = moves or self.rerun is not None
         self.settled = outcome is Outcome.ACCEPTED and not moves
         self._see()
 
@@ -370,6 +377,8 @@ class Envelope:
         if restarted:
             self.factor = point(self.reset_factor)
         self.queue, self.saved, self.settled = [EMPTY] * self.axes, None, True
+        if restarted:
+            self.rerun = None
         self.set_counters = False
         self.trail = list(self.start)
         self._see()

@@ -329,7 +329,7 @@ class Guard:
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
         # G and a write of ST6 resume the queue, R the save: they move only when something waits
         waiting = {"queue": any(p != EMPTY for p in e.queue),
-                   "save": e.saved is not None and e.save_moves}.get(
+                   "save": (e.saved is not None and e.save_moves) or e.rerun is not None}.get(
                        _RESUMES.get(command.name, ""), False)
         if reach != e.reach() or waiting:
             if self.interrupts.stopped:
