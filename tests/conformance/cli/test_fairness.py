@@ -31,7 +31,7 @@ def test_an_emulator_taking_a_reading_is_graded_by_the_tags():
     assert run_case(case, strict).verdict == FAIL
 
 
-def test_the_fairness_score_of_one_reading(capsys):
+def test_the_fairness_score_of_one_reading(capsys, fairness_on_one_profile):
     status = main(["fairness", "--no-reports",
                    "--reading", "plus-sign", "--cases", "3.frame.*", "-v"])
     out = capsys.readouterr().out
@@ -104,7 +104,8 @@ def test_a_check_that_names_no_rule_makes_a_reading_unfair(monkeypatch):
     assert not t.fair and "names no rule" in t.unfair[0]
 
 
-def test_fairness_runs_diff_and_names_the_rule_of_every_difference(capsys):
+def test_fairness_runs_diff_and_names_the_rule_of_every_difference(capsys,
+                                                                   fairness_on_one_profile):
     # the reference's R with nothing kept answered 5: the empty save's rule, as the
     # catalogue grades it, not the exact restore's [M]
     status = main(["fairness", "--no-reports", "--reading", "restore-nothing-kept-range",

@@ -54,7 +54,7 @@ def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
     assert lines[-1].startswith("FAILED — mutation score: 0/1")
 
 
-def test_fairness_numbers_each_reading_in_a_log(capsys):
+def test_fairness_numbers_each_reading_in_a_log(capsys, fairness_on_one_profile):
     assert main(["fairness", "--no-reports",
                  "--reading", "plus-sign", "--cases", "3.params.*"]) == 0
     # (lines saying it is still working, every 5 s, count nothing done)

@@ -12,7 +12,9 @@ import pytest
 
 from conformance.cli import main
 from conformance.cli.progress import Progress
-from conformance.verdicts.verdict import COULD_NOT_TEST, MISSING, PASS
+from conformance.run.selection import select
+from conformance.verdicts.verdict import COULD_NOT_TEST, ERROR, FAIL, MISSING, PASS
+from gve_fixtures.profile import available_profiles
 from tests.conformance.reports.toy import result
 
 #: the default run's three reports together stay under this (about 1,450 case runs:
@@ -38,6 +40,19 @@ def test_the_default_run_writes_at_most_2_5_mb(default_run):
     sizes = {p.name: p.stat().st_size for p in run_dir.iterdir()}
     assert status == 0 and set(sizes) == {"report.html", "results.json", "junit.xml"}
     assert sum(sizes.values()) <= LIMIT, sizes
+
+
+def test_the_clean_emulator_passes_every_case_on_every_profile(default_run):
+    """The default run is the clean emulator on every profile with every case (ci
+    settings): no case FAILs or ERRs it, on any profile (the control of the mutants'
+    tests, tests/conformance/test_mutants.py)."""
+    _, _, run_dir, _ = default_run
+    results = json.loads((run_dir / "results.json").read_text())["results"]
+    assert {r["profile"] for r in results} == set(available_profiles())
+    assert len(results) == len(available_profiles()) * len(select())
+    bad = [f"{r['id']} [{r['profile']}]: {r['verdict']}" for r in results
+           if r["verdict"] in (FAIL, ERROR)]
+    assert bad == []
 
 
 def test_the_default_run_reports_passed_with_its_metadata(default_run):
