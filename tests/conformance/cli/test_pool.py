@@ -4,6 +4,7 @@ map with the results so far, every worker ended, nothing raised past the pool.""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import signal
 import subprocess
@@ -68,13 +69,23 @@ def test_a_signal_to_this_process_stops_every_worker_and_ends_the_map(sig):
     assert pids and not any(_alive(p) for p in pids)
 
 
+def job_in(n: int) -> tuple[int, int]:
+    """:func:`job`, and the worker that ran it."""
+    return job(n), os.getpid()
+
+
 def test_a_signal_to_one_worker_alone_stops_them_all():
-    before = frozenset(_children())
+    # the worker is the one that ran job 0, the pool's the multiprocessing children: a
+    # process another test left starting meanwhile is no worker, and signalling it would
+    # stop nothing
+    before = {p.pid for p in multiprocessing.active_children()}
     with workers(2) as pool:
-        for result in pool.map(job, [0, 1, 2, 3]):
+        for result, worker in pool.map(job_in, [0, 1, 2, 3]):
             if result == 0:
-                pids = _children(before)
-                os.kill(pids[0], signal.SIGTERM)
+                pids = [p.pid for p in multiprocessing.active_children()
+                        if p.pid not in before]
+                assert worker in pids and len(pids) == 2
+                os.kill(worker, signal.SIGTERM)
     assert pool.interrupted
     assert not any(_alive(p) for p in pids)
 
