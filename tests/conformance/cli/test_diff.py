@@ -87,9 +87,13 @@ def _probes_over_a_pty(mutant: str | None, capsys) -> tuple[int, str]:
 
 def test_over_a_pty_the_probes_raise_nothing_against_the_emulator(capsys):
     """Every probe in real time against the correct emulator: their slow rates, waits
-    and reads at rest leave no disagreement within the timing band."""
+    and reads at rest leave no disagreement within the timing band; one a loaded machine
+    makes (the emulator's process late to step, seen once and not when replayed) is not
+    counted."""
     status, out = _probes_over_a_pty(None, capsys)
-    assert status == 0 and "PASS 1" in out and "not confirmed" not in out, out
+    assert status == 0 and "PASS 1" in out, out
+    unconfirmed = [line for line in out.splitlines() if "not confirmed" in line]
+    assert all(line.endswith("not counted") for line in unconfirmed), out
 
 
 @pytest.mark.slow
