@@ -128,6 +128,10 @@ class Read(enum.Enum):
 class Envelope:
     """One unit's axes for the whole run, in counter units from where the run began."""
 
+    #: a copy a frame is judged on (:meth:`would_reach`): where the axes may have been
+    #: is not kept on it
+    trial = False
+
     def __init__(self, axes: int, limit: float, factors: Sequence[int] = (1,),
                  reset_factor: int = 1) -> None:
         self.axes = axes
@@ -159,6 +163,7 @@ class Envelope:
         trial.__dict__.update(self.__dict__)
         trial.start, trial.queue, trial.offset = list(self.start), list(self.queue), \
             list(self.offset)
+        trial.trial = True
         event(trial)
         return trial.reach()
 
@@ -399,6 +404,8 @@ class Envelope:
         self.trail = list(self.start)
 
     def _see(self) -> None:
+        if self.trial:
+            return              # a trial's places seen are not kept: only its reach is read
         reach = self.reach()
         self.seen = [a.hull(b) for a, b in zip(self.seen, reach, strict=True)]
         self.trail = [a.hull(b) for a, b in zip(self.trail, reach, strict=True)]
