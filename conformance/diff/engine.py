@@ -133,6 +133,8 @@ class Pair:
         #: and the emulator's restore (a fork) costs more than its power-on
         self.restores = False
         self._teller: Teller | None = None     # the example's frames told ahead
+        #: virtual time: the step whose rig read agreed last, and both sides' instants then
+        self._seen: tuple[int, int, int] | None = None
         #: when the search's time is up (``--seconds``): a sequence stops between steps
         self.out_of_time: Callable[[], bool] = _never
         #: what the sequences reached (commands, table values, states), if counted
@@ -162,6 +164,7 @@ class Pair:
     def _run(self, steps: list[Step], *, ahead: bool) -> ExampleRun:
         out = ExampleRun()
         self._teller = None
+        self._seen = None
         if not self._begin(out):
             return out
         self._last = list(steps)
@@ -186,8 +189,14 @@ class Pair:
                 elif self._frames(step, place, out, earlier):
                     break
             else:
-                # what the rig sees at the end, whatever the sequence's last read was
-                if not out.ended:
+                # what the rig sees at the end, whatever the sequence's last read was;
+                # in virtual time a read the sequence ended with, at this very instant on
+                # both sides, is what the rigs see at the end: nothing has happened since
+                if out.ended:
+                    pass
+                elif self._seen == (len(steps) - 1, self.target.now, self.reference.now):
+                    out.records.append(StepRecord(Step(STATE), place=len(steps)))
+                else:
                     self._rig_state(Step(STATE), len(steps), out, earlier)
             if self._teller is not None:
                 self._teller.finish()
@@ -311,6 +320,8 @@ class Pair:
                 out.disagreement = self._disagreement(step, labelled, kind, out, earlier)
                 return True
         out.records.append(StepRecord(step, place=place))
+        if self.exact:
+            self._seen = (place, self.target.now, self.reference.now)
         return False
 
     def _frames(self, step: Step, place: int, out: ExampleRun, earlier: set[str]) -> bool:

@@ -87,19 +87,22 @@ class Side:
         self._origin = self.link.now
         return self.link
 
-    def open_powered(self, *, kept: bool = False) -> Link | None:
+    def open_powered(self, *, kept: bool = False,
+                     meanwhile: Callable[[], None] | None = None) -> Link | None:
         """A co-simulator's link begun at its power-on through the rig in place of the
         known state (RealSession.open_powered; with ``kept``, the unit powered on first
         kept where the simulator keeps a state, and restored for the next), and where its
         rig then sees
         the axes, from which the sequence's physical positions count (a fresh reference's
         count from 0): read once for the unit kept, since a restored one is that unit;
-        None where the target cannot be begun so (the known state then)."""
+        None where the target cannot be begun so (the known state then). ``meanwhile``:
+        work of the caller's done while the simulator powers the unit on (done whenever
+        a power-on is asked for, taken or not)."""
         if self.session is None:
             self.session = self.target.begin()
         if not getattr(self.session, "powers_on", False):
             return None
-        link = self.session.open_powered(kept=kept)
+        link = self.session.open_powered(kept=kept, meanwhile=meanwhile)
         if link is None:
             return None
         self.link = link

@@ -59,9 +59,9 @@ class Start:
         something behind shows in the sequence's first answers, a finding of its own.
         False where the target is not begun so (a real unit, a real-time simulator, a
         rig that refuses `power-on`): the known state then."""
-        if self.target.open_powered(kept=kept) is None:
+        # the fresh reference is made while the simulator powers its unit on
+        if self.target.open_powered(kept=kept, meanwhile=self.reference.open) is None:
             return False
-        self.reference.open()
         self.same_eeprom()
         self.reference.age(self.target.session.since_power_on / SECOND)
         self.timing.begin()

@@ -27,11 +27,16 @@ class Body:
         parsed = parse(body)
         return cls(parsed.key, parsed.params)
 
-    def fields(self, count: int) -> list[Span]:
+    def fields(self, count: int) -> tuple[Span, ...]:
         """The first ``count`` comma-separated integers (missing ones 0, unreadable ones
         unbounded)."""
-        parts = self.params.split(",") if self.params else []
-        return [number(parts[i]) if i < len(parts) else ZERO for i in range(count)]
+        return _fields(self.params, count)
+
+
+@lru_cache(maxsize=4096)     # a vector's fields are read when it is judged and booked
+def _fields(params: str, count: int) -> tuple[Span, ...]:
+    parts = params.split(",") if params else []
+    return tuple(number(parts[i]) if i < len(parts) else ZERO for i in range(count))
 
 
 def number(text: str, base: int = 10) -> Span:

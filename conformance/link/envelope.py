@@ -29,35 +29,44 @@ puts the axis anywhere on that trail, its counter counting from there.
 
 from __future__ import annotations
 
-import copy
 import enum
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from typing import NamedTuple
 
 INF = math.inf
+#: a named tuple made at C speed (the class's own ``__new__`` is Python): the guard makes
+#: thousands of spans a second
+_new = tuple.__new__
 
 
-@dataclass(frozen=True)
-class Span:
-    """An interval of positions (or of offsets, or of factors); bounds may be infinite."""
+class Span(NamedTuple):
+    """An interval of positions (or of offsets, or of factors); bounds may be infinite.
+    (A named tuple: the guard makes and compares thousands of them a second.)"""
 
     lo: float
     hi: float
 
-    def __add__(self, other: Span) -> Span:
-        return Span(self.lo + other.lo, self.hi + other.hi)
+    def __add__(self, other: Span) -> Span:  # type: ignore[override]
+        return _new(Span, (self.lo + other.lo, self.hi + other.hi))
 
     def __sub__(self, other: Span) -> Span:
         return Span(self.lo - other.hi, self.hi - other.lo)
 
     def times(self, factor: Span) -> Span:
+        if factor.lo == factor.hi == 1:
+            return self
         ends = [a * b for a in (self.lo, self.hi) for b in (factor.lo, factor.hi)
                 if not (math.isinf(a) and b == 0)]
         return Span(min(ends), max(ends))
 
     def hull(self, other: Span) -> Span:
-        return Span(min(self.lo, other.lo), max(self.hi, other.hi))
+        lo, hi = self.lo, self.hi
+        if other.lo < lo:
+            lo = other.lo
+        if other.hi > hi:
+            hi = other.hi
+        return self if lo == self.lo and hi == self.hi else _new(Span, (lo, hi))
 
     def meet(self, other: Span) -> Span | None:
         lo, hi = max(self.lo, other.lo), min(self.hi, other.hi)
@@ -80,8 +89,7 @@ ZERO = point(0)
 UNKNOWN = Span(-INF, INF)
 
 
-@dataclass(frozen=True)
-class Path:
+class Path(NamedTuple):
     """Vectors of one axis run in order from a start: their total and the lowest and
     highest partial sums (0 included: where the path starts)."""
 
@@ -90,8 +98,8 @@ class Path:
     high: float = 0
 
     def then(self, step: Span) -> Path:
-        total = self.total + step
-        return Path(total, min(self.low, total.lo), max(self.high, total.hi))
+        lo, hi = self.total.lo + step.lo, self.total.hi + step.hi
+        return _new(Path, (_new(Span, (lo, hi)), min(self.low, lo), max(self.high, hi)))
 
     @property
     def swing(self) -> Span:
@@ -120,6 +128,10 @@ class Read(enum.Enum):
 class Envelope:
     """One unit's axes for the whole run, in counter units from where the run began."""
 
+    #: a copy a frame is judged on (:meth:`would_reach`): where the axes may have been
+    #: is not kept on it
+    trial = False
+
     def __init__(self, axes: int, limit: float, factors: Sequence[int] = (1,),
                  reset_factor: int = 1) -> None:
         self.axes = axes
@@ -146,15 +158,17 @@ class Envelope:
     # -- what the unit may do ---------------------------------------------------------------
     def reach(self) -> list[Span]:
         """Per axis, every position the axis may be at now or reach with what it accepted."""
-        return [Span(s.lo + q.low, s.hi + q.high)
+        return [_new(Span, (s.lo + q.low, s.hi + q.high))
                 for s, q in zip(self.start, self.queue, strict=True)]
 
     def would_reach(self, event: Callable[[Envelope], None]) -> list[Span]:
         """The reach after ``event`` (applied to a copy): how to judge a frame before it
         is sent."""
-        trial = copy.copy(self)
+        trial = object.__new__(type(self))     # copy.copy's shallow copy, at less cost
+        trial.__dict__.update(self.__dict__)
         trial.start, trial.queue, trial.offset = list(self.start), list(self.queue), \
             list(self.offset)
+        trial.trial = True
         event(trial)
         return trial.reach()
 
@@ -408,6 +422,8 @@ class Envelope:
         self.trail = list(self.start)
 
     def _see(self) -> None:
+        if self.trial:
+            return              # a trial's places seen are not kept: only its reach is read
         reach = self.reach()
         self.seen = [a.hull(b) for a, b in zip(self.seen, reach, strict=True)]
         self.trail = [a.hull(b) for a, b in zip(self.trail, reach, strict=True)]

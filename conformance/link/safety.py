@@ -31,13 +31,12 @@ Public interface (docs/suite.md, "The session and its guard")::
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 from conformance.link.answer_time import AnswerTime
 from conformance.link.body import Body, number
-from conformance.link.bookkeeping import Bookkeeping, Depth, steps
+from conformance.link.bookkeeping import Bookkeeping, Depth, shallow, steps
 from conformance.link.envelope import EMPTY, INF, Envelope, Outcome, Span
 from conformance.link.framing import HostFrame, Response
 from conformance.link.ledger import EepromLedger
@@ -328,9 +327,10 @@ class Guard:
                 f"{steps(span.lo, self.scale)}..{steps(span.hi, self.scale)} full steps "
                 f"from where the run began, beyond the envelope ±{self.max_travel}")
         # G and a write of ST6 resume the queue, R the save: they move only when something waits
-        waiting = {"queue": any(p != EMPTY for p in e.queue),
-                   "save": (e.saved is not None and e.save_moves) or e.rerun is not None}.get(
-                       _RESUMES.get(command.name, ""), False)
+        resumes = _RESUMES.get(command.name)
+        waiting = (resumes == "queue" and any(p != EMPTY for p in e.queue)) or (
+            resumes == "save" and ((e.saved is not None and e.save_moves)
+                                   or e.rerun is not None))
         if reach != e.reach() or waiting:
             if self.interrupts.stopped:
                 raise SafetyStop(f"{body}: no motion after Ctrl-C")
@@ -376,7 +376,7 @@ class Guard:
         through when it comes to be sent, whatever the unit answered the ones before it.
         The copy asks nobody (motion not confirmed yet is refused on it) and changes
         nothing here."""
-        trial = copy.copy(self)
+        trial = shallow(self)
         trial.bookkeeping = self.bookkeeping.copy(self.liveness)
         trial.eeprom = self.eeprom.copy()
         trial.times = AnswerTime(self.profile, trial.envelope)

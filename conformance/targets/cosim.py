@@ -372,8 +372,10 @@ class CosimLine(SentAhead, KeptState):
                 if t < last:
                     self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: stamped {t}, "
                                 f"before the byte it sent before ({last})")
-                for i, value in enumerate(data):
-                    at = t + i * b
+                # bytes before the first CR change nothing until a CR has come
+                first = 0 if cr_sent or stop is not None else data.find(CR)
+                for i in range(len(data) if first < 0 else first, len(data)):
+                    value, at = data[i], t + i * b
                     if stop is not None or (cr_sent and at > end):
                         self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: a byte at "
                                     f"{at}, after the CR at "

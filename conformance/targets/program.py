@@ -77,16 +77,18 @@ class Program:
         """The next line read from standard output itself, waiting up to ``timeout``
         seconds (None: until one comes); None when none came or the output ended. A line
         longer than LINE_LIMIT comes in pieces."""
-        end = None if timeout is None else time.monotonic() + timeout
+        end: float | None = None             # (the clock read once it has to wait)
         while True:
             k = self._pending.find(b"\n")
             if k >= 0 or len(self._pending) >= LINE_LIMIT or (self._eof and self._pending):
                 k = min(len(self._pending), LINE_LIMIT) if k < 0 else k
-                raw = bytes(self._pending[:k])
+                raw = self._pending[:k]
                 del self._pending[:k + 1]
                 return raw.decode("utf-8", "replace").rstrip("\r")
             if self._eof:
                 return None
+            if timeout is not None and end is None:
+                end = time.monotonic() + timeout
             left = None if end is None else max(0.0, end - time.monotonic())
             try:
                 ready = select.select([self._fd, self._wake_r], [], [], left)[0]

@@ -271,7 +271,8 @@ class RealSession(Session):
         return info.real and info.virtual_time and self._power_on_refused == "" \
             and getattr(self.target, "rig", None) is not None
 
-    def open_powered(self, *, kept: bool = False) -> Link | None:
+    def open_powered(self, *, kept: bool = False,
+                     meanwhile: Callable[[], None] | None = None) -> Link | None:
         """A link to the unit just powered on through its rig, in place of the known state:
         the rig's hands off, the power cycled (the guard books it as a restart: counters
         zeroed, the axes where they stand), the restart waited out on the suite's clock
@@ -283,13 +284,17 @@ class RealSession(Session):
         docs/cosim.md), the first unit so powered on is kept and the next ones are that
         one restored (:attr:`restored`): the same reset state without the power-on and
         its wait (for a caller whose units leave nothing behind that a power-on keeps,
-        EEPROM bytes and the rig's rate switch: diff puts back what it wrote)."""
+        EEPROM bytes and the rig's rate switch: diff puts back what it wrote).
+        ``meanwhile``: work of the caller's done once the power-on is asked for, before
+        its replies are read (while a simulator that takes commands ahead runs it)."""
         self.start()
         self.guard.check_idle()
         link = self._new_link()
         rig = link.rig
         self.restored = kept and self._kept_power_on is not None
         if self.restored:
+            if meanwhile is not None:
+                meanwhile()
             link.port.restore()
             rig.forget_hands()             # restored as they were kept: off
             rig.on_power_on()
@@ -304,6 +309,8 @@ class RealSession(Session):
                 ahead = getattr(link.port, "power_on_ahead", None)
                 if ahead is not None:
                     ahead(wait, state=not kept)
+                if meanwhile is not None:
+                    meanwhile()
                 rig.power_on()
             except CouldNotTest as err:
                 self._power_on_refused = str(err)

@@ -14,7 +14,7 @@ from conformance.diff.grammar import Grammar, Options, load_grammar, probes
 from conformance.diff.gvt import steps_of, transcript
 from conformance.diff.labels import label
 from conformance.diff.sides import Side
-from conformance.diff.steps import FILL, FRAME, WAIT, Step
+from conformance.diff.steps import FILL, FRAME, STATE, WAIT, Step
 from conformance.link.stops import UnitRestarted
 from conformance.targets import parse_target
 from conformance.targets.emu import mutants
@@ -371,3 +371,20 @@ def test_what_a_packet_broken_by_h_shows_is_the_packet_rule_s_not_the_halt_s():
     assert d is not None and (d.command, d.rule, d.tag) == ("PF", "7.packet.all-or-nothing",
                                                             "D"), d
     assert "packet-broken" in d.earlier
+
+
+def test_a_sequence_ending_with_a_rig_read_is_not_read_again_at_its_end(monkeypatch):
+    """In virtual time the rigs read at the sequence's last step, at the same instant on
+    both sides, are what they see at its end: read once, its record kept all the same;
+    a sequence whose last step is a frame has them read at its end."""
+    reads = []
+    rig_state = Side.rig_state
+    monkeypatch.setattr(Side, "rig_state", lambda side: reads.append(side) or rig_state(side))
+    p = pair(None)
+    for steps, read in (([Step(FRAME, body="SR0"), Step(STATE)], 1),
+                        ([Step(STATE), Step(FRAME, body="SR0")], 2)):
+        reads.clear()
+        out = p.run(steps)
+        assert out.disagreement is None and not out.ended
+        assert len(reads) == 2 * read                  # the target's and the reference's
+        assert [r.place for r in out.records] == [0, 1, 2]
