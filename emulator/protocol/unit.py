@@ -310,7 +310,8 @@ class Unit:
                 else ErrorCode.UNKNOWN
             self._answer(raw, code, [], t, remember=known.remembered)
             return
-        if command.packet == DISCARD:
+        if command.packet == DISCARD and not (
+                name in ("@", ">") and self.readings.active("packet-open-through-queries")):
             ses.packet = None
         self._run(raw, command, name, params, t)
 
