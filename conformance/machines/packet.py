@@ -22,6 +22,7 @@ class PacketMachine(UnitMachine):
     def __init__(self, ctx: CaseContext) -> None:
         super().__init__(ctx)
         self.pending: list[str] = []          # the members sent since *S
+        self.measure_packet_counting()
 
     @initialize(summed=st.booleans())
     def mode(self, summed: bool) -> None:
