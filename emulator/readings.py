@@ -72,6 +72,12 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                                   "an open packet is closed only by *E: H, @, > and J "
                                   "inside it are members (failing it with 4, unanswered); "
                                   "a second *S still restarts it"),
+    "packet-frames-uncounted": (("8.index.packet-frames-counted",),
+                                "a packet's *S and *E do not advance the index: only its "
+                                "members are commands (\"*E10 -konec (bylo 10 příkazů)\")"),
+    "packet-open-through-queries": (("7.packet.breakers",),
+                                    "@ and > inside an open packet are answered at once "
+                                    "and leave it open: only *E, H and J end it"),
     "packet-committed-on-arrival": (("7.packet.all-or-nothing",),
                                     "each valid packet member takes effect as it arrives "
                                     "(B sets B, C is queued); *E still answers code,k, "

@@ -188,12 +188,19 @@ def mpg_values(ctx: CaseContext) -> None:
         r = link.send("SR6")
         ctx.expect(r is not None and r.values == ["00"], f"{shown}: MPG inert, ST6 = 00",
                    observed=show(r), expected="0,00", rule="9.reset.mpg-inert")
+        code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.OK,
+             f"{shown}: not a listed value, the MPG is not allowed: after J a vector is taken",
+             rule="9.reset.mpg")
+        link.poll("L" + vector(ctx, -1), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
+        finished(ctx, 10, lambda r: r.code != ErrorCode.QUEUE_FULL)
         # where the MPG is not allowed (M114 12.2 "jiná: MPG nepovoleno"), what Y& answers
-        # is silent: a reader may refuse it out of range, the [D] reading's rule judges
+        # is silent: a reader may refuse it out of range; and one may hold RUN from a Y&
+        # sent all the same (13.6.8 "Při odeslání Y+ nebo Y& je stav stroje v chodu"):
+        # the [D] reading's rule judges both
         answers(ctx, link.send("Y&"), "0,Y&", f"{shown}: Y&", rule="9.reset.mpg-inert")
         code(ctx, link.send("L" + vector(ctx, 1)), ErrorCode.OK,
-             f"{shown}: not a listed value, the MPG is not allowed: a vector is taken",
-             rule="9.reset.mpg")
+             f"{shown}: not a listed value: with Y& sent a vector is still taken",
+             rule="9.reset.mpg-inert")
         link.poll("L" + vector(ctx, -1), lambda r: r.code != ErrorCode.QUEUE_FULL, 10)
         finished(ctx, 10, lambda r: r.code != ErrorCode.QUEUE_FULL)
     answers(ctx, link.send("Y-"), "0,Y-", "the MPG off at the end", rule="10.cmd.mpg")

@@ -22,6 +22,7 @@ class PacketMachine(UnitMachine):
     def __init__(self, ctx: CaseContext) -> None:
         super().__init__(ctx)
         self.pending: list[str] = []          # the members sent since *S
+        self.measure_packet_counting()
 
     @initialize(summed=st.booleans())
     def mode(self, summed: bool) -> None:
@@ -67,6 +68,14 @@ class PacketMachine(UnitMachine):
         holds(r is not None and r.ok, "7.packet.breakers",
               f"@ inside a packet answered {r}")
         self.pending = []                 # answered, `@` ended the packet on the wire
+        # That `@` discards the packet is our reading [D]: the manual only says the unit
+        # answers once the packet's end arrives. A unit that keeps it open would take every
+        # frame after as a member and answer none, so an `*E0` ends it under either reading
+        # (`4,0`: there was none) before the machine goes on.
+        r = self.send("*E0")
+        holds(r is not None and r.code == ErrorCode.SYNTAX, "7.packet.breakers",
+              f"*E0 after @ inside a packet answered {r}: the packet was still open",
+              observed=r, expected="4,0")
 
     def teardown(self) -> None:
         if self.model.packet is None:

@@ -162,6 +162,8 @@ class ReadBackMachine(UnitMachine):
         #: last read before refusals (the line as the readings saw it, line_band's jitter)
         self.trips: list[float] = []
         super().__init__(ctx)
+        if "*S" in ctx.profile.commands:
+            self.measure_packet_counting()
         self.halted = False
         self.v = ctx.profile.reset.V
         self.resumed_end: list[int] = []

@@ -72,6 +72,27 @@ class UnitMachine(RuleBasedStateMachine):
         self.model.refused_counted = after != (again + (not self.model.uncounted)) % 256
         self.model.index = after
 
+    def measure_packet_counting(self) -> None:
+        """Whether a packet's `*S` and `*E` advance the index is a reading the manuals
+        leave open (8.index.packet-frames-counted [D], judged by its case): measured on
+        an empty packet (nothing to commit), then on one with a second `*S`, and the
+        model counts as the unit does."""
+        once = self._index_moved_by(["*S", "*E0"])
+        if once in (0, 1):
+            start = self._index_moved_by(["*S", "*S", "*E0"]) - once == 1
+            end = once - start == 1
+            self.model.uncounted = (*self.model.uncounted,
+                                    *(() if start else ("*S",)), *(() if end else ("*E",)))
+
+    def _index_moved_by(self, frames: list[str]) -> int:
+        """How far ``frames`` moved the unit's index (the last one's answer awaited)."""
+        before = self.index()
+        for body in frames[:-1]:
+            self.link.send(body, answer=False)
+        self.link.send(frames[-1])
+        self.model.index = self.index()
+        return (self.model.index - before) % 256
+
     def send(self, body: str, *, checksum_ok: bool = True, **kw) -> Response | None:
         """Send ``body`` (``kw`` as :meth:`Link.send` takes them) and book its arrival in
         the model (``checksum_ok``: whether its sum lets it count)."""

@@ -286,7 +286,8 @@ class Unit:
             text = text.upper()
         name, params = split(text)
         known = COMMANDS.get(name or "", _NONE)
-        if known.counted or self.mutant.active("index-counts-queries") \
+        delimiter = name in ("*S", "*E") and self.readings.active("packet-frames-uncounted")
+        if (known.counted and not delimiter) or self.mutant.active("index-counts-queries") \
                 or self.readings.active("queries-counted"):
             ses.count()
         if frame.too_long:                     # a syntax error (spec 3), also as a member
@@ -310,7 +311,8 @@ class Unit:
                 else ErrorCode.UNKNOWN
             self._answer(raw, code, [], t, remember=known.remembered)
             return
-        if command.packet == DISCARD:
+        if command.packet == DISCARD and not (
+                name in ("@", ">") and self.readings.active("packet-open-through-queries")):
             ses.packet = None
         self._run(raw, command, name, params, t)
 

@@ -47,6 +47,12 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     # H is a member (unanswered, failing the packet with 4), so *E1 finds one member
     "packet-closed-only-by-end": ([b"!0*S\r", b"!0H\r", b"!0*E1\r"],
                                   b"8\rC,0\r", b"4,1\r"),
+    # an empty packet moves the index by its *S and *E, or not at all
+    "packet-frames-uncounted": ([b"!0*S\r", b"!0*E0\r", b"!0@\r"],
+                                b"0,0\r0,2\r", b"0,0\r0,0\r"),
+    # @ answered inside the packet leaves it open: *E0 ends an empty packet
+    "packet-open-through-queries": ([b"!0*S\r", b"!0@\r", b"!0*E0\r"],
+                                    b"0,1\r4,0\r", b"0,1\r0,0\r"),
     # *E2 for one member fails the packet, but its C ran as it arrived
     "packet-committed-on-arrival": ([b"!0*S\r", b"!0C10,0,0\r", b"!0*E2\r", b"!0PF\r"],
                                     b"2,1\r0,0,0,0\r", b"2,1\r0,10,0,0\r"),

@@ -26,6 +26,10 @@ from gve_fixtures.rules import load_rules
 #: machinery meets it and no case shows it through a session)
 MACHINERY = {
     "packet-closed-only-by-end": {"7.packet.breakers"},
+    # @ answered inside a packet that it leaves open: the packet machine ends it with *E0
+    "packet-open-through-queries": {"7.packet.breakers"},
+    # the machines that send packets measure whether *S and *E count before they book
+    "packet-frames-uncounted": {"8.index.packet-frames-counted"},
     "slow-watchdog": {"3.frame.watchdog-time"},
     # the clean-up between cases and examples takes no second K: a K a case left is given
     # back with its R
@@ -45,7 +49,7 @@ MACHINERY = {
 #: begins at the co-simulator's power-on: the known state, which meets them every time,
 #: is run by the catalogue above)
 UNDRAWN = {"second-keep-refused", "restore-refused-while-run", "zero-vector-dwells",
-           "dwell-outlives-halt"}
+           "dwell-outlives-halt", "packet-open-through-queries", "packet-frames-uncounted"}
 
 
 def cosim_target(profile: str, readings: list[str]):
