@@ -202,6 +202,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # C into a full queue taken, or C refused with room
     "10.1.queue.cont-buffer": ("5.errors.queue-full", ("C", "code", set(), {"C"}, 1, 0)),
     # GVE54: a halted vector's remainder after an M taken while it was held
+    # a C refused (1) while an L runs, which the reference queued behind it
+    "10.1.queue.c-behind-line": ("10.1.cont.behind-line",
+                                 ("C", "code", set(), {"L"}, 0, 1)),
     "10.1.queue.captured": ("10.1.measured.captured",
                             ("PF", "position", {"mode-over-held"}, {"M", "H", "C"}, 0, 0)),
     # L while a vector runs taken
@@ -372,6 +375,8 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # vectors refused while the MPG holds RUN, its parameters never set
     "9.reset.mpg-parameters": ("9.reset.mpg-enabled",
                                ("L", "code", {"mpg-on"}, {"EW", "J"}, 7, 0, "GVE114")),
+    # Y& refused while an L runs
+    "10.cmd.mpg-while-moving": ("10.cmd.mpg.while-moving", ("Y", "code", set(), {"L"}, 0, 7)),
     # a Y& sent with EEPROM 06 as shipped: inert (RUN = 0)
     "9.reset.mpg-inert": ("9.reset.mpg-inert.as-shipped",
                           ("SR", "data", {"mpg-disabled"}, {"Y"}, 0, 0)),
