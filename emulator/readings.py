@@ -208,6 +208,13 @@ READINGS: dict[str, ReadingSpec] = {name: ReadingSpec(*spec) for name, spec in {
                          "SW6 writing STOP (bit 0, \"žádost o zastavení\") as 1 is a stop "
                          "request the unit accepts: INTA is set and a motion stops on its "
                          "ramp, as writing INTA does"),
+    "cont-waits-for-line": (("10.1.queue.c-behind-line",),
+                            "a C sent while an L is held (running or halted) answers 1, "
+                            "the queue full, until the L has ended: the CONT buffer is for "
+                            "CONT vectors and the L runs alone"),
+    "mpg-refused-while-moving": (("10.cmd.mpg-while-moving",),
+                                 "GVE114: `Y+` and `Y&` answer 7 while the axes move (`Y-` "
+                                 "is taken)"),
     "accel-byte-range": (("10.cmd.accel-range",),
                          "A takes 1..255 (thousands of pulses/s², one byte) and answers "
                          "5 above: the manuals state A20 at reset and no range"),

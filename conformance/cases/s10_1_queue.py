@@ -50,6 +50,18 @@ def l_busy(ctx: CaseContext) -> None:
                      rule="10.1.queue.line-alone")
 
 
+@case("10.1.cont.behind-line", rules=("10.1.queue.c-behind-line",))
+def c_behind_l(ctx: CaseContext) -> None:
+    """A C sent while an L runs is queued behind it (spec 10.1 [D]; a unit may answer 1
+    until the L has ended)."""
+    setup(ctx, "L" + vector(ctx, 300))
+    code(ctx, ctx.link.send("C" + vector(ctx, 10)), ErrorCode.OK, "C while an L runs → 0",
+         rule="10.1.queue.c-behind-line")
+    finished(ctx, 30)
+    ctx.expect_equal(position(ctx), [310, 0, 0], "the C ran after the L",
+                     rule="10.1.queue.c-behind-line")
+
+
 @case("10.1.line.wait-idiom",
       rules=("10.1.queue.wait-idiom",))
 def idiom(ctx: CaseContext) -> None:

@@ -182,6 +182,16 @@ def mpg_modes(ctx: CaseContext) -> None:
                 rule=on if c != "-" else "10.cmd.mpg")
 
 
+@case("10.cmd.mpg.while-moving", requires=("Y",), rules=("10.cmd.mpg-while-moving",))
+def mpg_while_moving(ctx: CaseContext) -> None:
+    """`Y&` (the reset's mode) sent while an L runs, the MPG not enabled (M114 12.2): taken
+    (spec 10 [D]; a unit may refuse it with 7 while the axes move)."""
+    configured(ctx, "mpg-off")
+    setup(ctx, "L" + vector(ctx, 300))
+    answers(ctx, ctx.link.send("Y&"), "0,Y&", "Y& while an L runs → 0,Y&",
+            rule="10.cmd.mpg-while-moving")
+
+
 @case("10.cmd.output.port", rig=True, rules=("10.cmd.output",))
 def output(ctx: CaseContext) -> None:
     configured(ctx, "outputs-by-host")

@@ -115,6 +115,8 @@ class Course:
         self.named = set(profile.eeprom.defaults)
         self.mpg = profile.mpg
         self.mpg_mode = profile.mpg.reset_mode if profile.mpg else ""
+        #: whether the mode is a `Y` sent's (M114 13.6.8's RUN = 1 is "při odeslání")
+        self.mpg_sent = False
         self.mpg_byte = (profile.eeprom.defaults.get(profile.mpg.enable_address,
                                                      profile.eeprom.erased)
                          if profile.mpg else 0)
@@ -142,8 +144,10 @@ class Course:
         elif command in _RESTARTS:         # the reset state: no save, the MPG's mode
             self.kept = False
             self.mpg_mode = self.mpg.reset_mode if self.mpg else ""
+            self.mpg_sent = False
         elif command == "Y":
             self.mpg_mode = params
+            self.mpg_sent = True
         elif eeprom_width(command):
             written = _addresses(params, eeprom_width(command))
             self.written |= written
@@ -255,6 +259,7 @@ class Course:
             "nothing-kept": not self.kept,
             shipped: bool(shipped),
             "mpg-on": self.mpg_on,
+            "mpg-disabled": self.mpg_disabled,
             "mode-over-held": self.mode_over_held,
         }
         return {flag for flag, on in flags.items() if on}
@@ -346,6 +351,14 @@ class Course:
         """Whether the hand wheel holds the axes: its mode on and EEPROM 06 enabling it."""
         return (self.mpg is not None and self.mpg_mode in ("+", "&")
                 and self.mpg_byte in self.mpg.enabling_values)
+
+    @property
+    def mpg_disabled(self) -> bool:
+        """Whether a `Y+` or `Y&` sent left the hand wheel's mode on with EEPROM 06 not
+        enabling it: whether it then holds RUN (M114 13.6.8) or is inert (12.2) is a
+        reading."""
+        return (self.mpg is not None and self.mpg_sent and self.mpg_mode in ("+", "&")
+                and self.mpg_byte not in self.mpg.enabling_values)
 
 
 def _addresses(params: str, width: int) -> set[int]:

@@ -34,6 +34,8 @@ def step_flags(step: Step, profile: Profile, *, in_packet: bool, summing: bool) 
         "lower-param": bool(name) and _has_lower(step.body[len(name):]),
         # the parameters after the wire name (SW6's is SW: `SW+6,00` has a plus)
         "plus": name != "%" and "+" in parse(step.body).params,
+        # a space among the parameters (`SW 6,00`): what it means is spec 3's decision
+        "space": bool(name) and " " in parse(step.body).params,
         "bad-checksum": step.checksum == "bad" and summing,
         "no-checksum": step.checksum == "none" and summing,
         "in-packet": in_packet,

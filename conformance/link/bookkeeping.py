@@ -293,7 +293,8 @@ class Bookkeeping:
             values = {names.index(command.name[1]): int(value.lo) if value.exact else None}
         else:
             values = {}
-        return lambda e: e.counters(values, outcome)
+        every = command.name == "N"
+        return lambda e: e.counters(values, outcome, every_axis=every)
 
     def _reference(self, command: Body, outcome: Outcome,
                    code: int | None) -> Callable[[Envelope], None]:
@@ -322,7 +323,8 @@ class Bookkeeping:
         self._fact(command, r)
         if (name == "SR" and number(command.params) == point(6)) or name == "F":
             st6 = r.values[0] if r.values else ""
-            if is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP):
+            if (is_hex_byte(st6) and not int(st6, 16) & (St6.RUN | St6.STOP)
+                    and not self.envelope.st6_written):
                 self.envelope.ended()
         elif name in _POSITION:
             axes = 2 if name == "P" else min(3, self.envelope.axes)
@@ -492,7 +494,7 @@ _EVENTS: dict[str, Callable[[Envelope, Outcome], None]] = {
     "J": lambda e, o: e.discard(o, restart=True),    # ... counters zeroed, mode reset
     "R": lambda e, o: e.restore(o),
     "G": lambda e, o: e.unsettle(),                  # resumes what is already counted
-    "SW6": lambda e, o: e.unsettle(),
+    "SW6": lambda e, o: e.write_st6(o),
 }
 
 

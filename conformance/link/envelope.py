@@ -154,6 +154,8 @@ class Envelope:
         self.trail = [ZERO] * axes               # ... since a read at rest last agreed
         self.set_counters = False                # N/N<axis> taken since the last read at rest
         self.unheld: list[int] = []              # axes whose set counter read back otherwise
+        #: an `SW6` taken while vectors were held: ST6's RUN may be what it wrote
+        self.st6_written = False
 
     # -- what the unit may do ---------------------------------------------------------------
     def reach(self) -> list[Span]:
@@ -210,6 +212,7 @@ class Envelope:
         self.start = [s + q.total for s, q in zip(self.start, self.queue, strict=True)]
         self.queue = [EMPTY] * self.axes
         self.settled = True
+        self.st6_written = False
 
     def _carry(self, moves: Sequence[Span]) -> None:
         """The axes moved by ``moves`` while a save is held: its run, which starts from
@@ -223,6 +226,7 @@ class Envelope:
         self._carry([q.swing for q in self.queue])
         self.start = self.reach()
         self.queue = [EMPTY] * self.axes
+        self.st6_written = False
 
     def discard(self, outcome: Outcome, *, keep: bool = False, restart: bool = False) -> None:
         """`D` (the queue emptied where the axes stand), `K` (``keep``: the queue saved
@@ -276,16 +280,21 @@ class Envelope:
         self.settled = outcome is Outcome.ACCEPTED and not moves
         self._see()
 
-    def counters(self, values: dict[int, int | None], outcome: Outcome) -> None:
-        """`N` (every axis to 0) or `N<axis> n`: the counters move, the axes do not. The
-        unit takes them only when nothing runs (spec 5: 7 whenever RUN = 1). A value of
-        None: the counter's new value is not known."""
+    def counters(self, values: dict[int, int | None], outcome: Outcome, *,
+                 every_axis: bool = True) -> None:
+        """`N` (``every_axis``: every axis to 0) or `N<axis> n`: the counters move, the
+        axes do not. A unit takes `N` only when nothing runs (spec 5 [M]: 7 whenever
+        RUN = 1); `N<axis>` too by our decision only, so a unit may take it with a halted
+        remainder held, or while the axes move (M114 sets no bar on it): the counter is
+        then set wherever on the queue's way the axis stands. A value of None: the
+        counter's new value is not known."""
         if outcome is Outcome.REFUSED:
             return
-        if outcome is Outcome.ACCEPTED:
+        if outcome is Outcome.ACCEPTED and every_axis:
             self.ended()
         for axis, value in values.items():
-            here = self.start[axis] + self.queue[axis].total
+            here = self.start[axis] + (self.queue[axis].total if every_axis
+                                       else self.queue[axis].swing)
             new = UNKNOWN if value is None else here - point(value)
             self.offset[axis] = new if outcome is Outcome.ACCEPTED else self.offset[axis].hull(new)
         self.set_counters = self.set_counters or bool(values)
@@ -313,6 +322,14 @@ class Envelope:
             self.factor = point(factor)
         elif outcome is Outcome.UNCLEAR:
             self.factor = self.factor.hull(point(factor))
+
+    def write_st6(self, outcome: Outcome) -> None:
+        """`SW6`: it may start or stop motion the bookkeeping already counts, and a unit
+        may store the RUN bit it was given (the manuals: it writes ST6), so RUN = 0 read
+        after it no longer shows that the queue has ended."""
+        if outcome is not Outcome.REFUSED and any(q != EMPTY for q in self.queue):
+            self.st6_written = True
+        self.unsettle()
 
     def unsettle(self) -> None:
         """Something may have started motion that the bookkeeping already counts (`G`,

@@ -67,6 +67,10 @@ def cmd_cont(dev: Device, ses: Session, p: str, t: int) -> Reply:
             else ErrorCode.SYNTAX
         raise CommandError(code, "after K the queue takes one L only")
     dev.refuse_vectors_to_mpg()
+    if dev.readings.active("cont-waits-for-line") and dev.motion.queued(t) \
+            and not dev.last_continuous:
+        # the L accepted alone is still held: the C waits until it has ended
+        raise CommandError(ErrorCode.QUEUE_FULL, "a C waits until the L has ended")
     room = dev.profile.buffer - (1 if dev.mutant.active("queue-one-short") else 0)
     if dev.motion.queued(t) >= room:
         if dev.mutant.active("refused-vector-queued"):
@@ -345,5 +349,8 @@ def cmd_mpg(dev: Device, ses: Session, p: str, t: int) -> Reply:
         raise CommandError(ErrorCode.SYNTAX, "Y takes +, & or -")
     if p != "-" and not dev.mpg_parameters_in_range():
         raise CommandError(ErrorCode.RANGE, "an MPG parameter is out of range")
+    if p != "-" and dev.readings.active("mpg-refused-while-moving") \
+            and dev.motion.flags(t).moving:
+        raise CommandError(ErrorCode.BUSY, "the hand wheel is not turned on while vectors run")
     dev.state.mpg = p
     return ["Y" + p]

@@ -54,6 +54,8 @@ class Device:
         self._unsaved: dict[int, int] = {}
         #: the last vector queued, in commanded steps (the mutant refused-vector-overwrites)
         self.last_vector: tuple[int, ...] | None = None
+        #: whether the last vector accepted was a C (an L is accepted only alone)
+        self.last_continuous = False
         scale = profile.position_scale if profile.microstep is not None else 1
         self.motion = create(len(profile.axes), profile.max_rate * scale, stepper=stepper,
                              deviations=mutant.deviations | readings.deviations)
@@ -301,6 +303,7 @@ class Device:
         if act("a-axis-alone-ignored") and len(steps) == 4 and not any(steps[:3]):
             steps = (0, 0, 0, 0)
         self.last_vector = steps
+        self.last_continuous = continuous
         accel *= 1000 * f
         path2 = sum(s * s for s in steps[:3])
         along = m.VK and not act("path-speed-ignored")

@@ -112,6 +112,9 @@ POINTS: dict[str, tuple[list[Step], bytes, bytes]] = {
     "accel-along-path": ([b"!0VK\r", 0.001, b"!0V2000\r", 0.001, b"!0L300,400,0\r", 0.1,
                           b"!0PF\r"], b"0\r0\r0\r0,71,95,0\r", b"0\r0\r0\r0,59,79,0\r"),
     # a halted L holds RUN: R refused, where the clean unit restores an empty save
+    # a C sent while an L runs: queued behind it, or 1 until the L has ended (then 0)
+    "cont-waits-for-line": ([b"!0L1000,0,0\r", 0.001, b"!0C10,0,0\r", 1.5, b"!0C10,0,0\r"],
+                            b"0\r0\r0\r", b"0\r1\r0\r"),
     "restore-refused-while-run": ([b"!0L1000,0,0\r", 0.01, b"!0H\r", b"!0R\r"],
                                   b"0\r8\r0\r", b"0\r8\rF\r"),
     # C700 then C-700 at A5, B500: 0.7 s on the reversal is passed at B500 (back at 677)
@@ -135,6 +138,9 @@ _MPG_SETTINGS: list[Step] = [
 #: readings of what only the GVE114 has, on a GVE114-500: EEPROM 06 enables the MPG; its
 #: parameters are erased (FF), so under the reading it does not hold RUN after J
 POINTS_114: dict[str, tuple[list[Step], bytes, bytes]] = {
+    # Y& while an L runs: taken, or 7 while the axes move
+    "mpg-refused-while-moving": ([b"!0L1000,0,0,0\r", 0.001, b"!0Y&\r"], b"0\r0,Y&\r",
+                                 b"0\r7\r"),
     "mpg-needs-parameters": ([b"!0EW06,01\r", b"!0J\r", 2.5, b"!0SR6\r", b"!0Y+\r"],
                              b"0\r0\r0,40\r0,Y+\r", b"0\r0\r0,00\r5\r"),
     # every MPG setting of 12.4-12.7 in range, the spindle speed (4C) still erased

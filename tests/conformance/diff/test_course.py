@@ -136,3 +136,15 @@ def test_the_course_keeps_no_packet_of_its_own(exchanges):
                                                                   answer))
         wire = observe(wire, body, answer, address)
     assert c.in_packet == wire.packet_open
+
+
+def test_the_hand_wheel_sent_on_without_eeprom_06_enabling_it_is_a_reading():
+    c = Course(parse_target("emu:GVE114-500").profile)       # EEPROM 06 as shipped: FF
+    assert "mpg-disabled" not in c.context(0, "SR", "SR6", None)   # reset's & alone
+    c.took("Y", "Y+", ok(1))
+    assert "mpg-disabled" in c.context(2 * MS, "SR", "SR6", None)
+    c.took("Y", "Y-", ok(3))
+    assert "mpg-disabled" not in c.context(4 * MS, "SR", "SR6", None)
+    c.took("Y", "Y&", ok(5))
+    c.took("EW", "EW06,01", ok(6))                           # enabling: the manual's case
+    assert "mpg-disabled" not in c.context(7 * MS, "SR", "SR6", None)

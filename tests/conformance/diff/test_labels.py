@@ -60,6 +60,19 @@ def test_a_plus_sign_or_a_lower_case_digit_names_the_parameter_rule():
     assert label("EW", "code", {"lower"}, set(), 3, 0) == "3.frame.upper-case"
 
 
+def test_a_space_among_the_parameters_refused_as_syntax_is_the_decimal_rule():
+    assert label("SW6", "code", {"space"}, set(), 4, 0) == "3.params.decimal"
+
+
+def test_the_hand_wheel_sent_on_while_eeprom_06_does_not_enable_it_is_the_inert_rule():
+    assert label("SR", "data", {"mpg-disabled"}, {"Y"}, 0, 0) == "9.reset.mpg-inert"
+    assert label("L", "code", {"mpg-disabled"}, {"Y"}, 0, 7) == "9.reset.mpg-inert"
+
+
+def test_n_axis_refused_after_a_halt_by_the_reference_only_is_the_run_decision():
+    assert label("NX", "code", set(), {"C", "H"}, 7, 0) == "5.code.busy-run-decided"
+
+
 def test_three_hex_digits_refused_as_syntax_are_the_hex_digits_rule():
     assert label("SW", "code", {"long-hex"}, set(), 5, 4) == "3.params.hex-digits"
     assert label("ER", "code", {"long-hex"}, set(), 0, 4) == "3.params.hex-digits"
@@ -189,6 +202,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # C into a full queue taken, or C refused with room
     "10.1.queue.cont-buffer": ("5.errors.queue-full", ("C", "code", set(), {"C"}, 1, 0)),
     # GVE54: a halted vector's remainder after an M taken while it was held
+    # a C refused (1) while an L runs, which the reference queued behind it
+    "10.1.queue.c-behind-line": ("10.1.cont.behind-line",
+                                 ("C", "code", set(), {"L"}, 0, 1)),
     "10.1.queue.captured": ("10.1.measured.captured",
                             ("PF", "position", {"mode-over-held"}, {"M", "H", "C"}, 0, 0)),
     # L while a vector runs taken
@@ -297,6 +313,9 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     "5.code.busy-eeprom": ("10.6.eeprom.refused-while-moving",
                            ("EW", "code", set(), {"L"}, 7, 0)),
     "5.code.ok": ("5.errors.ok", ("L", "code", set(), set(), 0, 4)),
+    # N<axis> refused with RUN = 1 held after H, nothing moving
+    "5.code.busy-run-decided": ("5.code.busy-while-halted",
+                                ("NX", "code", set(), {"C", "H"}, 7, 0)),
     "5.code.range": ("5.errors.out-of-range", ("SW", "code", set(), set(), 5, 4)),
     # the MPG holding RUN: D refused while it does
     "5.moving.definition": ("9.reset.mpg-enabled", ("D", "code", set(), {"EW", "J"}, 7, 0)),
@@ -356,6 +375,11 @@ PAIRS: dict[str, tuple[str, tuple]] = {
     # vectors refused while the MPG holds RUN, its parameters never set
     "9.reset.mpg-parameters": ("9.reset.mpg-enabled",
                                ("L", "code", {"mpg-on"}, {"EW", "J"}, 7, 0, "GVE114")),
+    # Y& refused while an L runs
+    "10.cmd.mpg-while-moving": ("10.cmd.mpg.while-moving", ("Y", "code", set(), {"L"}, 0, 7)),
+    # a Y& sent with EEPROM 06 as shipped: inert (RUN = 0)
+    "9.reset.mpg-inert": ("9.reset.mpg-inert.as-shipped",
+                          ("SR", "data", {"mpg-disabled"}, {"Y"}, 0, 0)),
     # a co-simulator's power-on that left the checksum mode on: its first answer summed
     "9.reset.state": ("9.reset.after-j", ("SR", "data", {"summing-after-power-on"}, set(),
                                           0, 0)),

@@ -38,3 +38,10 @@ def test_a_step_s_address_case_and_checksum_are_its_flags():
     bad = Step(FRAME, "V10", checksum="bad")
     assert "bad-checksum" in step_flags(bad, GVE114, in_packet=False, summing=True)
     assert "bad-checksum" not in step_flags(bad, GVE114, in_packet=False, summing=False)
+
+
+def test_a_space_among_the_parameters_is_its_context():
+    assert "space" in step_flags(Step(FRAME, "SW 6,00"), GVE114, in_packet=False,
+                                 summing=False)
+    assert "space" not in step_flags(Step(FRAME, "SW6,00"), GVE114, in_packet=False,
+                                     summing=False)

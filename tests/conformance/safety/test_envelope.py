@@ -259,3 +259,34 @@ def test_a_save_given_back_may_still_be_held_and_run_again():
     sent(g, "PF", "0,500,0,0")
     assert x(g) == (500, 500) and not g.restarts and not g.untracked
     assert "R" in refused(g, "R")          # a third run would leave the ±500 envelope
+
+
+def test_a_counter_set_on_one_axis_with_a_halted_remainder_held_ends_nothing():
+    # N<axis> is refused while RUN = 1 by our decision only: a unit may take it after H
+    g = guard()
+    sent(g, "C200,0,0")
+    sent(g, "C200,0,0")
+    sent(g, "H", "8")
+    sent(g, "NY-5", "8")
+    assert x(g) == (0, 400)                # still anywhere on the halted queue's way
+    sent(g, "P", "8,60,-5")                # at rest where the halt left it, no contradiction
+    assert not g.lost
+    sent(g, "D", "8")                      # the remainder dropped where X stands
+    sent(g, "PF", "8,60,-5,0")
+    assert x(g) == (60, 60) and not g.lost
+
+
+def test_run_clear_read_after_an_st6_write_does_not_end_the_queue():
+    # a unit may store the RUN bit SW6 writes: 0 then tells nothing of the held vectors
+    g = guard()
+    sent(g, "C200,0,0")
+    sent(g, "C200,0,0")
+    sent(g, "SW6,80", "8")
+    sent(g, "SR6", "8,80")
+    assert x(g) == (0, 400)
+    sent(g, "PF", "8,0,0,0")               # not taken for a read at rest
+    assert not g.lost
+    sent(g, "D", "8")
+    sent(g, "SR6", "8,80")
+    sent(g, "PF", "8,0,0,0")
+    assert x(g) == (0, 0) and not g.lost
