@@ -372,8 +372,7 @@ class CosimLine(SentAhead, KeptState):
                 if t < last:
                     self.talk.fail(f"after {command!r} it sent {shown(said, 120)}: stamped {t}, "
                                 f"before the byte it sent before ({last})")
-                # bytes before the first CR change nothing until a CR has come
-                first = 0 if cr_sent or stop is not None else data.find(CR)
+                first = 0 if cr_sent or stop is not None else data.find(CR)  # none breaks before CR
                 for i in range(len(data) if first < 0 else first, len(data)):
                     value, at = data[i], t + i * b
                     if stop is not None or (cr_sent and at > end):
