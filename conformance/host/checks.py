@@ -110,12 +110,10 @@ def frames(rec: Recording, line: LineFacts, out: Judgement) -> None:
     probing = probes(rec)
     for ex in rec.exchanges:
         out.judged |= ex.parsed.judged
+        probe = ex.n in probing
         for p in ex.parsed.problems:
-            if ex.n in probing:
-                out.add(p.rule, _at(ex.frame.start, line), ex.text, f"{p.what}: {PROBE}",
-                        "D")
-            else:
-                out.add(p.rule, _at(ex.frame.start, line), ex.text, p.what)
+            out.add(p.rule, _at(ex.frame.start, line), ex.text,
+                    f"{p.what}: {PROBE}" if probe else p.what, "D" if probe else None)
     for frag in rec.fragments:
         out.judged.add("3.frame.grammar")
         shown = show(frag.data)
@@ -148,12 +146,10 @@ def refusals(rec: Recording, line: LineFacts, out: Judgement) -> None:
         opened = opened or ex.parsed.command == "*S"
         if ex.fault is None and ex.code in rules and not _lapsed(ex) and not closer:
             answer = b"".join(ex.answer).decode("latin-1").strip()
-            if ex.n in probing:
-                out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
-                        f"the unit answered {answer}; {PROBE}", "D")
-            else:
-                out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
-                        f"the unit answered {answer}")
+            probe = ex.n in probing
+            out.add(rules[ErrorCode(ex.code)], _at(ex.frame.start, line), ex.text,
+                    f"the unit answered {answer}" + (f"; {PROBE}" if probe else ""),
+                    "D" if probe else None)
 
 
 def _lapsed(ex: Exchange) -> bool:
