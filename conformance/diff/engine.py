@@ -176,7 +176,7 @@ class Pair:
                     out.ended = "the search's time ran out"
                     break
                 if step.kind == WAIT:
-                    self.target.wait(step.seconds)
+                    self.target.wait(step.seconds, self.timing.waiting(step.seconds))
                     self.timing.waited()
                     out.records.append(StepRecord(step, place=place))
                 elif step.kind == INPUT:

@@ -177,8 +177,10 @@ class Side:
             return link.answer_timeout(body, len(data))
         return link.byte_seconds(len(data) + 64) + 0.005
 
-    def wait(self, seconds: float) -> bytes:
-        return self.link.wait(seconds)
+    def wait(self, seconds: float, meanwhile: Callable[[], None] | None = None) -> bytes:
+        """Let ``seconds`` pass; ``meanwhile``: work of the caller's done while a port
+        that takes a wait ahead waits (Link.wait)."""
+        return self.link.wait(seconds, meanwhile=meanwhile)
 
     def set_input(self, port: int, value: int) -> bool:
         """Set a rig input; False (and the rig lost) when the rig does not do it: a rig

@@ -70,9 +70,18 @@ class Timing:
         """The target's exchange began at ``at``: the reference acts on the frame then."""
         self.reference.catch_up(at)
 
+    def waiting(self, seconds: float) -> Callable[[], None]:
+        """The reference's part of a wait of ``seconds`` the target is about to begin, to
+        be done while the target waits (:meth:`waited` then finds it done)."""
+        end = self.target.now + round(seconds * 1e9)
+        return lambda: self._waited_to(end)
+
     def waited(self) -> None:
         """The target waited a while: the reference waits as long."""
-        self._follow(self.target.now)
+        self._waited_to(self.target.now)
+
+    def _waited_to(self, end: int) -> None:
+        self._follow(end)
 
     def retimed(self, command: str, target: RoundTrip | None,
                 reference: RoundTrip | None = None) -> None:
@@ -141,12 +150,12 @@ class RealTime(Timing):
     def sent(self, at: int) -> None:
         pass
 
-    def waited(self) -> None:
+    def _waited_to(self, end: int) -> None:
         # looked at before the wait's end too: a motion that ended early in a long wait
         # is at rest for a read right after it
-        self._follow(self.target.now - 2 * SETTLE_NS)
+        self._follow(end - 2 * SETTLE_NS)
         self._watch_reference()
-        self._follow(self.target.now)
+        self._follow(end)
 
     def retimed(self, command: str, target: RoundTrip | None,
                 reference: RoundTrip | None = None) -> None:
@@ -230,11 +239,11 @@ class Readings(Timing):
         self.edge_at: int | None = None     # when RUN or STOP last changed
         self.cut = self.lost = False        # a frame stopped the motion short of its end
 
-    def waited(self) -> None:
+    def _waited_to(self, end: int) -> None:
         # looked at the reach before the wait's end too: an end within it is near the read
-        self._follow(self.target.now - max(self.reach()))
+        self._follow(end - max(self.reach()))
         self._watch()
-        self._follow(self.target.now)
+        self._follow(end)
         self._watch()
 
     def retimed(self, command: str, target: RoundTrip | None,

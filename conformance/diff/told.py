@@ -48,7 +48,7 @@ class Told:
 
     data: bytes
     step: Step
-    reference: RoundTrip
+    reference: RoundTrip | None = None      # (None until the reference has run it)
     ended: str = ""                # the reference gone silent for good at this frame
     ran: bool = False              # the target ran it when told (else it goes out live)
 
@@ -59,6 +59,11 @@ def tellable(step: Step) -> bool:
     part of the exchange at the answer, not where the listening ends)."""
     return ((step.kind == FRAME or (step.kind == FILL and step.times > 0))
             and step.lines == 1 and step.stall is None and not step.raw)
+
+
+def _silent(told: Told) -> RoundTrip:
+    """What a reference gone silent gave a frame: nothing."""
+    return RoundTrip(told.data, b"", 0, 0, None, told.step.lines)
 
 
 class Teller:
@@ -76,8 +81,10 @@ class Teller:
         self.drifted = False
 
     def tell(self, place: int, repeat: int) -> None:
-        """Run the reference ahead over the frames from frame ``repeat`` of step
-        ``place`` on, and tell the target those the guard lets through (at least two)."""
+        """Tell the target the frames from frame ``repeat`` of step ``place`` on that the
+        guard lets through (at least two), and run the reference over them while the
+        target runs them. A fill is run on the reference as it is planned: how many of
+        its frames go is the reference's answers' (until the queue is full)."""
         link = self.side.link
         if not (self._more(place, repeat) and link.takes_ahead):
             if self._read_after(place):
@@ -85,33 +92,49 @@ class Teller:
             return
         ahead, planned = Ahead(link), []
         address = self.side.target.address
+        eager = self.steps[place].kind == FILL
         last = place
         while place < len(self.steps) and len(planned) < MOST:
             step = self.steps[place]
-            if not tellable(step):
+            if not tellable(step) or (step.kind == FILL and not eager):
                 break
             data = step.frame_bytes(address, link.checksums)
             if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
                 break
             last = place
-            reference, ended = self.refer(step, data)
-            if step.answer and reference.answer:
-                # the target answers when the reference did, or differs: then its frames
-                # told after it need not run
-                ahead.due(reference.received_at - reference.sent_at)
-            planned.append(Told(data, step, reference, ended))
-            if ended or not step.answer or command_of(step.body) in ENDS:
+            told = Told(data, step)
+            planned.append(told)
+            if eager:
+                self._refer(told, ahead)
+                if told.ended:
+                    break
+            if not step.answer or command_of(step.body) in ENDS:
                 break
-            if step.kind == FILL and repeat + 1 < step.times and reference.code == ErrorCode.OK:
+            if eager and step.kind == FILL and repeat + 1 < step.times \
+                    and told.reference.code == ErrorCode.OK:
                 repeat += 1
             else:
                 place, repeat = place + 1, 0
         if planned and self._read_after(last):
             self.side.state_next()
+        if len(planned) < 2 and not eager:
+            return          # one frame: it goes out live, the reference run meanwhile
         try:
-            ran = ahead.tell()
+            launched = ahead.launch()
+            # the reference runs the frames while the target does (its answers then
+            # only read, each when its frame's turn comes)
+            ended = ""
+            for told in () if eager else planned:
+                if ended:
+                    # the reference gone silent for good: the sequence ends at that frame
+                    told.reference, told.ended = _silent(told), ended
+                else:
+                    self._refer(told, None)
+                    ended = told.ended
+            ran = ahead.landed() if launched else 0
         except BaseException:
-            # a simulator that broke the protocol midway may have run any of them
+            # a simulator that broke the protocol midway, or a run cut short meanwhile,
+            # may have run any of them
             for told in planned:
                 told.ran = True
             self.forget(planned)
@@ -119,6 +142,17 @@ class Teller:
         for i, told in enumerate(planned):
             told.ran = i < ran
         self.queue.extend(planned)
+
+    def _refer(self, told: Told, ahead: Ahead | None) -> None:
+        """A told frame run on the reference; ``ahead``: the list it was admitted to last,
+        told when the target's answer is due (the reference's own)."""
+        step = told.step
+        told.reference, told.ended = self.refer(step, told.data)
+        reference = told.reference
+        if ahead is not None and step.answer and reference.answer:
+            # the target answers when the reference did, or differs: then its frames
+            # told after it need not run
+            ahead.due(reference.received_at - reference.sent_at)
 
     def _read_after(self, place: int) -> bool:
         """Whether the rig's state is read right after the frame of step ``place`` (a

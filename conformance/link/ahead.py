@@ -5,9 +5,10 @@ answer the frames told before it could get.
 A frame told is on the target's line at once: the simulator runs it before the suite
 has read a single answer. So a frame is told only when the guard's judgement of it
 cannot depend on those answers: on the copy, every frame let through is booked as
-though it got any answer (Guard.book_any), and nothing is told after a position read (a
-read that contradicts the bookkeeping moves it anywhere, or shows the unit restarted,
-which ends the case). The first frame the copy refuses ends the frames told; it goes
+though it got any answer (Guard.book_any), and after a position read (a read that
+contradicts the bookkeeping moves it anywhere, or shows the unit restarted, which ends
+the case) only frames that set nothing moving are told, as the guard tells its own
+(Guard.told_ahead). The first frame the copy refuses ends the frames told; it goes
 out, judged with the answers before it, when its turn comes. Each told frame is still
 judged and booked by the run's guard as it is sent.
 """
@@ -17,12 +18,10 @@ from __future__ import annotations
 from conformance.link.body import Body
 from conformance.link.link import Link
 from conformance.link.liveness import TargetNotResponding
+from conformance.link.safety import after_a_read
 from conformance.link.signals import Interrupted
 from conformance.link.stops import SafetyStop
-from conformance.protocol.catalogue import classes
 from conformance.protocol.framer import HostFramer
-
-_POSITION = classes(position=True)
 
 
 class Ahead:
@@ -33,6 +32,7 @@ class Ahead:
         self.open = link.takes_ahead
         self.guard = link.guard.ahead() if self.open else link.guard
         self.frames: list[tuple[bytes, float, int | None]] = []
+        self._read = False                # a position read admitted
 
     def admit(self, data: bytes, timeout: float) -> bool:
         """Whether the raw frame ``data`` (whole frames only), whose answer is awaited
@@ -44,6 +44,11 @@ class Ahead:
         if not frames or b"".join(f.wire for f in frames) != data:
             self.open = False
             return False
+        may, read = after_a_read([Body.parse(body).name for f in frames
+                                  for body in f.bodies(None)], self._read)
+        if not may:
+            self.open = False                 # the read's answer decides what may follow
+            return False
         try:
             self.guard.check_frames(frames, None)
         except (SafetyStop, Interrupted, TargetNotResponding):
@@ -52,8 +57,7 @@ class Ahead:
         for f in frames:
             for body in f.bodies(None):
                 self.guard.book_any(body, f.address)
-                if Body.parse(body).name in _POSITION:
-                    self.open = False         # told last: its answer decides what may follow
+        self._read = read
         self.frames.append((data, timeout, None))
         return True
 
@@ -67,6 +71,14 @@ class Ahead:
     def tell(self) -> int:
         """Tell the port the frames admitted: how many of them the target ran (0: none was
         told, each goes out as it comes)."""
-        if len(self.frames) < 2:
-            return 0
-        return self.link.port.expect(self.frames)
+        return self.landed() if self.launch() else 0
+
+    def launch(self) -> bool:
+        """Tell the port the frames admitted, its reply left to be read (:meth:`landed`)
+        while the caller works and the target runs them; whether they were told (never
+        fewer than two)."""
+        return len(self.frames) >= 2 and self.link.port.tell(self.frames)
+
+    def landed(self) -> int:
+        """How many of the frames told the target ran (the port's reply, read now)."""
+        return self.link.port.landed()

@@ -178,10 +178,16 @@ class Link:
         the command (spec 6, 10 J)."""
         return self.view.summed_after(body)
 
-    def wait(self, seconds: float, spent: Spent = Spent.WAITS) -> bytes:
+    def wait(self, seconds: float, spent: Spent = Spent.WAITS,
+             meanwhile: Callable[[], None] | None = None) -> bytes:
         """Let ``seconds`` pass, booked under ``spent`` (what the caller waits for: the
-        suite's own wait unless it says otherwise); returns whatever arrived meanwhile."""
+        suite's own wait unless it says otherwise); returns whatever arrived meanwhile.
+        ``meanwhile``: work of the caller's done while a port that takes a wait ahead (a
+        co-simulator's) waits; with any other port it is not done here."""
         self.guard.check_idle()
+        launch = getattr(self.port, "launch_wait", None)
+        if meanwhile is not None and launch is not None and launch(seconds):
+            meanwhile()
         data = self._receiver.during(seconds, spent)
         # raw frames not read for an answer: booked as unanswered now, not only when a
         # later frame goes out on this link (there may be none: a `*S` that ends an

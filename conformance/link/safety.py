@@ -64,6 +64,17 @@ _SUMMING = classes(summing=True)
 _MOVE_NOTHING = classes(motion=False, own_speed=False, resumes=None, destructive=False,
                         eeprom=0)
 _POSITION_READS = classes(position=True)
+
+
+def after_a_read(names: Sequence[str], read: bool) -> tuple[bool, bool]:
+    """Frames of commands ``names`` told ahead, ``read``: a position read told before
+    them (its answer may move the axes anywhere in the bookkeeping's eyes): whether they
+    may be told (after a read, only what sets nothing moving), and whether a read is
+    told before the frames after them."""
+    if read and not all(name in _MOVE_NOTHING for name in names):
+        return False, True
+    return True, read or any(name in _POSITION_READS for name in names)
+
 #: what a command sets moving again, by name: "queue" or "save"
 _RESUMES = {n: c.resumes for n, c in catalogue().items() if c.resumes}
 
@@ -358,14 +369,15 @@ class Guard:
         read = False
         for body in bodies:
             name = Body.parse(body).name            # SW6 apart from the other SW
-            if read and name not in _MOVE_NOTHING:
+            may, after = after_a_read([name], read)
+            if not may:
                 break
             try:
                 trial.check(body, address)
             except (SafetyStop, Interrupted, TargetNotResponding):
                 break
             trial.book_any(body, address)
-            read = read or name in _POSITION_READS
+            read = after
             admitted.append(body)
         return admitted
 

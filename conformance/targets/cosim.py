@@ -209,9 +209,24 @@ class SentAhead:
         it would (:meth:`ask`, :meth:`advance_to`), sent now in one write where the
         simulator takes them so and more than one is to go (else each goes in its turn);
         whether they were sent. The line must be quiet: nothing of its own under way."""
-        if not (self.pipelines and len(commands) > 1 and self._tx is None
-                and self._inflight is None and self._told is None and not self._ahead
-                and not self.talk.ahead):
+        if not (len(commands) > 1 and self._quiet):
+            return False
+        self.talk.send_ahead(commands)
+        return True
+
+    @property
+    def _quiet(self) -> bool:
+        """Commands may be sent ahead: the simulator takes them so, and nothing of the
+        line's own is under way."""
+        return (self.pipelines and self._tx is None and self._inflight is None
+                and self._told is None and not self._ahead and not self.talk.ahead)
+
+    def launch_wait(self, seconds: float) -> bool:
+        """The `until`s of a wait of ``seconds`` from now (:meth:`advance`) sent now, their
+        replies read by that wait: the suite may do other work meanwhile, while the
+        simulator runs them. Whether they were sent (the line quiet)."""
+        commands = self.untils(self.now + round(seconds * SECOND))
+        if not (commands and self._quiet):
             return False
         self.talk.send_ahead(commands)
         return True
@@ -538,6 +553,11 @@ class CosimLine(SentAhead, KeptState):
         self._told = (command, plan)
         return True
 
+    def landed(self) -> int:
+        """The reply to the frames :meth:`tell` told, read now: how many of them the
+        simulator ran (0: none is told)."""
+        return self._land_told()
+
     @property
     def tells(self) -> bool:
         """Whether frames may be told now: the simulator takes `batch`, and nothing is
@@ -727,6 +747,10 @@ class CosimPort:
         (CosimLine.tell): whether they were told."""
         return self.line.tell(frames)
 
+    def landed(self) -> int:
+        """The reply to the frames told, read now (CosimLine.landed): how many ran."""
+        return self.line.landed()
+
     @property
     def tells(self) -> bool:
         """Whether frames may be told now (CosimLine.tells)."""
@@ -755,6 +779,10 @@ class CosimPort:
     def launch(self, timeout: float | None) -> None:
         """The write goes out now for the read to come with ``timeout`` (CosimLine.launch)."""
         self.line.launch(timeout)
+
+    def launch_wait(self, seconds: float) -> bool:
+        """A wait's commands sent now, read by the wait (CosimLine.launch_wait)."""
+        return self.line.launch_wait(seconds)
 
     def read(self, size: int = 1) -> bytes:
         return self.line.read(size, self.timeout)
