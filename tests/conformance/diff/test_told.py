@@ -23,7 +23,8 @@ from conformance.diff.index_base import QUERIES
 from conformance.diff.labels import command_of
 from conformance.diff.sides import Side
 from conformance.diff.start import Start
-from conformance.diff.steps import FRAME, Step
+from conformance.diff.steps import FRAME, WAIT, Step
+from conformance.diff.timing import Timing
 from conformance.link.virtual import line_of
 from conformance.targets import parse_target
 from conformance.targets.session import RealSession
@@ -246,3 +247,31 @@ def test_the_reference_begins_while_the_co_simulator_runs_the_known_state(pairs,
     assert seen == [True, False]
     assert outcome(overlapped) == outcome(after)
     assert overlapped.disagreement is None and overlapped.frames == len(steps)
+
+
+def test_the_reference_runs_the_frames_told_while_the_co_simulator_does(pairs, monkeypatch):
+    """A batch is told before the reference runs its frames: each runs on the reference
+    while the simulator's reply is unread; a wait's `until`s likewise go out before the
+    reference waits. The sequence runs as it does frame by frame."""
+    pair = pairs["clean"]
+    steps = [Step(FRAME, body=body) for body in ("V400", "SR0", "L100,0,0", "SR6")]
+    steps += [Step(WAIT, seconds=1.5), *(Step(FRAME, body=b) for b in ("SR6", "F"))]
+    pending: list[tuple[str, bool]] = []
+    refer, follow = Pair._refer, Timing._follow
+
+    def referred(self, step, data):
+        pending.append((step.body, line_of(self.target.link.port)._told is not None))
+        return refer(self, step, data)
+
+    def followed(self, instant):
+        pending.append(("wait", bool(line_of(self.target.link.port).talk.ahead)))
+        follow(self, instant)
+
+    monkeypatch.setattr(Pair, "_refer", referred)
+    monkeypatch.setattr(Timing, "_follow", followed)
+    ahead, single = both(pair, steps)
+    told = pending[:pending.index(("wait", True)) + 1]
+    assert told == [("V400", True), ("SR0", True), ("L100,0,0", True), ("SR6", True),
+                    ("wait", True)], told
+    assert outcome(ahead) == outcome(single)
+    assert ahead.disagreement is None and ahead.frames == 6

@@ -524,6 +524,29 @@ def test_the_untils_of_a_long_wait_go_in_one_write_where_the_simulator_takes_the
     assert ahead == [["tx"], ["until", "until", "until"]]
 
 
+def _launched_wait(line):
+    """A `?` sent, then a wait of 2.5 s launched (CosimLine.launch_wait) and waited:
+    whether it was launched, the replies still unread then, and the clock after."""
+    start = line.now
+    line.write(b"!0?\r")
+    line.read(64, 0.0)                  # the frame goes out: no wait for its answer
+    launched = line.launch_wait(2.5)
+    unread = len(line.talk.ahead)
+    line.advance(2.5)
+    return launched, unread, line.read(64, 0.0), line.now - start
+
+
+def test_a_wait_launched_before_it_is_waited_is_the_same_wait_in_one_write():
+    one_by_one, seen = _writes(False, _launched_wait)
+    ahead, seen_ahead = _writes(True, _launched_wait)
+    # the simulator runs the wait's three `until`s while the suite does other work
+    assert seen_ahead[:2] == (True, 3) and seen[:2] == (False, 0)
+    assert seen_ahead[2:] == seen[2:] == (b"0,IP84 v3 27.1.2010\r", 4 * 86806 + 2_500_000_000)
+    # one by one, the answer's CR stops the first `until` short: one more is sent
+    assert one_by_one == [["tx"], ["until"], ["until"], ["until"], ["until"]]
+    assert ahead == [["tx"], ["until", "until", "until"]]
+
+
 def _powered(line, then: str = "state"):
     """A power-on sent ahead with its restart and `state`, taken in turn (or ``then``
     asked first): what it answered and the clock."""
