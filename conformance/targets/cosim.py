@@ -439,7 +439,7 @@ class CosimLine(SentAhead, KeptState):
     def _step(self, t: int) -> bool:
         """One command toward the instant ``t`` (the write not sent yet first): True when
         it stopped at a CR to the host."""
-        self._land_told()
+        self.landed()
         if self._inflight is not None:
             return self._land()
         self.talk.usable()
@@ -483,7 +483,7 @@ class CosimLine(SentAhead, KeptState):
         meanwhile, while the simulator runs the frame. Only when that read has to send
         it: nothing waits to be read (bytes received already, say during an injected
         pause, may be the answer the read takes, and the write then waits)."""
-        self._land_told()
+        self.landed()
         if self._tx is None or self._ahead or self._rx or self.talk.broken \
                 or self.talk.ahead:
             return
@@ -524,7 +524,7 @@ class CosimLine(SentAhead, KeptState):
         whose answer is due is told with that, so that one answered later (or not at
         all) ends the batch, its read going on from there.
         Returns how many of the frames the simulator ran (0: none was told)."""
-        return self._land_told() if self.tell(frames) else 0
+        return self.landed() if self.tell(frames) else 0
 
     def tell(self, frames: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]]
              ) -> bool:
@@ -553,11 +553,6 @@ class CosimLine(SentAhead, KeptState):
         self._told = (command, plan)
         return True
 
-    def landed(self) -> int:
-        """The reply to the frames :meth:`tell` told, read now: how many of them the
-        simulator ran (0: none is told)."""
-        return self._land_told()
-
     @property
     def tells(self) -> bool:
         """Whether frames may be told now: the simulator takes `batch`, and nothing is
@@ -565,7 +560,7 @@ class CosimLine(SentAhead, KeptState):
         return ("batch" in self.extensions and self._tx is None and not self._rx
                 and not self._ahead and self._inflight is None and self._told is None)
 
-    def _land_told(self) -> int:
+    def landed(self) -> int:
         """Read the reply to the frames told (:meth:`tell`), checked frame by frame: how
         many of them the simulator ran (0: none is told)."""
         if self._told is None:
@@ -605,7 +600,7 @@ class CosimLine(SentAhead, KeptState):
     def _flush(self) -> None:
         """Send the write not sent yet (its clock to the end of its bytes), or read the
         reply to the one launched, or to the frames told."""
-        self._land_told()
+        self.landed()
         if self._inflight is not None:
             self._land()
         if self._tx is not None:
@@ -614,7 +609,7 @@ class CosimLine(SentAhead, KeptState):
     def advance_to(self, t: int) -> None:
         """Let virtual time pass up to the instant ``t`` (a write not sent yet goes out
         with it: `tx HEX T`, one exchange)."""
-        self._land_told()
+        self.landed()
         if self._inflight is not None:
             self._land()
         if self._tx is not None:
@@ -658,7 +653,7 @@ class CosimLine(SentAhead, KeptState):
         """Whether the host's bytes ``data``, written now, are the next frame told ahead:
         the simulator has run them already (their write only takes its part of the
         reply)."""
-        self._land_told()
+        self.landed()
         return (self._tx is None and self._inflight is None and bool(self._ahead)
                 and (self._ahead[0].data, self._ahead[0].start) == (data, self.now))
 
@@ -676,7 +671,7 @@ class CosimLine(SentAhead, KeptState):
         """Up to ``size`` bytes (stopping after ``terminator``), waiting at most
         ``timeout`` seconds of virtual time: the clock stops when the terminator is there
         (a CR, as every answer ends) or at the timeout."""
-        self._land_told()
+        self.landed()
         if self._tx is None:
             self._catch_up()
         deadline = self.now + (LONGEST_WAIT_NS if timeout is None else round(timeout * SECOND))
