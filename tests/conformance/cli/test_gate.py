@@ -64,13 +64,3 @@ def test_the_time_limit_stops_the_workers_too(capsys):
                    MISSED, "--seconds", "0.5"])
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert status == INCOMPLETE_STATUS and "the time limit of 0.5 s came after" in last, last
-
-
-def test_fairness_writes_its_junit_too(tmp_path, capsys, fairness_on_one_profile):
-    junit = tmp_path / "f.xml"
-    assert main(["fairness", "--no-reports", "--reading", "plus-sign", "--cases", "3.frame.*",
-                 "--junitxml", str(junit)]) == 0
-    last = capsys.readouterr().out.strip().splitlines()[-1]
-    assert last.startswith("PASSED — fairness score: 1/1")
-    (case,) = _testcases(junit).values()
-    assert case.get("name") == "plus-sign" and case.find("failure") is None

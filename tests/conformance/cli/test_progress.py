@@ -54,14 +54,6 @@ def test_a_missed_mutant_is_listed_again_at_the_end(capsys):
     assert lines[-1].startswith("FAILED — mutation score: 0/1")
 
 
-def test_fairness_numbers_each_reading_in_a_log(capsys, fairness_on_one_profile):
-    assert main(["fairness", "--no-reports",
-                 "--reading", "plus-sign", "--cases", "3.params.*"]) == 0
-    # (lines saying it is still working, every 5 s, count nothing done)
-    (step,) = [s for s in _steps(capsys.readouterr().out) if s[0] > 0]
-    assert step[:2] == (1, 1) and "plus-sign" in step[2]
-
-
 def test_diff_says_how_far_it_is_at_every_tenth(capsys):
     assert main(["diff", "--target", "emu:GVE84-100", "--examples", "20", "--no-probes",
                  "--no-reports", "--seed", "3"]) == 0
