@@ -21,6 +21,10 @@ from gve_fixtures.profile import load_profile
 MUTANTS = emu.mutants()
 
 
+# the mutation gate (`gve-conformance mutation --sweep`, a step of .ci/run) runs this very
+# hunt for every mutant and fails on a mutant missed or an ERROR met: slow, as the other
+# tests the gates repeat
+@pytest.mark.slow
 @pytest.mark.parametrize("mutant", sorted(MUTANTS))
 def test_the_suite_fails_every_mutant(mutant: str) -> None:
     h = hunt(mutant)
