@@ -11,17 +11,19 @@ from pathlib import Path
 
 from conformance.reports.banner import run_verdict
 from conformance.reports.files import ReportNotWritten, write_text
-from conformance.reports.html import render_html
 from conformance.reports.junit import render_junit, write_junit
 from conformance.reports.logs import compact, compact_checks, compact_traces
 from conformance.reports.sections import section_key, section_name
 from conformance.run.runner import RunResult
 
-__all__ = ["ReportNotWritten", "render_html", "render_junit", "to_json", "write_junit",
-           "write_reports"]
+__all__ = ["ReportNotWritten", "render_junit", "to_json", "write_junit", "write_reports"]
 
 
 def write_reports(run: RunResult, folder: str | Path) -> Path:
+    # the page's template and plots are loaded only by a run that writes one: a command
+    # that writes no report starts without them
+    from conformance.reports.html import render_html
+
     out = Path(folder) / run.run_id
     write_junit(run, out / "junit.xml")
     write_text(out / "results.json", json.dumps(to_json(run), separators=(",", ":")))
