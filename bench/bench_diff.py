@@ -31,6 +31,7 @@ from conformance.diff.engine import Budget, Pair, search
 from conformance.diff.grammar import Options
 from conformance.diff.sides import Side
 from conformance.link.liveness import TargetNotResponding
+from conformance.link.signals import StopSignals
 from conformance.targets import parse_target
 
 BUDGET_FRAMES = 10_000
@@ -67,8 +68,11 @@ class Run:
 def frames_per_second(mutant: str | None, frames: int, *, cosim: bool = False,
                       snapshot: bool = False, searches: int | None = None) -> Run:
     """Searches that send ``frames`` frames (or the first ``searches`` of them, the same
-    seeds); ``snapshot``: through a co-simulator that restores its first power-on."""
+    seeds); ``snapshot``: through a co-simulator that restores its first power-on. Both
+    sides count the run's stop signals under its handler, as `gve-conformance diff` runs
+    them (a write asks a flag; without the handler each write swaps the handlers)."""
     reference = parse_target("emu:GVE84-100")
+    interrupts = StopSignals()
     if cosim:
         # the envelope docs/cosim.md gives for the long moves; judged as in process, by
         # the project's arithmetic (--strict: the emulator claims it), so both rows
@@ -76,14 +80,14 @@ def frames_per_second(mutant: str | None, frames: int, *, cosim: bool = False,
         target = parse_target(cosim_spec(mutant, snapshot=snapshot), profile="GVE84-100",
                               allow_destructive=True, max_travel=MAX_TRAVEL, strict=True)
         target.preflight()
-        side = Side(target, target.begin())
     else:
         target = parse_target("emu:GVE84-100" + (f"?mutant={mutant}" if mutant else ""))
-        side = Side(target)
-    pair = Pair(side, Side(reference), target.profile)
+    pair = Pair(Side(target, target.begin(interrupts)),
+                Side(reference, reference.begin(interrupts)), target.profile)
     pair.restores = snapshot
     try:
-        return _search(pair, frames, searches)
+        with interrupts.catching():
+            return _search(pair, frames, searches)
     finally:
         if cosim:
             target.session.finish()

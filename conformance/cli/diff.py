@@ -183,7 +183,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: {COULD_NOT_TEST}: {one_line(err)}", file=sys.stderr)
         return 1
     ask_first(args, target, meta)
-    pair = Pair(Side(target, session), Side(reference), target.profile)
+    # the reference counts the run's signals too: its writes ask a flag, not swap handlers
+    pair = Pair(Side(target, session), Side(reference, reference.begin(interrupts)),
+                target.profile)
     options = Options(destructive=args.allow_destructive,
                       rig=target.info.has_rig and reference.info.has_rig)
     examples = args.examples if args.examples is not None or args.seconds else DEFAULT_EXAMPLES

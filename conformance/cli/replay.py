@@ -65,7 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     for line in [] if args.quiet else header(args.file, target.info.spec, reference.info.spec,
                                              target.profile.name, t.meta):
         print(line, flush=True)
-    pair = Pair(Side(target, session), Side(reference), target.profile)
+    # the reference counts the run's signals too: its writes ask a flag, not swap handlers
+    pair = Pair(Side(target, session), Side(reference, reference.begin(interrupts)),
+                target.profile)
     outcome = None
     try:
         with interrupts.catching():
