@@ -21,6 +21,7 @@ only where another handler is installed are the handlers swapped around the writ
 
 from __future__ import annotations
 
+import _signal
 import contextlib
 import signal
 import threading
@@ -35,6 +36,7 @@ class Interrupted(KeyboardInterrupt):
 #: the signals that stop a run as Ctrl-C does: a CI job's timeout and a closed terminal
 #: send SIGTERM and SIGHUP, and the machine must halt for them too
 STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_STOPPING_NUMBERS = tuple(int(sig) for sig in STOPPING)
 
 
 class StopSignals:
@@ -112,13 +114,15 @@ class StopSignals:
         # inside the block would inherit it through exec and never see SIGINT, SIGTERM
         # or SIGHUP (a fleet's member, a host program, a simulator).
         caught: list[int] = []
-        handlers = {sig: signal.signal(sig, lambda sig, _: caught.append(sig))
-                    for sig in STOPPING}
+        # (_signal's own calls: signal.signal wraps each in enum conversions that cost
+        # ten times the call, and a link asks for this block around every write)
+        handlers = {sig: _signal.signal(sig, lambda sig, _: caught.append(sig))
+                    for sig in _STOPPING_NUMBERS}
         try:
             yield
         finally:
             for sig, handler in handlers.items():
-                signal.signal(sig, handler)
+                _signal.signal(sig, handler)
             for sig in caught:
                 _deliver(sig, handlers[sig])
 
