@@ -119,6 +119,7 @@ class Teller:
             self.side.state_next()
         if len(planned) < 2 and not eager:
             return          # one frame: it goes out live, the reference run meanwhile
+        launched: bool | None = None        # (None: being told, its write maybe gone)
         try:
             launched = ahead.launch()
             # the reference runs the frames while the target does (its answers then
@@ -133,11 +134,12 @@ class Teller:
                     ended = told.ended
             ran = ahead.landed() if launched else 0
         except BaseException:
-            # a simulator that broke the protocol midway, or a run cut short meanwhile,
-            # may have run any of them
-            for told in planned:
-                told.ran = True
-            self.forget(planned)
+            # told, a simulator that broke the protocol midway, or a run cut short
+            # meanwhile, may have run any of them (untold, none went out)
+            if launched is not False:
+                for told in planned:
+                    told.ran = True
+                self.forget(planned)
             raise
         for i, told in enumerate(planned):
             told.ran = i < ran

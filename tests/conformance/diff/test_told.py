@@ -275,3 +275,27 @@ def test_the_reference_runs_the_frames_told_while_the_co_simulator_does(pairs, m
                     ("wait", True)], told
     assert outcome(ahead) == outcome(single)
     assert ahead.disagreement is None and ahead.frames == 6
+
+
+def test_a_run_cut_short_while_the_reference_runs_the_frames_told_books_them(monkeypatch):
+    """Ctrl-C lands while the reference runs a batch the simulator was told: the guard
+    books every frame of it as though run (it may have been), and the line's next use
+    reads the simulator's reply first."""
+    with mutant_pair("range-error-code") as pair:
+        guard = pair.target.target.session.guard
+        refer, calls = Pair._refer, []
+
+        def cut(self, step, data):
+            calls.append(step.body)
+            if len(calls) == 2:
+                raise KeyboardInterrupt
+            return refer(self, step, data)
+
+        monkeypatch.setattr(Pair, "_refer", cut)
+        steps = [Step(FRAME, body=body) for body in ("C120,0,0", "C120,0,0", "SR6")]
+        with pytest.raises(KeyboardInterrupt):
+            pair.run(steps)
+        assert line_of(pair.target.link.port)._told is not None, "told, reply not read"
+        assert guard.envelope.reach()[0].hi >= 240 * guard.scale
+        monkeypatch.setattr(Pair, "_refer", refer)
+        assert pair.target.link.send("SR6") is not None      # the reply read, then SR6
