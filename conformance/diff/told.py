@@ -90,31 +90,8 @@ class Teller:
             if self._read_after(place):
                 self.side.state_next()
             return
-        ahead, planned = Ahead(link), []
-        address = self.side.target.address
         eager = self.steps[place].kind == FILL
-        last = place
-        while place < len(self.steps) and len(planned) < MOST:
-            step = self.steps[place]
-            if not tellable(step) or (step.kind == FILL and not eager):
-                break
-            data = step.frame_bytes(address, link.checksums)
-            if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
-                break
-            last = place
-            told = Told(data, step)
-            planned.append(told)
-            if eager:
-                self._refer(told, ahead)
-                if told.ended:
-                    break
-            if not step.answer or command_of(step.body) in ENDS:
-                break
-            if eager and step.kind == FILL and repeat + 1 < step.times \
-                    and told.reference.code == ErrorCode.OK:
-                repeat += 1
-            else:
-                place, repeat = place + 1, 0
+        ahead, planned, last = self._plan(place, repeat, eager)
         if planned and self._read_after(last):
             self.side.state_next()
         if len(planned) < 2 and not eager:
@@ -122,16 +99,8 @@ class Teller:
         launched: bool | None = None        # (None: being told, its write maybe gone)
         try:
             launched = ahead.launch()
-            # the reference runs the frames while the target does (its answers then
-            # only read, each when its frame's turn comes)
-            ended = ""
-            for told in () if eager else planned:
-                if ended:
-                    # the reference gone silent for good: the sequence ends at that frame
-                    told.reference, told.ended = _silent(told), ended
-                else:
-                    self._refer(told, None)
-                    ended = told.ended
+            if not eager:
+                self._refer_all(planned)     # while the target runs them
             ran = ahead.landed() if launched else 0
         except BaseException:
             # told, a simulator that broke the protocol midway, or a run cut short
@@ -144,6 +113,44 @@ class Teller:
         for i, told in enumerate(planned):
             told.ran = i < ran
         self.queue.extend(planned)
+
+    def _plan(self, place: int, repeat: int, eager: bool) -> tuple[Ahead, list[Told], int]:
+        """The frames from frame ``repeat`` of step ``place`` on that the guard lets
+        through, each run on the reference as it is planned where ``eager`` (a fill, and
+        what follows it); with the list they were admitted to and the last step's place."""
+        link = self.side.link
+        ahead, planned, last = Ahead(link), [], place
+        while place < len(self.steps) and len(planned) < MOST:
+            step = self.steps[place]
+            if not tellable(step) or (step.kind == FILL and not eager):
+                break
+            data = step.frame_bytes(self.side.target.address, link.checksums)
+            if not ahead.admit(data, self.side.awaited(data, step.body, step.answer)):
+                break
+            last = place
+            told = Told(data, step)
+            planned.append(told)
+            if eager:
+                self._refer(told, ahead)
+            if told.ended or not step.answer or command_of(step.body) in ENDS:
+                break
+            if eager and step.kind == FILL and repeat + 1 < step.times \
+                    and told.reference.code == ErrorCode.OK:
+                repeat += 1
+            else:
+                place, repeat = place + 1, 0
+        return ahead, planned, last
+
+    def _refer_all(self, planned: list[Told]) -> None:
+        """The frames planned run on the reference in turn; once it has gone silent for
+        good, the rest get nothing (the sequence ends at that frame)."""
+        ended = ""
+        for told in planned:
+            if ended:
+                told.reference, told.ended = _silent(told), ended
+            else:
+                self._refer(told, None)
+                ended = told.ended
 
     def _refer(self, told: Told, ahead: Ahead | None) -> None:
         """A told frame run on the reference; ``ahead``: the list it was admitted to last,

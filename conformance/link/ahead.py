@@ -68,11 +68,6 @@ class Ahead:
         data, timeout, _ = self.frames[-1]
         self.frames[-1] = (data, timeout, ns)
 
-    def tell(self) -> int:
-        """Tell the port the frames admitted: how many of them the target ran (0: none was
-        told, each goes out as it comes)."""
-        return self.landed() if self.launch() else 0
-
     def launch(self) -> bool:
         """Tell the port the frames admitted, its reply left to be read (:meth:`landed`)
         while the caller works and the target runs them; whether they were told (never
