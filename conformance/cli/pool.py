@@ -115,15 +115,18 @@ class Workers:
     def __exit__(self, *exc: object) -> None:
         self._end()
 
-    def map(self, fn: Callable[[Any], Any], items: Iterable[Any]) -> Iterator[Any]:
+    def map(self, fn: Callable[[Any], Any], items: Iterable[Any],
+            lane: Callable[[Any], str] | None = None) -> Iterator[Any]:
         """The results of ``fn`` on each item, in the order of the items, until a stopping
         signal ends the map (then :attr:`interrupted`). A job that raised raises
-        WorkerFailed here once the workers have ended."""
+        WorkerFailed here once the workers have ended. With ``lane``, the items of each
+        lane run ``jobs`` at a time, the lanes side by side (jobs that mostly wait beside
+        jobs that work)."""
         todo = list(enumerate(items))
         if self.jobs <= 1 or len(todo) <= 1:
             yield from self._here(fn, [item for _, item in todo])
             return
-        yield from self._there(fn, todo)
+        yield from self._there(fn, todo, lane or (lambda _: ""))
 
     # -- one job: in this process --------------------------------------------------------------
     def _here(self, fn: Callable[[Any], Any], items: list[Any]) -> Iterator[Any]:
@@ -167,11 +170,12 @@ class Workers:
                 signal.signal(sig, handler)
 
     # -- several: in worker processes ----------------------------------------------------------
-    def _there(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]]) -> Iterator[Any]:
+    def _there(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]],
+               lane: Callable[[Any], str]) -> Iterator[Any]:
         stopping = _Stopping(lambda: [p.pid for p in self._processes if p.pid])
         try:
             with stopping.catching():
-                yield from self._run(fn, todo, stopping)
+                yield from self._run(fn, todo, lane, stopping)
                 self.interrupted = self.interrupted or stopping.stopped
                 self._end()
         except KeyboardInterrupt:                   # a third signal: no more waiting
@@ -183,12 +187,15 @@ class Workers:
             raise WorkerFailed(self.failed)
 
     def _run(self, fn: Callable[[Any], Any], todo: list[tuple[int, Any]],
-             stopping: StopSignals) -> Iterator[Any]:
+             lane: Callable[[Any], str], stopping: StopSignals) -> Iterator[Any]:
         context = multiprocessing.get_context()
         idle: list[Connection] = []
         busy: dict[Connection, int] = {}
         done: dict[int, Any] = {}
-        for _ in range(min(self.jobs, len(todo))):
+        lanes = {index: lane(item) for index, item in todo}
+        running = dict.fromkeys(lanes.values(), 0)      # jobs under way, per lane
+        wanted = sum(min(self.jobs, list(lanes.values()).count(name)) for name in running)
+        for _ in range(wanted):
             here, there = context.Pipe()
             process = context.Process(target=_serve, args=(there,), daemon=True)
             # started with the signals held: a worker exists before one is passed on
@@ -204,9 +211,14 @@ class Workers:
             if deadline is not None and time.monotonic() >= deadline:
                 self.timed_out = True           # _end stops the workers under way
                 return
-            while idle and pending:
+            for job in list(pending):
+                index, item = job
+                if not idle:
+                    break
+                if running[lanes[index]] >= self.jobs:
+                    continue                         # its lane is full: a later one may go
                 conn = idle.pop()
-                index, item = pending.pop(0)
+                pending.remove(job)
                 try:
                     conn.send((fn, item))
                 except OSError:                      # it ended meanwhile: as if signalled
@@ -214,8 +226,10 @@ class Workers:
                     stopping.signal()
                     break
                 busy[conn] = index
+                running[lanes[index]] += 1
             for conn in wait(list(busy), timeout=0.2):
                 index = busy.pop(conn)
+                running[lanes[index]] -= 1
                 try:
                     outcome, value = conn.recv()
                 except (EOFError, OSError):

@@ -1,4 +1,4 @@
-"""The worker pool of `mutation` and `fairness`: SIGINT, SIGTERM and SIGHUP alike — to
+"""The worker pool of `mutation`, `fairness` and `corpus`: SIGINT, SIGTERM and SIGHUP alike — to
 the main process, to one worker alone, or the main process killed outright — end the
 map with the results so far, every worker ended, nothing raised past the pool."""
 
@@ -95,6 +95,44 @@ def test_without_a_signal_every_result_comes_in_order_and_the_workers_end():
         got = list(pool.map(pid_of_worker, range(9)))
     assert not pool.interrupted and len(got) == 9
     assert os.getpid() not in got and not any(_alive(p) for p in set(got))
+
+
+#: per lane: its jobs under way now, and the most ever at once (the workers are forked:
+#: they share these)
+_UNDER_WAY = {lane: multiprocessing.Value("i", 0) for lane in ("wait", "work")}
+_MOST = {lane: multiprocessing.Value("i", 0) for lane in ("wait", "work")}
+_WORKED = multiprocessing.Event()
+
+
+def laned(item: tuple[str, int]) -> tuple[str, int, bool]:
+    """A `wait` job ends once a `work` job has run; a `work` job runs once two `wait`
+    jobs are under way (False: what it waited for never came)."""
+    lane, n = item
+    with _UNDER_WAY[lane].get_lock():
+        _UNDER_WAY[lane].value += 1
+        _MOST[lane].value = max(_MOST[lane].value, _UNDER_WAY[lane].value)
+    if lane == "work":
+        end = time.monotonic() + LONG
+        while _UNDER_WAY["wait"].value < 2 and time.monotonic() < end and not _WORKED.is_set():
+            pass
+        seen = _WORKED.is_set() or _UNDER_WAY["wait"].value >= 2
+        _WORKED.set()
+    else:
+        seen = _WORKED.wait(LONG)
+    with _UNDER_WAY[lane].get_lock():
+        _UNDER_WAY[lane].value -= 1
+    return lane, n, seen
+
+
+def test_each_lane_runs_jobs_at_a_time_beside_the_others():
+    """Jobs that wait on one that works, listed first: with a lane each, as many of each
+    run at a time as the pool has jobs, side by side, and the results come in order."""
+    items = [("wait", n) for n in range(3)] + [("work", n) for n in range(3)]
+    with workers(2) as pool:
+        got = list(pool.map(laned, items, lane=lambda item: item[0]))
+    assert [(lane, n) for lane, n, _ in got] == items
+    assert all(seen for *_, seen in got)
+    assert _MOST["wait"].value == 2 and _MOST["work"].value <= 2
 
 
 def test_a_job_that_raises_is_the_pools_error_once_the_workers_ended():
