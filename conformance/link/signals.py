@@ -82,7 +82,7 @@ class StopSignals:
         While this object's handler is installed (:meth:`catching`), a flag its handler
         reads; else the handlers are swapped for the block (:meth:`held`)."""
         if self._caught and threading.current_thread() is threading.main_thread() \
-                and all(signal.getsignal(sig) == self.signal for sig in STOPPING):
+                and all(_signal.getsignal(sig) == self.signal for sig in _STOPPING_NUMBERS):
             return self._writing
         return self.held()
 

@@ -182,7 +182,7 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
     params = trace.get("params") or {}
     if params:
         title += "  (" + ", ".join(f"{k} {v}" for k, v in params.items()) + ")"
-    pos_ax.set_title(title, fontsize=9)
+    pos_ax.set_title(title, fontsize=9, y=1.0)
     pos_ax.set_ylabel("position (steps)")
     if rate_ax is not None:
         rate_ax.set_ylabel("rate (steps/s)")
