@@ -168,7 +168,6 @@ def _helped() -> list[tuple[str, str]]:
     return [("--help", line) for line in EXAMPLES if "emu:" in line or "exec:" in line]
 
 
-RUNNING = _running() + _helped()
 
 
 def _argv(line: str) -> list[str]:
@@ -191,6 +190,18 @@ def _argv(line: str) -> list[str]:
     if program and a_run and option not in words:
         words += [option, PROGRAM_CASES]
     return words
+
+
+def _once_each(commands: list[tuple[str, str]]) -> list[tuple[str, str]]:
+    """The commands, one of each that runs alike (the same command in several places:
+    where they all are, the first one's text)."""
+    places: dict[tuple[str, ...], tuple[list[str], str]] = {}
+    for where, line in commands:
+        places.setdefault(tuple(_argv(line)), ([], line))[0].append(where)
+    return [("+".join(dict.fromkeys(wheres)), line) for wheres, line in places.values()]
+
+
+RUNNING = _once_each(_running() + _helped())
 
 
 def _expected_status(line: str) -> int:
