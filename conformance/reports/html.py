@@ -1,6 +1,6 @@
 """One self-contained HTML page: the banner PASSED/FAILED and, right
 under it, what failed (each failing case with the check that failed it, linked to the
-case); then the run's metadata, the units (as found and as left), a chart and a matrix of
+case); then the run's metadata, the units (as found and as left), bars and a matrix of
 verdicts by spec section (cells link to the cases), filters (a little inline script:
 works offline), and per case its checks, pictures of its motion (the fault marked), notes
 and wire log. No external assets.
@@ -172,6 +172,15 @@ def _sections(run: RunResult, full: bool) -> list[_Section]:
     return out
 
 
+def _bars(sections: list[_Section]) -> list[dict]:
+    """Per section, a bar of its case runs stacked by verdict, as wide as its share of the
+    largest section's (drawn by the page itself: no plotting library needed)."""
+    largest = max((sum(n for _, n in s.counts) for s in sections), default=0) or 1
+    return [{"key": s.key, "title": s.title,
+             "width": round(100 * sum(n for _, n in s.counts) / largest, 1),
+             "parts": [(v, n) for v, n in s.counts if n]} for s in sections]
+
+
 def _coverage(run: RunResult) -> dict | None:
     """Which rules of the spec the run's cases can fail, per section and profile."""
     report = run.meta.coverage
@@ -225,12 +234,13 @@ def render_html(run: RunResult, full_logs: bool | None = None) -> str:
     verdict, reason = run_verdict(run)
     counts = run.counts()
     sections = _sections(run, full)
-    chart = plots.verdict_chart([(s.title, Counter(dict(s.counts))) for s in sections])
     return _templates().get_template("report.html.j2").render(
         run=run, verdict=verdict, reason=reason, css=_asset("report.css"),
         js=_asset("report.js"), verdicts=ORDER,
         counts=[(v, counts[v]) for v in ORDER if v in counts], meta=_meta(run),
         failed=failures(run),
         untested=[f"{counts[v]} {v}" for v in _UNJUDGED if counts.get(v)],
-        units=units_view(run), chart=Markup(chart) if chart else None, sections=sections,
+        units=units_view(run), bars=_bars(sections),
+        plots_off=any(r.traces for r in run.results) and not plots.available(),
+        sections=sections,
         coverage=_coverage(run))

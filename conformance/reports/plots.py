@@ -3,7 +3,6 @@
 to SVG text). Without matplotlib every function returns None and the report says that
 plots are off.
 
-- :func:`verdict_chart`: per spec section, a bar of its case verdicts.
 - :func:`trace_chart`: a motion trace (``CaseResult.traces``) — position and rate
   against time as sampled from the target, over the spec's model, with the tolerance
   band the check used (none in virtual time, where it is zero) and the trace's faults
@@ -25,10 +24,8 @@ import numpy as np
 MAX_POINTS = 40
 #: the step train shows at most this many pulses
 MAX_PULSES = 120
-#: verdict colours, the same as the page's (report.css)
-COLOURS = {"PASS": "#6cc35a", "NON-STRICT": "#e5b935", "FAIL": "#d9483b",
-           "ERROR": "#8b1e14", "INFO": "#6f93d8", "MISSING": "#bbbbbb",
-           "COULD-NOT-TEST": "#8d8d8d"}
+#: a fault's colour: the FAIL verdict's of the page's bars (report.css)
+FAIL_COLOUR = "#d9483b"
 #: how opaque the tolerance band is drawn
 BAND_ALPHA = 0.15
 _AXIS_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
@@ -85,26 +82,6 @@ def _thin(points: Sequence, limit: int = MAX_POINTS) -> list:
         return list(points)
     idx = np.unique(np.linspace(0, len(points) - 1, limit).round().astype(int))
     return [points[i] for i in idx]
-
-
-def verdict_chart(rows: list[tuple[str, dict[str, int]]], key: str = "verdicts") -> str | None:
-    """A horizontal bar per (label, {verdict: count}), stacked in the given verdict order."""
-    if not available() or not rows:
-        return None
-    fig = _figure(7.5, 0.9 + 0.24 * len(rows))
-    ax = fig.add_subplot()
-    labels = [label for label, _ in rows][::-1]
-    left = np.zeros(len(rows))
-    for verdict, colour in COLOURS.items():
-        counts = np.array([c.get(verdict, 0) for _, c in rows][::-1], dtype=float)
-        if counts.any():
-            ax.barh(labels, counts, left=left, color=colour, label=verdict, height=0.7)
-            left += counts
-    ax.set_xlabel("case runs")
-    ax.tick_params(labelsize=8)
-    fig.legend(fontsize=7, ncols=len(COLOURS), loc="outside upper center")
-    ax.spines[["top", "right"]].set_visible(False)
-    return _svg(fig, key)
 
 
 def _columns(series: Sequence) -> tuple[np.ndarray, np.ndarray]:
@@ -195,7 +172,7 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
 
 
 #: how a fault is drawn: what the unit did in the verdict's red, what the spec wants black
-_OBSERVED, _EXPECTED = COLOURS["FAIL"], "#000000"
+_OBSERVED, _EXPECTED = FAIL_COLOUR, "#000000"
 
 
 def _mark_faults(faults: list[dict], pos_ax, rate_ax) -> None:

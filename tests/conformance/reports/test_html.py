@@ -105,8 +105,31 @@ def test_motion_traces_are_drawn_as_inline_svg():
     case = page[page.index("id='case-10.2.toy.moves-GVE84-100'"):]
     case = case[:case.index("</details>")]
     assert "<svg" in case and "trapezoid X" in case
-    assert page.count("<svg") == 2                 # the case and the verdict chart
+    assert page.count("<svg") == 1                 # the case's: the bars are the page's
     assert "<?xml" not in page and "<!DOCTYPE svg" not in page
+
+
+def _bar(page: str, title: str) -> str:
+    bars = page[page.index("<div class='bars'>"):page.index("<table>")]
+    return re.search(rf"<span class='label'>{re.escape(title)}</span>(.*?)</div>", bars)[1]
+
+
+def test_the_verdicts_of_each_section_are_a_bar_the_page_draws_itself():
+    """A bar per section, its case runs stacked by verdict (each a link that filters the
+    cases), as wide as its share of the largest section's; no picture, no plotting."""
+    run = toy_run()
+    run.results += [result("6.toy.more", "PASS"), result("6.toy.again", "PASS"),
+                    result("6.toy.other", "FAIL")]
+    page = render_html(run)
+    parse(page)
+    six = _bar(page, "6 Checksums")
+    assert "width:100.0%" in six
+    assert re.findall(r"<a class='([A-Z-]+)' style='flex-grow:(\d+)'", six) == [
+        ("FAIL", "2"), ("PASS", "2")]
+    assert "data-section='6' data-verdict='FAIL'" in six
+    eight = _bar(page, "8 Index @ and repeat &gt;")
+    assert "width:25.0%" in eight and "class='NON-STRICT' style='flex-grow:1'" in eight
+    assert "<svg" not in page[page.index("<div class='bars'>"):page.index("<table>")]
 
 
 def test_a_case_passing_on_several_profiles_shows_once():
