@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import io
 import re
+import threading
 from collections.abc import Sequence
 from functools import cache
 
@@ -132,43 +133,77 @@ def trace_chart(trace: dict, key: str, rate: bool = True) -> str | None:
                      if (sp.size and np.ptp(sp[:, i]) > 0) or (mp.size and np.ptp(mp[:, i]) > 0)}
                     | {f["axis"] for f in faults if f.get("kind") == "position"
                        and f["axis"] < width})
+    with _CANVAS_LOCK:
+        fig, pos_ax, rate_ax = _blank(*_canvas(rate))
+        for i in moving or range(min(width, 1)):
+            colour, name = _AXIS_COLOURS[i % 4], names[i] if i < len(names) else f"axis {i}"
+            if mp.size:
+                grid = np.linspace(mt[0], mt[-1], MAX_POINTS)
+                model_i = np.interp(grid, mt, mp[:, i])
+                if seconds or steps:
+                    lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
+                    pos_ax.fill_between(grid, lo, hi, color=colour, alpha=BAND_ALPHA, linewidth=0)
+                pos_ax.plot(grid, model_i, "--", color=colour, linewidth=1, label=f"{name} model")
+                if rate_ax is not None:
+                    rt, rv = _rate(grid, model_i[:, None])
+                    rate_ax.plot(rt, rv[:, 0], "--", color=colour, linewidth=1)
+            if sp.size:
+                # samples are readings (PF) at instants: points, not a line between them
+                pos_ax.plot(st, sp[:, i], "o", color=colour, markersize=3.5, label=f"{name} read")
+                if rate_ax is not None:
+                    rt, rv = _rate(st, sp[:, i:i + 1])
+                    rate_ax.plot(rt, rv[:, 0], "o", color=colour, markersize=3.5)
+        _mark_faults(faults, pos_ax, rate_ax)
+        title = trace.get("name", "motion")
+        params = trace.get("params") or {}
+        if params:
+            title += "  (" + ", ".join(f"{k} {v}" for k, v in params.items()) + ")"
+        pos_ax.set_title(title, fontsize=9, y=1.0)
+        pos_ax.set_ylabel("position (steps)")
+        if rate_ax is not None:
+            rate_ax.set_ylabel("rate (steps/s)")
+        band = band_text(seconds, steps)
+        (rate_ax or pos_ax).set_xlabel("time (s)" + (f"; {band}" if band else ""))
+        if pos_ax.get_legend_handles_labels()[0]:
+            pos_ax.legend(fontsize=7, ncols=2)
+        for ax in (pos_ax, rate_ax or pos_ax):
+            ax.tick_params(labelsize=8)
+        return _svg(fig, key)
+
+
+#: one trace chart is drawn at a time on the canvas of its shape
+_CANVAS_LOCK = threading.Lock()
+
+
+@cache
+def _canvas(rate: bool) -> tuple:
+    """The figure and axes a trace chart of this shape is drawn on, made once: laying out
+    a figure and its ticks costs more than drawing the chart."""
     height = 4.4 if rate else 2.6
     fig = _figure(7.5, height, {"left": 0.12, "right": 0.98, "top": 1 - 0.3 / height,
                                 "bottom": 0.5 / height, "hspace": 0.12})
     pos_ax, rate_ax = fig.subplots(2, 1, sharex=True) if rate else (fig.add_subplot(), None)
-    for i in moving or range(min(width, 1)):
-        colour, name = _AXIS_COLOURS[i % 4], names[i] if i < len(names) else f"axis {i}"
-        if mp.size:
-            grid = np.linspace(mt[0], mt[-1], MAX_POINTS)
-            model_i = np.interp(grid, mt, mp[:, i])
-            if seconds or steps:
-                lo, hi = _band(grid, mt, mp[:, i], seconds, steps)
-                pos_ax.fill_between(grid, lo, hi, color=colour, alpha=BAND_ALPHA, linewidth=0)
-            pos_ax.plot(grid, model_i, "--", color=colour, linewidth=1, label=f"{name} model")
-            if rate_ax is not None:
-                rt, rv = _rate(grid, model_i[:, None])
-                rate_ax.plot(rt, rv[:, 0], "--", color=colour, linewidth=1)
-        if sp.size:
-            # samples are readings (PF) at instants: points, not a line between them
-            pos_ax.plot(st, sp[:, i], "o", color=colour, markersize=3.5, label=f"{name} read")
-            if rate_ax is not None:
-                rt, rv = _rate(st, sp[:, i:i + 1])
-                rate_ax.plot(rt, rv[:, 0], "o", color=colour, markersize=3.5)
-    _mark_faults(faults, pos_ax, rate_ax)
-    title = trace.get("name", "motion")
-    params = trace.get("params") or {}
-    if params:
-        title += "  (" + ", ".join(f"{k} {v}" for k, v in params.items()) + ")"
-    pos_ax.set_title(title, fontsize=9, y=1.0)
-    pos_ax.set_ylabel("position (steps)")
-    if rate_ax is not None:
-        rate_ax.set_ylabel("rate (steps/s)")
-    band = band_text(seconds, steps)
-    (rate_ax or pos_ax).set_xlabel("time (s)" + (f"; {band}" if band else ""))
-    pos_ax.legend(fontsize=7, ncols=2)
-    for ax in (pos_ax, rate_ax or pos_ax):
-        ax.tick_params(labelsize=8)
-    return _svg(fig, key)
+    return fig, pos_ax, rate_ax
+
+
+def _blank(fig, pos_ax, rate_ax) -> tuple:
+    """The canvas without the last chart: its lines, areas, marks, legend and texts gone,
+    the limits to be set by what is drawn next."""
+    for ax in (pos_ax, rate_ax):
+        if ax is None:
+            continue
+        for artist in [*ax.lines, *ax.collections, *ax.patches, *ax.texts]:
+            artist.remove()
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+        ax.set_title("")
+        ax.set_xlabel("")
+        ax.set_ylabel("")
+        ax.relim()
+        ax.set_xlim(0, 1)                   # a new axes' limits, until something is drawn
+        ax.set_ylim(0, 1)
+        ax.set_autoscale_on(True)
+    return fig, pos_ax, rate_ax
 
 
 #: how a fault is drawn: what the unit did in the verdict's red, what the spec wants black

@@ -89,6 +89,22 @@ def test_a_wrong_reading_is_marked_against_what_was_expected():
     assert "read wrong" not in _svg_texts(plots.trace_chart(TRACE, "k"))
 
 
+def test_a_chart_is_the_same_whatever_was_drawn_before_it():
+    """The canvas a chart is drawn on is kept for the next: nothing of one chart (its
+    marks, legend, band, limits, title) shows in the next, even one with nothing to draw."""
+    marked = dict(TRACE, name="marked", params={}, tolerance={},
+                  samples=[(t / 10, [0, -5 * t, 0]) for t in range(11)], model=[],
+                  faults=[{"kind": "instant", "what": "H answered", "observed": 0.3,
+                           "expected": [0.1, 0.2]}])
+    empty = {"name": "nothing moved", "samples": [], "model": []}
+    charts = [TRACE, marked, empty]
+    drawn = [plots.trace_chart(trace, "k") for trace in charts + charts[::-1]]
+    for n, trace in enumerate(charts):
+        plots._canvas.cache_clear()                # a canvas never drawn on
+        alone = plots.trace_chart(trace, "k")
+        assert drawn[n] == alone == drawn[-1 - n], trace["name"]
+
+
 def test_the_list_is_worst_first_and_names_a_case_once_for_its_profiles(no_plots):
     run = toy_run()
     twin = result("6.toy.fails", FAIL, checks=run.results[2].checks)
