@@ -142,7 +142,7 @@ STAND_IN = "python -m emulator --model GVE84-100"
 WRITTEN_BY_ANOTHER = ("reports/X/",)
 #: a documented search runs here for a number of sequences drawn from a known seed instead
 #: of its --seconds (the same end every time): (virtual time, real time)
-SEARCH = {True: ["--examples", "300", "--seed", "1"], False: ["--examples", "40", "--seed", "1"]}
+SEARCH = {True: ["--examples", "300", "--seed", "1"], False: ["--examples", "20", "--seed", "1"]}
 #: the cases a run through a program runs here when it names none (the whole catalogue
 #: through a program takes minutes: tests/conformance/test_serial_target.py and the
 #: co-simulation's tests run it)
