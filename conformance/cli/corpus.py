@@ -23,10 +23,11 @@ import sys
 import tempfile
 import time
 import tomllib
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from conformance.cli.gate import Gate, GateItem, under_way
+from conformance.cli.gate import Gate, GateItem
 from conformance.cli.pool import workers
 from conformance.cli.progress import HEARTBEAT, Progress
 from conformance.cli.usage import (
@@ -289,8 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         + (f"; {still_open} FAIL(s) of the suite's open defects listed" if still_open
            else ""),
         interrupted=pool.interrupted, timed_out=pool.timed_out, failed_word="unfair",
-        under_way=sum(under_way(args.jobs, len([i for i in rest if i.kind == kind]), 0)
-                      for kind in {i.kind for i in rest}))
+        under_way=sum(min(args.jobs, n) for n in Counter(i.kind for i in rest).values()))
 
 
 def _lines(t: Trial, verbose: bool) -> list[str]:

@@ -42,12 +42,10 @@ def available() -> bool:
     return True
 
 
-def _figure(width: float, height: float, margins: dict[str, float] | None = None):
-    """A figure laid out by matplotlib, or with fixed ``margins`` (fractions of the
-    figure, as ``subplots_adjust`` takes them): much faster where the layout is known."""
+def _figure(width: float, height: float, margins: dict[str, float]):
+    """A figure with fixed ``margins`` (fractions of the figure, as ``subplots_adjust``
+    takes them): much faster than matplotlib's own layout, and the layout is known."""
     from matplotlib.figure import Figure
-    if margins is None:
-        return Figure(figsize=(width, height), dpi=72, layout="constrained")
     fig = Figure(figsize=(width, height), dpi=72)
     fig.subplots_adjust(**margins)
     return fig
