@@ -28,6 +28,7 @@ import sys
 import threading
 import time
 import traceback
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import Connection, wait
 from typing import Any
@@ -193,9 +194,9 @@ class Workers:
         busy: dict[Connection, int] = {}
         done: dict[int, Any] = {}
         lanes = {index: lane(item) for index, item in todo}
-        running = dict.fromkeys(lanes.values(), 0)      # jobs under way, per lane
-        wanted = sum(min(self.jobs, list(lanes.values()).count(name)) for name in running)
-        for _ in range(wanted):
+        per_lane = Counter(lanes.values())
+        running = dict.fromkeys(per_lane, 0)            # jobs under way, per lane
+        for _ in range(sum(min(self.jobs, n) for n in per_lane.values())):
             here, there = context.Pipe()
             process = context.Process(target=_serve, args=(there,), daemon=True)
             # started with the signals held: a worker exists before one is passed on
