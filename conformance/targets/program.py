@@ -35,6 +35,8 @@ TERM_SECONDS = 2.0
 HELD_LINES = 1000
 #: a line longer than this comes in pieces of this length (garbage stays bounded)
 LINE_LIMIT = 1 << 20
+#: how long a line awaited with a timeout is polled for before the reader sleeps
+POLL_SECONDS = 100e-6
 
 _RUNNING: set[Program] = set()
 
@@ -91,7 +93,7 @@ class Program:
                 end = time.monotonic() + timeout
             left = None if end is None else max(0.0, end - time.monotonic())
             try:
-                ready = select.select([self._fd, self._wake_r], [], [], left)[0]
+                ready = self._ready(left)
                 data = (b"" if self._wake_r in ready else
                         os.read(self._fd, 1 << 16) if ready else None)
             except (OSError, ValueError):              # closed by stop()
@@ -101,6 +103,23 @@ class Program:
             if not data:
                 self._eof = True
             self._pending += data
+
+    def _ready(self, left: float | None) -> list[int]:
+        """The descriptors readable within ``left`` seconds (None: whenever). A reply
+        awaited with a timeout (a co-simulator's, which mostly comes within tens of
+        microseconds) is first polled for up to :data:`POLL_SECONDS`: a process that
+        sleeps at once is woken late (tens of microseconds a time on a virtual machine,
+        each of a sequence's exchanges). A reader without a timeout (the thread that
+        reads a program in the background) never polls."""
+        fds = [self._fd, self._wake_r]
+        if left:
+            until = time.perf_counter() + min(left, POLL_SECONDS)
+            while time.perf_counter() < until:
+                ready = select.select(fds, [], [], 0)[0]
+                if ready:
+                    return ready
+            left = max(0.0, left - POLL_SECONDS)
+        return select.select(fds, [], [], left)[0]
 
     def read_in_background(self) -> None:
         """From now on a thread reads standard output as it comes, so that the program

@@ -63,6 +63,28 @@ def test_lines_come_in_order_and_none_is_made_up():
         p.stop()
 
 
+#: answers `go` at once, then again once its second line, on the next `go`, has waited
+#: well past the poll a reader makes before it sleeps
+LATER = [sys.executable, "-c",
+         "import sys, time\nprint('ready', flush=True)\nsys.stdin.readline()\n"
+         "print('at once', flush=True)\nsys.stdin.readline()\ntime.sleep(0.2)\n"
+         "print('later', flush=True)\nsys.stdin.read()"]
+
+
+def test_a_line_awaited_is_read_whether_it_comes_while_the_reader_polls_or_after():
+    p = Program(LATER)
+    try:
+        assert p.line(10) == "ready"
+        assert p.line(program_module.POLL_SECONDS / 2) is None   # a timeout within the poll
+        p.send("go")
+        assert p.line(10) == "at once"
+        p.send("go")
+        assert p.line(10) == "later"              # came after the poll: the reader slept
+        assert p.line(0.05) is None
+    finally:
+        p.stop()
+
+
 def test_a_stopped_program_s_reader_has_ended_and_the_next_program_s_line_comes_whole():
     first = Program(ECHO)
     assert first.line(10) == "ready"
