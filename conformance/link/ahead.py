@@ -72,7 +72,7 @@ class Ahead:
         """Tell the port the frames admitted, its reply left to be read (:meth:`landed`)
         while the caller works and the target runs them; whether they were told (never
         fewer than two)."""
-        return len(self.frames) >= 2 and self.link.port.tell(self.frames)
+        return len(self.frames) >= 2 and self.link.tell_port(self.frames, read=False)
 
     def landed(self) -> int:
         """How many of the frames told the target ran (the port's reply, read now)."""

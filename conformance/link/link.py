@@ -333,12 +333,28 @@ class Link:
                 zip(bodies, framed, strict=True)]
         work = self.meanwhile
         if work is None:
-            expect(told)
+            self.tell_port(told, read=True)
         # with work to do meanwhile, the port's reply is read when the link next uses
         # it: the work runs while the port runs the frames
-        elif getattr(self.port, "tell", expect)(told):
+        elif self.tell_port(told, read=False):
             self.meanwhile = None
             work()
+
+    def tell_port(self, told: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]],
+                  *, read: bool) -> bool:
+        """Tell the port frames ahead (each with its answer's timeout, and due instant
+        where known: CosimLine.expect), its reply read now (``read``) or when the link next
+        uses the port; whether they were told. A port told frames runs them at once, so
+        the signals are asked at that instant, as for a write (:meth:`_write`): where one
+        bars frames now, nothing is told, and each frame is then barred at its own
+        write."""
+        interrupts = self.guard.interrupts
+        with interrupts.writing():
+            if interrupts.bars(own=bool(self.guard.own_frames())):
+                return False
+            if read or getattr(self.port, "tell", None) is None:
+                return self.port.expect(told) > 0
+            return self.port.tell(told)
 
     @property
     def takes_ahead(self) -> bool:

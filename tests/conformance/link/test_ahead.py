@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from conformance.link.ahead import Ahead
 from conformance.link.body import Body
 from conformance.link.framing import frame, parse_response
+from conformance.link.link import Link
 from conformance.link.liveness import TargetNotResponding
 from conformance.link.safety import Guard
 from conformance.link.stops import SafetyStop, UnitRestarted
@@ -173,3 +174,39 @@ def test_the_frames_a_link_tells_are_let_through_whatever_the_answers_before_the
             continue                       # whatever the guard thinks then: nothing moves
         g.check(body)                      # SafetyStop if the guard refuses it now
         read = not sent(g, body, text) or Body.parse(body).name in POSITION_READS
+
+
+class _TellingPort:
+    """A port that takes frames told ahead and keeps what it was told."""
+
+    def __init__(self) -> None:
+        self.told: list[list[bytes]] = []
+
+    def expect(self, frames) -> int:
+        self.tell(frames)
+        return len(frames)
+
+    def tell(self, frames) -> bool:
+        self.told.append([data for data, *_ in frames])
+        return True
+
+
+@pytest.mark.parametrize("own", [False, True])
+def test_a_signal_after_the_frames_were_judged_keeps_them_untold(own):
+    """Frames told a co-simulator run at once: a signal that lands once they were judged
+    and before they are told keeps them all off its line (each is then barred at its own
+    write); a signal answered by `H` bars the session's own frames no more."""
+    g = guard()
+    port = _TellingPort()
+    ln = Link(port, g)
+    with g.own_frames() if own else contextlib.nullcontext():
+        ahead = Ahead(ln)
+        assert all(ahead.admit(frame(body, 0, False), 0.25) for body in ("SR6", "SR0"))
+        g.interrupts.signal()                         # Ctrl-C, no `H` sent yet
+        assert not ahead.launch() and port.told == []
+        ln.tell_port(ahead.frames, read=True)
+        assert port.told == []
+        g.interrupts.handle()                         # the session sent `H` and `D`
+        assert ahead.launch() is own
+        assert port.told == ([[frame("SR6", 0, False), frame("SR0", 0, False)]] if own
+                             else [])
