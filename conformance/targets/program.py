@@ -37,6 +37,9 @@ HELD_LINES = 1000
 LINE_LIMIT = 1 << 20
 #: how long a line awaited with a timeout is polled for before the reader sleeps
 POLL_SECONDS = 100e-6
+#: a wait for the processor this long while polling means another process wanted it: the
+#: reader sleeps instead (on a loaded machine polling slows everyone)
+SHARED_SECONDS = 50e-6
 
 _RUNNING: set[Program] = set()
 
@@ -113,12 +116,18 @@ class Program:
         reads a program in the background) never polls."""
         fds = [self._fd, self._wake_r]
         if left:
-            until = time.perf_counter() + min(left, POLL_SECONDS)
-            while time.perf_counter() < until:
+            began = last = time.perf_counter()
+            until = began + min(left, POLL_SECONDS)
+            while last < until:
                 ready = select.select(fds, [], [], 0)[0]
                 if ready:
                     return ready
-            left = max(0.0, left - POLL_SECONDS)
+                os.sched_yield()        # awake, yet any other process that can run runs
+                now = time.perf_counter()
+                if now - last > SHARED_SECONDS:
+                    break               # one did: the processor is wanted, sleep
+                last = now
+            left = max(0.0, left - (time.perf_counter() - began))
         return select.select(fds, [], [], left)[0]
 
     def read_in_background(self) -> None:
