@@ -342,12 +342,10 @@ class Link:
 
     def tell_port(self, told: Sequence[tuple[bytes, float] | tuple[bytes, float, int | None]],
                   *, read: bool) -> bool:
-        """Tell the port frames ahead (each with its answer's timeout, and due instant
-        where known: CosimLine.expect), its reply read now (``read``) or when the link next
-        uses the port; whether they were told. A port told frames runs them at once, so
-        the signals are asked at that instant, as for a write (:meth:`_write`): where one
-        bars frames now, nothing is told, and each frame is then barred at its own
-        write."""
+        """Tell the port frames ahead (CosimLine.expect), its reply read now (``read``) or
+        when the link next uses the port; whether they were told. The port runs them at
+        once: the signals are asked then, as for a write (:meth:`_write`); where one bars
+        frames, none is told (each is then barred at its own write)."""
         interrupts = self.guard.interrupts
         with interrupts.writing():
             if interrupts.bars(own=bool(self.guard.own_frames())):
