@@ -6,7 +6,9 @@ time over the text protocol, each sequence begun at the simulator's power-on thr
 rig, judged by the project's arithmetic as in process: --strict), its sequences per
 second and their ratio to the in-process figure; and the same ratio per CPU second (this
 process's and the simulator's): on a loaded machine the two processes take turns and the
-wall-clock ratio falls towards it, on an idle one the simulator runs beside the suite.
+wall-clock ratio falls towards it, on an idle one the simulator runs beside the suite
+(and stays awake for the suite's next command, emulator/link/awake.py: processor time
+the per-CPU figure counts).
 Both sides run the same searches (the same seeds, as many as the in-process run took to
 send the frames), so the ratio compares the same sequences and frames; the line says so,
 or how they differ.

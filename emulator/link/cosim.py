@@ -32,10 +32,12 @@ import gc
 import os
 import select
 import sys
+import time
 from collections.abc import Callable
 from typing import BinaryIO, NoReturn, TextIO
 
 from emulator.link import control
+from emulator.link.awake import Awake
 from emulator.link.control import Quit
 from emulator.link.line import Line, TimeRangeError, byte_time
 from emulator.link.server import CONTROL_LIMIT, StdoutGone
@@ -50,6 +52,10 @@ MAX_BAUD = 10**9
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
         "| snapshot | restore | in PORT HEX | switch AXIS POS|none | rate POS|none "
         "| power-on | state | quit  [@ADDRESS on in, switch, rate, power-on, state]")
+
+
+#: a turn awake this long means another process took the processor: the server sleeps
+_SHARED_SECONDS = 50e-6
 
 
 class CosimError(ValueError):
@@ -349,6 +355,7 @@ class _Commands:
         except (AttributeError, OSError, ValueError):
             self.fd = None
         self.pending = bytearray()
+        self.awake = Awake()
 
     def readline(self, limit: int) -> bytes:
         """The next line with its newline, at most ``limit`` bytes of it (b"": the end)."""
@@ -361,12 +368,28 @@ class _Commands:
                 out = bytes(self.pending[:end])
                 del self.pending[:end]
                 return out
-            data = os.read(self.fd, 1 << 16)
+            data = self._read()
             if not data:
                 out = bytes(self.pending)
                 self.pending.clear()
                 return out
             self.pending += data
+
+    def _read(self) -> bytes:
+        """What comes next on the descriptor: awake for it up to the window (awake.py),
+        each turn yielding the processor, and asleep from the first turn on which another
+        process took it."""
+        assert self.fd is not None
+        began = last = time.perf_counter()
+        until = began + self.awake.window
+        while last < until and not select.select([self.fd], [], [], 0)[0]:
+            os.sched_yield()
+            now = time.perf_counter()
+            if now - last > _SHARED_SECONDS:
+                break
+            last = now
+        self.awake.waited(last - began)
+        return os.read(self.fd, 1 << 16)
 
     def waiting(self) -> bool:
         """Whether a whole command is here already, read or on the descriptor."""
