@@ -350,9 +350,7 @@ class Link:
         with interrupts.writing():
             if interrupts.bars(own=bool(self.guard.own_frames())):
                 return False
-            if read or getattr(self.port, "tell", None) is None:
-                return self.port.expect(told) > 0
-            return self.port.tell(told)
+            return self.port.expect(told) > 0 if read else self.port.tell(told)
 
     @property
     def takes_ahead(self) -> bool:

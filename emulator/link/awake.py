@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import select
 import time
 from collections.abc import Callable
 
@@ -25,6 +26,8 @@ SECONDS = 500e-6
 EVERY = 0.1
 #: the processors to spare (idle, or this server's awake time) to stay awake
 SPARE = 0.5
+#: a turn awake this long means another process took the processor: asleep from then on
+SHARED = 50e-6
 _TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 
 
@@ -51,6 +54,19 @@ class Awake:
         self._since = clock()
         self._idle_then = idle()
         self._awake = 0.0                    # seconds spent awake since then
+
+    def until_readable(self, fd: int) -> None:
+        """Poll ``fd`` for up to the window, yielding the processor at each turn, and
+        stop at the first turn on which another process took it; then :meth:`waited`."""
+        began = last = time.perf_counter()
+        until = began + self.window
+        while last < until and not select.select([fd], [], [], 0)[0]:
+            os.sched_yield()
+            now = time.perf_counter()
+            if now - last > SHARED:
+                break
+            last = now
+        self.waited(last - began)
 
     def waited(self, awake: float) -> None:
         """A wait is over, ``awake`` seconds of it spent awake; every :data:`EVERY`

@@ -32,7 +32,6 @@ import gc
 import os
 import select
 import sys
-import time
 from collections.abc import Callable
 from typing import BinaryIO, NoReturn, TextIO
 
@@ -52,10 +51,6 @@ MAX_BAUD = 10**9
 HELP = ("commands: tx HEX [T] | until T | batch D HEX [D HEX ...] | next | baud N "
         "| snapshot | restore | in PORT HEX | switch AXIS POS|none | rate POS|none "
         "| power-on | state | quit  [@ADDRESS on in, switch, rate, power-on, state]")
-
-
-#: a turn awake this long means another process took the processor: the server sleeps
-_SHARED_SECONDS = 50e-6
 
 
 class CosimError(ValueError):
@@ -376,19 +371,9 @@ class _Commands:
             self.pending += data
 
     def _read(self) -> bytes:
-        """What comes next on the descriptor: awake for it up to the window (awake.py),
-        each turn yielding the processor, and asleep from the first turn on which another
-        process took it."""
+        """What comes next on the descriptor, awake for it a while first (awake.py)."""
         assert self.fd is not None
-        began = last = time.perf_counter()
-        until = began + self.awake.window
-        while last < until and not select.select([self.fd], [], [], 0)[0]:
-            os.sched_yield()
-            now = time.perf_counter()
-            if now - last > _SHARED_SECONDS:
-                break
-            last = now
-        self.awake.waited(last - began)
+        self.awake.until_readable(self.fd)
         return os.read(self.fd, 1 << 16)
 
     def waiting(self) -> bool:
